@@ -1,0 +1,132 @@
+#include "core/area_estimator.h"
+
+#include <cmath>
+
+#include "absl/strings/str_format.h"
+#include "core/status_macros.h"
+
+namespace sfc {
+namespace {
+
+absl::Status NotFinite(double u, double v) {
+  return absl::InvalidArgumentError(absl::StrFormat(
+      "the surface is not finite (NaN or infinity) at (u,v) = (%.17g, %.17g); fix its formula or "
+      "parameter box so it is defined everywhere on the box",
+      u, v));
+}
+
+absl::StatusOr<Vec3> FinitePoint(const Surface& surface, double u, double v) {
+  const Vec3 p = surface.Point(u, v);
+  if (!IsFinite(p)) return NotFinite(u, v);
+  return p;
+}
+
+double TriangleArea(const Vec3& a, const Vec3& b, const Vec3& c) {
+  return 0.5 * Norm(Cross(b - a, c - a));
+}
+
+}  // namespace
+
+absl::StatusOr<DensityAt> EvaluateDensity(const Surface& surface, const Density& density, double u,
+                                          double v) {
+  const SurfaceJet jet = surface.Jet(u, v, density.NeedsCurvature() ? 2 : 1);
+  if (!IsFinite(jet.p)) return NotFinite(u, v);
+  const SurfaceGeometry geo = GeometryOf(jet);
+  SurfacePoint point;
+  point.u = u;
+  point.v = v;
+  point.p = jet.p;
+  point.normal = geo.normal;
+  point.gaussian_curvature = geo.gaussian_curvature;
+  point.mean_curvature = geo.mean_curvature;
+  DensityAt out;
+  out.p = jet.p;
+  out.delta = density.Value(point);
+  out.area_element = geo.area_element;
+  if (!std::isfinite(out.delta) || out.delta < 0) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the density is %g at (u,v) = (%.17g, %.17g); densities must be finite and >= 0", out.delta,
+        u, v));
+  }
+  // A derivative that overflows (a singular parameterisation) gives an infinite
+  // area element; the point itself is finite, so treat the element as unusable.
+  if (!std::isfinite(out.area_element)) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the surface's area element is not finite at (u,v) = (%.17g, %.17g); the parameterisation "
+        "is singular there (consider a reparameterisation, paper Sect. 5.3)",
+        u, v));
+  }
+  return out;
+}
+
+absl::StatusOr<double> CellMass(const Surface& surface, const Density& density,
+                                AreaEstimator estimator, double u0, double v0, double h) {
+  switch (estimator) {
+    case AreaEstimator::kFirstFundamentalForm: {
+      ASSIGN_OR_RETURN(const DensityAt d, EvaluateDensity(surface, density, u0 + h / 2, v0 + h / 2));
+      return d.delta * d.area_element * h * h;
+    }
+    case AreaEstimator::kSquare: {
+      ASSIGN_OR_RETURN(const Vec3 p00, FinitePoint(surface, u0, v0));
+      ASSIGN_OR_RETURN(const Vec3 p10, FinitePoint(surface, u0 + h, v0));
+      ASSIGN_OR_RETURN(const Vec3 p11, FinitePoint(surface, u0 + h, v0 + h));
+      ASSIGN_OR_RETURN(const Vec3 p01, FinitePoint(surface, u0, v0 + h));
+      ASSIGN_OR_RETURN(const DensityAt d, EvaluateDensity(surface, density, u0 + h / 2, v0 + h / 2));
+      return d.delta * (TriangleArea(p00, p10, p11) + TriangleArea(p00, p11, p01));
+    }
+    case AreaEstimator::kQuadrature: {
+      // 3-point Gauss-Legendre on [0,1]: exact for polynomials of degree 5.
+      static constexpr double kNode[3] = {0.5 - 0.3872983346207417, 0.5,
+                                          0.5 + 0.3872983346207417};
+      static constexpr double kWeight[3] = {5.0 / 18, 8.0 / 18, 5.0 / 18};
+      double sum = 0;
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+          ASSIGN_OR_RETURN(const DensityAt d, EvaluateDensity(surface, density, u0 + kNode[i] * h,
+                                                              v0 + kNode[j] * h));
+          sum += kWeight[i] * kWeight[j] * d.delta * d.area_element;
+        }
+      }
+      return sum * h * h;
+    }
+    case AreaEstimator::kTriangle:
+      break;
+  }
+  return absl::InternalError("CellMass called with the triangle estimator");
+}
+
+absl::StatusOr<double> TriangleMass(const Surface& surface, const Density& density, double prev_u,
+                                    double prev_v, double cur_u, double cur_v, double next_u,
+                                    double next_v) {
+  ASSIGN_OR_RETURN(const Vec3 a, FinitePoint(surface, prev_u, prev_v));
+  ASSIGN_OR_RETURN(const Vec3 b, FinitePoint(surface, cur_u, cur_v));
+  ASSIGN_OR_RETURN(const Vec3 c, FinitePoint(surface, next_u, next_v));
+  ASSIGN_OR_RETURN(const DensityAt d,
+                   EvaluateDensity(surface, density, (prev_u + cur_u + next_u) / 3,
+                                   (prev_v + cur_v + next_v) / 3));
+  return d.delta * TriangleArea(a, b, c);
+}
+
+std::string_view AreaEstimatorName(AreaEstimator e) {
+  switch (e) {
+    case AreaEstimator::kTriangle:
+      return "triangle";
+    case AreaEstimator::kSquare:
+      return "square";
+    case AreaEstimator::kFirstFundamentalForm:
+      return "fff";
+    case AreaEstimator::kQuadrature:
+      return "quadrature";
+  }
+  return "fff";
+}
+
+std::optional<AreaEstimator> AreaEstimatorFromName(std::string_view name) {
+  for (AreaEstimator e : {AreaEstimator::kTriangle, AreaEstimator::kSquare,
+                          AreaEstimator::kFirstFundamentalForm, AreaEstimator::kQuadrature}) {
+    if (name == AreaEstimatorName(e)) return e;
+  }
+  return std::nullopt;
+}
+
+}  // namespace sfc

@@ -1,0 +1,53 @@
+// Estimators of a curve vertex's share of int delta dS (paper Sect. 3,
+// estimators (a), (b), (c); ALGORITHM.md step 2), plus a cell quadrature.
+//
+// All functions are pure and thread-safe. Errors: InvalidArgument when the
+// surface is not finite or the density is negative or not finite at a point
+// the estimator evaluates; the message names the point.
+#ifndef SFCSAMPLER_CORE_AREA_ESTIMATOR_H_
+#define SFCSAMPLER_CORE_AREA_ESTIMATOR_H_
+
+#include <optional>
+#include <string_view>
+
+#include "absl/status/statusor.h"
+#include "core/density.h"
+#include "core/surface.h"
+
+namespace sfc {
+
+enum class AreaEstimator {
+  kTriangle,               // (a) area of f(v_{l-1}) f(v_l) f(v_{l+1}) x delta at its centroid
+  kSquare,                 // (b) area of the mapped cell (two triangles) x delta at the centre
+  kFirstFundamentalForm,   // (c) delta sqrt(EG - F^2) at the centre x cell area: the reference
+  kQuadrature,             // (c) integrated by 3x3 Gauss-Legendre over the cell
+};
+
+std::string_view AreaEstimatorName(AreaEstimator e);  // "triangle", "square", "fff", "quadrature"
+std::optional<AreaEstimator> AreaEstimatorFromName(std::string_view name);
+
+// delta and the area element at one parameter point.
+struct DensityAt {
+  Vec3 p;
+  double delta = 0;
+  double area_element = 0;
+};
+absl::StatusOr<DensityAt> EvaluateDensity(const Surface& surface, const Density& density, double u,
+                                          double v);
+
+// int over the cell [u0,u0+h] x [v0,v0+h] of delta dS, estimated by (b), (c)
+// or the quadrature. For (c) the cell area h^2 is the paper's w^(kmax - k)
+// normalisation. REQUIRES: estimator != kTriangle.
+absl::StatusOr<double> CellMass(const Surface& surface, const Density& density,
+                                AreaEstimator estimator, double u0, double v0, double h);
+
+// Estimator (a) for the vertex `cur` with curve neighbours `prev` and `next`
+// (parameter points): the area of the mapped triangle times delta at the
+// parameter centroid. Zero when the three mapped vertices are collinear.
+absl::StatusOr<double> TriangleMass(const Surface& surface, const Density& density, double prev_u,
+                                    double prev_v, double cur_u, double cur_v, double next_u,
+                                    double next_v);
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_CORE_AREA_ESTIMATOR_H_

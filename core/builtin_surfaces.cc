@@ -1,0 +1,185 @@
+#include "core/builtin_surfaces.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sfc {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+class Plane final : public Surface {
+ public:
+  Vec3 Point(double u, double v) const override { return {u, v, 0}; }
+  SurfaceJet Jet(double u, double v, int) const override {
+    SurfaceJet j;
+    j.p = {u, v, 0};
+    j.fu = {1, 0, 0};
+    j.fv = {0, 1, 0};
+    return j;
+  }
+};
+
+class Sphere final : public Surface {
+ public:
+  explicit Sphere(double r) : r_(r) {}
+  Vec3 Point(double u, double v) const override {
+    const double st = std::sin(kPi * u), ct = std::cos(kPi * u);
+    const double sp = std::sin(2 * kPi * v), cp = std::cos(2 * kPi * v);
+    return {r_ * st * cp, r_ * st * sp, r_ * ct};
+  }
+  SurfaceJet Jet(double u, double v, int order) const override {
+    const double st = std::sin(kPi * u), ct = std::cos(kPi * u);
+    const double sp = std::sin(2 * kPi * v), cp = std::cos(2 * kPi * v);
+    SurfaceJet j;
+    j.p = {r_ * st * cp, r_ * st * sp, r_ * ct};
+    j.fu = Vec3{ct * cp, ct * sp, -st} * (kPi * r_);
+    j.fv = Vec3{-st * sp, st * cp, 0} * (2 * kPi * r_);
+    if (order >= 2) {
+      j.fuu = j.p * (-kPi * kPi);
+      j.fuv = Vec3{-ct * sp, ct * cp, 0} * (2 * kPi * kPi * r_);
+      j.fvv = Vec3{st * cp, st * sp, 0} * (-4 * kPi * kPi * r_);
+    }
+    return j;
+  }
+
+ private:
+  const double r_;
+};
+
+class Torus final : public Surface {
+ public:
+  Torus(double big_r, double r) : big_r_(big_r), r_(r) {}
+  Vec3 Point(double u, double v) const override {
+    const double a = 2 * kPi * u, b = 2 * kPi * v;
+    const double w = big_r_ + r_ * std::cos(b);
+    return {w * std::cos(a), w * std::sin(a), r_ * std::sin(b)};
+  }
+  SurfaceJet Jet(double u, double v, int order) const override {
+    const double sa = std::sin(2 * kPi * u), ca = std::cos(2 * kPi * u);
+    const double sb = std::sin(2 * kPi * v), cb = std::cos(2 * kPi * v);
+    const double w = big_r_ + r_ * cb;
+    const double k = 2 * kPi;
+    SurfaceJet j;
+    j.p = {w * ca, w * sa, r_ * sb};
+    j.fu = Vec3{-w * sa, w * ca, 0} * k;
+    j.fv = Vec3{-r_ * sb * ca, -r_ * sb * sa, r_ * cb} * k;
+    if (order >= 2) {
+      j.fuu = Vec3{-w * ca, -w * sa, 0} * (k * k);
+      j.fuv = Vec3{r_ * sb * sa, -r_ * sb * ca, 0} * (k * k);
+      j.fvv = Vec3{-r_ * cb * ca, -r_ * cb * sa, -r_ * sb} * (k * k);
+    }
+    return j;
+  }
+
+ private:
+  const double big_r_, r_;
+};
+
+class MonkeySaddle final : public Surface {
+ public:
+  Vec3 Point(double u, double v) const override {
+    const double s = 2 * u - 1, t = 2 * v - 1;
+    return {s, t, s * s * s - 3 * s * t * t};
+  }
+  SurfaceJet Jet(double u, double v, int order) const override {
+    const double s = 2 * u - 1, t = 2 * v - 1;
+    SurfaceJet j;
+    j.p = {s, t, s * s * s - 3 * s * t * t};
+    j.fu = {2, 0, 2 * (3 * s * s - 3 * t * t)};
+    j.fv = {0, 2, 2 * (-6 * s * t)};
+    if (order >= 2) {
+      j.fuu = {0, 0, 4 * 6 * s};
+      j.fuv = {0, 0, 4 * -6 * t};
+      j.fvv = {0, 0, 4 * -6 * s};
+    }
+    return j;
+  }
+};
+
+class EightSurface final : public Surface {
+ public:
+  Vec3 Point(double u, double v) const override {
+    const double a = 2 * kPi * u, b = kPi * v - kPi / 2;
+    const double s2b = std::sin(2 * b);
+    return {std::cos(a) * s2b, std::sin(a) * s2b, std::sin(b)};
+  }
+  SurfaceJet Jet(double u, double v, int order) const override {
+    const double a = 2 * kPi * u, b = kPi * v - kPi / 2;
+    const double sa = std::sin(a), ca = std::cos(a);
+    const double s2b = std::sin(2 * b), c2b = std::cos(2 * b);
+    const double sb = std::sin(b), cb = std::cos(b);
+    SurfaceJet j;
+    j.p = {ca * s2b, sa * s2b, sb};
+    j.fu = Vec3{-sa * s2b, ca * s2b, 0} * (2 * kPi);
+    j.fv = Vec3{2 * ca * c2b, 2 * sa * c2b, cb} * kPi;
+    if (order >= 2) {
+      j.fuu = Vec3{-ca * s2b, -sa * s2b, 0} * (4 * kPi * kPi);
+      j.fuv = Vec3{-2 * sa * c2b, 2 * ca * c2b, 0} * (2 * kPi * kPi);
+      j.fvv = Vec3{-4 * ca * s2b, -4 * sa * s2b, -sb} * (kPi * kPi);
+    }
+    return j;
+  }
+};
+
+class WhitneyUmbrella final : public Surface {
+ public:
+  Vec3 Point(double u, double v) const override {
+    const double s = 2 * u - 1, t = 2 * v - 1;
+    return {s * t, s, t * t};
+  }
+  SurfaceJet Jet(double u, double v, int order) const override {
+    const double s = 2 * u - 1, t = 2 * v - 1;
+    SurfaceJet j;
+    j.p = {s * t, s, t * t};
+    j.fu = {2 * t, 2, 0};
+    j.fv = {2 * s, 0, 4 * t};
+    if (order >= 2) j.fuv = {4, 0, 0}, j.fvv = {0, 0, 8};
+    return j;
+  }
+};
+
+// Signed power sign(c)|c|^e.
+double SignedPow(double c, double e) { return std::copysign(std::pow(std::fabs(c), e), c); }
+
+class Superellipsoid final : public Surface {
+ public:
+  Superellipsoid(double e, bool reparam) : e_(e), reparam_(reparam) {}
+  Vec3 Point(double u, double v) const override {
+    const double a = Angle(u, -kPi / 2, 2), b = Angle(v, -kPi, 4);
+    const double ca = SignedPow(std::cos(a), e_), sa = SignedPow(std::sin(a), e_);
+    const double cb = SignedPow(std::cos(b), e_), sb = SignedPow(std::sin(b), e_);
+    return {ca * cb, ca * sb, sa};
+  }
+
+ private:
+  // Maps x in [0,1] onto [start, start + pieces * pi/2], piecewise by quarter
+  // turns, with the double-ended power law when reparameterising.
+  double Angle(double x, double start, int pieces) const {
+    if (!reparam_) return start + x * pieces * (kPi / 2);
+    const double y = x * pieces;
+    const int piece = std::min(static_cast<int>(y), pieces - 1);
+    const double s = y - piece;
+    const double s3 = s * s * s, r3 = (1 - s) * (1 - s) * (1 - s);
+    return start + (piece + s3 / (s3 + r3)) * (kPi / 2);
+  }
+
+  const double e_;
+  const bool reparam_;
+};
+
+}  // namespace
+
+std::unique_ptr<Surface> MakePlane() { return std::make_unique<Plane>(); }
+std::unique_ptr<Surface> MakeSphere(double radius) { return std::make_unique<Sphere>(radius); }
+std::unique_ptr<Surface> MakeTorus(double major_radius, double minor_radius) {
+  return std::make_unique<Torus>(major_radius, minor_radius);
+}
+std::unique_ptr<Surface> MakeMonkeySaddle() { return std::make_unique<MonkeySaddle>(); }
+std::unique_ptr<Surface> MakeEightSurface() { return std::make_unique<EightSurface>(); }
+std::unique_ptr<Surface> MakeWhitneyUmbrella() { return std::make_unique<WhitneyUmbrella>(); }
+std::unique_ptr<Surface> MakeSuperellipsoid(double exponent, bool power_reparameterisation) {
+  return std::make_unique<Superellipsoid>(exponent, power_reparameterisation);
+}
+
+}  // namespace sfc

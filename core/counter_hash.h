@@ -1,0 +1,32 @@
+// Counter-based random numbers: a pure function of (seed, stream, counter).
+//
+// ALGORITHM.md "Random access": jitter U_k is a hash of (seed, k), so any
+// sample can be computed alone. The mixer is SplitMix64's finaliser (Steele,
+// Lea and Flood 2014), applied twice. Stateless and thread-safe.
+#ifndef SFCSAMPLER_CORE_COUNTER_HASH_H_
+#define SFCSAMPLER_CORE_COUNTER_HASH_H_
+
+#include <cstdint>
+
+namespace sfc {
+
+inline uint64_t Mix64(uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+// 64 well-mixed bits for `counter` in the stream `stream` of `seed`.
+inline uint64_t CounterHash(uint64_t seed, uint64_t stream, uint64_t counter) {
+  const uint64_t key = Mix64(seed + 0x9e3779b97f4a7c15ULL * (stream + 1));
+  return Mix64(key ^ Mix64(counter + 0x632be59bd9b4e019ULL));
+}
+
+// A double uniform in [0,1) with 53 random bits.
+inline double CounterUniform(uint64_t seed, uint64_t stream, uint64_t counter) {
+  return static_cast<double>(CounterHash(seed, stream, counter) >> 11) * 0x1.0p-53;
+}
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_CORE_COUNTER_HASH_H_

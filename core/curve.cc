@@ -1,0 +1,231 @@
+#include "core/curve.h"
+
+#include <cassert>
+#include <functional>
+
+namespace sfc {
+namespace {
+
+// The 8 symmetries of the square, as an index: bit 0 swaps x and y, then
+// bit 1 mirrors x and bit 2 mirrors y. Acting on cell (i, j) of an n x n grid.
+struct Cell {
+  int i, j;
+  bool operator==(const Cell& o) const { return i == o.i && j == o.j; }
+};
+
+Cell Apply(int t, Cell c, int n) {
+  if (t & 1) std::swap(c.i, c.j);
+  if (t & 2) c.i = n - 1 - c.i;
+  if (t & 4) c.j = n - 1 - c.j;
+  return c;
+}
+
+// a o b: apply b first, then a. Identified by the image of a point with a
+// trivial stabiliser.
+int Compose(int a, int b) {
+  const Cell probe{0, 1};
+  const Cell target = Apply(a, Apply(b, probe, 4), 4);
+  for (int t = 0; t < 8; ++t) {
+    if (Apply(t, probe, 4) == target) return t;
+  }
+  assert(false);
+  return 0;
+}
+
+}  // namespace
+
+// A curve is given by its base visiting order (orientation 0) and the corner
+// of the unit cell where it ends; it always starts at corner (0,0). The
+// orientation of every child is derived, not tabulated by hand: each child's
+// sub-curve must start at the corner where the previous one ended, and end on
+// a corner shared with the next child (the last at the parent's end corner).
+// Among equal choices the one without a swap wins, which gives the classic
+// serpentine Peano curve.
+struct Curve::Definition {
+  CurveType type;
+  int grid;
+  std::vector<Cell> order;
+  Cell end_corner;
+  int max_depth;
+};
+
+namespace {
+
+std::vector<int> DeriveChildOrientations(const std::vector<Cell>& order, Cell end_corner,
+                                         int grid) {
+  const int w = static_cast<int>(order.size());
+  std::vector<int> orient(w, -1);
+  static constexpr int kPreference[8] = {0, 2, 4, 6, 1, 3, 5, 7};
+  auto corner_of = [&](int child, int t, Cell base_corner) {
+    const Cell local = Apply(t, base_corner, 2);
+    return Cell{order[child].i + local.i, order[child].j + local.j};
+  };
+  auto is_corner_of = [&](Cell p, int child) {
+    const int di = p.i - order[child].i, dj = p.j - order[child].j;
+    return (di == 0 || di == 1) && (dj == 0 || dj == 1);
+  };
+  const Cell parent_end{end_corner.i * grid, end_corner.j * grid};
+  std::function<bool(int, Cell)> place = [&](int c, Cell entry) {
+    if (c == w) return true;
+    for (int t : kPreference) {
+      if (!(corner_of(c, t, Cell{0, 0}) == entry)) continue;
+      const Cell exit = corner_of(c, t, end_corner);
+      const bool ok = c + 1 < w ? is_corner_of(exit, c + 1) : exit == parent_end;
+      if (!ok) continue;
+      orient[c] = t;
+      if (place(c + 1, exit)) return true;
+    }
+    return false;
+  };
+  const bool found = place(0, Cell{0, 0});
+  assert(found);
+  (void)found;
+  return orient;
+}
+
+const Curve::Definition& DefinitionOf(CurveType type);
+
+}  // namespace
+
+Curve::Curve(const Definition& def)
+    : type_(def.type),
+      grid_(def.grid),
+      arity_(def.grid * def.grid),
+      max_depth_(def.max_depth) {
+  const std::vector<int> orient = DeriveChildOrientations(def.order, def.end_corner, grid_);
+  children_.resize(8 * arity_);
+  for (int s = 0; s < 8; ++s) {
+    for (int c = 0; c < arity_; ++c) {
+      const Cell pos = Apply(s, def.order[c], grid_);
+      children_[s * arity_ + c] = Child{static_cast<uint8_t>(pos.i), static_cast<uint8_t>(pos.j),
+                                        static_cast<uint8_t>(Compose(s, orient[c]))};
+    }
+  }
+  // Powers of w up to w^D (also covers continuation: w^L <= 2^53 < w^D).
+  pow_w_.assign(max_depth_ + 1, 1);
+  for (int k = 1; k <= max_depth_; ++k) pow_w_[k] = pow_w_[k - 1] * arity_;
+  pow_g_.assign(2 * max_depth_ + 1, 1.0);
+  for (int k = 1; k <= 2 * max_depth_; ++k) pow_g_[k] = pow_g_[k - 1] * grid_;
+  continuation_levels_ = 0;
+  while (pow_w_[continuation_levels_ + 1] <= (uint64_t{1} << 53)) ++continuation_levels_;
+  digit_bits_ = arity_ == 4 ? 2 : 0;
+
+  // Chunk tables: the effect of chunk_levels_ levels at once (<= 256 entries).
+  chunk_levels_ = arity_ == 4 ? 4 : 2;
+  const int chunk_size = static_cast<int>(pow_w_[chunk_levels_]);
+  chunks_.resize(8 * chunk_size);
+  for (int s = 0; s < 8; ++s) {
+    for (int value = 0; value < chunk_size; ++value) {
+      int state = s, x = 0, y = 0;
+      for (int level = chunk_levels_ - 1; level >= 0; --level) {
+        const int digit = static_cast<int>(value / pow_w_[level]) % arity_;
+        const Child& ch = ChildOf(state, digit);
+        x = x * grid_ + ch.dx;
+        y = y * grid_ + ch.dy;
+        state = ch.state;
+      }
+      chunks_[s * chunk_size + value] =
+          ChunkEntry{static_cast<uint16_t>(x), static_cast<uint16_t>(y), static_cast<uint8_t>(state)};
+    }
+  }
+}
+
+int Curve::DepthOfSpan(uint64_t span) const {
+  if (digit_bits_) return max_depth_ - __builtin_ctzll(span) / digit_bits_;
+  int k = 0;
+  while (pow_w_[k] < span) ++k;
+  return max_depth_ - k;
+}
+
+void Curve::Descend(uint64_t digits, int levels, uint64_t* x, uint64_t* y, int* state) const {
+  uint64_t px = 0, py = 0;
+  int s = *state;
+  // Digit extraction by shifts when w is a power of two, else by division.
+  auto top_digits = [&](int below, int count) -> uint64_t {
+    if (digit_bits_) {
+      return (digits >> (below * digit_bits_)) & ((uint64_t{1} << (count * digit_bits_)) - 1);
+    }
+    return (digits / pow_w_[below]) % pow_w_[count];
+  };
+  int remaining = levels;
+  const int head = levels % chunk_levels_;
+  for (int k = 0; k < head; ++k) {
+    --remaining;
+    const Child& ch = ChildOf(s, static_cast<int>(top_digits(remaining, 1)));
+    px = px * grid_ + ch.dx;
+    py = py * grid_ + ch.dy;
+    s = ch.state;
+  }
+  const int chunk_size = static_cast<int>(pow_w_[chunk_levels_]);
+  const uint64_t scale = pow_w_[chunk_levels_] == 256 ? 16 : 9;  // g^chunk_levels
+  while (remaining > 0) {
+    remaining -= chunk_levels_;
+    const ChunkEntry& e = chunks_[s * chunk_size + top_digits(remaining, chunk_levels_)];
+    px = px * scale + e.x;
+    py = py * scale + e.y;
+    s = e.state;
+  }
+  *x = px;
+  *y = py;
+  *state = s;
+}
+
+namespace {
+
+const Curve::Definition& DefinitionOf(CurveType type) {
+  static const Curve::Definition kHilbert{
+      CurveType::kHilbert, 2, {{0, 0}, {0, 1}, {1, 1}, {1, 0}}, {1, 0}, 31};
+  // A 3x3 meander (Wunderlich's family): up the left column, along the top,
+  // down into the centre and out along the bottom. It has no axis of symmetry.
+  static const Curve::Definition kHilbert2{
+      CurveType::kHilbert2,
+      3,
+      {{0, 0}, {0, 1}, {0, 2}, {1, 2}, {2, 2}, {2, 1}, {1, 1}, {1, 0}, {2, 0}},
+      {1, 0},
+      20};
+  static const Curve::Definition kPeano{
+      CurveType::kPeano,
+      3,
+      {{0, 0}, {0, 1}, {0, 2}, {1, 2}, {1, 1}, {1, 0}, {2, 0}, {2, 1}, {2, 2}},
+      {1, 1},
+      20};
+  switch (type) {
+    case CurveType::kHilbert:
+      return kHilbert;
+    case CurveType::kHilbert2:
+      return kHilbert2;
+    case CurveType::kPeano:
+      return kPeano;
+  }
+  return kHilbert;
+}
+
+}  // namespace
+
+const Curve& Curve::Get(CurveType type) {
+  static const Curve* const kCurves[3] = {new Curve(DefinitionOf(CurveType::kHilbert)),
+                                          new Curve(DefinitionOf(CurveType::kHilbert2)),
+                                          new Curve(DefinitionOf(CurveType::kPeano))};
+  return *kCurves[static_cast<int>(type)];
+}
+
+std::string_view CurveName(CurveType type) {
+  switch (type) {
+    case CurveType::kHilbert:
+      return "hilbert";
+    case CurveType::kHilbert2:
+      return "hilbert2";
+    case CurveType::kPeano:
+      return "peano";
+  }
+  return "hilbert";
+}
+
+std::optional<CurveType> CurveFromName(std::string_view name) {
+  for (CurveType t : {CurveType::kHilbert, CurveType::kHilbert2, CurveType::kPeano}) {
+    if (name == CurveName(t)) return t;
+  }
+  return std::nullopt;
+}
+
+}  // namespace sfc

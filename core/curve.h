@@ -1,0 +1,98 @@
+// Space-filling curves on the unit square, behind one table-driven
+// abstraction (paper Sect. 3 and Fig. 3; ALGORITHM.md "Curves").
+//
+// A curve of grid g subdivides a cell into w = g*g children visited in a fixed
+// order. Each cell carries an orientation ("state"), one of the 8 symmetries of
+// the square; a child's position and state follow from its parent's state by
+// table look-up, which is the paper's GenerateChildren "permutation".
+//
+// Curve indices are 64-bit: the curve at the deepest level D has w^D vertices
+// (Hilbert: D = 31, 4^31 = 2^62; 3x3 curves: D = 20, 9^20 < 2^64). A cell at
+// depth d covers the index range [prefix * w^(D-d), (prefix+1) * w^(D-d)).
+//
+// Thread-safety: Curve objects are immutable singletons; all methods are
+// thread-safe.
+#ifndef SFCSAMPLER_CORE_CURVE_H_
+#define SFCSAMPLER_CORE_CURVE_H_
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+namespace sfc {
+
+enum class CurveType {
+  kHilbert,   // 2x2, w = 4
+  kHilbert2,  // "Hilbert II": 3x3 meander from a corner to an adjacent corner, no axis of symmetry
+  kPeano,     // 3x3 serpentine from a corner to the opposite corner
+};
+
+std::string_view CurveName(CurveType type);              // "hilbert", "hilbert2", "peano"
+std::optional<CurveType> CurveFromName(std::string_view name);
+
+class Curve {
+ public:
+  // The orientation of the root cell.
+  static constexpr int kRootState = 0;
+
+  static const Curve& Get(CurveType type);
+
+  Curve(const Curve&) = delete;
+  Curve& operator=(const Curve&) = delete;
+
+  CurveType type() const { return type_; }
+  int grid() const { return grid_; }        // g, cells per side per subdivision
+  int arity() const { return arity_; }      // w = g*g
+  int max_depth() const { return max_depth_; }  // D
+  // w^(D - depth): the number of deepest-level indices a cell at `depth` covers.
+  uint64_t Span(int depth) const { return pow_w_[max_depth_ - depth]; }
+  // Inverse of Span(). REQUIRES: span == Span(d) for some d in [0, D].
+  int DepthOfSpan(uint64_t span) const;
+  // w^k and g^k. REQUIRES: 0 <= k <= D (g^k up to 2 D).
+  uint64_t PowW(int k) const { return pow_w_[k]; }
+  double PowG(int k) const { return pow_g_[k]; }
+
+  // Levels of analytic continuation inside a leaf: L such that w^L <= 2^53,
+  // i.e. every bit of a double fraction in [0,1) is used (Hilbert 26, 3x3 16).
+  int continuation_levels() const { return continuation_levels_; }
+
+  struct Child {
+    uint8_t dx, dy;  // offset in the parent's g x g grid
+    uint8_t state;   // the child's orientation
+  };
+  // Child `c` (0 <= c < w, in curve order) of a cell with orientation `state`.
+  const Child& ChildOf(int state, int c) const { return children_[state * arity_ + c]; }
+
+  // Follows `levels` base-w digits of `digits` (most significant first) down
+  // from a cell with orientation `*state`. On return (*x, *y) is the reached
+  // cell's position in units of g^-levels of the start cell, and *state its
+  // orientation. REQUIRES: levels <= D + continuation_levels(), digits < w^levels
+  // when levels <= D.
+  void Descend(uint64_t digits, int levels, uint64_t* x, uint64_t* y, int* state) const;
+
+  // How a curve type is specified (see curve.cc); for the implementation.
+  struct Definition;
+
+ private:
+  explicit Curve(const Definition& def);
+
+  struct ChunkEntry {
+    uint16_t x, y;
+    uint8_t state;
+  };
+
+  CurveType type_;
+  int grid_, arity_, max_depth_, continuation_levels_;
+  int chunk_levels_;  // levels resolved per look-up in Descend
+  int digit_bits_;    // log2(w) when w is a power of two, else 0
+  std::vector<uint64_t> pow_w_;
+  std::vector<double> pow_g_;
+  std::vector<Child> children_;       // [state][child]
+  std::vector<ChunkEntry> chunks_;    // [state][chunk value]
+};
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_CORE_CURVE_H_

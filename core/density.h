@@ -1,0 +1,44 @@
+// Sampling densities delta >= 0 on a surface (paper Sect. 3: "a non-negative
+// bounded density function").
+//
+// Thread-safety: implementations are immutable and thread-safe.
+#ifndef SFCSAMPLER_CORE_DENSITY_H_
+#define SFCSAMPLER_CORE_DENSITY_H_
+
+#include <memory>
+
+#include "core/vec3.h"
+
+namespace sfc {
+
+// What a density may depend on at one surface point.
+struct SurfacePoint {
+  double u = 0, v = 0;  // unit-square parameters
+  Vec3 p;               // f(u, v)
+  Vec3 normal;
+  double gaussian_curvature = 0;  // valid only if the density NeedsCurvature()
+  double mean_curvature = 0;      // likewise
+};
+
+class Density {
+ public:
+  virtual ~Density() = default;
+  // True when Value() reads the curvatures (so callers evaluate 2nd-order jets).
+  virtual bool NeedsCurvature() const { return false; }
+  // delta at the point. Callers reject negative or non-finite values.
+  virtual double Value(const SurfacePoint& point) const = 0;
+};
+
+// delta = 1.
+std::unique_ptr<Density> MakeUniformDensity();
+
+// delta = max(|K|, floor): proportional to |Gaussian curvature| (paper
+// Sect. 5.2); the floor keeps flat regions sampled. REQUIRES: floor >= 0.
+std::unique_ptr<Density> MakeGaussianCurvatureDensity(double floor);
+
+// delta = max(|H|, floor), H the mean curvature. REQUIRES: floor >= 0.
+std::unique_ptr<Density> MakeMeanCurvatureDensity(double floor);
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_CORE_DENSITY_H_

@@ -1,0 +1,283 @@
+#include "core/sampler.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+#include "absl/strings/str_format.h"
+#include "core/status_macros.h"
+
+namespace sfc {
+
+Sampler::Sampler(std::shared_ptr<const CurveTree> tree, std::shared_ptr<const Surface> surface,
+                 std::shared_ptr<const Density> density, Sequence sequence)
+    : tree_(std::move(tree)),
+      surface_(std::move(surface)),
+      density_(std::move(density)),
+      sequence_(sequence) {
+  last_positive_leaf_ = tree_->leaf_count() - 1;
+  while (last_positive_leaf_ > 0 &&
+         !(tree_->mass_end(last_positive_leaf_) > tree_->mass_begin(last_positive_leaf_))) {
+    --last_positive_leaf_;
+  }
+}
+
+size_t Sampler::LeafForMass(double m) const {
+  const auto& ends = tree_->mass_ends();
+  const size_t l = static_cast<size_t>(std::upper_bound(ends.begin(), ends.end(), m) - ends.begin());
+  // q_k S_M can round up to S_M itself: it then belongs to the last leaf with mass.
+  return l >= ends.size() ? last_positive_leaf_ : l;
+}
+
+uint64_t Sampler::FirstIndexAtOrAbove(double m) const {
+  uint64_t lo = 0, hi = sequence_.count();
+  while (lo < hi) {
+    const uint64_t mid = lo + (hi - lo) / 2;
+    if (MassCoordinate(mid) >= m) {
+      hi = mid;
+    } else {
+      lo = mid + 1;
+    }
+  }
+  return lo;
+}
+
+SampleCursor::SampleCursor(std::shared_ptr<const Sampler> sampler, Region region,
+                           SampleFields fields)
+    : sampler_(std::move(sampler)), region_(region), fields_(fields) {}
+
+absl::StatusOr<std::unique_ptr<SampleCursor>> SampleCursor::Create(
+    std::shared_ptr<const Sampler> sampler, uint64_t begin, uint64_t end, const Region& region,
+    const SampleFields& fields) {
+  const uint64_t count = sampler->sequence().count();
+  if (begin > end || end > count) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the index range [%d, %d) is not inside the set of %d samples; it needs begin <= end <= "
+        "count",
+        begin, end, count));
+  }
+  RETURN_IF_ERROR(region.Validate());
+  auto cursor = std::unique_ptr<SampleCursor>(new SampleCursor(std::move(sampler), region, fields));
+  RETURN_IF_ERROR(cursor->PlanRegion(begin, end));
+  return cursor;
+}
+
+absl::Status SampleCursor::PlanRegion(uint64_t begin, uint64_t end) {
+  const Sampler& sampler = *sampler_;
+  if (!sampler.sequence().monotone()) {
+    // Index order is not curve order: sort the range by mass coordinate (ties
+    // by index), which is the order of the curve.
+    std::vector<std::pair<double, uint64_t>> keyed;
+    keyed.reserve(end - begin);
+    for (uint64_t k = begin; k < end; ++k) keyed.emplace_back(sampler.MassCoordinate(k), k);
+    std::sort(keyed.begin(), keyed.end());
+    order_.reserve(keyed.size());
+    for (const auto& [m, k] : keyed) order_.push_back(k);
+    use_order_ = true;
+    return absl::OkStatus();
+  }
+  if (region_.kind == Region::Kind::kAll) {
+    if (begin < end) segments_.push_back({begin, end});
+    if (!segments_.empty()) next_k_ = segments_[0].begin;
+    return absl::OkStatus();
+  }
+
+  const CurveTree& tree = sampler.tree();
+  const Curve& curve = tree.curve();
+  const Surface& surface = sampler.surface();
+  const uint64_t count = sampler.sequence().count();
+
+  // Adds the samples of leaves [a, b) (clipped to [begin, end)) as a segment.
+  auto add_leaves = [&](size_t a, size_t b) {
+    const uint64_t kb = a == 0 ? 0 : sampler.FirstIndexAtOrAbove(tree.mass_begin(a));
+    const uint64_t ke = tree.mass_end(b - 1) >= tree.total_mass()
+                            ? count
+                            : sampler.FirstIndexAtOrAbove(tree.mass_end(b - 1));
+    const uint64_t lo = std::max(kb, begin), hi = std::min(ke, end);
+    if (lo >= hi) return;
+    if (!segments_.empty() && segments_.back().end == lo) {
+      segments_.back().end = hi;
+    } else {
+      segments_.push_back({lo, hi});
+    }
+  };
+
+  enum class Overlap { kNone, kPartial, kInside };
+  // Parameter cell against the region. For a 3D box the patch is bounded by
+  // the box of f at its 3x3 grid of points grown by the largest distance from
+  // its centre to them; this assumes a patch does not bulge further than that
+  // from its 9 points, which holds for cells fine enough to pass the paper's
+  // flatness test. Samples are always tested exactly, so the bound only
+  // prunes.
+  auto overlap = [&](double u0, double v0, double h) -> absl::StatusOr<Overlap> {
+    if (region_.kind == Region::Kind::kParameterRect) {
+      if (u0 > region_.u1 || u0 + h < region_.u0 || v0 > region_.v1 || v0 + h < region_.v0) {
+        return Overlap::kNone;
+      }
+      const bool inside = u0 >= region_.u0 && u0 + h <= region_.u1 && v0 >= region_.v0 &&
+                          v0 + h <= region_.v1;
+      return inside ? Overlap::kInside : Overlap::kPartial;
+    }
+    Vec3 pts[9];
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        const double u = u0 + i * (h / 2), v = v0 + j * (h / 2);
+        pts[3 * i + j] = surface.Point(u, v);
+        if (!IsFinite(pts[3 * i + j])) {
+          return absl::InvalidArgumentError(absl::StrFormat(
+              "the surface is not finite (NaN or infinity) at (u,v) = (%.17g, %.17g)", u, v));
+        }
+      }
+    }
+    Vec3 lo = pts[0], hi = pts[0];
+    double grow = 0;
+    for (const Vec3& p : pts) {
+      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+      grow = std::max(grow, Norm(p - pts[4]));
+    }
+    lo = lo - Vec3{grow, grow, grow};
+    hi = hi + Vec3{grow, grow, grow};
+    const Vec3& rl = region_.lo;
+    const Vec3& rh = region_.hi;
+    if (lo.x > rh.x || hi.x < rl.x || lo.y > rh.y || hi.y < rl.y || lo.z > rh.z || hi.z < rl.z) {
+      return Overlap::kNone;
+    }
+    const bool inside = lo.x >= rl.x && hi.x <= rh.x && lo.y >= rl.y && hi.y <= rh.y &&
+                        lo.z >= rl.z && hi.z <= rh.z;
+    return inside ? Overlap::kInside : Overlap::kPartial;
+  };
+
+  // Walks the tree's cells in curve order, descending only where a cell
+  // straddles the region's boundary.
+  std::function<absl::Status(int, uint64_t, uint64_t, uint64_t, int)> visit =
+      [&](int depth, uint64_t start, uint64_t x, uint64_t y, int state) -> absl::Status {
+    const size_t a = tree.LeafAt(start);
+    const size_t b = tree.LeafAt(start + curve.Span(depth) - 1) + 1;
+    const double h = 1.0 / curve.PowG(depth);
+    ASSIGN_OR_RETURN(const Overlap o, overlap(x * h, y * h, h));
+    if (o == Overlap::kNone) return absl::OkStatus();
+    if (o == Overlap::kInside || b - a == 1) {
+      add_leaves(a, b);
+      return absl::OkStatus();
+    }
+    const int g = curve.grid();
+    for (int c = 0; c < curve.arity(); ++c) {
+      const Curve::Child& ch = curve.ChildOf(state, c);
+      RETURN_IF_ERROR(visit(depth + 1, start + c * curve.Span(depth + 1), x * g + ch.dx,
+                            y * g + ch.dy, ch.state));
+    }
+    return absl::OkStatus();
+  };
+  RETURN_IF_ERROR(visit(0, 0, 0, 0, Curve::kRootState));
+  if (!segments_.empty()) next_k_ = segments_[0].begin;
+  return absl::OkStatus();
+}
+
+bool SampleCursor::done() const {
+  return use_order_ ? order_pos_ >= order_.size() : segment_ >= segments_.size();
+}
+
+absl::StatusOr<size_t> SampleCursor::Next(size_t max, SampleBatch* batch) {
+  size_t produced = 0;
+  while (produced < max) {
+    uint64_t k;
+    if (use_order_) {
+      if (order_pos_ >= order_.size()) break;
+      k = order_[order_pos_++];
+    } else {
+      if (segment_ >= segments_.size()) break;
+      k = next_k_++;
+      if (next_k_ >= segments_[segment_].end && ++segment_ < segments_.size()) {
+        next_k_ = segments_[segment_].begin;
+      }
+    }
+    bool kept = false;
+    RETURN_IF_ERROR(Emit(k, batch, &kept));
+    produced += kept;
+  }
+  return produced;
+}
+
+absl::Status SampleCursor::Emit(uint64_t k, SampleBatch* batch, bool* kept) {
+  const Sampler& sampler = *sampler_;
+  const CurveTree& tree = sampler.tree();
+  const Curve& curve = tree.curve();
+  const double m = sampler.MassCoordinate(k);
+
+  // Consecutive samples mostly fall in the same or the next few leaves.
+  size_t l = SIZE_MAX;
+  if (cached_leaf_ != SIZE_MAX) {
+    for (size_t c = cached_leaf_, stop = std::min(cached_leaf_ + 4, tree.leaf_count()); c < stop;
+         ++c) {
+      if (m < tree.mass_end(c)) {
+        if (m >= tree.mass_begin(c)) l = c;
+        break;
+      }
+    }
+  }
+  if (l == SIZE_MAX) l = sampler.LeafForMass(m);
+  if (l != cached_leaf_) {
+    cached_cell_ = tree.LeafCell(l);
+    cached_leaf_ = l;
+  }
+  const double begin_mass = tree.mass_begin(l);
+  const double t = std::clamp((m - begin_mass) / (tree.mass_end(l) - begin_mass), 0.0, 1.0);
+
+  // Analytic continuation: follow t down the leaf's own curve.
+  const int levels = curve.continuation_levels();
+  const uint64_t scale = curve.PowW(levels);
+  const uint64_t digits = std::min(static_cast<uint64_t>(t * static_cast<double>(scale)), scale - 1);
+  uint64_t cx, cy;
+  int state = cached_cell_.state;
+  curve.Descend(digits, levels, &cx, &cy, &state);
+  const double cell = cached_cell_.size / curve.PowG(levels);
+  const double u = cached_cell_.u0 + (static_cast<double>(cx) + 0.5) * cell;
+  const double v = cached_cell_.v0 + (static_cast<double>(cy) + 0.5) * cell;
+
+  const bool need_jet = fields_.normal || fields_.density;
+  SurfaceJet jet;
+  if (need_jet) {
+    jet = sampler.surface().Jet(u, v, fields_.density && sampler.density().NeedsCurvature() ? 2 : 1);
+  } else {
+    jet.p = sampler.surface().Point(u, v);
+  }
+  if (!IsFinite(jet.p)) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "sample %d falls at (u,v) = (%.17g, %.17g), where the surface is not finite; fix the "
+        "surface so it is defined everywhere on its box",
+        k, u, v));
+  }
+  *kept = region_.Contains(u, v, jet.p);
+  if (!*kept) return absl::OkStatus();
+
+  batch->index.push_back(k);
+  batch->u.push_back(u);
+  batch->v.push_back(v);
+  batch->x.push_back(jet.p.x);
+  batch->y.push_back(jet.p.y);
+  batch->z.push_back(jet.p.z);
+  if (need_jet) {
+    const SurfaceGeometry geo = GeometryOf(jet);
+    if (fields_.normal) {
+      batch->nx.push_back(geo.normal.x);
+      batch->ny.push_back(geo.normal.y);
+      batch->nz.push_back(geo.normal.z);
+    }
+    if (fields_.density) {
+      SurfacePoint point;
+      point.u = u, point.v = v, point.p = jet.p, point.normal = geo.normal;
+      point.gaussian_curvature = geo.gaussian_curvature;
+      point.mean_curvature = geo.mean_curvature;
+      batch->density.push_back(sampler.density().Value(point));
+    }
+  }
+  if (fields_.curve_position) {
+    const double span = static_cast<double>(tree.leaf_end(l) - tree.leaf_start(l));
+    batch->curve_position.push_back((static_cast<double>(tree.leaf_start(l)) + t * span) /
+                                    static_cast<double>(curve.Span(0)));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace sfc

@@ -1,0 +1,105 @@
+// Equalisation (paper Fig. 1 line 8; ALGORITHM.md step 4) and the samples it
+// yields, by index range or region, in curve order.
+//
+// Sample k lands in the leaf l with S_{l-1} <= q_k S_M < S_l. Inside the leaf
+// the curve continues analytically (ALGORITHM.md, "Position inside a leaf"):
+// the fraction t = (q_k S_M - S_{l-1}) / s_l is followed down the leaf's own
+// curve for continuation_levels() more levels (all 52 bits of t for Hilbert),
+// and the sample sits at the centre of the cell reached. Nothing is snapped to
+// leaf centres, and the result is a pure function of (tree, sequence, k).
+//
+// Thread-safety: Sampler is immutable and thread-safe. A SampleCursor is used
+// by one thread at a time.
+#ifndef SFCSAMPLER_CORE_SAMPLER_H_
+#define SFCSAMPLER_CORE_SAMPLER_H_
+
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/curve_tree.h"
+#include "core/density.h"
+#include "core/region.h"
+#include "core/sample_batch.h"
+#include "core/sequence.h"
+#include "core/surface.h"
+
+namespace sfc {
+
+class Sampler {
+ public:
+  // REQUIRES: `tree` was built from `surface` and `density`.
+  Sampler(std::shared_ptr<const CurveTree> tree, std::shared_ptr<const Surface> surface,
+          std::shared_ptr<const Density> density, Sequence sequence);
+
+  const CurveTree& tree() const { return *tree_; }
+  const Surface& surface() const { return *surface_; }
+  const Density& density() const { return *density_; }
+  const Sequence& sequence() const { return sequence_; }
+  const std::shared_ptr<const CurveTree>& tree_ptr() const { return tree_; }
+
+  // q_k S_M: sample k's mass coordinate along the curve.
+  double MassCoordinate(uint64_t k) const { return sequence_.At(k) * tree_->total_mass(); }
+  // The leaf holding mass coordinate m (zero-mass leaves are never chosen).
+  size_t LeafForMass(double m) const;
+  // First k in [0, count) whose mass coordinate is >= m, for monotone
+  // sequences; count if none.
+  uint64_t FirstIndexAtOrAbove(double m) const;
+
+ private:
+  std::shared_ptr<const CurveTree> tree_;
+  std::shared_ptr<const Surface> surface_;
+  std::shared_ptr<const Density> density_;
+  Sequence sequence_;
+  size_t last_positive_leaf_ = 0;
+};
+
+class SampleCursor {
+ public:
+  // Samples with index in [begin, end) that lie in `region`, in curve order.
+  // For monotone sequences the cost is proportional to the samples emitted
+  // plus the tree cells on the region's boundary; other sequences sort the
+  // range by curve position first (cost O(n log n), n = end - begin).
+  // Errors: INVALID_ARGUMENT for begin > end, end > count, or an empty region;
+  // RESOURCE_EXHAUSTED is not raised here (the caller bounds count).
+  static absl::StatusOr<std::unique_ptr<SampleCursor>> Create(std::shared_ptr<const Sampler> sampler,
+                                                              uint64_t begin, uint64_t end,
+                                                              const Region& region,
+                                                              const SampleFields& fields);
+
+  // Appends up to `max` samples to `batch` (which it does not clear) and
+  // returns how many; 0 once the cursor is exhausted. Errors: INVALID_ARGUMENT
+  // when the surface or density is not finite at a sample.
+  absl::StatusOr<size_t> Next(size_t max, SampleBatch* batch);
+
+  bool done() const;
+
+ private:
+  SampleCursor(std::shared_ptr<const Sampler> sampler, Region region, SampleFields fields);
+  absl::Status PlanRegion(uint64_t begin, uint64_t end);
+  absl::Status Emit(uint64_t k, SampleBatch* batch, bool* kept);
+
+  struct Segment {
+    uint64_t begin, end;
+  };
+
+  const std::shared_ptr<const Sampler> sampler_;
+  const Region region_;
+  const SampleFields fields_;
+  // Monotone sequences: index segments in curve order.
+  std::vector<Segment> segments_;
+  size_t segment_ = 0;
+  uint64_t next_k_ = 0;
+  // Other sequences: the indices sorted by curve position.
+  std::vector<uint64_t> order_;
+  size_t order_pos_ = 0;
+  bool use_order_ = false;
+  // The last leaf decoded, reused by consecutive samples.
+  size_t cached_leaf_ = SIZE_MAX;
+  CurveTree::Cell cached_cell_{};
+};
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_CORE_SAMPLER_H_

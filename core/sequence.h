@@ -1,0 +1,53 @@
+// One-dimensional sequences q_k in [0,1) that are placed along the curve
+// (paper Sect. 3, "Create1DPoints"; ALGORITHM.md step 3).
+//
+// Every q_k is a pure function of (kind, count, seed, k), so any index can be
+// computed alone. Thread-safety: immutable value type.
+#ifndef SFCSAMPLER_CORE_SEQUENCE_H_
+#define SFCSAMPLER_CORE_SEQUENCE_H_
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+namespace sfc {
+
+enum class SequenceKind {
+  kJittered,      // q_k = (k + U_k) / N: the paper's method of choice (default)
+  kEqual,         // q_k = (k + 1/2) / N
+  kRandom,        // q_k = U'_k, independent uniforms
+  kVanDerCorput,  // q_k = base-2 radical inverse of k
+  kProgressive,   // Owen-scrambled base-2 radical inverse: every prefix of
+                  // length 2^m puts exactly one q in each [j/2^m, (j+1)/2^m)
+};
+
+std::string_view SequenceName(SequenceKind kind);  // "jittered", "equal", ...
+std::optional<SequenceKind> SequenceFromName(std::string_view name);
+
+class Sequence {
+ public:
+  // REQUIRES: count >= 1; count <= 2^32 for the radical-inverse kinds.
+  Sequence(SequenceKind kind, uint64_t count, uint64_t seed)
+      : kind_(kind), count_(count), seed_(seed) {}
+
+  SequenceKind kind() const { return kind_; }
+  uint64_t count() const { return count_; }
+  uint64_t seed() const { return seed_; }
+
+  // True when q_k is non-decreasing in k, so index order is curve order and an
+  // index range is a contiguous stretch of the curve.
+  bool monotone() const { return kind_ == SequenceKind::kJittered || kind_ == SequenceKind::kEqual; }
+
+  // q_k in [0,1]. REQUIRES: k < count() (the radical-inverse kinds accept any
+  // k < 2^32: they do not depend on count).
+  double At(uint64_t k) const;
+
+ private:
+  SequenceKind kind_;
+  uint64_t count_;
+  uint64_t seed_;
+};
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_CORE_SEQUENCE_H_

@@ -1,0 +1,54 @@
+// Parametric surfaces f : [0,1]^2 -> R^3 and their differential geometry.
+//
+// Every surface maps the unit square; a surface with another native
+// parameter box maps it linearly (ALGORITHM.md, "Inputs and output"), so all
+// derivatives here are taken with respect to the unit-square parameters.
+//
+// Thread-safety: Surface implementations are immutable after construction and
+// their const methods may be called from many threads at once.
+#ifndef SFCSAMPLER_CORE_SURFACE_H_
+#define SFCSAMPLER_CORE_SURFACE_H_
+
+#include "core/vec3.h"
+
+namespace sfc {
+
+// Position and partial derivatives of f at one parameter point.
+struct SurfaceJet {
+  Vec3 p;              // f(u, v)
+  Vec3 fu, fv;         // first derivatives
+  Vec3 fuu, fuv, fvv;  // second derivatives; zero unless asked for (order 2)
+};
+
+class Surface {
+ public:
+  virtual ~Surface() = default;
+
+  // f(u, v). REQUIRES: (u, v) in [0,1]^2. May return a non-finite vector for
+  // a surface that is singular there; callers check (see IsFinite).
+  virtual Vec3 Point(double u, double v) const = 0;
+
+  // Position and derivatives up to `order` (1 or 2). The default takes finite
+  // differences of Point(): 4th-order central differences for the first
+  // derivatives (one-sided 2nd order within 2h of an edge, h = 1e-3 resp.
+  // 1e-5), 2nd-order central differences for the second ones (h = 1e-4).
+  // Stencils never leave the unit square. Surfaces with closed forms override.
+  virtual SurfaceJet Jet(double u, double v, int order) const;
+};
+
+// First fundamental form, normal and curvatures at one point.
+struct SurfaceGeometry {
+  Vec3 normal;                // unit normal fu x fv / |fu x fv| (zero if degenerate)
+  double e = 0, f = 0, g = 0;  // first fundamental form E, F, G
+  double area_element = 0;    // sqrt(EG - F^2) = |fu x fv|
+  double gaussian_curvature = 0;  // K = (LN - M^2) / (EG - F^2)
+  double mean_curvature = 0;      // H = (EN - 2FM + GL) / (2 (EG - F^2))
+};
+
+// Computes the geometry from a jet. Curvatures need an order-2 jet; they are
+// zero where the area element vanishes (a singular point).
+SurfaceGeometry GeometryOf(const SurfaceJet& jet);
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_CORE_SURFACE_H_

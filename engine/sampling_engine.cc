@@ -1,0 +1,104 @@
+#include "engine/sampling_engine.h"
+
+#include "absl/strings/str_format.h"
+#include "catalog/catalog.h"
+#include "core/status_macros.h"
+
+namespace sfc {
+
+SamplingEngine::SamplingEngine(EngineLimits limits, TreeSource* source)
+    : limits_(limits), source_(source) {}
+
+absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint64_t count) const {
+  if (count == 0) return absl::InvalidArgumentError("count must be >= 1");
+  if (count > limits_.max_count) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "count %d is above this server's limit of %d samples per request (max_count); split the "
+        "request into index ranges or shards",
+        count, limits_.max_count));
+  }
+  for (const auto* text : {&spec.surface, &spec.density}) {
+    if (text->size() > limits_.max_spec_length) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "a surface or density spec of %d characters is longer than the limit of %d "
+          "(max_spec_length)",
+          text->size(), limits_.max_spec_length));
+    }
+  }
+  ASSIGN_OR_RETURN(SurfaceFromSpec surface, MakeSurface(spec.surface));
+  ASSIGN_OR_RETURN(DensityFromSpec density, MakeDensity(spec.density));
+  CurveTreeOptions options = spec.options;
+  options.max_leaves = std::min(options.max_leaves, limits_.max_tree_leaves);
+
+  PreparedTree prepared;
+  prepared.key = MakeTreeKey(surface.canonical, density.canonical, options);
+  prepared.grade = CurveTree::GradeFor(count);
+  prepared.surface = surface.surface;
+  prepared.density = density.density;
+  TreeFactory factory;
+  factory.build = [&](int grade) {
+    return CurveTree::Build(*prepared.surface, *prepared.density, options, grade);
+  };
+  factory.refine = [&](const CurveTree& coarser, int grade) {
+    return coarser.Refined(*prepared.surface, *prepared.density, grade);
+  };
+  ASSIGN_OR_RETURN(prepared.lookup, source_->Get(prepared.key, prepared.grade, factory));
+  return prepared;
+}
+
+absl::StatusOr<std::pair<uint64_t, uint64_t>> SamplingEngine::ResolveRange(
+    const SampleRequest& request) {
+  const uint64_t n = request.count;
+  if (request.shard_count > 0) {
+    if (request.begin != 0 || request.end != 0) {
+      return absl::InvalidArgumentError("ask for either an index range or a shard, not both");
+    }
+    if (request.shard_index >= request.shard_count) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "shard index %d must be below the shard count %d", request.shard_index, request.shard_count));
+    }
+    // Shard i of K holds [floor(iN/K), floor((i+1)N/K)).
+    auto bound = [&](uint64_t i) {
+      return static_cast<uint64_t>(static_cast<unsigned __int128>(i) * n / request.shard_count);
+    };
+    return std::make_pair(bound(request.shard_index), bound(request.shard_index + 1));
+  }
+  const uint64_t end = request.end == 0 ? n : request.end;
+  if (request.begin > end || end > n) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the index range [%d, %d) is not inside the set of %d samples; it needs begin <= end <= "
+        "count",
+        request.begin, end, n));
+  }
+  return std::make_pair(request.begin, end);
+}
+
+absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request) const {
+  if (request.count == 0) return absl::InvalidArgumentError("count must be >= 1");
+  const bool radical_inverse = request.sequence == SequenceKind::kVanDerCorput ||
+                               request.sequence == SequenceKind::kProgressive;
+  if (radical_inverse && request.count > (uint64_t{1} << 32)) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the %s sequence supports at most 2^32 samples", SequenceName(request.sequence)));
+  }
+  ASSIGN_OR_RETURN(const auto range, ResolveRange(request));
+  RETURN_IF_ERROR(request.region.Validate());
+  const uint64_t tree_count = request.tree_count == 0 ? request.count : request.tree_count;
+  SamplingJob job;
+  ASSIGN_OR_RETURN(job.tree, Prepare(request.tree, tree_count));
+  if (request.count > limits_.max_count) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "count %d is above this server's limit of %d samples per request (max_count)", request.count,
+        limits_.max_count));
+  }
+  job.sampler = std::make_shared<const Sampler>(job.tree.lookup.tree, job.tree.surface,
+                                                job.tree.density,
+                                                Sequence(request.sequence, request.count, request.seed));
+  job.begin = range.first;
+  job.end = range.second;
+  ASSIGN_OR_RETURN(job.cursor,
+                   SampleCursor::Create(job.sampler, job.begin, job.end, request.region, request.fields));
+  return job;
+}
+
+}  // namespace sfc

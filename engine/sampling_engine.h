@@ -1,0 +1,62 @@
+// Turns a SampleRequest into a validated sampling job: resolves the specs,
+// checks every limit, gets the curve tree from a TreeSource and opens a
+// cursor over the requested part of the set. Shared by the embedded CLI and
+// the gRPC server.
+//
+// Thread-safety: SamplingEngine is thread-safe (it holds only constants and a
+// thread-safe TreeSource). A Job is used by one thread at a time.
+#ifndef SFCSAMPLER_ENGINE_SAMPLING_ENGINE_H_
+#define SFCSAMPLER_ENGINE_SAMPLING_ENGINE_H_
+
+#include <memory>
+
+#include "absl/status/statusor.h"
+#include "core/sampler.h"
+#include "engine/sample_request.h"
+#include "engine/tree_key.h"
+#include "engine/tree_source.h"
+
+namespace sfc {
+
+struct PreparedTree {
+  TreeKey key;
+  int grade = 0;
+  TreeLookup lookup;
+  std::shared_ptr<const Surface> surface;
+  std::shared_ptr<const Density> density;
+};
+
+struct SamplingJob {
+  PreparedTree tree;
+  std::shared_ptr<const Sampler> sampler;
+  uint64_t begin = 0, end = 0;  // the resolved index range
+  std::unique_ptr<SampleCursor> cursor;
+};
+
+class SamplingEngine {
+ public:
+  // `source` is not owned and must outlive the engine.
+  SamplingEngine(EngineLimits limits, TreeSource* source);
+
+  const EngineLimits& limits() const { return limits_; }
+
+  // The tree for `spec`, fine enough for `count` samples. Errors:
+  // INVALID_ARGUMENT (bad spec, count 0 or above max_count, surface or density
+  // errors), RESOURCE_EXHAUSTED (tree budget).
+  absl::StatusOr<PreparedTree> Prepare(const TreeSpec& spec, uint64_t count) const;
+
+  // Validates `request` and opens its cursor. Errors as Prepare, plus
+  // INVALID_ARGUMENT for a bad range, shard or region.
+  absl::StatusOr<SamplingJob> Start(const SampleRequest& request) const;
+
+  // The index range [begin, end) a request selects (before its region).
+  static absl::StatusOr<std::pair<uint64_t, uint64_t>> ResolveRange(const SampleRequest& request);
+
+ private:
+  const EngineLimits limits_;
+  TreeSource* const source_;
+};
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_ENGINE_SAMPLING_ENGINE_H_
