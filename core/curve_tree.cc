@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/status_macros.h"
 
@@ -158,6 +159,7 @@ class CurveTree::Builder {
   absl::Status Geometric(int depth, uint64_t start, uint64_t x, uint64_t y, int state) {
     const double h = 1.0 / curve_.PowG(depth);
     const double u0 = x * h, v0 = y * h;
+    NoteDepth(depth, u0 + h / 2, v0 + h / 2);
     ASSIGN_OR_RETURN(const double spread, CellSpread(u0, v0, h));
     const bool wants_split = spread > options_.tolerance;
     if (wants_split && depth < options_.depth_cap) {
@@ -205,6 +207,7 @@ class CurveTree::Builder {
     const int g = curve_.grid();
     const uint64_t span = curve_.Span(depth + 1);
     const double h = 1.0 / curve_.PowG(depth + 1);
+    NoteDepth(depth + 1, (x * g + 0.5) * h, (y * g + 0.5) * h);
     for (int c = 0; c < curve_.arity(); ++c) {
       const Curve::Child& ch = curve_.ChildOf(state, c);
       const uint64_t cx = x * g + ch.dx, cy = y * g + ch.dy;
@@ -238,10 +241,24 @@ class CurveTree::Builder {
   }
 
   absl::Status Keep(uint64_t start, double mass) {
-    if (starts_.size() >= options_.max_leaves) return LeafBudgetError(options_.max_leaves);
+    if (starts_.size() >= options_.max_leaves) {
+      // Say where the tree was growing deepest: usually a singularity.
+      return absl::ResourceExhaustedError(absl::StrCat(
+          LeafBudgetError(options_.max_leaves).message(),
+          absl::StrFormat(". The deepest split so far is at depth %d near (u,v) = (%.9g, %.9g)%s",
+                          deepest_, deepest_u_, deepest_v_,
+                          deepest_ >= 20 ? "; the surface may be singular there" : "")));
+    }
     starts_.push_back(start);
     masses_.push_back(mass);
     return absl::OkStatus();
+  }
+
+  void NoteDepth(int depth, double u, double v) {
+    if (depth <= deepest_) return;
+    deepest_ = depth;
+    deepest_u_ = u;
+    deepest_v_ = v;
   }
 
   CurveTree::Cell CellOf(uint64_t start, uint64_t end) const {
@@ -259,6 +276,8 @@ class CurveTree::Builder {
   const Curve& curve_;
   const AreaEstimator decision_estimator_;
   double limit_ = 0;
+  int deepest_ = 0;
+  double deepest_u_ = 0.5, deepest_v_ = 0.5;
   std::vector<uint64_t> starts_;
   std::vector<double> masses_;
   PrecisionReport report_;

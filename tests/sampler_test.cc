@@ -1,0 +1,227 @@
+// Properties of equalisation and the sample sets: determinism, random access
+// (ranges, shards, regions equal slices and filters of the full set),
+// samples on the surface, and counts per cell within the jittering bound.
+#include "core/sampler.h"
+
+#include <cmath>
+#include <set>
+
+#include "gtest/gtest.h"
+#include "tests/test_util.h"
+
+namespace sfc {
+namespace {
+
+using testing::Collect;
+using testing::MakeSampler;
+using testing::MakeSetup;
+
+void ExpectSameSamples(const SampleBatch& a, const SampleBatch& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a.index[i], b.index[i]) << i;
+    ASSERT_EQ(a.u[i], b.u[i]) << i;  // bit-identical, not approximately
+    ASSERT_EQ(a.v[i], b.v[i]) << i;
+    ASSERT_EQ(a.x[i], b.x[i]) << i;
+    ASSERT_EQ(a.y[i], b.y[i]) << i;
+    ASSERT_EQ(a.z[i], b.z[i]) << i;
+  }
+}
+
+TEST(Sampler, SameRequestAndSeedGiveTheSameSamplesAndOtherSeedsDoNot) {
+  const uint64_t n = 3000;
+  const auto s1 = MakeSetup("eight", "gaussian:floor=0.1", n);
+  const auto s2 = MakeSetup("eight", "gaussian:floor=0.1", n);  // a second, independent build
+  const SampleBatch a = Collect(MakeSampler(s1, SequenceKind::kJittered, n, 7), 0, n);
+  const SampleBatch b = Collect(MakeSampler(s2, SequenceKind::kJittered, n, 7), 0, n, {}, {}, 17);
+  ExpectSameSamples(a, b);
+  const SampleBatch c = Collect(MakeSampler(s1, SequenceKind::kJittered, n, 8), 0, n);
+  int same = 0;
+  for (size_t i = 0; i < n; ++i) same += a.u[i] == c.u[i];
+  EXPECT_LT(same, 3);
+}
+
+TEST(Sampler, IndexRangesAndShardsAreSlicesOfTheFullSet) {
+  const uint64_t n = 5000;
+  const auto s = MakeSetup("torus", "uniform", n);
+  for (SequenceKind kind : {SequenceKind::kJittered, SequenceKind::kProgressive}) {
+    auto sampler = MakeSampler(s, kind, n, 3);
+    const SampleBatch full = Collect(sampler, 0, n);
+    ASSERT_EQ(full.size(), n);
+    // Every index exactly once.
+    std::set<uint64_t> indices(full.index.begin(), full.index.end());
+    EXPECT_EQ(indices.size(), n);
+    if (kind == SequenceKind::kJittered) {
+      // Index order is curve order: the range is the slice.
+      const SampleBatch part = Collect(sampler, 1234, 3456);
+      SampleBatch slice;
+      for (size_t i = 1234; i < 3456; ++i) {
+        slice.index.push_back(full.index[i]);
+        slice.u.push_back(full.u[i]), slice.v.push_back(full.v[i]);
+        slice.x.push_back(full.x[i]), slice.y.push_back(full.y[i]), slice.z.push_back(full.z[i]);
+      }
+      ExpectSameSamples(part, slice);
+      // Shards 0..K-1 concatenated are the full set, in order.
+      SampleBatch joined;
+      const uint64_t k = 7;
+      for (uint64_t i = 0; i < k; ++i) {
+        const SampleBatch shard = Collect(sampler, i * n / k, (i + 1) * n / k);
+        for (size_t j = 0; j < shard.size(); ++j) {
+          joined.index.push_back(shard.index[j]);
+          joined.u.push_back(shard.u[j]), joined.v.push_back(shard.v[j]);
+          joined.x.push_back(shard.x[j]), joined.y.push_back(shard.y[j]), joined.z.push_back(shard.z[j]);
+        }
+      }
+      ExpectSameSamples(joined, full);
+    }
+  }
+}
+
+// The set restricted to a region, computed by descending the tree, equals the
+// full set filtered by the region, element for element.
+TEST(Sampler, RegionQueriesEqualTheFilteredFullSet) {
+  const uint64_t n = 20000;
+  const auto s = MakeSetup("monkey_saddle", "gaussian:floor=0.05", n);
+  auto sampler = MakeSampler(s, SequenceKind::kJittered, n, 11);
+  const SampleBatch full = Collect(sampler, 0, n);
+  const Region regions[] = {
+      Region::ParameterRect(0.1, 0.35, 0.6, 0.95),
+      Region::ParameterRect(0.0, 1.0, 0.0, 0.5),
+      Region::Box({-0.3, -0.5, -0.2}, {0.4, 0.2, 0.3}),
+      Region::Box({0.5, 0.5, -3}, {1, 1, 3}),
+  };
+  for (const Region& region : regions) {
+    SampleBatch expected;
+    for (size_t i = 0; i < full.size(); ++i) {
+      if (!region.Contains(full.u[i], full.v[i], {full.x[i], full.y[i], full.z[i]})) continue;
+      expected.index.push_back(full.index[i]);
+      expected.u.push_back(full.u[i]), expected.v.push_back(full.v[i]);
+      expected.x.push_back(full.x[i]), expected.y.push_back(full.y[i]), expected.z.push_back(full.z[i]);
+    }
+    ASSERT_GT(expected.size(), 100u);
+    ExpectSameSamples(Collect(sampler, 0, n, region), expected);
+  }
+}
+
+TEST(Sampler, SamplesLieOnTheSurfaceInsideTheParameterBox) {
+  const uint64_t n = 4000;
+  for (const char* surface : {"sphere:r=2", "whitney", "superellipsoid:reparam=1", "eight"}) {
+    const auto s = MakeSetup(surface, "uniform", n);
+    const SampleBatch b = Collect(MakeSampler(s, SequenceKind::kJittered, n, 5), 0, n);
+    ASSERT_EQ(b.size(), n);
+    for (size_t i = 0; i < n; ++i) {
+      ASSERT_GE(b.u[i], 0.0);
+      ASSERT_LE(b.u[i], 1.0);
+      ASSERT_GE(b.v[i], 0.0);
+      ASSERT_LE(b.v[i], 1.0);
+      const Vec3 p = s.surface->Point(b.u[i], b.v[i]);
+      ASSERT_EQ(p, (Vec3{b.x[i], b.y[i], b.z[i]})) << surface << " sample " << i;
+    }
+  }
+  // On the sphere of radius 2 every point is at distance 2 from the centre.
+  const auto s = MakeSetup("sphere:r=2", "uniform", n);
+  const SampleBatch b = Collect(MakeSampler(s, SequenceKind::kJittered, n, 5), 0, n);
+  for (size_t i = 0; i < n; ++i) ASSERT_NEAR(std::hypot(b.x[i], b.y[i], b.z[i]), 2.0, 1e-12);
+}
+
+TEST(Sampler, NoTwoSamplesCoincide) {
+  // The paper snaps to cell centres; the analytic continuation does not.
+  const uint64_t n = 50000;
+  CurveTreeOptions coarse;
+  coarse.rho = 64;  // leaves hold many samples each
+  const auto s = MakeSetup("plane", "expr:u+v", n, coarse);
+  const SampleBatch b = Collect(MakeSampler(s, SequenceKind::kJittered, n, 2), 0, n);
+  std::set<std::pair<double, double>> points;
+  for (size_t i = 0; i < n; ++i) points.insert({b.u[i], b.v[i]});
+  EXPECT_EQ(points.size(), n);
+  EXPECT_LT(s.tree->leaf_count(), n / 8);
+}
+
+// Every cell of the curve's own subdivision is a contiguous stretch of the
+// curve, so jittered sampling puts N * mass(cell) / total samples in it, give
+// or take the two strata cut by the stretch's ends: |count - expected| < 2,
+// plus the error of the area x density estimate.
+void ExpectCellCountsWithinJitterBound(const char* surface, const char* density, uint64_t n,
+                                       const std::function<double(double, double, double, double)>& true_mass,
+                                       double total, int depth, double slack) {
+  const auto s = MakeSetup(surface, density, n);
+  const SampleBatch b = Collect(MakeSampler(s, SequenceKind::kJittered, n, 9), 0, n);
+  const int side = 1 << depth;
+  std::vector<int> counts(side * side, 0);
+  for (size_t i = 0; i < n; ++i) {
+    const int cx = std::min(side - 1, static_cast<int>(b.u[i] * side));
+    const int cy = std::min(side - 1, static_cast<int>(b.v[i] * side));
+    ++counts[cx * side + cy];
+  }
+  double worst = 0;
+  for (int cx = 0; cx < side; ++cx) {
+    for (int cy = 0; cy < side; ++cy) {
+      const double h = 1.0 / side;
+      const double expected = n * true_mass(cx * h, (cx + 1) * h, cy * h, (cy + 1) * h) / total;
+      worst = std::max(worst, std::fabs(counts[cx * side + cy] - expected));
+    }
+  }
+  EXPECT_LT(worst, 2.0 + slack) << surface << " " << density;
+}
+
+TEST(Sampler, CountsPerCellMatchTheAreaOnTheSphere) {
+  // Area of the sphere over theta in [pi a, pi b], phi in [2 pi c, 2 pi d].
+  const double pi = 3.14159265358979323846;
+  auto area = [&](double a, double b, double c, double d) {
+    return (std::cos(pi * a) - std::cos(pi * b)) * 2 * pi * (d - c);
+  };
+  ExpectCellCountsWithinJitterBound("sphere", "uniform", 30000, area, 4 * pi, 3, 0.1);
+}
+
+TEST(Sampler, CountsPerCellFollowDensityUPlusVOnTheSquare) {
+  auto mass = [](double a, double b, double c, double d) {
+    return (b - a) * (d - c) * ((a + b) / 2 + (c + d) / 2);
+  };
+  ExpectCellCountsWithinJitterBound("plane", "expr:u+v", 30000, mass, 1.0, 4, 0.05);
+}
+
+TEST(Sampler, ProgressivePrefixesAreStratifiedAndExtendTheSet) {
+  const uint64_t n1 = 1024, n2 = 4096;
+  const auto s = MakeSetup("sphere", "uniform", n2);  // one tree sized for both
+  auto small = MakeSampler(s, SequenceKind::kProgressive, n1, 4);
+  auto large = MakeSampler(s, SequenceKind::kProgressive, n2, 4);
+  // Every power-of-two prefix puts one q in each stratum.
+  for (uint64_t m = 1; m <= n2; m *= 2) {
+    std::set<uint64_t> strata;
+    for (uint64_t k = 0; k < m; ++k) strata.insert(static_cast<uint64_t>(large->sequence().At(k) * m));
+    EXPECT_EQ(strata.size(), m);
+  }
+  // Samples [0, n1) of the larger set are the smaller set.
+  const SampleBatch a = Collect(small, 0, n1);
+  const SampleBatch b = Collect(large, 0, n1);
+  ExpectSameSamples(a, b);
+}
+
+TEST(Sequence, JitteredSamplesStayInTheirStrataAndAreMonotone) {
+  const uint64_t n = 10000;
+  Sequence seq(SequenceKind::kJittered, n, 99);
+  double previous = -1;
+  for (uint64_t k = 0; k < n; ++k) {
+    const double q = seq.At(k);
+    ASSERT_GE(q * n, static_cast<double>(k));
+    ASSERT_LE(q * n, static_cast<double>(k + 1));
+    ASSERT_GE(q, previous);
+    previous = q;
+  }
+}
+
+TEST(Sampler, RandomAndRadicalInverseSequencesComeOutInCurveOrder) {
+  const uint64_t n = 3000;
+  const auto s = MakeSetup("plane", "uniform", n);
+  for (SequenceKind kind : {SequenceKind::kRandom, SequenceKind::kVanDerCorput}) {
+    auto sampler = MakeSampler(s, kind, n, 1);
+    SampleFields fields;
+    fields.curve_position = true;
+    const SampleBatch b = Collect(sampler, 0, n, {}, fields);
+    ASSERT_EQ(b.size(), n);
+    for (size_t i = 1; i < n; ++i) ASSERT_LE(b.curve_position[i - 1], b.curve_position[i]);
+  }
+}
+
+}  // namespace
+}  // namespace sfc

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs everything sfcsampler needs from Debian bookworm's packages.
+# Skips apt when every package is already installed. Safe to run again.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config   # compiler and build
+  libabsl-dev                                    # Status, StatusOr, strings, Mutex (core)
+  libmuparser-dev                                # user-defined surface and density expressions
+  libcli11-dev                                   # command-line flags
+  libgtest-dev libgmock-dev                      # tests
+  libbenchmark-dev                               # benchmarks
+  libgrpc++-dev libgrpc-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler  # service
+  libspdlog-dev                                  # server logs
+  prometheus-cpp-dev                             # server metrics
+  libcairo2-dev libpng-dev                       # pictures
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+sudo=""
+[ "$(id -u)" -eq 0 ] || sudo="sudo"
+echo "setup: installing ${missing[*]}" >&2
+$sudo apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
