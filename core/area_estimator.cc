@@ -29,20 +29,29 @@ double TriangleArea(const Vec3& a, const Vec3& b, const Vec3& c) {
 
 absl::StatusOr<DensityAt> EvaluateDensity(const Surface& surface, const Density& density, double u,
                                           double v) {
-  const SurfaceJet jet = surface.Jet(u, v, density.NeedsCurvature() ? 2 : 1);
+  // Curvatures and the normal are computed only for densities that read them:
+  // this is the tree build's innermost call.
+  const bool curvature = density.NeedsCurvature();
+  const SurfaceJet jet = surface.Jet(u, v, curvature ? 2 : 1);
   if (!IsFinite(jet.p)) return NotFinite(u, v);
-  const SurfaceGeometry geo = GeometryOf(jet);
   SurfacePoint point;
   point.u = u;
   point.v = v;
   point.p = jet.p;
-  point.normal = geo.normal;
-  point.gaussian_curvature = geo.gaussian_curvature;
-  point.mean_curvature = geo.mean_curvature;
+  double area_element;
+  if (curvature) {
+    const SurfaceGeometry geo = GeometryOf(jet);
+    point.normal = geo.normal;
+    point.gaussian_curvature = geo.gaussian_curvature;
+    point.mean_curvature = geo.mean_curvature;
+    area_element = geo.area_element;
+  } else {
+    area_element = Norm(Cross(jet.fu, jet.fv));
+  }
   DensityAt out;
   out.p = jet.p;
   out.delta = density.Value(point);
-  out.area_element = geo.area_element;
+  out.area_element = area_element;
   if (!std::isfinite(out.delta) || out.delta < 0) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "the density is %g at (u,v) = (%.17g, %.17g); densities must be finite and >= 0", out.delta,

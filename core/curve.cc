@@ -113,7 +113,10 @@ Curve::Curve(const Definition& def)
   // Chunk tables: the effect of chunk_levels_ levels at once (<= 256 entries).
   chunk_levels_ = arity_ == 4 ? 4 : 2;
   const int chunk_size = static_cast<int>(pow_w_[chunk_levels_]);
-  chunks_.resize(8 * chunk_size);
+  chunk_shift_ = 0;
+  while ((1 << chunk_shift_) < chunk_size) ++chunk_shift_;
+  chunk_side_ = static_cast<uint64_t>(pow_g_[chunk_levels_]);
+  chunks_.resize(8 << chunk_shift_);
   for (int s = 0; s < 8; ++s) {
     for (int value = 0; value < chunk_size; ++value) {
       int state = s, x = 0, y = 0;
@@ -124,7 +127,7 @@ Curve::Curve(const Definition& def)
         y = y * grid_ + ch.dy;
         state = ch.state;
       }
-      chunks_[s * chunk_size + value] =
+      chunks_[(s << chunk_shift_) + value] =
           ChunkEntry{static_cast<uint16_t>(x), static_cast<uint16_t>(y), static_cast<uint8_t>(state)};
     }
   }
@@ -135,39 +138,6 @@ int Curve::DepthOfSpan(uint64_t span) const {
   int k = 0;
   while (pow_w_[k] < span) ++k;
   return max_depth_ - k;
-}
-
-void Curve::Descend(uint64_t digits, int levels, uint64_t* x, uint64_t* y, int* state) const {
-  uint64_t px = 0, py = 0;
-  int s = *state;
-  // Digit extraction by shifts when w is a power of two, else by division.
-  auto top_digits = [&](int below, int count) -> uint64_t {
-    if (digit_bits_) {
-      return (digits >> (below * digit_bits_)) & ((uint64_t{1} << (count * digit_bits_)) - 1);
-    }
-    return (digits / pow_w_[below]) % pow_w_[count];
-  };
-  int remaining = levels;
-  const int head = levels % chunk_levels_;
-  for (int k = 0; k < head; ++k) {
-    --remaining;
-    const Child& ch = ChildOf(s, static_cast<int>(top_digits(remaining, 1)));
-    px = px * grid_ + ch.dx;
-    py = py * grid_ + ch.dy;
-    s = ch.state;
-  }
-  const int chunk_size = static_cast<int>(pow_w_[chunk_levels_]);
-  const uint64_t scale = pow_w_[chunk_levels_] == 256 ? 16 : 9;  // g^chunk_levels
-  while (remaining > 0) {
-    remaining -= chunk_levels_;
-    const ChunkEntry& e = chunks_[s * chunk_size + top_digits(remaining, chunk_levels_)];
-    px = px * scale + e.x;
-    py = py * scale + e.y;
-    s = e.state;
-  }
-  *x = px;
-  *y = py;
-  *state = s;
 }
 
 namespace {

@@ -48,6 +48,10 @@ class Curve {
   int max_depth() const { return max_depth_; }  // D
   // w^(D - depth): the number of deepest-level indices a cell at `depth` covers.
   uint64_t Span(int depth) const { return pow_w_[max_depth_ - depth]; }
+  // The depth-`depth` cell prefix of curve index `index`: index / Span(depth).
+  uint64_t Prefix(uint64_t index, int depth) const {
+    return digit_bits_ ? index >> (digit_bits_ * (max_depth_ - depth)) : index / Span(depth);
+  }
   // Inverse of Span(). REQUIRES: span == Span(d) for some d in [0, D].
   int DepthOfSpan(uint64_t span) const;
   // w^k and g^k. REQUIRES: 0 <= k <= D (g^k up to 2 D).
@@ -70,7 +74,36 @@ class Curve {
   // cell's position in units of g^-levels of the start cell, and *state its
   // orientation. REQUIRES: levels <= D + continuation_levels(), digits < w^levels
   // when levels <= D.
-  void Descend(uint64_t digits, int levels, uint64_t* x, uint64_t* y, int* state) const;
+  void Descend(uint64_t digits, int levels, uint64_t* x, uint64_t* y, int* state) const {
+    // Inline: this is the sampler's innermost loop (twice per sample). The
+    // leading levels % chunk_levels_ digits go one at a time, the rest a chunk
+    // per look-up; digits are read by shifts when w is a power of two.
+    uint64_t px = 0, py = 0;
+    int s = *state;
+    int remaining = levels;
+    for (int head = levels % chunk_levels_; head > 0; --head) {
+      --remaining;
+      const uint64_t digit = digit_bits_ ? (digits >> (remaining * digit_bits_)) & (arity_ - 1)
+                                         : (digits / pow_w_[remaining]) % arity_;
+      const Child& ch = children_[s * arity_ + digit];
+      px = px * grid_ + ch.dx;
+      py = py * grid_ + ch.dy;
+      s = ch.state;
+    }
+    const uint64_t chunk_mask = pow_w_[chunk_levels_] - 1;
+    while (remaining > 0) {
+      remaining -= chunk_levels_;
+      const uint64_t chunk = digit_bits_ ? (digits >> (remaining * digit_bits_)) & chunk_mask
+                                         : (digits / pow_w_[remaining]) % pow_w_[chunk_levels_];
+      const ChunkEntry& e = chunks_[(static_cast<uint64_t>(s) << chunk_shift_) + chunk];
+      px = px * chunk_side_ + e.x;
+      py = py * chunk_side_ + e.y;
+      s = e.state;
+    }
+    *x = px;
+    *y = py;
+    *state = s;
+  }
 
   // How a curve type is specified (see curve.cc); for the implementation.
   struct Definition;
@@ -86,6 +119,8 @@ class Curve {
   CurveType type_;
   int grid_, arity_, max_depth_, continuation_levels_;
   int chunk_levels_;  // levels resolved per look-up in Descend
+  int chunk_shift_;   // log2 of the chunk table's row length (rows padded to a power of two)
+  uint64_t chunk_side_;  // g^chunk_levels_
   int digit_bits_;    // log2(w) when w is a power of two, else 0
   std::vector<uint64_t> pow_w_;
   std::vector<double> pow_g_;

@@ -89,8 +89,9 @@ class CurveTree::Builder {
     const size_t n = prev.leaf_count();
     starts_.clear();
     masses_.clear();
-    starts_.reserve(n);
-    masses_.reserve(n);
+    // Most passes that split grow the tree by less than half.
+    starts_.reserve(n + n / 2);
+    masses_.reserve(n + n / 2);
     for (size_t l = 0; l < n; ++l) {
       const double s = prev.mass_end(l) - prev.mass_begin(l);
       if (s <= limit_) {
@@ -376,6 +377,8 @@ absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Refined(const Surfac
     }
     tree->grade_ = g;
   }
+  tree->starts_.shrink_to_fit();
+  tree->mass_end_.shrink_to_fit();
   return std::shared_ptr<const CurveTree>(std::move(tree));
 }
 
@@ -383,7 +386,7 @@ CurveTree::Cell CurveTree::LeafCell(size_t l) const {
   const int depth = leaf_depth(l);
   uint64_t x, y;
   int state = Curve::kRootState;
-  curve_->Descend(starts_[l] / curve_->Span(depth), depth, &x, &y, &state);
+  curve_->Descend(curve_->Prefix(starts_[l], depth), depth, &x, &y, &state);
   const double h = 1.0 / curve_->PowG(depth);
   return {x * h, y * h, h, depth, state};
 }

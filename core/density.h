@@ -15,15 +15,16 @@ namespace sfc {
 struct SurfacePoint {
   double u = 0, v = 0;  // unit-square parameters
   Vec3 p;               // f(u, v)
-  Vec3 normal;
-  double gaussian_curvature = 0;  // valid only if the density NeedsCurvature()
+  Vec3 normal;                    // valid only if the density NeedsCurvature()
+  double gaussian_curvature = 0;  // likewise
   double mean_curvature = 0;      // likewise
 };
 
 class Density {
  public:
   virtual ~Density() = default;
-  // True when Value() reads the curvatures (so callers evaluate 2nd-order jets).
+  // True when Value() reads the normal or the curvatures (so callers evaluate
+  // 2nd-order jets and the full geometry).
   virtual bool NeedsCurvature() const { return false; }
   // delta at the point. Callers reject negative or non-finite values.
   virtual double Value(const SurfacePoint& point) const = 0;

@@ -205,16 +205,20 @@ absl::Status SampleCursor::Emit(uint64_t k, SampleBatch* batch, bool* kept) {
   const Curve& curve = tree.curve();
   const double m = sampler.MassCoordinate(k);
 
-  // Consecutive samples mostly fall in the same or the next few leaves.
+  // Consecutive samples fall in the same or a nearby later leaf: gallop
+  // forward from the last one before falling back to a full binary search.
   size_t l = SIZE_MAX;
-  if (cached_leaf_ != SIZE_MAX) {
-    for (size_t c = cached_leaf_, stop = std::min(cached_leaf_ + 4, tree.leaf_count()); c < stop;
-         ++c) {
-      if (m < tree.mass_end(c)) {
-        if (m >= tree.mass_begin(c)) l = c;
-        break;
-      }
+  const auto& ends = tree.mass_ends();
+  if (cached_leaf_ != SIZE_MAX && m >= tree.mass_begin(cached_leaf_)) {
+    size_t lo = cached_leaf_, step = 1, hi = lo;
+    while (hi < ends.size() && ends[hi] <= m) {
+      lo = hi + 1;
+      hi = lo + step;
+      step *= 2;
     }
+    hi = std::min(hi, ends.size());
+    l = static_cast<size_t>(std::upper_bound(ends.begin() + lo, ends.begin() + hi, m) - ends.begin());
+    if (l >= ends.size()) l = SIZE_MAX;
   }
   if (l == SIZE_MAX) l = sampler.LeafForMass(m);
   if (l != cached_leaf_) {

@@ -1,0 +1,106 @@
+// Core sampler benchmarks (issue: tree build + 10^6 samples on the unit
+// sphere; generation from a built tree; bytes per leaf). Run one core:
+//   taskset -c 0 ./build/bench/core_benchmark
+#include <memory>
+
+#include "benchmark/benchmark.h"
+#include "core/builtin_surfaces.h"
+#include "core/curve_tree.h"
+#include "core/density.h"
+#include "core/sampler.h"
+
+namespace sfc {
+namespace {
+
+constexpr uint64_t kMillion = 1'000'000;
+
+std::shared_ptr<const Surface> Sphere() { return std::shared_ptr<const Surface>(MakeSphere(1)); }
+std::shared_ptr<const Density> Uniform() { return std::shared_ptr<const Density>(MakeUniformDensity()); }
+
+// Reads every sample of the cursor in batches of 64 Ki; returns the count.
+uint64_t Drain(SampleCursor& cursor, SampleBatch& batch) {
+  uint64_t total = 0;
+  while (true) {
+    batch.Clear();
+    const size_t n = *cursor.Next(65536, &batch);
+    if (n == 0) return total;
+    total += n;
+  }
+}
+
+void BM_BuildTreeAndSampleSphere(benchmark::State& state) {
+  const uint64_t n = state.range(0);
+  CurveTreeOptions options;
+  options.rho = static_cast<double>(state.range(1));
+  auto surface = Sphere();
+  auto density = Uniform();
+  SampleBatch batch;
+  size_t leaves = 0;
+  for (auto _ : state) {
+    auto tree = *CurveTree::Build(*surface, *density, options, CurveTree::GradeFor(n));
+    leaves = tree->leaf_count();
+    auto sampler = std::make_shared<const Sampler>(tree, surface, density,
+                                                   Sequence(SequenceKind::kJittered, n, 1));
+    auto cursor = *SampleCursor::Create(sampler, 0, n, {}, {});
+    benchmark::DoNotOptimize(Drain(*cursor, batch));
+  }
+  state.counters["leaves"] = static_cast<double>(leaves);
+  state.SetItemsProcessed(state.iterations() * n);
+}
+// Second argument: rho (1 is the default; larger trades sub-leaf density
+// accuracy for a coarser tree).
+BENCHMARK(BM_BuildTreeAndSampleSphere)
+    ->Args({kMillion, 1})
+    ->Args({kMillion, 4})
+    ->Unit(benchmark::kMillisecond);
+
+void BM_BuildTreeOnlySphere(benchmark::State& state) {
+  const uint64_t n = state.range(0);
+  auto surface = Sphere();
+  auto density = Uniform();
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(*CurveTree::Build(*surface, *density, {}, CurveTree::GradeFor(n)));
+  }
+}
+BENCHMARK(BM_BuildTreeOnlySphere)->Arg(kMillion)->Unit(benchmark::kMillisecond);
+
+// Generation alone: 10^6 samples with surface evaluation from a built tree.
+void BM_SampleFromBuiltTree(benchmark::State& state) {
+  const uint64_t n = kMillion;
+  const auto curve = static_cast<CurveType>(state.range(0));
+  auto surface = state.range(1) ? std::shared_ptr<const Surface>(MakePlane()) : Sphere();
+  auto density = Uniform();
+  CurveTreeOptions options;
+  options.curve = curve;
+  auto tree = *CurveTree::Build(*surface, *density, options, CurveTree::GradeFor(n));
+  auto sampler = std::make_shared<const Sampler>(tree, surface, density,
+                                                 Sequence(SequenceKind::kJittered, n, 1));
+  SampleBatch batch;
+  for (auto _ : state) {
+    auto cursor = *SampleCursor::Create(sampler, 0, n, {}, {});
+    benchmark::DoNotOptimize(Drain(*cursor, batch));
+  }
+  state.SetItemsProcessed(state.iterations() * n);
+  state.SetLabel(std::string(CurveName(curve)) + (state.range(1) ? " plane" : " sphere"));
+}
+BENCHMARK(BM_SampleFromBuiltTree)
+    ->Args({static_cast<int>(CurveType::kHilbert), 0})
+    ->Args({static_cast<int>(CurveType::kHilbert), 1})
+    ->Args({static_cast<int>(CurveType::kHilbert2), 0})
+    ->Unit(benchmark::kMillisecond);
+
+// Bytes per leaf, measured from the tree's own arrays.
+void BM_BytesPerLeaf(benchmark::State& state) {
+  auto surface = Sphere();
+  auto density = Uniform();
+  std::shared_ptr<const CurveTree> tree;
+  for (auto _ : state) tree = *CurveTree::Build(*surface, *density, {}, CurveTree::GradeFor(kMillion));
+  state.counters["bytes_per_leaf"] = static_cast<double>(tree->bytes()) / tree->leaf_count();
+  state.counters["leaves"] = static_cast<double>(tree->leaf_count());
+}
+BENCHMARK(BM_BytesPerLeaf)->Iterations(1)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace sfc
+
+BENCHMARK_MAIN();
