@@ -1,0 +1,247 @@
+#include "proto/convert.h"
+
+#include "absl/strings/str_format.h"
+#include "core/status_macros.h"
+
+namespace sfc {
+namespace {
+
+template <typename Column>
+void Put(const std::vector<double>& from, Column* to) {
+  to->Reserve(static_cast<int>(from.size()));
+  for (double d : from) to->AddAlreadyReserved(static_cast<typename Column::value_type>(d));
+}
+
+template <typename Columns>
+void PutColumns(const SampleBatch& b, const SampleFields& fields, Columns* c) {
+  Put(b.u, c->mutable_u());
+  Put(b.v, c->mutable_v());
+  Put(b.x, c->mutable_x());
+  Put(b.y, c->mutable_y());
+  Put(b.z, c->mutable_z());
+  if (fields.normal) {
+    Put(b.nx, c->mutable_nx());
+    Put(b.ny, c->mutable_ny());
+    Put(b.nz, c->mutable_nz());
+  }
+  if (fields.density) Put(b.density, c->mutable_density());
+  if (fields.curve_position) Put(b.curve_position, c->mutable_curve_position());
+}
+
+template <typename Column>
+absl::Status Take(const char* name, const Column& from, size_t n, std::vector<double>* to) {
+  if (static_cast<size_t>(from.size()) != n) {
+    return absl::DataLossError(absl::StrFormat(
+        "a batch's column %s has %d values for %d samples", name, from.size(), n));
+  }
+  to->insert(to->end(), from.begin(), from.end());
+  return absl::OkStatus();
+}
+
+template <typename Columns>
+absl::Status TakeColumns(const Columns& c, const SampleFields& fields, size_t n, SampleBatch* b) {
+  RETURN_IF_ERROR(Take("u", c.u(), n, &b->u));
+  RETURN_IF_ERROR(Take("v", c.v(), n, &b->v));
+  RETURN_IF_ERROR(Take("x", c.x(), n, &b->x));
+  RETURN_IF_ERROR(Take("y", c.y(), n, &b->y));
+  RETURN_IF_ERROR(Take("z", c.z(), n, &b->z));
+  if (fields.normal) {
+    RETURN_IF_ERROR(Take("nx", c.nx(), n, &b->nx));
+    RETURN_IF_ERROR(Take("ny", c.ny(), n, &b->ny));
+    RETURN_IF_ERROR(Take("nz", c.nz(), n, &b->nz));
+  }
+  if (fields.density) RETURN_IF_ERROR(Take("density", c.density(), n, &b->density));
+  if (fields.curve_position) {
+    RETURN_IF_ERROR(Take("curve_position", c.curve_position(), n, &b->curve_position));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<TreeSpec> FromProto(const v1::TreeSpec& p) {
+  TreeSpec spec;
+  if (!p.surface().empty()) spec.surface = p.surface();
+  if (!p.density().empty()) spec.density = p.density();
+  switch (p.curve()) {
+    case v1::CURVE_HILBERT: spec.options.curve = CurveType::kHilbert; break;
+    case v1::CURVE_HILBERT2: spec.options.curve = CurveType::kHilbert2; break;
+    case v1::CURVE_PEANO: spec.options.curve = CurveType::kPeano; break;
+    default: return absl::InvalidArgumentError(absl::StrFormat("unknown curve %d", p.curve()));
+  }
+  switch (p.estimator()) {
+    case v1::AREA_ESTIMATOR_FFF: spec.options.estimator = AreaEstimator::kFirstFundamentalForm; break;
+    case v1::AREA_ESTIMATOR_TRIANGLE: spec.options.estimator = AreaEstimator::kTriangle; break;
+    case v1::AREA_ESTIMATOR_SQUARE: spec.options.estimator = AreaEstimator::kSquare; break;
+    case v1::AREA_ESTIMATOR_QUADRATURE: spec.options.estimator = AreaEstimator::kQuadrature; break;
+    default:
+      return absl::InvalidArgumentError(absl::StrFormat("unknown area estimator %d", p.estimator()));
+  }
+  spec.options.tolerance = p.tolerance();
+  spec.options.depth_cap = p.depth_cap();
+  spec.options.rho = p.rho() == 0 ? 1.0 : p.rho();
+  return spec;
+}
+
+v1::TreeSpec ToProto(const TreeSpec& spec) {
+  v1::TreeSpec p;
+  p.set_surface(spec.surface);
+  p.set_density(spec.density);
+  switch (spec.options.curve) {
+    case CurveType::kHilbert: p.set_curve(v1::CURVE_HILBERT); break;
+    case CurveType::kHilbert2: p.set_curve(v1::CURVE_HILBERT2); break;
+    case CurveType::kPeano: p.set_curve(v1::CURVE_PEANO); break;
+  }
+  switch (spec.options.estimator) {
+    case AreaEstimator::kFirstFundamentalForm: p.set_estimator(v1::AREA_ESTIMATOR_FFF); break;
+    case AreaEstimator::kTriangle: p.set_estimator(v1::AREA_ESTIMATOR_TRIANGLE); break;
+    case AreaEstimator::kSquare: p.set_estimator(v1::AREA_ESTIMATOR_SQUARE); break;
+    case AreaEstimator::kQuadrature: p.set_estimator(v1::AREA_ESTIMATOR_QUADRATURE); break;
+  }
+  p.set_tolerance(spec.options.tolerance);
+  p.set_depth_cap(spec.options.depth_cap);
+  p.set_rho(spec.options.rho);
+  return p;
+}
+
+absl::StatusOr<SampleRequest> FromProto(const v1::SampleRequest& p) {
+  SampleRequest r;
+  ASSIGN_OR_RETURN(r.tree, FromProto(p.tree()));
+  switch (p.sequence()) {
+    case v1::SEQUENCE_JITTERED: r.sequence = SequenceKind::kJittered; break;
+    case v1::SEQUENCE_EQUAL: r.sequence = SequenceKind::kEqual; break;
+    case v1::SEQUENCE_RANDOM: r.sequence = SequenceKind::kRandom; break;
+    case v1::SEQUENCE_VAN_DER_CORPUT: r.sequence = SequenceKind::kVanDerCorput; break;
+    case v1::SEQUENCE_PROGRESSIVE: r.sequence = SequenceKind::kProgressive; break;
+    default: return absl::InvalidArgumentError(absl::StrFormat("unknown sequence %d", p.sequence()));
+  }
+  if (p.precision() != v1::PRECISION_FLOAT64 && p.precision() != v1::PRECISION_FLOAT32) {
+    return absl::InvalidArgumentError(absl::StrFormat("unknown precision %d", p.precision()));
+  }
+  r.count = p.count();
+  r.seed = p.seed();
+  r.tree_count = p.tree_count();
+  r.begin = p.begin();
+  r.end = p.end();
+  r.shard_index = p.shard_index();
+  r.shard_count = p.shard_count();
+  if (p.has_parameter_rect()) {
+    const auto& q = p.parameter_rect();
+    r.region = Region::ParameterRect(q.u0(), q.u1(), q.v0(), q.v1());
+  } else if (p.has_box()) {
+    const auto& b = p.box();
+    r.region = Region::Box({b.min_x(), b.min_y(), b.min_z()}, {b.max_x(), b.max_y(), b.max_z()});
+  }
+  r.fields.normal = p.normals();
+  r.fields.density = p.density();
+  r.fields.curve_position = p.curve_position();
+  return r;
+}
+
+v1::SampleRequest ToProto(const SampleRequest& r) {
+  v1::SampleRequest p;
+  *p.mutable_tree() = ToProto(r.tree);
+  switch (r.sequence) {
+    case SequenceKind::kJittered: p.set_sequence(v1::SEQUENCE_JITTERED); break;
+    case SequenceKind::kEqual: p.set_sequence(v1::SEQUENCE_EQUAL); break;
+    case SequenceKind::kRandom: p.set_sequence(v1::SEQUENCE_RANDOM); break;
+    case SequenceKind::kVanDerCorput: p.set_sequence(v1::SEQUENCE_VAN_DER_CORPUT); break;
+    case SequenceKind::kProgressive: p.set_sequence(v1::SEQUENCE_PROGRESSIVE); break;
+  }
+  p.set_count(r.count);
+  p.set_seed(r.seed);
+  p.set_tree_count(r.tree_count);
+  p.set_begin(r.begin);
+  p.set_end(r.end);
+  p.set_shard_index(r.shard_index);
+  p.set_shard_count(r.shard_count);
+  if (r.region.kind == Region::Kind::kParameterRect) {
+    auto* q = p.mutable_parameter_rect();
+    q->set_u0(r.region.u0), q->set_u1(r.region.u1), q->set_v0(r.region.v0), q->set_v1(r.region.v1);
+  } else if (r.region.kind == Region::Kind::kBox) {
+    auto* b = p.mutable_box();
+    b->set_min_x(r.region.lo.x), b->set_min_y(r.region.lo.y), b->set_min_z(r.region.lo.z);
+    b->set_max_x(r.region.hi.x), b->set_max_y(r.region.hi.y), b->set_max_z(r.region.hi.z);
+  }
+  p.set_normals(r.fields.normal);
+  p.set_density(r.fields.density);
+  p.set_curve_position(r.fields.curve_position);
+  return p;
+}
+
+void ToProto(const SampleBatch& b, const SampleFields& fields, v1::Precision precision,
+             v1::SampleBatch* out) {
+  const size_t n = b.size();
+  out->set_size(static_cast<uint32_t>(n));
+  bool consecutive = true;
+  for (size_t i = 1; i < n && consecutive; ++i) consecutive = b.index[i] == b.index[i - 1] + 1;
+  out->set_first_index(n ? b.index[0] : 0);
+  if (!consecutive) {
+    out->mutable_index()->Reserve(static_cast<int>(n));
+    for (uint64_t k : b.index) out->mutable_index()->AddAlreadyReserved(k);
+  }
+  if (precision == v1::PRECISION_FLOAT32) {
+    PutColumns(b, fields, out->mutable_f32());
+  } else {
+    PutColumns(b, fields, out->mutable_f64());
+  }
+}
+
+absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fields, SampleBatch* out) {
+  const size_t n = in.size();
+  if (in.index_size() != 0 && static_cast<size_t>(in.index_size()) != n) {
+    return absl::DataLossError(absl::StrFormat("a batch has %d indices for %d samples", in.index_size(), n));
+  }
+  if (n > 0 && !in.has_f64() && !in.has_f32()) return absl::DataLossError("a batch has no columns");
+  if (in.index_size() == 0) {
+    for (size_t i = 0; i < n; ++i) out->index.push_back(in.first_index() + i);
+  } else {
+    out->index.insert(out->index.end(), in.index().begin(), in.index().end());
+  }
+  if (n == 0) return absl::OkStatus();
+  return in.has_f64() ? TakeColumns(in.f64(), fields, n, out) : TakeColumns(in.f32(), fields, n, out);
+}
+
+void ToProto(const PreparedTree& t, v1::TreeInfo* out) {
+  const CurveTree& tree = *t.lookup.tree;
+  out->set_key(t.key.Hex());
+  out->set_key_with_grade(t.key.HexWithGrade(t.grade));
+  out->set_canonical(t.key.canonical);
+  out->set_grade(t.grade);
+  out->set_cache_hit(t.lookup.cache_hit);
+  out->set_refined(t.lookup.refined);
+  out->set_leaves(tree.leaf_count());
+  out->set_bytes(tree.bytes());
+  out->set_min_depth(tree.min_depth());
+  out->set_max_depth(tree.max_depth());
+  out->set_tolerance(tree.options().tolerance);
+  out->set_flatness_capped_leaves(tree.precision().geometry_capped_leaves);
+  out->set_mass_capped_leaves(tree.precision().mass_capped_leaves);
+  for (const DepthCapHit& h : tree.precision().worst) {
+    auto* w = out->add_warnings();
+    w->set_test(h.test == DepthCapHit::Test::kGeometry ? "flatness" : "mass");
+    w->set_u0(h.u0), w->set_v0(h.v0), w->set_size(h.size);
+    w->set_measured(h.measured), w->set_limit(h.limit);
+  }
+}
+
+void ToProto(const CatalogEntry& e, v1::CatalogEntry* out) {
+  out->set_name(e.name);
+  out->set_formula(e.formula);
+  out->set_description(e.description);
+  for (const CatalogParameter& p : e.parameters) {
+    auto* q = out->add_parameters();
+    q->set_name(p.name), q->set_default_value(p.default_value), q->set_meaning(p.meaning);
+  }
+}
+
+grpc::Status ToGrpcStatus(const absl::Status& status) {
+  // absl and gRPC share the canonical code numbering.
+  return grpc::Status(static_cast<grpc::StatusCode>(status.code()), std::string(status.message()));
+}
+
+absl::Status FromGrpcStatus(const grpc::Status& status) {
+  return absl::Status(static_cast<absl::StatusCode>(status.error_code()), status.error_message());
+}
+
+}  // namespace sfc

@@ -1,0 +1,43 @@
+// Conversions between the sfcsampler.v1 wire types and the engine's types,
+// shared by the server and the client library so both sides agree exactly.
+// Also the one place that maps absl::Status to and from grpc::Status.
+// Thread-safety: pure functions.
+#ifndef SFCSAMPLER_PROTO_CONVERT_H_
+#define SFCSAMPLER_PROTO_CONVERT_H_
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "catalog/catalog.h"
+#include "core/sample_batch.h"
+#include "engine/sample_request.h"
+#include "engine/sampling_engine.h"
+#include "grpcpp/support/status.h"
+#include "sfcsampler/v1/sampler.pb.h"
+
+namespace sfc {
+
+namespace v1 = ::sfcsampler::v1;
+
+// INVALID_ARGUMENT for enum values this build does not know.
+absl::StatusOr<TreeSpec> FromProto(const v1::TreeSpec& spec);
+absl::StatusOr<SampleRequest> FromProto(const v1::SampleRequest& request);
+v1::TreeSpec ToProto(const TreeSpec& spec);
+v1::SampleRequest ToProto(const SampleRequest& request);
+
+// Fills `out` with `batch` in the requested precision. Consecutive indices
+// are sent as first_index alone.
+void ToProto(const SampleBatch& batch, const SampleFields& fields, v1::Precision precision,
+             v1::SampleBatch* out);
+// Appends the samples of `in` to `out`. DATA_LOSS when a column has the
+// wrong length or a requested column is missing.
+absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fields, SampleBatch* out);
+
+void ToProto(const PreparedTree& tree, v1::TreeInfo* out);
+void ToProto(const CatalogEntry& entry, v1::CatalogEntry* out);
+
+grpc::Status ToGrpcStatus(const absl::Status& status);
+absl::Status FromGrpcStatus(const grpc::Status& status);
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_PROTO_CONVERT_H_

@@ -1,0 +1,57 @@
+// A running sfcsampler server: the sampler service with health checking and
+// reflection on the main address, a health-only listener for probes, and the
+// Prometheus endpoint. Used by sfcsampler-server and by the tests, which
+// start real servers on loopback ports.
+//
+// Thread-safety: Shutdown() may be called from any thread, once.
+#ifndef SFCSAMPLER_SERVER_SAMPLER_SERVER_H_
+#define SFCSAMPLER_SERVER_SAMPLER_SERVER_H_
+
+#include <memory>
+
+#include "absl/status/statusor.h"
+#include "grpcpp/server.h"
+#include "prometheus/exposer.h"
+#include "server/metrics.h"
+#include "server/sampler_service.h"
+#include "server/server_options.h"
+#include "server/tree_cache.h"
+
+namespace sfc {
+
+class SamplerServer {
+ public:
+  // Starts listening. Port 0 in an address picks a free port (see port()).
+  // Errors: INVALID_ARGUMENT for unreadable TLS files, UNAVAILABLE when an
+  // address cannot be bound.
+  static absl::StatusOr<std::unique_ptr<SamplerServer>> Start(const ServerOptions& options);
+  ~SamplerServer();
+
+  int port() const { return port_; }
+  int health_port() const { return health_port_; }
+  int metrics_port() const;
+
+  // Stops accepting, lets in-flight calls run up to `grace_seconds`, then
+  // cancels them; health turns NOT_SERVING first.
+  void Shutdown(double grace_seconds);
+
+  const TreeCache& cache() const { return *cache_; }
+  const SamplerService& service() const { return *service_; }
+
+ private:
+  SamplerServer() = default;
+
+  std::unique_ptr<ServerMetrics> metrics_;
+  std::unique_ptr<TreeCache> cache_;
+  std::unique_ptr<SamplerService> service_;
+  std::unique_ptr<grpc::Server> server_;
+  std::unique_ptr<grpc::Server> health_server_;
+  std::unique_ptr<prometheus::Exposer> exposer_;
+  std::shared_ptr<prometheus::Collectable> cache_collector_;
+  int port_ = 0;
+  int health_port_ = 0;
+};
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_SERVER_SAMPLER_SERVER_H_

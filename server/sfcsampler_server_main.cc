@@ -1,0 +1,78 @@
+// sfcsampler-server: serves sfcsampler.v1.Sampler over gRPC with a shared
+// curve-tree cache. SIGTERM or SIGINT shuts it down gracefully: it stops
+// accepting, lets in-flight streams finish within --shutdown-grace, then
+// cancels them.
+#include <signal.h>
+
+#include <fstream>
+#include <iostream>
+
+#include "CLI/CLI.hpp"
+#include "absl/strings/strip.h"
+#include "server/sampler_server.h"
+#include "spdlog/spdlog.h"
+
+int main(int argc, char** argv) {
+  sfc::ServerOptions o;
+  std::string token_file, log_level = "info";
+  CLI::App app{"sfcsampler-server: density-controlled surface sampling over gRPC"};
+  app.add_option("--address", o.address, "host:port of the sampler service")->capture_default_str();
+  app.add_option("--health-address", o.health_address,
+                 "host:port of a health-only listener without TLS or token (\"\" = none)")
+      ->capture_default_str();
+  app.add_option("--metrics-address", o.metrics_address, "host:port of Prometheus /metrics (\"\" = none)")
+      ->capture_default_str();
+  app.add_option("--max-count", o.limits.max_count, "largest N per request")->capture_default_str();
+  app.add_option("--max-tree-leaves", o.limits.max_tree_leaves, "largest tree, in leaves (16 bytes each)")
+      ->capture_default_str();
+  app.add_option("--max-spec-length", o.limits.max_spec_length, "longest surface or density spec, characters")
+      ->capture_default_str();
+  app.add_option("--cache-bytes", o.cache_bytes, "tree cache budget in bytes (LRU eviction)")
+      ->capture_default_str();
+  app.add_option("--max-concurrent-streams", o.max_concurrent_streams, "Sample streams at once")
+      ->capture_default_str();
+  app.add_option("--max-batch-size", o.max_batch_size, "most samples per message")->capture_default_str();
+  app.add_option("--request-deadline", o.request_deadline_seconds, "longest a stream may run, seconds")
+      ->capture_default_str();
+  app.add_option("--shutdown-grace", o.shutdown_grace_seconds,
+                 "seconds in-flight streams get on SIGTERM before they are cancelled")
+      ->capture_default_str();
+  app.add_option("--tls-cert", o.tls_cert_file, "PEM certificate chain; with --tls-key enables TLS");
+  app.add_option("--tls-key", o.tls_key_file, "PEM private key");
+  app.add_option("--token-file", token_file, "file holding the bearer token every sampler RPC must carry");
+  app.add_option("--log-level", log_level, "trace | debug | info | warn | error")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+
+  spdlog::set_level(spdlog::level::from_str(log_level));
+  if (!token_file.empty()) {
+    std::ifstream in(token_file);
+    std::string token((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    o.token = std::string(absl::StripAsciiWhitespace(token));
+    if (!in || o.token.empty()) {
+      std::cerr << "sfcsampler-server: cannot read a token from " << token_file << "\n";
+      return 2;
+    }
+    if (o.tls_cert_file.empty()) spdlog::warn("a bearer token without TLS travels in clear text");
+  }
+
+  // Block the shutdown signals before gRPC starts its threads, then wait for
+  // one on this thread.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  auto server = sfc::SamplerServer::Start(o);
+  if (!server.ok()) {
+    std::cerr << "sfcsampler-server: " << server.status().message() << "\n";
+    return 1;
+  }
+  int signal_number = 0;
+  sigwait(&signals, &signal_number);
+  spdlog::info("signal={} shutting down, grace={}s active_streams={}", signal_number,
+               o.shutdown_grace_seconds, (*server)->service().active_streams());
+  (*server)->Shutdown(o.shutdown_grace_seconds);
+  spdlog::info("stopped");
+  return 0;
+}
