@@ -1,0 +1,229 @@
+#include "client/sampler_client.h"
+
+#include <chrono>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "absl/strings/str_format.h"
+#include "catalog/catalog.h"
+#include "engine/tree_key.h"
+#include "grpc/health/v1/health.grpc.pb.h"
+#include "grpcpp/client_context.h"
+#include "grpcpp/create_channel.h"
+#include "grpcpp/security/credentials.h"
+#include "proto/convert.h"
+
+namespace sfc {
+namespace {
+
+namespace v1 = ::sfcsampler::v1;
+
+}  // namespace
+
+SamplerClient::SamplerClient(const ClientOptions& options, std::shared_ptr<grpc::Channel> channel)
+    : options_(options), channel_(std::move(channel)), stub_(v1::Sampler::NewStub(channel_)) {}
+
+absl::StatusOr<std::unique_ptr<SamplerClient>> SamplerClient::Connect(const ClientOptions& options) {
+  std::shared_ptr<grpc::ChannelCredentials> credentials;
+  if (options.tls) {
+    grpc::SslCredentialsOptions ssl;
+    if (!options.tls_root_certs_file.empty()) {
+      std::ifstream in(options.tls_root_certs_file);
+      if (!in) {
+        return absl::InvalidArgumentError(
+            absl::StrFormat("cannot read TLS roots \"%s\"", options.tls_root_certs_file));
+      }
+      std::stringstream ss;
+      ss << in.rdbuf();
+      ssl.pem_root_certs = ss.str();
+    }
+    credentials = grpc::SslCredentials(ssl);
+  } else {
+    credentials = grpc::InsecureChannelCredentials();
+  }
+  grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(-1);
+  auto channel = grpc::CreateCustomChannel(options.target, credentials, args);
+  return std::unique_ptr<SamplerClient>(new SamplerClient(options, std::move(channel)));
+}
+
+std::string SamplerClient::SurfaceKey(const TreeSpec& spec) {
+  auto surface = MakeSurface(spec.surface);
+  auto density = MakeDensity(spec.density);
+  if (surface.ok() && density.ok()) {
+    return MakeTreeKey(surface->canonical, density->canonical, spec.options).Hex();
+  }
+  // The server will reject the spec; any stable key routes the error.
+  return absl::StrFormat("%016x", Fnv1a64(spec.surface + "|" + spec.density));
+}
+
+void SamplerClient::Decorate(grpc::ClientContext* context, const std::string& surface_key) const {
+  if (!options_.token.empty()) context->AddMetadata("authorization", "Bearer " + options_.token);
+  context->AddMetadata("x-surface-key", surface_key);
+  if (options_.deadline_seconds > 0) {
+    context->set_deadline(std::chrono::system_clock::now() +
+                          std::chrono::milliseconds(static_cast<int64_t>(options_.deadline_seconds * 1000)));
+  }
+}
+
+SampleRequest SamplerClient::Range(SampleRequest request, uint64_t begin, uint64_t end) {
+  request.shard_index = request.shard_count = 0;
+  request.begin = begin;
+  request.end = end;
+  return request;
+}
+
+SampleRequest SamplerClient::Shard(SampleRequest request, uint64_t i, uint64_t k) {
+  request.begin = request.end = 0;
+  request.shard_index = i;
+  request.shard_count = k;
+  return request;
+}
+
+absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& request,
+                                                    const BatchCallback& on_batch) {
+  const std::string key = SurfaceKey(request.tree);
+  const bool monotone = Sequence(request.sequence, 1, 0).monotone();
+  StreamSummary summary;
+  bool have_header = false;
+  // What to ask for next: monotone sets resume at the index after the last
+  // one received (indices grow along the stream); others are re-requested
+  // whole and the samples already delivered are skipped.
+  SampleRequest next = request;
+  uint64_t skip = 0;
+  uint64_t last_index = 0;
+  double backoff = options_.resume_backoff_seconds;
+  SampleBatch batch;
+  for (int attempt = 0;; ++attempt) {
+    v1::SampleRequest wire = ToProto(next);
+    wire.set_precision(options_.precision);
+    wire.set_batch_size(options_.batch_size);
+    grpc::ClientContext context;
+    Decorate(&context, key);
+    auto reader = stub_->Sample(&context, wire);
+    v1::SampleResponse response;
+    uint64_t this_stream = 0;
+    absl::Status callback_error;
+    while (reader->Read(&response)) {
+      if (response.has_header() && !have_header) {
+        summary.header = response.header();
+        have_header = true;
+      }
+      batch.Clear();
+      if (absl::Status s = AppendFromProto(response.batch(), request.fields, &batch); !s.ok()) {
+        callback_error = s;
+        break;
+      }
+      this_stream += batch.size();
+      if (skip > 0) {
+        // Drop what an earlier attempt already delivered (non-monotone sets).
+        const size_t drop = std::min<uint64_t>(skip, batch.size());
+        skip -= drop;
+        SampleBatch rest;
+        for (size_t i = drop; i < batch.size(); ++i) {
+          rest.index.push_back(batch.index[i]);
+          rest.u.push_back(batch.u[i]), rest.v.push_back(batch.v[i]);
+          rest.x.push_back(batch.x[i]), rest.y.push_back(batch.y[i]), rest.z.push_back(batch.z[i]);
+          if (request.fields.normal) {
+            rest.nx.push_back(batch.nx[i]), rest.ny.push_back(batch.ny[i]), rest.nz.push_back(batch.nz[i]);
+          }
+          if (request.fields.density) rest.density.push_back(batch.density[i]);
+          if (request.fields.curve_position) rest.curve_position.push_back(batch.curve_position[i]);
+        }
+        batch = std::move(rest);
+      }
+      if (batch.size() == 0) continue;
+      if (absl::Status s = on_batch(summary.header, batch); !s.ok()) {
+        callback_error = s;
+        break;
+      }
+      summary.received += batch.size();
+      last_index = batch.index.back();
+    }
+    if (!callback_error.ok()) {
+      context.TryCancel();
+      reader->Finish();
+      return callback_error;
+    }
+    const grpc::Status status = reader->Finish();
+    if (status.ok()) {
+      // Nothing silently lost: the server says how many it sent.
+      const auto& trailers = context.GetServerTrailingMetadata();
+      auto it = trailers.find("x-samples-sent");
+      if (it != trailers.end() && std::to_string(this_stream) != std::string(it->second.data(), it->second.size())) {
+        return absl::DataLossError(absl::StrFormat(
+            "the server sent %s samples but %d arrived", std::string(it->second.data(), it->second.size()),
+            this_stream));
+      }
+      if (have_header && summary.header.expected_samples() >= 0 &&
+          summary.received != static_cast<uint64_t>(summary.header.expected_samples())) {
+        return absl::DataLossError(absl::StrFormat("expected %d samples, received %d",
+                                                   summary.header.expected_samples(), summary.received));
+      }
+      return summary;
+    }
+    if (status.error_code() != grpc::StatusCode::UNAVAILABLE || attempt >= options_.max_resumes) {
+      absl::Status s = FromGrpcStatus(status);
+      return absl::Status(s.code(), absl::StrFormat("%s (received %d samples%s)", s.message(),
+                                                    summary.received,
+                                                    summary.received ? absl::StrFormat(", last index %d", last_index) : ""));
+    }
+    // Resume.
+    ++summary.resumes;
+    std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int64_t>(backoff * 1000)));
+    backoff *= 2;
+    if (monotone && summary.received > 0) {
+      const auto range = SamplingEngine::ResolveRange(request);
+      if (!range.ok()) return range.status();
+      next = Range(request, last_index + 1, range->second);
+    } else if (!monotone) {
+      skip = summary.received;
+    }
+  }
+}
+
+absl::StatusOr<v1::PrepareResponse> SamplerClient::Prepare(const TreeSpec& spec, uint64_t count) {
+  v1::PrepareRequest request;
+  *request.mutable_tree() = ToProto(spec);
+  request.set_count(count);
+  grpc::ClientContext context;
+  Decorate(&context, SurfaceKey(spec));
+  v1::PrepareResponse response;
+  const grpc::Status status = stub_->Prepare(&context, request, &response);
+  if (!status.ok()) return FromGrpcStatus(status);
+  return response;
+}
+
+absl::StatusOr<v1::ListCatalogResponse> SamplerClient::ListCatalog() {
+  grpc::ClientContext context;
+  Decorate(&context, "");
+  v1::ListCatalogResponse response;
+  const grpc::Status status = stub_->ListCatalog(&context, {}, &response);
+  if (!status.ok()) return FromGrpcStatus(status);
+  return response;
+}
+
+absl::StatusOr<v1::CacheStats> SamplerClient::GetCacheStats() {
+  grpc::ClientContext context;
+  Decorate(&context, "");
+  v1::CacheStats response;
+  const grpc::Status status = stub_->GetCacheStats(&context, {}, &response);
+  if (!status.ok()) return FromGrpcStatus(status);
+  return response;
+}
+
+absl::StatusOr<bool> SamplerClient::CheckHealth(const std::string& service) {
+  auto stub = grpc::health::v1::Health::NewStub(channel_);
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(
+                                                              options_.deadline_seconds > 0 ? static_cast<int>(options_.deadline_seconds) : 5));
+  grpc::health::v1::HealthCheckRequest request;
+  request.set_service(service);
+  grpc::health::v1::HealthCheckResponse response;
+  const grpc::Status status = stub->Check(&context, request, &response);
+  if (!status.ok()) return FromGrpcStatus(status);
+  return response.status() == grpc::health::v1::HealthCheckResponse::SERVING;
+}
+
+}  // namespace sfc

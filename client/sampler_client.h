@@ -1,0 +1,78 @@
+// C++ client library for sfcsampler.v1.
+//
+// Sample() streams a request's batches in curve order to a callback. When the
+// stream breaks with UNAVAILABLE (a server restart, a proxy moving the
+// connection) it resumes from the first index not yet received, so the
+// callback sees every sample exactly once; anything short of the full set is
+// an error that says how many samples arrived. Every call carries the
+// x-surface-key header (the tree key) for consistent-hash proxies.
+//
+// Thread-safety: a SamplerClient may be used from several threads at once.
+#ifndef SFCSAMPLER_CLIENT_SAMPLER_CLIENT_H_
+#define SFCSAMPLER_CLIENT_SAMPLER_CLIENT_H_
+
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "core/sample_batch.h"
+#include "engine/sample_request.h"
+#include "grpcpp/channel.h"
+#include "sfcsampler/v1/sampler.grpc.pb.h"
+
+namespace sfc {
+
+struct ClientOptions {
+  std::string target = "127.0.0.1:50051";  // host:port
+  std::string token;                       // bearer token; "" = none
+  bool tls = false;                        // use TLS ...
+  std::string tls_root_certs_file;         // ... trusting these roots ("" = system roots)
+  int max_resumes = 5;                     // UNAVAILABLE retries per Sample() call
+  double resume_backoff_seconds = 0.2;     // first wait; doubles each time
+  double deadline_seconds = 0;             // per RPC; 0 = none
+  ::sfcsampler::v1::Precision precision = ::sfcsampler::v1::PRECISION_FLOAT64;
+  uint32_t batch_size = 65536;             // samples per message
+};
+
+struct StreamSummary {
+  ::sfcsampler::v1::StreamHeader header;  // from the first stream
+  uint64_t received = 0;
+  int resumes = 0;
+};
+
+class SamplerClient {
+ public:
+  static absl::StatusOr<std::unique_ptr<SamplerClient>> Connect(const ClientOptions& options);
+
+  using BatchCallback =
+      std::function<absl::Status(const ::sfcsampler::v1::StreamHeader&, const SampleBatch&)>;
+  // Streams `request`; a callback error cancels the stream and is returned.
+  absl::StatusOr<StreamSummary> Sample(const SampleRequest& request, const BatchCallback& on_batch);
+
+  absl::StatusOr<::sfcsampler::v1::PrepareResponse> Prepare(const TreeSpec& spec, uint64_t count);
+  absl::StatusOr<::sfcsampler::v1::ListCatalogResponse> ListCatalog();
+  absl::StatusOr<::sfcsampler::v1::CacheStats> GetCacheStats();
+  // grpc.health.v1 Check of `service` ("" = the whole server): true when SERVING.
+  absl::StatusOr<bool> CheckHealth(const std::string& service = "");
+
+  // Range and shard helpers: the same request restricted to [begin, end) or
+  // to shard i of k.
+  static SampleRequest Range(SampleRequest request, uint64_t begin, uint64_t end);
+  static SampleRequest Shard(SampleRequest request, uint64_t i, uint64_t k);
+
+  // The tree key the server will use for `spec`, as sent in x-surface-key.
+  static std::string SurfaceKey(const TreeSpec& spec);
+
+ private:
+  explicit SamplerClient(const ClientOptions& options, std::shared_ptr<grpc::Channel> channel);
+  void Decorate(grpc::ClientContext* context, const std::string& surface_key) const;
+
+  const ClientOptions options_;
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<::sfcsampler::v1::Sampler::Stub> stub_;
+};
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_CLIENT_SAMPLER_CLIENT_H_
