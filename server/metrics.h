@@ -31,6 +31,7 @@ class ServerMetrics {
   void StreamStarted() { active_streams_->Increment(); }
   void StreamEnded() { active_streams_->Decrement(); }
   void ObserveBuild(double seconds) { build_seconds_->Observe(seconds); }
+  double samples_streamed() const { return samples_->Value(); }
 
  private:
   std::shared_ptr<prometheus::Registry> registry_;

@@ -37,6 +37,7 @@ class SamplerServer {
 
   const TreeCache& cache() const { return *cache_; }
   const SamplerService& service() const { return *service_; }
+  const ServerMetrics& metrics() const { return *metrics_; }
 
  private:
   SamplerServer() = default;

@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# The CLI over the wire against a real sfcsampler-server on loopback: the same
+# files as the embedded mode, prepare/cache/health, and a graceful SIGTERM
+# that lets an in-flight stream finish.
+set -euo pipefail
+cli="$1"
+server="$2"
+tmp=$(mktemp -d)
+pid=""
+cleanup() { [ -n "$pid" ] && kill "$pid" 2>/dev/null; rm -rf "$tmp"; }
+trap cleanup EXIT
+fail() { echo "FAIL: $*" >&2; [ -f "$tmp/server.log" ] && tail -5 "$tmp/server.log" >&2; exit 1; }
+
+# Pick free loopback ports by binding port 0 through the server itself.
+"$server" --address 127.0.0.1:0 --health-address 127.0.0.1:0 --metrics-address 127.0.0.1:0 \
+  --shutdown-grace 20 > "$tmp/server.log" 2>&1 &
+pid=$!
+for _ in $(seq 100); do grep -q "listening" "$tmp/server.log" && break; sleep 0.05; done
+port=$(sed -n 's/.* port=\([0-9]*\) health_port=.*/\1/p' "$tmp/server.log")
+health=$(sed -n 's/.*health_port=\([0-9]*\).*/\1/p' "$tmp/server.log")
+[ -n "$port" ] || fail "server did not start"
+addr="127.0.0.1:$port"
+
+[ "$("$cli" health --server "$addr")" = SERVING ] || fail "health on the main port"
+[ "$("$cli" health --server "127.0.0.1:$health")" = SERVING ] || fail "health on the probe port"
+
+for args in "--surface torus --density gaussian:floor=0.1 --count 20000 --seed 4" \
+            "--surface sphere --count 20000 --region box:0,0,0,1,1,1 --normals --curve-position" \
+            "--surface plane --density expr:u+v --count 5000 --sequence progressive --shard 1/3"; do
+  # shellcheck disable=SC2086
+  "$cli" sample $args -q -o "$tmp/embedded.csv"
+  # shellcheck disable=SC2086
+  "$cli" sample $args -q -o "$tmp/wire.csv" --server "$addr"
+  cmp -s "$tmp/embedded.csv" "$tmp/wire.csv" || fail "embedded and wire CSV differ for: $args"
+  # shellcheck disable=SC2086
+  "$cli" sample $args -q --format ply -o "$tmp/embedded.ply"
+  # shellcheck disable=SC2086
+  "$cli" sample $args -q --format ply -o "$tmp/wire.ply" --server "$addr"
+  cmp -s "$tmp/embedded.ply" "$tmp/wire.ply" || fail "embedded and wire PLY differ for: $args"
+done
+
+"$cli" prepare --surface eight --count 100000 --server "$addr" > "$tmp/key" 2> "$tmp/prepare.err"
+"$cli" sample --surface eight --count 100000 --server "$addr" -o /dev/null 2> "$tmp/hit.err"
+grep -q "cache hit" "$tmp/hit.err" || fail "a prepared tree should be a cache hit"
+"$cli" cache --server "$addr" | grep -q "hits: " || fail "cache statistics"
+
+# SIGTERM during a stream: the stream still completes within the grace period.
+"$cli" sample --surface sphere --count 3000000 --batch-size 1000 -q -o "$tmp/long.csv" --server "$addr" &
+client=$!
+sleep 1
+kill -TERM "$pid"
+wait "$client" || fail "the in-flight stream did not survive a graceful shutdown"
+[ "$(wc -l < "$tmp/long.csv")" -eq 3000001 ] || fail "the in-flight stream lost samples"
+wait "$pid" || fail "the server did not exit cleanly"
+pid=""
+grep -q "stopped" "$tmp/server.log" || fail "no shutdown log"
+echo "cli_server_test: all checks passed"

@@ -1,0 +1,375 @@
+// The service end to end: a real sfcsampler server on a loopback port and the
+// real client library, no mocks. Checks the behaviour users rely on
+// (SERVICE.md): slices and shards, resume, the shared cache, eviction,
+// flow control, cancellation, and every bad input's status code.
+#include <atomic>
+#include <chrono>
+#include <thread>
+
+#include "client/sampler_client.h"
+#include "gtest/gtest.h"
+#include "server/sampler_server.h"
+
+namespace sfc {
+namespace {
+
+namespace v1 = ::sfcsampler::v1;
+using std::chrono::milliseconds;
+
+ServerOptions LoopbackOptions() {
+  ServerOptions o;
+  o.address = "127.0.0.1:0";
+  o.health_address = "";
+  o.metrics_address = "";
+  return o;
+}
+
+struct Running {
+  std::unique_ptr<SamplerServer> server;
+  std::unique_ptr<SamplerClient> client;
+};
+
+Running StartServer(const ServerOptions& options, ClientOptions client = {}) {
+  Running r;
+  auto server = SamplerServer::Start(options);
+  EXPECT_TRUE(server.ok()) << server.status();
+  r.server = *std::move(server);
+  client.target = "127.0.0.1:" + std::to_string(r.server->port());
+  r.client = *SamplerClient::Connect(client);
+  return r;
+}
+
+SampleRequest Request(const std::string& surface, uint64_t count, uint64_t seed = 1) {
+  SampleRequest r;
+  r.tree.surface = surface;
+  r.count = count;
+  r.seed = seed;
+  return r;
+}
+
+// All samples of a request, as one batch.
+absl::StatusOr<SampleBatch> Fetch(SamplerClient& client, const SampleRequest& request,
+                                  StreamSummary* summary = nullptr) {
+  SampleBatch all;
+  auto s = client.Sample(request, [&](const v1::StreamHeader&, const SampleBatch& b) {
+    all.index.insert(all.index.end(), b.index.begin(), b.index.end());
+    for (auto [from, to] : {std::pair{&b.u, &all.u}, {&b.v, &all.v}, {&b.x, &all.x}, {&b.y, &all.y}, {&b.z, &all.z}}) {
+      to->insert(to->end(), from->begin(), from->end());
+    }
+    return absl::OkStatus();
+  });
+  if (!s.ok()) return s.status();
+  if (summary) *summary = *s;
+  return all;
+}
+
+void ExpectEqual(const SampleBatch& a, const SampleBatch& b) {
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(a.index, b.index);
+  EXPECT_EQ(a.u, b.u);
+  EXPECT_EQ(a.v, b.v);
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(a.y, b.y);
+  EXPECT_EQ(a.z, b.z);
+}
+
+TEST(Server, ShardsJoinToTheFullSetInOrder) {
+  Running r = StartServer(LoopbackOptions());
+  const SampleRequest full_request = Request("torus", 20000, 5);
+  auto full = Fetch(*r.client, full_request);
+  ASSERT_TRUE(full.ok()) << full.status();
+  ASSERT_EQ(full->size(), 20000u);
+  SampleBatch joined;
+  for (uint64_t i = 0; i < 6; ++i) {
+    auto shard = Fetch(*r.client, SamplerClient::Shard(full_request, i, 6));
+    ASSERT_TRUE(shard.ok()) << shard.status();
+    for (auto [from, to] : {std::pair{&shard->u, &joined.u}, {&shard->v, &joined.v}, {&shard->x, &joined.x},
+                            {&shard->y, &joined.y}, {&shard->z, &joined.z}}) {
+      to->insert(to->end(), from->begin(), from->end());
+    }
+    joined.index.insert(joined.index.end(), shard->index.begin(), shard->index.end());
+  }
+  ExpectEqual(joined, *full);
+}
+
+TEST(Server, AStreamCutByTheClientResumesByteIdentical) {
+  Running r = StartServer(LoopbackOptions());
+  const SampleRequest request = Request("eight", 30000, 2);
+  auto uncut = Fetch(*r.client, request);
+  ASSERT_TRUE(uncut.ok());
+  // Cut after 7000 samples: the callback refuses more, which cancels.
+  SampleBatch first;
+  auto cut = r.client->Sample(request, [&](const v1::StreamHeader&, const SampleBatch& b) {
+    for (size_t i = 0; i < b.size() && first.size() < 7000; ++i) {
+      first.index.push_back(b.index[i]);
+      first.u.push_back(b.u[i]), first.v.push_back(b.v[i]);
+      first.x.push_back(b.x[i]), first.y.push_back(b.y[i]), first.z.push_back(b.z[i]);
+    }
+    return first.size() < 7000 ? absl::OkStatus() : absl::CancelledError("cut");
+  });
+  ASSERT_EQ(cut.status().code(), absl::StatusCode::kCancelled);
+  auto rest = Fetch(*r.client, SamplerClient::Range(request, first.index.back() + 1, request.count));
+  ASSERT_TRUE(rest.ok());
+  for (auto [from, to] : {std::pair{&rest->u, &first.u}, {&rest->v, &first.v}, {&rest->x, &first.x},
+                          {&rest->y, &first.y}, {&rest->z, &first.z}}) {
+    to->insert(to->end(), from->begin(), from->end());
+  }
+  first.index.insert(first.index.end(), rest->index.begin(), rest->index.end());
+  ExpectEqual(first, *uncut);
+}
+
+TEST(Server, TheClientResumesAcrossAServerRestart) {
+  ServerOptions options = LoopbackOptions();
+  auto server = *SamplerServer::Start(options);
+  const int port = server->port();
+  ClientOptions co;
+  co.target = "127.0.0.1:" + std::to_string(port);
+  co.batch_size = 1000;
+  co.resume_backoff_seconds = 0.3;
+  auto client = *SamplerClient::Connect(co);
+  const SampleRequest request = Request("sphere", 200000, 8);
+  auto reference = Fetch(*client, request);
+  ASSERT_TRUE(reference.ok());
+
+  std::atomic<bool> restarted{false};
+  std::unique_ptr<SamplerServer> second;
+  SampleBatch got;
+  StreamSummary summary;
+  auto result = client->Sample(request, [&](const v1::StreamHeader&, const SampleBatch& b) {
+    got.index.insert(got.index.end(), b.index.begin(), b.index.end());
+    got.u.insert(got.u.end(), b.u.begin(), b.u.end());
+    if (!restarted && got.size() >= 50000) {
+      // Kill the server under the stream and bring a new one up on the same port.
+      restarted = true;
+      std::thread([&] {
+        server->Shutdown(0);
+        options.address = "127.0.0.1:" + std::to_string(port);
+        second = *SamplerServer::Start(options);
+      }).join();
+    }
+    return absl::OkStatus();
+  });
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_GE(result->resumes, 1);
+  EXPECT_EQ(got.index, reference->index);
+  EXPECT_EQ(got.u, reference->u);
+}
+
+TEST(Server, EmbeddedAndWireSamplesAreIdentical) {
+  Running r = StartServer(LoopbackOptions());
+  SampleRequest request = Request("monkey_saddle", 5000, 3);
+  request.tree.density = "gaussian:floor=0.1";
+  request.region = Region::Box({-0.5, -0.5, -1}, {0.5, 0.5, 1});
+  DirectTreeSource source;
+  SamplingEngine engine({}, &source);
+  auto job = engine.Start(request);
+  ASSERT_TRUE(job.ok());
+  SampleBatch local;
+  while (*job->cursor->Next(4096, &local) > 0) {
+  }
+  auto wire = Fetch(*r.client, request);
+  ASSERT_TRUE(wire.ok());
+  ExpectEqual(*wire, local);
+}
+
+TEST(Server, ASecondRequestHitsAndEightConcurrentFirstRequestsBuildOnce) {
+  Running r = StartServer(LoopbackOptions());
+  std::vector<std::thread> threads;
+  std::atomic<int> ok{0};
+  for (int i = 0; i < 8; ++i) {
+    threads.emplace_back([&, i] {
+      if (Fetch(*r.client, Request("eight", 200000, i)).ok()) ++ok;
+    });
+  }
+  for (auto& t : threads) t.join();
+  EXPECT_EQ(ok.load(), 8);
+  auto stats = r.client->GetCacheStats();
+  ASSERT_TRUE(stats.ok());
+  EXPECT_EQ(stats->builds(), 1u);
+  EXPECT_EQ(stats->misses(), 1u);
+  EXPECT_EQ(stats->hits() + stats->waits(), 7u);
+
+  StreamSummary summary;
+  ASSERT_TRUE(Fetch(*r.client, Request("eight", 200000, 99), &summary).ok());
+  EXPECT_TRUE(summary.header.tree().cache_hit());
+  EXPECT_EQ(r.client->GetCacheStats()->builds(), 1u);
+}
+
+TEST(Server, ALargerCountRefinesTheCachedTree) {
+  Running r = StartServer(LoopbackOptions());
+  TreeSpec spec;
+  spec.surface = "torus";
+  ASSERT_TRUE(r.client->Prepare(spec, 1000).ok());
+  StreamSummary summary;
+  ASSERT_TRUE(Fetch(*r.client, Request("torus", 100000), &summary).ok());
+  EXPECT_TRUE(summary.header.tree().refined());
+  const auto stats = *r.client->GetCacheStats();
+  EXPECT_EQ(stats.builds(), 1u);
+  EXPECT_EQ(stats.refinements(), 1u);
+}
+
+TEST(Server, EvictionUnderASmallBudgetLosesNoInFlightStream) {
+  ServerOptions options = LoopbackOptions();
+  options.cache_bytes = 1 << 20;  // smaller than any of these trees
+  ClientOptions co;
+  co.batch_size = 500;
+  Running r = StartServer(options, co);
+  const SampleRequest slow = Request("sphere", 60000, 4);
+  auto reference = Fetch(*r.client, slow);
+  ASSERT_TRUE(reference.ok());
+  SampleBatch got;
+  bool evicted = false;
+  auto result = r.client->Sample(slow, [&](const v1::StreamHeader&, const SampleBatch& b) {
+    got.index.insert(got.index.end(), b.index.begin(), b.index.end());
+    got.x.insert(got.x.end(), b.x.begin(), b.x.end());
+    if (!evicted) {
+      evicted = true;  // other jobs push this stream's tree out of the cache
+      EXPECT_TRUE(Fetch(*r.client, Request("torus", 60000)).ok());
+      EXPECT_TRUE(Fetch(*r.client, Request("eight", 60000)).ok());
+      EXPECT_GE(r.client->GetCacheStats()->evictions(), 2u);
+    }
+    return absl::OkStatus();
+  });
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_EQ(got.index, reference->index);
+  EXPECT_EQ(got.x, reference->x);
+}
+
+TEST(Server, ASlowReaderDoesNotMakeTheServerGenerateAhead) {
+  ClientOptions co;
+  co.batch_size = 16384;  // 655 KB a message in float64
+  Running r = StartServer(LoopbackOptions(), co);
+  const uint64_t n = 4'000'000;
+  int batches = 0;
+  double streamed_after_stall = 0;
+  auto result = r.client->Sample(Request("plane", n), [&](const v1::StreamHeader&, const SampleBatch&) {
+    if (++batches == 2) {
+      std::this_thread::sleep_for(milliseconds(1000));
+      streamed_after_stall = r.server->metrics().samples_streamed();
+      return absl::CancelledError("done");
+    }
+    return absl::OkStatus();
+  });
+  EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled);
+  // Only what HTTP/2 flow control admits was produced: a few MB, not 4 M samples.
+  EXPECT_LT(streamed_after_stall, 40 * 16384.0);
+  EXPECT_GE(streamed_after_stall, 2 * 16384.0);
+}
+
+TEST(Server, ACancelledStreamIsFreedAtOnce) {
+  ClientOptions co;
+  co.batch_size = 1000;
+  Running r = StartServer(LoopbackOptions(), co);
+  auto result = r.client->Sample(Request("sphere", 1'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
+    EXPECT_EQ(r.server->service().active_streams(), 1u);
+    return absl::CancelledError("enough");
+  });
+  EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled);
+  // "At once": well within 200 ms of the cancel, not after the 10^6 samples.
+  const auto until = std::chrono::steady_clock::now() + milliseconds(200);
+  while (r.server->service().active_streams() != 0 && std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(milliseconds(1));
+  }
+  EXPECT_EQ(r.server->service().active_streams(), 0u);
+  EXPECT_LT(r.server->metrics().samples_streamed(), 1'000'000.0);
+}
+
+void ExpectStatus(const absl::Status& s, absl::StatusCode code, const std::string& mentions) {
+  EXPECT_EQ(s.code(), code) << s;
+  EXPECT_NE(s.message().find(mentions), std::string::npos) << s.message() << " should mention " << mentions;
+}
+
+TEST(Server, EveryBadInputGetsItsStatusCode) {
+  ServerOptions options = LoopbackOptions();
+  options.limits.max_count = 1'000'000;
+  options.limits.max_tree_leaves = 100'000;
+  options.limits.max_spec_length = 200;
+  options.max_batch_size = 10000;
+  ClientOptions co;
+  co.batch_size = 1000;
+  Running r = StartServer(options, co);
+  auto fetch = [&](SampleRequest q) { return Fetch(*r.client, q).status(); };
+  const auto kInvalid = absl::StatusCode::kInvalidArgument;
+  ExpectStatus(fetch(Request("klein", 10)), kInvalid, "unknown surface");
+  ExpectStatus(fetch(Request("expr:x=u;y=v;z=sqrt(u-0.5)", 10)), kInvalid, "not finite");
+  SampleRequest negative = Request("plane", 10);
+  negative.tree.density = "expr:u-0.5";
+  ExpectStatus(fetch(negative), kInvalid, ">= 0");
+  SampleRequest zero = Request("plane", 10);
+  zero.tree.density = "expr:0";
+  ExpectStatus(fetch(zero), kInvalid, "integrates");
+  SampleRequest region = Request("sphere", 10);
+  region.region = Region::ParameterRect(0.4, 0.2, 0, 1);
+  ExpectStatus(fetch(region), kInvalid, "empty");
+  ExpectStatus(fetch(Request("sphere", 0)), kInvalid, "count");
+  ExpectStatus(fetch(Request("sphere", 2'000'000)), kInvalid, "max_count");
+  ExpectStatus(fetch(Request("expr:x=u;y=v;z=" + std::string(300, '1'), 10)), kInvalid, "max_spec_length");
+  ExpectStatus(fetch(Request("sphere", 1'000'000)), absl::StatusCode::kResourceExhausted, "max_leaves");
+  ExpectStatus(fetch(Request("expr:x=u;y=v;z=u**v", 10)), kInvalid, "position");
+
+  ClientOptions big_batches;
+  big_batches.target = "127.0.0.1:" + std::to_string(r.server->port());
+  big_batches.batch_size = 20000;
+  auto client = *SamplerClient::Connect(big_batches);
+  ExpectStatus(Fetch(*client, Request("sphere", 10)).status(), kInvalid, "max_batch_size");
+}
+
+TEST(Server, StreamsBeyondTheConcurrencyLimitAreResourceExhausted) {
+  ServerOptions options = LoopbackOptions();
+  options.max_concurrent_streams = 1;
+  ClientOptions co;
+  co.batch_size = 1000;
+  Running r = StartServer(options, co);
+  absl::Status second;
+  auto first = r.client->Sample(Request("sphere", 100000), [&](const v1::StreamHeader&, const SampleBatch&) {
+    if (second.ok()) second = Fetch(*r.client, Request("torus", 10)).status();
+    return absl::OkStatus();
+  });
+  EXPECT_TRUE(first.ok()) << first.status();
+  ExpectStatus(second, absl::StatusCode::kResourceExhausted, "max_concurrent_streams");
+}
+
+TEST(Server, TheServerDeadlineEndsLongStreams) {
+  ServerOptions options = LoopbackOptions();
+  options.request_deadline_seconds = 0.2;
+  ClientOptions co;
+  co.batch_size = 100;
+  Running r = StartServer(options, co);
+  auto result = r.client->Sample(Request("sphere", 1'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
+    std::this_thread::sleep_for(milliseconds(20));
+    return absl::OkStatus();
+  });
+  ExpectStatus(result.status(), absl::StatusCode::kDeadlineExceeded, "resume after the last index");
+}
+
+TEST(Server, ATokenIsRequiredWhenSetButHealthStaysOpen) {
+  ServerOptions options = LoopbackOptions();
+  options.token = "s3cret";
+  Running r = StartServer(options);
+  ExpectStatus(Fetch(*r.client, Request("sphere", 10)).status(), absl::StatusCode::kUnauthenticated,
+               "Bearer");
+  EXPECT_TRUE(*r.client->CheckHealth());
+  ClientOptions co;
+  co.target = "127.0.0.1:" + std::to_string(r.server->port());
+  co.token = "s3cret";
+  auto authorised = *SamplerClient::Connect(co);
+  EXPECT_TRUE(Fetch(*authorised, Request("sphere", 10)).ok());
+}
+
+TEST(Server, Float32PayloadsCarryTheSameSamplesRounded) {
+  ClientOptions co;
+  co.precision = v1::PRECISION_FLOAT32;
+  Running r = StartServer(LoopbackOptions(), co);
+  auto f32 = Fetch(*r.client, Request("torus", 3000));
+  ClientOptions co64;
+  co64.target = "127.0.0.1:" + std::to_string(r.server->port());
+  auto f64 = Fetch(**SamplerClient::Connect(co64), Request("torus", 3000));
+  ASSERT_TRUE(f32.ok() && f64.ok());
+  ASSERT_EQ(f32->size(), f64->size());
+  for (size_t i = 0; i < f32->size(); ++i) {
+    ASSERT_EQ(f32->x[i], static_cast<double>(static_cast<float>(f64->x[i])));
+  }
+}
+
+}  // namespace
+}  // namespace sfc
