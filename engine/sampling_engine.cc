@@ -28,7 +28,7 @@ absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint6
   ASSIGN_OR_RETURN(SurfaceFromSpec surface, MakeSurface(spec.surface));
   ASSIGN_OR_RETURN(DensityFromSpec density, MakeDensity(spec.density));
   CurveTreeOptions options = spec.options;
-  options.max_leaves = std::min(options.max_leaves, limits_.max_tree_leaves);
+  options.max_leaves = limits_.max_tree_leaves;  // the server sets the budget, not the request
 
   PreparedTree prepared;
   prepared.key = MakeTreeKey(surface.canonical, density.canonical, options);
