@@ -36,4 +36,13 @@ set +e
 set -e
 [ "$code" -ne 0 ] && grep -q "unknown surface" "$tmp/err" || fail "unknown surface error"
 "$cli" surfaces | grep -q "monkey_saddle" || fail "surfaces listing"
+# Evidence commands: a tiny protocol run writes its table, CSV and plots; a
+# render writes a PNG.
+"$cli" eval --l-max 4 --out-dir "$tmp/eval" > "$tmp/eval.txt" 2> /dev/null
+grep -q "hilbert-jittered" "$tmp/eval.txt" || fail "eval slope table"
+for f in discrepancy.csv slopes.md plane-rectangular.svg plane-triangular.png sphere-spherical.png; do
+  [ -s "$tmp/eval/$f" ] || fail "eval did not write $f"
+done
+"$cli" render --surface torus --count 2000 --what samples -o "$tmp/t.png" 2> /dev/null
+[ "$(head -c 4 "$tmp/t.png" | tail -c 3)" = "PNG" ] || fail "render PNG"
 echo "cli_test: all checks passed"

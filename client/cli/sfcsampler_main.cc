@@ -16,6 +16,9 @@
 #include "core/curve.h"
 #include "core/sequence.h"
 #include "engine/sampling_engine.h"
+#include "evaluation/plot.h"
+#include "evaluation/protocol.h"
+#include "render/render.h"
 #include "proto/convert.h"
 
 namespace sfc {
@@ -248,6 +251,105 @@ int RunHealth(const Connection& conn) {
   return *serving ? 0 : 1;
 }
 
+struct EvalFlags {
+  std::string setting = "fast";
+  int l_min = 0, l_max = 0;
+  std::vector<std::string> plane, sphere;
+  std::string out_dir = "eval-out";
+  uint64_t seed = 1;
+};
+
+int RunEval(const EvalFlags& f) {
+  ProtocolOptions options;
+  if (f.setting == "full") {
+    options.l_max = 19;
+  } else if (f.setting != "fast") {
+    return Fail(absl::InvalidArgumentError("--setting must be fast or full"));
+  }
+  if (f.l_min) options.l_min = f.l_min;
+  if (f.l_max) options.l_max = f.l_max;
+  options.plane_methods = f.plane;
+  options.sphere_methods = f.sphere;
+  options.seed = f.seed;
+  const auto start = std::chrono::steady_clock::now();
+  const bool tty = isatty(STDERR_FILENO);
+  auto rows = RunProtocol(options, [&](int done, int total) {
+    // On a terminal a live counter; in a log a line every tenth.
+    if (!tty && done % std::max(1, total / 10) != 0 && done != total) return;
+    std::fprintf(stderr, tty ? "\reval: %d / %d point sets, %.0f s" : "eval: %d / %d point sets, %.0f s\n",
+                 done, total, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  });
+  std::fprintf(stderr, "\n");
+  if (!rows.ok()) return Fail(rows.status());
+  const std::string tables = SlopeTables(Slopes(*rows));
+  std::printf("N = 2^l and 2^l + 2^(l-1), l = %d..%d, seed %llu\n\n%s", options.l_min,
+              options.l_max, static_cast<unsigned long long>(options.seed), tables.c_str());
+  std::string mkdir = "mkdir -p '" + f.out_dir + "'";
+  if (std::system(mkdir.c_str()) != 0) return Fail(absl::UnavailableError("cannot create " + f.out_dir));
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::FILE* out = std::fopen((f.out_dir + "/" + name).c_str(), "w");
+    if (!out) return false;
+    std::fputs(text.c_str(), out);
+    return std::fclose(out) == 0;
+  };
+  if (!write("discrepancy.csv", RowsCsv(*rows)) || !write("slopes.md", tables)) {
+    return Fail(absl::UnavailableError("cannot write into " + f.out_dir));
+  }
+  for (const char* measure : {"rectangular", "circular", "triangular"}) {
+    if (auto st = PlotDiscrepancy(*rows, "plane", measure, f.out_dir + "/plane-" + measure); !st.ok()) return Fail(st);
+  }
+  if (auto st = PlotDiscrepancy(*rows, "sphere", "spherical", f.out_dir + "/sphere-spherical"); !st.ok()) {
+    return Fail(st);
+  }
+  std::fprintf(stderr, "wrote %s/discrepancy.csv, slopes.md and plots (svg, png)\n", f.out_dir.c_str());
+  return 0;
+}
+
+struct RenderFlags {
+  std::string what = "samples";
+  std::string view = "35,25";
+  int size = 900;
+  std::string title;
+  std::string output = "render.png";
+};
+
+int RunRender(const RequestFlags& flags, const RenderFlags& r) {
+  auto request = ToSampleRequest(flags);
+  if (!request.ok()) return Fail(request.status());
+  View view;
+  view.width = view.height = r.size;
+  view.title = r.title;
+  if (std::sscanf(r.view.c_str(), "%lf,%lf", &view.azimuth_degrees, &view.elevation_degrees) != 2) {
+    return Fail(absl::InvalidArgumentError("--view takes AZIMUTH,ELEVATION in degrees, e.g. 35,25"));
+  }
+  request->fields.normal = true;
+  DirectTreeSource source;
+  SamplingEngine engine(EngineLimits{}, &source);
+  auto job = engine.Start(*request);
+  if (!job.ok()) return Fail(job.status());
+  absl::Status status;
+  if (r.what == "curve" || r.what == "param-curve") {
+    const CurveTree& tree = *job->tree.lookup.tree;
+    status = r.what == "curve" ? RenderCurve(tree, *job->tree.surface, view, r.output)
+                               : RenderParameterCurve(tree, view, r.output);
+  } else if (r.what == "samples" || r.what == "param-samples") {
+    SampleBatch all;
+    while (true) {
+      auto n = job->cursor->Next(1 << 16, &all);
+      if (!n.ok()) return Fail(n.status());
+      if (*n == 0) break;
+    }
+    status = r.what == "samples" ? RenderSamples(all, view, r.output)
+                                 : RenderParameterSamples(all, view, r.output);
+  } else {
+    return Fail(absl::InvalidArgumentError("--what must be samples, curve, param-samples or param-curve"));
+  }
+  if (!status.ok()) return Fail(status);
+  std::fprintf(stderr, "wrote %s (%s, %zu leaves)\n", r.output.c_str(), r.what.c_str(),
+               job->tree.lookup.tree->leaf_count());
+  return 0;
+}
+
 int RunSurfaces() {
   PrintCatalog("surfaces (--surface NAME[:KEY=VALUE;...]):", SurfaceCatalog());
   PrintCatalog("\ndensities (--density NAME[:KEY=VALUE;...] or expr:EXPRESSION):", DensityCatalog());
@@ -297,10 +399,35 @@ int main(int argc, char** argv) {
 
   app.add_subcommand("surfaces", "list the surfaces, densities, curves and sequences with their formulas");
 
+  sfc::EvalFlags eval_flags;
+  CLI::App* eval = app.add_subcommand("eval", "run the paper's discrepancy protocol and compare slopes with Tables 1-2");
+  eval->add_option("--setting", eval_flags.setting, "fast (N up to 12288, minutes) or full (up to 1572864)")
+      ->capture_default_str();
+  eval->add_option("--l-min", eval_flags.l_min, "smallest l (N = 2^l and 2^l + 2^(l-1))");
+  eval->add_option("--l-max", eval_flags.l_max, "largest l");
+  eval->add_option("--plane-methods", eval_flags.plane, "subset of: random jittered2d sobol halton hammersley hilbert-jittered hilbert2-jittered peano-jittered")
+      ->delimiter(',');
+  eval->add_option("--sphere-methods", eval_flags.sphere, "subset of: random hammersley fibonacci hilbert-jittered-fff hilbert-jittered-triangle hilbert-jittered-quadrature")
+      ->delimiter(',');
+  eval->add_option("--out-dir", eval_flags.out_dir, "where the CSV, the slope tables and the plots go")->capture_default_str();
+  eval->add_option("--seed", eval_flags.seed, "seed of the random and jittered sets")->capture_default_str();
+
+  sfc::RenderFlags render_flags;
+  CLI::App* render = app.add_subcommand("render", "draw samples or the adaptive curve as a PNG");
+  sfc::AddTreeFlags(render, &flags);
+  sfc::AddSampleFlags(render, &flags);
+  render->add_option("--what", render_flags.what, "samples | curve | param-samples | param-curve")->capture_default_str();
+  render->add_option("--view", render_flags.view, "AZIMUTH,ELEVATION in degrees")->capture_default_str();
+  render->add_option("--size", render_flags.size, "picture width and height in pixels")->capture_default_str();
+  render->add_option("--title", render_flags.title, "caption");
+  render->add_option("--output,-o", render_flags.output, "PNG file")->capture_default_str();
+
   CLI11_PARSE(app, argc, argv);
   if (sample->parsed()) return sfc::RunSample(flags, format, ascii, output, batch_size, quiet, conn);
   if (prepare->parsed()) return sfc::RunPrepare(flags, conn);
   if (cache->parsed()) return sfc::RunCache(conn);
   if (health->parsed()) return sfc::RunHealth(conn);
+  if (eval->parsed()) return sfc::RunEval(eval_flags);
+  if (render->parsed()) return sfc::RunRender(flags, render_flags);
   return sfc::RunSurfaces();
 }

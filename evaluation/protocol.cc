@@ -1,0 +1,271 @@
+#include "evaluation/protocol.h"
+
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "core/builtin_surfaces.h"
+#include "core/discrepancy.h"
+#include "core/reference_sets.h"
+#include "core/sampler.h"
+#include "core/status_macros.h"
+
+namespace sfc {
+namespace {
+
+// Paper Table 1 (rectangular, circular, triangular) and Table 2 (spherical).
+const std::map<std::string, std::vector<double>>& PaperPlane() {
+  static const auto* const k = new std::map<std::string, std::vector<double>>{
+      {"random", {-0.49, -0.50, -0.49}},
+      {"sobol", {-0.90, -0.70, -0.58}},
+      {"jittered2d", {-0.75, -0.74, -0.72}},
+      {"hilbert-jittered", {-0.73, -0.73, -0.72}},
+  };
+  return *k;
+}
+const std::map<std::string, double>& PaperSphere() {
+  static const auto* const k = new std::map<std::string, double>{
+      {"random", -0.49},
+      {"hammersley", -0.75},
+      {"hilbert-jittered-fff", -0.73},
+      {"hilbert-jittered-triangle", -0.71},
+  };
+  return *k;
+}
+
+// Our sampler: trees by grade, each refined from the previous one, as the
+// server's cache does.
+class OurSampler {
+ public:
+  OurSampler(std::shared_ptr<const Surface> surface, CurveTreeOptions options)
+      : surface_(std::move(surface)), density_(MakeUniformDensity()), options_(options) {}
+
+  absl::StatusOr<SampleBatch> Sample(uint64_t n, uint64_t seed) {
+    const int grade = CurveTree::GradeFor(n);
+    if (!tree_ || tree_->grade() != grade) {
+      if (tree_ && tree_->grade() < grade) {
+        ASSIGN_OR_RETURN(tree_, tree_->Refined(*surface_, *density_, grade));
+      } else {
+        ASSIGN_OR_RETURN(tree_, CurveTree::Build(*surface_, *density_, options_, grade));
+      }
+    }
+    auto sampler = std::make_shared<const Sampler>(tree_, surface_, density_,
+                                                   Sequence(SequenceKind::kJittered, n, seed));
+    ASSIGN_OR_RETURN(auto cursor, SampleCursor::Create(sampler, 0, n, {}, {}));
+    SampleBatch all;
+    while (true) {
+      ASSIGN_OR_RETURN(const size_t got, cursor->Next(1 << 16, &all));
+      if (got == 0) break;
+    }
+    return all;
+  }
+
+ private:
+  std::shared_ptr<const Surface> surface_;
+  std::shared_ptr<const Density> density_;
+  CurveTreeOptions options_;
+  std::shared_ptr<const CurveTree> tree_;
+};
+
+std::vector<uint64_t> Sizes(int l_min, int l_max) {
+  std::vector<uint64_t> sizes;
+  for (int l = l_min; l <= l_max; ++l) {
+    sizes.push_back(uint64_t{1} << l);
+    sizes.push_back((uint64_t{1} << l) + (uint64_t{1} << (l - 1)));
+  }
+  return sizes;
+}
+
+CurveTreeOptions CurveOptions(CurveType curve, AreaEstimator estimator) {
+  CurveTreeOptions o;
+  o.curve = curve;
+  o.estimator = estimator;
+  o.max_leaves = uint64_t{1} << 27;
+  return o;
+}
+
+}  // namespace
+
+const std::vector<std::string>& PlaneMethods() {
+  static const auto* const k = new std::vector<std::string>{
+      "random", "jittered2d", "sobol", "halton", "hammersley",
+      "hilbert-jittered", "hilbert2-jittered", "peano-jittered"};
+  return *k;
+}
+
+const std::vector<std::string>& SphereMethods() {
+  static const auto* const k = new std::vector<std::string>{
+      "random", "hammersley", "fibonacci", "hilbert-jittered-fff", "hilbert-jittered-triangle",
+      "hilbert-jittered-quadrature"};
+  return *k;
+}
+
+absl::StatusOr<std::vector<ProtocolRow>> RunProtocol(const ProtocolOptions& options,
+                                                     const std::function<void(int, int)>& progress) {
+  if (options.l_min < 1 || options.l_max < options.l_min || options.l_max > 22) {
+    return absl::InvalidArgumentError("sizes need 1 <= l_min <= l_max <= 22");
+  }
+  const auto plane = options.plane_methods.empty() ? PlaneMethods() : options.plane_methods;
+  const auto sphere = options.sphere_methods.empty() ? SphereMethods() : options.sphere_methods;
+  for (const auto& m : plane) {
+    if (std::find(PlaneMethods().begin(), PlaneMethods().end(), m) == PlaneMethods().end()) {
+      return absl::InvalidArgumentError(absl::StrCat("unknown plane method ", m));
+    }
+  }
+  for (const auto& m : sphere) {
+    if (std::find(SphereMethods().begin(), SphereMethods().end(), m) == SphereMethods().end()) {
+      return absl::InvalidArgumentError(absl::StrCat("unknown sphere method ", m));
+    }
+  }
+  const std::vector<uint64_t> sizes = Sizes(options.l_min, options.l_max);
+  const int total = static_cast<int>((plane.size() + sphere.size()) * sizes.size());
+  int done = 0;
+  std::vector<ProtocolRow> rows;
+  std::shared_ptr<const Surface> unit_square = MakePlane(), unit_sphere = MakeSphere(1);
+
+  for (const std::string& method : plane) {
+    std::unique_ptr<OurSampler> ours;
+    if (method == "hilbert-jittered") ours = std::make_unique<OurSampler>(unit_square, CurveOptions(CurveType::kHilbert, AreaEstimator::kFirstFundamentalForm));
+    if (method == "hilbert2-jittered") ours = std::make_unique<OurSampler>(unit_square, CurveOptions(CurveType::kHilbert2, AreaEstimator::kFirstFundamentalForm));
+    if (method == "peano-jittered") ours = std::make_unique<OurSampler>(unit_square, CurveOptions(CurveType::kPeano, AreaEstimator::kFirstFundamentalForm));
+    for (uint64_t n : sizes) {
+      const auto start = std::chrono::steady_clock::now();
+      std::vector<Point2> pts;
+      if (ours) {
+        ASSIGN_OR_RETURN(const SampleBatch b, ours->Sample(n, options.seed));
+        pts.resize(b.size());
+        for (size_t i = 0; i < b.size(); ++i) pts[i] = {b.u[i], b.v[i]};
+      } else if (method == "random") {
+        pts = RandomSquare(n, options.seed);
+      } else if (method == "jittered2d") {
+        pts = JitteredSquare(n, options.seed);
+      } else if (method == "sobol") {
+        pts = SobolSquare(n);
+      } else if (method == "halton") {
+        pts = HaltonSquare(n);
+      } else {
+        pts = HammersleySquare(n);
+      }
+      ProtocolRow row;
+      row.domain = "plane";
+      row.method = method;
+      row.n = n;
+      row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      row.rectangular = StarDiscrepancy(pts, options.star_corners);
+      row.circular = QuarterDiscDiscrepancy(pts);
+      row.triangular = TriangleDiscrepancy(pts, options.triangle_grid);
+      rows.push_back(row);
+      if (progress) progress(++done, total);
+    }
+  }
+  for (const std::string& method : sphere) {
+    std::unique_ptr<OurSampler> ours;
+    if (method == "hilbert-jittered-fff") ours = std::make_unique<OurSampler>(unit_sphere, CurveOptions(CurveType::kHilbert, AreaEstimator::kFirstFundamentalForm));
+    if (method == "hilbert-jittered-triangle") ours = std::make_unique<OurSampler>(unit_sphere, CurveOptions(CurveType::kHilbert, AreaEstimator::kTriangle));
+    if (method == "hilbert-jittered-quadrature") ours = std::make_unique<OurSampler>(unit_sphere, CurveOptions(CurveType::kHilbert, AreaEstimator::kQuadrature));
+    for (uint64_t n : sizes) {
+      const auto start = std::chrono::steady_clock::now();
+      std::vector<Vec3> pts;
+      if (ours) {
+        ASSIGN_OR_RETURN(const SampleBatch b, ours->Sample(n, options.seed));
+        pts.resize(b.size());
+        for (size_t i = 0; i < b.size(); ++i) pts[i] = Vec3{b.x[i], b.y[i], b.z[i]};
+      } else if (method == "random") {
+        pts = RandomSphere(n, options.seed);
+      } else if (method == "hammersley") {
+        pts = HammersleySphere(n);
+      } else {
+        pts = FibonacciSphere(n);
+      }
+      ProtocolRow row;
+      row.domain = "sphere";
+      row.method = method;
+      row.n = n;
+      row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      row.spherical = SphericalTriangleDiscrepancy(pts, options.sphere_triangles, options.seed);
+      rows.push_back(row);
+      if (progress) progress(++done, total);
+    }
+  }
+  return rows;
+}
+
+std::vector<SlopeRow> Slopes(const std::vector<ProtocolRow>& rows) {
+  struct Fit {
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    int n = 0;
+    void Add(double x, double y) { sx += x, sy += y, sxx += x * x, sxy += x * y, ++n; }
+    double Slope() const { return (n * sxy - sx * sy) / (n * sxx - sx * sx); }
+  };
+  std::map<std::tuple<std::string, std::string, std::string>, Fit> fits;
+  std::vector<std::tuple<std::string, std::string, std::string>> order;
+  auto add = [&](const ProtocolRow& r, const char* measure, const std::optional<double>& d) {
+    if (!d || !(*d > 0)) return;
+    const auto key = std::make_tuple(r.domain, r.method, std::string(measure));
+    if (!fits.count(key)) order.push_back(key);
+    fits[key].Add(std::log(static_cast<double>(r.n)), std::log(*d));
+  };
+  for (const ProtocolRow& r : rows) {
+    add(r, "rectangular", r.rectangular);
+    add(r, "circular", r.circular);
+    add(r, "triangular", r.triangular);
+    add(r, "spherical", r.spherical);
+  }
+  std::vector<SlopeRow> out;
+  for (const auto& key : order) {
+    SlopeRow s;
+    std::tie(s.domain, s.method, s.measure) = key;
+    s.slope = fits[key].Slope();
+    if (s.domain == "plane" && PaperPlane().count(s.method)) {
+      const int i = s.measure == "rectangular" ? 0 : s.measure == "circular" ? 1 : 2;
+      s.paper = PaperPlane().at(s.method)[i];
+    }
+    if (s.domain == "sphere" && PaperSphere().count(s.method)) s.paper = PaperSphere().at(s.method);
+    out.push_back(s);
+  }
+  return out;
+}
+
+std::string RowsCsv(const std::vector<ProtocolRow>& rows) {
+  std::string out = "domain,method,n,rectangular,circular,triangular,spherical,seconds\n";
+  auto cell = [](const std::optional<double>& d) { return d ? absl::StrFormat("%.6g", *d) : std::string(); };
+  for (const ProtocolRow& r : rows) {
+    absl::StrAppend(&out, r.domain, ",", r.method, ",", r.n, ",", cell(r.rectangular), ",",
+                    cell(r.circular), ",", cell(r.triangular), ",", cell(r.spherical), ",",
+                    absl::StrFormat("%.4f", r.seconds), "\n");
+  }
+  return out;
+}
+
+std::string SlopeTables(const std::vector<SlopeRow>& slopes) {
+  auto find = [&](const std::string& domain, const std::string& method, const std::string& measure) -> const SlopeRow* {
+    for (const SlopeRow& s : slopes) {
+      if (s.domain == domain && s.method == method && s.measure == measure) return &s;
+    }
+    return nullptr;
+  };
+  auto cell = [](const SlopeRow* s) {
+    if (!s) return std::string("");
+    return s->paper ? absl::StrFormat("%.2f (paper %.2f)", s->slope, *s->paper) : absl::StrFormat("%.2f", s->slope);
+  };
+  std::string out = "Plane, slope of log D against log N (ours, paper Table 1):\n\n"
+                    "| method | rectangular | circular | triangular |\n|---|---:|---:|---:|\n";
+  std::vector<std::string> seen;
+  for (const SlopeRow& s : slopes) {
+    if (s.domain != "plane" || std::find(seen.begin(), seen.end(), s.method) != seen.end()) continue;
+    seen.push_back(s.method);
+    absl::StrAppend(&out, "| ", s.method, " | ", cell(find("plane", s.method, "rectangular")), " | ",
+                    cell(find("plane", s.method, "circular")), " | ",
+                    cell(find("plane", s.method, "triangular")), " |\n");
+  }
+  absl::StrAppend(&out, "\nSphere, spherical triangles (ours, paper Table 2):\n\n| method | spherical |\n|---|---:|\n");
+  for (const SlopeRow& s : slopes) {
+    if (s.domain == "sphere") absl::StrAppend(&out, "| ", s.method, " | ", cell(&s), " |\n");
+  }
+  return out;
+}
+
+}  // namespace sfc
