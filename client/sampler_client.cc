@@ -163,7 +163,14 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& request
       }
       return summary;
     }
-    if (status.error_code() != grpc::StatusCode::UNAVAILABLE || attempt >= options_.max_resumes) {
+    // Resumable: the server is unreachable, or a proxy reset the stream when
+    // its replica died (nginx answers with RST_STREAM INTERNAL_ERROR, which
+    // gRPC reports as INTERNAL). Requests are pure functions of their fields,
+    // so asking again is safe.
+    const bool transport_reset = status.error_code() == grpc::StatusCode::INTERNAL &&
+                                 status.error_message().find("RST_STREAM") != std::string::npos;
+    const bool resumable = status.error_code() == grpc::StatusCode::UNAVAILABLE || transport_reset;
+    if (!resumable || attempt >= options_.max_resumes) {
       absl::Status s = FromGrpcStatus(status);
       return absl::Status(s.code(), absl::StrFormat("%s (received %d samples%s)", s.message(),
                                                     summary.received,

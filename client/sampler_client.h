@@ -1,8 +1,9 @@
 // C++ client library for sfcsampler.v1.
 //
 // Sample() streams a request's batches in curve order to a callback. When the
-// stream breaks with UNAVAILABLE (a server restart, a proxy moving the
-// connection) it resumes from the first index not yet received, so the
+// stream breaks with UNAVAILABLE (a server restart) or a proxy's stream reset
+// (RST_STREAM, when the replica behind it died) it resumes from the first
+// index not yet received, so the
 // callback sees every sample exactly once; anything short of the full set is
 // an error that says how many samples arrived. Every call carries the
 // x-surface-key header (the tree key) for consistent-hash proxies.
@@ -28,7 +29,7 @@ struct ClientOptions {
   std::string token;                       // bearer token; "" = none
   bool tls = false;                        // use TLS ...
   std::string tls_root_certs_file;         // ... trusting these roots ("" = system roots)
-  int max_resumes = 5;                     // UNAVAILABLE retries per Sample() call
+  int max_resumes = 5;                     // resumes per Sample() call
   double resume_backoff_seconds = 0.2;     // first wait; doubles each time
   double deadline_seconds = 0;             // per RPC; 0 = none
   ::sfcsampler::v1::Precision precision = ::sfcsampler::v1::PRECISION_FLOAT64;

@@ -23,7 +23,7 @@ struct ProtocolOptions {
   std::vector<std::string> plane_methods;   // empty: all
   std::vector<std::string> sphere_methods;  // empty: all
   uint64_t seed = 1;
-  int star_corners = 512;     // see StarDiscrepancy
+  int star_corners = 2048;    // see StarDiscrepancy
   int triangle_grid = 256;    // see TriangleDiscrepancy
   int sphere_triangles = 128; // see SphericalTriangleDiscrepancy
 };

@@ -13,7 +13,8 @@ packages=(
   libgrpc++-dev libgrpc-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler  # service
   libspdlog-dev                                  # server logs
   prometheus-cpp-dev                             # server metrics
-  libcairo2-dev libpng-dev                       # pictures
+  libcairo2-dev libpng-dev                       # pictures and plots
+  nginx                                          # the consistent-hash gRPC proxy of the scale-out test
 )
 
 missing=()
