@@ -19,7 +19,7 @@ namespace sfc {
 
 struct ProtocolOptions {
   int l_min = 1;
-  int l_max = 13;  // the fast setting; the paper's full range ends at 19 (1.5 M points)
+  int l_max = 13;  // the fast setting (N up to 12288); the paper goes to 20 (1572864 points)
   std::vector<std::string> plane_methods;   // empty: all
   std::vector<std::string> sphere_methods;  // empty: all
   uint64_t seed = 1;

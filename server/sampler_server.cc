@@ -3,6 +3,7 @@
 #include <chrono>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "absl/strings/str_format.h"
 #include "grpcpp/ext/proto_server_reflection_plugin.h"
@@ -90,7 +91,7 @@ absl::StatusOr<std::unique_ptr<SamplerServer>> SamplerServer::Start(const Server
 }
 
 SamplerServer::~SamplerServer() {
-  if (server_) Shutdown(0);
+  if (server_) Shutdown(0, 0);
 }
 
 int SamplerServer::metrics_port() const {
@@ -99,7 +100,7 @@ int SamplerServer::metrics_port() const {
   return ports.empty() ? 0 : ports[0];
 }
 
-void SamplerServer::Shutdown(double grace_seconds) {
+void SamplerServer::Shutdown(double grace_seconds, double drain_seconds) {
   if (!server_) return;
   server_->GetHealthCheckService()->SetServingStatus(false);
   if (health_server_) health_server_->GetHealthCheckService()->SetServingStatus(false);
@@ -110,6 +111,12 @@ void SamplerServer::Shutdown(double grace_seconds) {
   if (health_server_) health_server_->Shutdown(deadline);
   server_->Wait();
   if (health_server_) health_server_->Wait();
+  // gRPC counts a call as done once its status is queued; up to a flow-control
+  // window of its last messages may still be on the way. Linger briefly so
+  // they reach the client before the transports close.
+  if (drain_seconds > 0) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int64_t>(drain_seconds * 1000)));
+  }
   server_.reset();
   health_server_.reset();
 }

@@ -32,8 +32,9 @@ class SamplerServer {
   int metrics_port() const;
 
   // Stops accepting, lets in-flight calls run up to `grace_seconds`, then
-  // cancels them; health turns NOT_SERVING first.
-  void Shutdown(double grace_seconds);
+  // cancels them; health turns NOT_SERVING first. Then waits `drain_seconds`
+  // for finished streams' last bytes to reach their clients.
+  void Shutdown(double grace_seconds, double drain_seconds = 1.0);
 
   const TreeCache& cache() const { return *cache_; }
   const SamplerService& service() const { return *service_; }

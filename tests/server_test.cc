@@ -142,7 +142,7 @@ TEST(Server, TheClientResumesAcrossAServerRestart) {
       // Kill the server under the stream and bring a new one up on the same port.
       restarted = true;
       std::thread([&] {
-        server->Shutdown(0);
+        server->Shutdown(0, 0);
         options.address = "127.0.0.1:" + std::to_string(port);
         second = *SamplerServer::Start(options);
       }).join();

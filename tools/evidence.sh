@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Reproduces docs/EVIDENCE.md's material: the discrepancy protocol (fast or
 # full setting) and the pictures of the paper's Figs. 9-14.
-#   bash tools/evidence.sh [fast|full]
+#   bash tools/evidence.sh [fast|full|pictures]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 bash "$root/tools/build.sh"
@@ -9,7 +9,10 @@ sfc="$root/build/client/sfcsampler"
 out="$root/docs/evidence"
 mkdir -p "$out"
 setting="${1:-fast}"
-"$sfc" eval --setting "$setting" --out-dir "$out/eval-$setting" | tee "$out/eval-$setting/table.txt"
+if [ "$setting" != pictures ]; then
+  mkdir -p "$out/eval-$setting"
+  "$sfc" eval --setting "$setting" --out-dir "$out/eval-$setting" | tee "$out/eval-$setting/table.txt"
+fi
 
 r() { "$sfc" render --size 600 "$@"; }
 # Fig. 9: the unit square with densities 1, u, u + v (3000 points).
