@@ -79,7 +79,8 @@ start=$(date +%s%N)
 $engine stop -t 20 sfcsampler-test > /dev/null || fail "stop failed"
 stop_ms=$(( ($(date +%s%N) - start) / 1000000 ))
 code=$($engine inspect --format '{{.State.ExitCode}}' sfcsampler-test)
-$engine logs sfcsampler-test 2>&1 | grep -q "stopped" || fail "no graceful shutdown in the logs"
+$engine logs sfcsampler-test > "$work/container.log" 2>&1
+grep -q "stopped" "$work/container.log" || fail "no graceful shutdown in the logs"
 [ "$code" = 0 ] || fail "the server exited with $code on SIGTERM"
 echo "stopped gracefully (SIGTERM, exit 0) in ${stop_ms} ms"
 echo "container test passed: engine $engine, image $((size / 1000000)) MB, build ${build_seconds} s"
