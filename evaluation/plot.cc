@@ -97,6 +97,7 @@ absl::Status PlotDiscrepancy(const std::vector<ProtocolRow>& rows, const std::st
     const std::optional<double>& d = measure == "rectangular" ? r.rectangular
                                      : measure == "circular"  ? r.circular
                                      : measure == "triangular" ? r.triangular
+                                     : measure == "density"    ? r.density
                                                                : r.spherical;
     if (d && *d > 0) series[r.method].points.push_back({std::log10(static_cast<double>(r.n)), std::log10(*d)});
   }

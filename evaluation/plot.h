@@ -12,7 +12,8 @@
 namespace sfc {
 
 // Writes `path_stem`.svg and `path_stem`.png for one domain and measure
-// ("rectangular", "circular", "triangular" or "spherical"), one line per method.
+// ("rectangular", "circular", "triangular", "spherical" or "density"), one
+// line per method.
 absl::Status PlotDiscrepancy(const std::vector<ProtocolRow>& rows, const std::string& domain,
                              const std::string& measure, const std::string& path_stem);
 

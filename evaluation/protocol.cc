@@ -7,7 +7,10 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "catalog/catalog.h"
+#include "core/area_estimator.h"
 #include "core/builtin_surfaces.h"
+#include "core/counter_hash.h"
 #include "core/discrepancy.h"
 #include "core/reference_sets.h"
 #include "core/sampler.h"
@@ -40,8 +43,9 @@ const std::map<std::string, double>& PaperSphere() {
 // server's cache does.
 class OurSampler {
  public:
-  OurSampler(std::shared_ptr<const Surface> surface, CurveTreeOptions options)
-      : surface_(std::move(surface)), density_(MakeUniformDensity()), options_(options) {}
+  OurSampler(std::shared_ptr<const Surface> surface, CurveTreeOptions options,
+             std::shared_ptr<const Density> density = MakeUniformDensity())
+      : surface_(std::move(surface)), density_(std::move(density)), options_(options) {}
 
   absl::StatusOr<SampleBatch> Sample(uint64_t n, uint64_t seed) {
     const int grade = CurveTree::GradeFor(n);
@@ -87,6 +91,40 @@ CurveTreeOptions CurveOptions(CurveType curve, AreaEstimator estimator) {
   return o;
 }
 
+// Surfaces other than the plane and the sphere, where the density
+// discrepancy over parameter rectangles tells whether a density is honoured.
+struct SurfaceCase {
+  const char* surface;
+  const char* density;
+};
+constexpr SurfaceCase kSurfaceCases[] = {
+    {"torus", "uniform"},
+    {"eight", "gaussian:floor=0.05"},
+    {"monkey_saddle", "gaussian:floor=0.01"},
+    {"plane", "expr:u+v"},
+};
+
+// i.i.d. points with density proportional to delta dA, by rejection: the
+// baseline that should give a slope of -1/2.
+absl::StatusOr<std::vector<Point2>> RandomWithDensity(const Surface& surface, const Density& density,
+                                                      uint64_t n, uint64_t seed) {
+  double peak = 0;
+  for (int i = 0; i < 64; ++i) {
+    for (int j = 0; j < 64; ++j) {
+      ASSIGN_OR_RETURN(const DensityAt d, EvaluateDensity(surface, density, (i + 0.5) / 64, (j + 0.5) / 64));
+      peak = std::max(peak, d.delta * d.area_element);
+    }
+  }
+  peak *= 1.5;  // margin over the grid's maximum
+  std::vector<Point2> pts;
+  for (uint64_t k = 0; pts.size() < n; ++k) {
+    const double u = CounterUniform(seed, 31, k), v = CounterUniform(seed, 32, k);
+    ASSIGN_OR_RETURN(const DensityAt d, EvaluateDensity(surface, density, u, v));
+    if (CounterUniform(seed, 33, k) * peak < d.delta * d.area_element) pts.push_back({u, v});
+  }
+  return pts;
+}
+
 }  // namespace
 
 const std::vector<std::string>& PlaneMethods() {
@@ -122,6 +160,7 @@ absl::StatusOr<std::vector<ProtocolRow>> RunProtocol(const ProtocolOptions& opti
   }
   const std::vector<uint64_t> sizes = Sizes(options.l_min, options.l_max);
   const int total = static_cast<int>((plane.size() + sphere.size()) * sizes.size());
+  // (The surface section reports no progress; it takes a few seconds.)
   int done = 0;
   std::vector<ProtocolRow> rows;
   std::shared_ptr<const Surface> unit_square = MakePlane(), unit_sphere = MakeSphere(1);
@@ -190,6 +229,48 @@ absl::StatusOr<std::vector<ProtocolRow>> RunProtocol(const ProtocolOptions& opti
       if (progress) progress(++done, total);
     }
   }
+  if (options.surfaces) {
+    for (const SurfaceCase& c : kSurfaceCases) {
+      ASSIGN_OR_RETURN(const SurfaceFromSpec surface, MakeSurface(c.surface));
+      ASSIGN_OR_RETURN(const DensityFromSpec density, MakeDensity(c.density));
+      const std::string domain = absl::StrCat("surface ", c.surface, " with ", c.density);
+      // Cell integrals of delta dA by 3x3 Gauss-Legendre on a 256 x 256 grid,
+      // computed once per surface.
+      constexpr int kGrid = 256;
+      std::vector<double> cells(kGrid * kGrid);
+      for (int i = 0; i < kGrid; ++i) {
+        for (int j = 0; j < kGrid; ++j) {
+          ASSIGN_OR_RETURN(cells[i * kGrid + j],
+                           CellMass(*surface.surface, *density.density, AreaEstimator::kQuadrature,
+                                    static_cast<double>(i) / kGrid, static_cast<double>(j) / kGrid, 1.0 / kGrid));
+        }
+      }
+      auto cell_mass = [&](double u0, double v0, double) {
+        return cells[std::lround(u0 * kGrid) * kGrid + std::lround(v0 * kGrid)];
+      };
+      OurSampler ours(surface.surface, CurveOptions(CurveType::kHilbert, AreaEstimator::kFirstFundamentalForm),
+                      density.density);
+      for (const char* method : {"random", "hilbert-jittered"}) {
+        for (uint64_t n : sizes) {
+          const auto start = std::chrono::steady_clock::now();
+          std::vector<Point2> pts;
+          if (std::string(method) == "random") {
+            ASSIGN_OR_RETURN(pts, RandomWithDensity(*surface.surface, *density.density, n, options.seed));
+          } else {
+            ASSIGN_OR_RETURN(const SampleBatch b, ours.Sample(n, options.seed));
+            for (size_t i = 0; i < b.size(); ++i) pts.push_back({b.u[i], b.v[i]});
+          }
+          ProtocolRow row;
+          row.domain = domain;
+          row.method = method;
+          row.n = n;
+          row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+          row.density = ParameterRectDiscrepancy(pts, cell_mass, kGrid);
+          rows.push_back(row);
+        }
+      }
+    }
+  }
   return rows;
 }
 
@@ -213,6 +294,7 @@ std::vector<SlopeRow> Slopes(const std::vector<ProtocolRow>& rows) {
     add(r, "circular", r.circular);
     add(r, "triangular", r.triangular);
     add(r, "spherical", r.spherical);
+    add(r, "density", r.density);
   }
   std::vector<SlopeRow> out;
   for (const auto& key : order) {
@@ -230,11 +312,12 @@ std::vector<SlopeRow> Slopes(const std::vector<ProtocolRow>& rows) {
 }
 
 std::string RowsCsv(const std::vector<ProtocolRow>& rows) {
-  std::string out = "domain,method,n,rectangular,circular,triangular,spherical,seconds\n";
+  std::string out = "domain,method,n,rectangular,circular,triangular,spherical,density,seconds\n";
   auto cell = [](const std::optional<double>& d) { return d ? absl::StrFormat("%.6g", *d) : std::string(); };
   for (const ProtocolRow& r : rows) {
     absl::StrAppend(&out, r.domain, ",", r.method, ",", r.n, ",", cell(r.rectangular), ",",
                     cell(r.circular), ",", cell(r.triangular), ",", cell(r.spherical), ",",
+                    cell(r.density), ",",
                     absl::StrFormat("%.4f", r.seconds), "\n");
   }
   return out;
@@ -264,6 +347,18 @@ std::string SlopeTables(const std::vector<SlopeRow>& slopes) {
   absl::StrAppend(&out, "\nSphere, spherical triangles (ours, paper Table 2):\n\n| method | spherical |\n|---|---:|\n");
   for (const SlopeRow& s : slopes) {
     if (s.domain == "sphere") absl::StrAppend(&out, "| ", s.method, " | ", cell(&s), " |\n");
+  }
+  absl::StrAppend(&out, "\nOther surfaces, density discrepancy over parameter rectangles (not in the paper):\n\n"
+                        "| surface and density | random (i.i.d. by the density) | hilbert-jittered |\n|---|---:|---:|\n");
+  std::vector<std::string> domains;
+  for (const SlopeRow& s : slopes) {
+    if (s.measure == "density" && std::find(domains.begin(), domains.end(), s.domain) == domains.end()) {
+      domains.push_back(s.domain);
+    }
+  }
+  for (const std::string& d : domains) {
+    absl::StrAppend(&out, "| ", d.substr(8), " | ", cell(find(d, "random", "density")), " | ",
+                    cell(find(d, "hilbert-jittered", "density")), " |\n");
   }
   return out;
 }

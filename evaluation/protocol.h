@@ -22,6 +22,7 @@ struct ProtocolOptions {
   int l_max = 13;  // the fast setting (N up to 12288); the paper goes to 20 (1572864 points)
   std::vector<std::string> plane_methods;   // empty: all
   std::vector<std::string> sphere_methods;  // empty: all
+  bool surfaces = true;  // also the density discrepancy on other surfaces
   uint64_t seed = 1;
   int star_corners = 2048;    // see StarDiscrepancy
   int triangle_grid = 256;    // see TriangleDiscrepancy
@@ -30,10 +31,11 @@ struct ProtocolOptions {
 
 // One point set's discrepancies; absent measures do not apply to its domain.
 struct ProtocolRow {
-  std::string domain;  // "plane" or "sphere"
+  std::string domain;  // "plane", "sphere", or "surface <spec> with <density>"
   std::string method;
   uint64_t n = 0;
   std::optional<double> rectangular, circular, triangular, spherical;
+  std::optional<double> density;  // ParameterRectDiscrepancy, for "surface ..." domains
   double seconds = 0;  // time to make the set
 };
 

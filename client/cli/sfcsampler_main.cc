@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <set>
 
 #include "CLI/CLI.hpp"
 #include "absl/strings/str_format.h"
@@ -300,6 +301,19 @@ int RunEval(const EvalFlags& f) {
   }
   if (auto st = PlotDiscrepancy(*rows, "sphere", "spherical", f.out_dir + "/sphere-spherical"); !st.ok()) {
     return Fail(st);
+  }
+  std::set<std::string> surfaces;
+  for (const ProtocolRow& row : *rows) {
+    if (row.density) surfaces.insert(row.domain);
+  }
+  for (const std::string& domain : surfaces) {
+    std::string stem = domain.substr(8);  // after "surface "
+    for (char& c : stem) {
+      if (!std::isalnum(static_cast<unsigned char>(c))) c = '-';
+    }
+    if (auto st = PlotDiscrepancy(*rows, domain, "density", f.out_dir + "/surface-" + stem); !st.ok()) {
+      return Fail(st);
+    }
   }
   std::fprintf(stderr, "wrote %s/discrepancy.csv, slopes.md and plots (svg, png)\n", f.out_dir.c_str());
   return 0;
