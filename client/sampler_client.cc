@@ -121,16 +121,7 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& request
         const size_t drop = std::min<uint64_t>(skip, batch.size());
         skip -= drop;
         SampleBatch rest;
-        for (size_t i = drop; i < batch.size(); ++i) {
-          rest.index.push_back(batch.index[i]);
-          rest.u.push_back(batch.u[i]), rest.v.push_back(batch.v[i]);
-          rest.x.push_back(batch.x[i]), rest.y.push_back(batch.y[i]), rest.z.push_back(batch.z[i]);
-          if (request.fields.normal) {
-            rest.nx.push_back(batch.nx[i]), rest.ny.push_back(batch.ny[i]), rest.nz.push_back(batch.nz[i]);
-          }
-          if (request.fields.density) rest.density.push_back(batch.density[i]);
-          if (request.fields.curve_position) rest.curve_position.push_back(batch.curve_position[i]);
-        }
+        rest.AppendFrom(batch, drop, batch.size());
         batch = std::move(rest);
       }
       if (batch.size() == 0) continue;

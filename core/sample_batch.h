@@ -24,6 +24,23 @@ struct SampleBatch {
   std::vector<double> curve_position;
 
   size_t size() const { return index.size(); }
+
+  // Appends samples [begin, end) of `other`, with whichever optional columns
+  // `other` has. REQUIRES: begin <= end <= other.size(), and this batch has the
+  // same optional columns (or is empty).
+  void AppendFrom(const SampleBatch& other, size_t begin, size_t end) {
+    index.insert(index.end(), other.index.begin() + begin, other.index.begin() + end);
+    std::vector<double> SampleBatch::*const columns[] = {
+        &SampleBatch::u,  &SampleBatch::v,  &SampleBatch::x,  &SampleBatch::y,       &SampleBatch::z,
+        &SampleBatch::nx, &SampleBatch::ny, &SampleBatch::nz, &SampleBatch::density, &SampleBatch::curve_position};
+    for (auto column : columns) {
+      const std::vector<double>& from = other.*column;
+      if (from.empty()) continue;
+      std::vector<double>& to = this->*column;
+      to.insert(to.end(), from.begin() + begin, from.begin() + end);
+    }
+  }
+  void Append(const SampleBatch& other) { AppendFrom(other, 0, other.size()); }
   void Clear() {
     for (auto* c : {&u, &v, &x, &y, &z, &nx, &ny, &nz, &density, &curve_position}) c->clear();
     index.clear();

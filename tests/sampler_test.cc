@@ -55,22 +55,13 @@ TEST(Sampler, IndexRangesAndShardsAreSlicesOfTheFullSet) {
       // Index order is curve order: the range is the slice.
       const SampleBatch part = Collect(sampler, 1234, 3456);
       SampleBatch slice;
-      for (size_t i = 1234; i < 3456; ++i) {
-        slice.index.push_back(full.index[i]);
-        slice.u.push_back(full.u[i]), slice.v.push_back(full.v[i]);
-        slice.x.push_back(full.x[i]), slice.y.push_back(full.y[i]), slice.z.push_back(full.z[i]);
-      }
+      slice.AppendFrom(full, 1234, 3456);
       ExpectSameSamples(part, slice);
       // Shards 0..K-1 concatenated are the full set, in order.
       SampleBatch joined;
       const uint64_t k = 7;
       for (uint64_t i = 0; i < k; ++i) {
-        const SampleBatch shard = Collect(sampler, i * n / k, (i + 1) * n / k);
-        for (size_t j = 0; j < shard.size(); ++j) {
-          joined.index.push_back(shard.index[j]);
-          joined.u.push_back(shard.u[j]), joined.v.push_back(shard.v[j]);
-          joined.x.push_back(shard.x[j]), joined.y.push_back(shard.y[j]), joined.z.push_back(shard.z[j]);
-        }
+        joined.Append(Collect(sampler, i * n / k, (i + 1) * n / k));
       }
       ExpectSameSamples(joined, full);
     }
@@ -93,10 +84,9 @@ TEST(Sampler, RegionQueriesEqualTheFilteredFullSet) {
   for (const Region& region : regions) {
     SampleBatch expected;
     for (size_t i = 0; i < full.size(); ++i) {
-      if (!region.Contains(full.u[i], full.v[i], {full.x[i], full.y[i], full.z[i]})) continue;
-      expected.index.push_back(full.index[i]);
-      expected.u.push_back(full.u[i]), expected.v.push_back(full.v[i]);
-      expected.x.push_back(full.x[i]), expected.y.push_back(full.y[i]), expected.z.push_back(full.z[i]);
+      if (region.Contains(full.u[i], full.v[i], {full.x[i], full.y[i], full.z[i]})) {
+        expected.AppendFrom(full, i, i + 1);
+      }
     }
     ASSERT_GT(expected.size(), 100u);
     ExpectSameSamples(Collect(sampler, 0, n, region), expected);

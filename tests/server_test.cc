@@ -52,10 +52,7 @@ absl::StatusOr<SampleBatch> Fetch(SamplerClient& client, const SampleRequest& re
                                   StreamSummary* summary = nullptr) {
   SampleBatch all;
   auto s = client.Sample(request, [&](const v1::StreamHeader&, const SampleBatch& b) {
-    all.index.insert(all.index.end(), b.index.begin(), b.index.end());
-    for (auto [from, to] : {std::pair{&b.u, &all.u}, {&b.v, &all.v}, {&b.x, &all.x}, {&b.y, &all.y}, {&b.z, &all.z}}) {
-      to->insert(to->end(), from->begin(), from->end());
-    }
+    all.Append(b);
     return absl::OkStatus();
   });
   if (!s.ok()) return s.status();
@@ -83,11 +80,7 @@ TEST(Server, ShardsJoinToTheFullSetInOrder) {
   for (uint64_t i = 0; i < 6; ++i) {
     auto shard = Fetch(*r.client, SamplerClient::Shard(full_request, i, 6));
     ASSERT_TRUE(shard.ok()) << shard.status();
-    for (auto [from, to] : {std::pair{&shard->u, &joined.u}, {&shard->v, &joined.v}, {&shard->x, &joined.x},
-                            {&shard->y, &joined.y}, {&shard->z, &joined.z}}) {
-      to->insert(to->end(), from->begin(), from->end());
-    }
-    joined.index.insert(joined.index.end(), shard->index.begin(), shard->index.end());
+    joined.Append(*shard);
   }
   ExpectEqual(joined, *full);
 }
@@ -100,21 +93,13 @@ TEST(Server, AStreamCutByTheClientResumesByteIdentical) {
   // Cut after 7000 samples: the callback refuses more, which cancels.
   SampleBatch first;
   auto cut = r.client->Sample(request, [&](const v1::StreamHeader&, const SampleBatch& b) {
-    for (size_t i = 0; i < b.size() && first.size() < 7000; ++i) {
-      first.index.push_back(b.index[i]);
-      first.u.push_back(b.u[i]), first.v.push_back(b.v[i]);
-      first.x.push_back(b.x[i]), first.y.push_back(b.y[i]), first.z.push_back(b.z[i]);
-    }
+    first.AppendFrom(b, 0, std::min<size_t>(b.size(), 7000 - first.size()));
     return first.size() < 7000 ? absl::OkStatus() : absl::CancelledError("cut");
   });
   ASSERT_EQ(cut.status().code(), absl::StatusCode::kCancelled);
   auto rest = Fetch(*r.client, SamplerClient::Range(request, first.index.back() + 1, request.count));
   ASSERT_TRUE(rest.ok());
-  for (auto [from, to] : {std::pair{&rest->u, &first.u}, {&rest->v, &first.v}, {&rest->x, &first.x},
-                          {&rest->y, &first.y}, {&rest->z, &first.z}}) {
-    to->insert(to->end(), from->begin(), from->end());
-  }
-  first.index.insert(first.index.end(), rest->index.begin(), rest->index.end());
+  first.Append(*rest);
   ExpectEqual(first, *uncut);
 }
 
