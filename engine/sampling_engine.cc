@@ -75,6 +75,13 @@ absl::StatusOr<std::pair<uint64_t, uint64_t>> SamplingEngine::ResolveRange(
 
 absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request) const {
   if (request.count == 0) return absl::InvalidArgumentError("count must be >= 1");
+  if (request.count > limits_.max_count) {
+    // Checked before any tree is built for it.
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "count %d is above this server's limit of %d samples per request (max_count); split the "
+        "request into index ranges or shards",
+        request.count, limits_.max_count));
+  }
   const bool radical_inverse = request.sequence == SequenceKind::kVanDerCorput ||
                                request.sequence == SequenceKind::kProgressive;
   if (radical_inverse && request.count > (uint64_t{1} << 32)) {
@@ -86,11 +93,6 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request) 
   const uint64_t tree_count = request.tree_count == 0 ? request.count : request.tree_count;
   SamplingJob job;
   ASSIGN_OR_RETURN(job.tree, Prepare(request.tree, tree_count));
-  if (request.count > limits_.max_count) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "count %d is above this server's limit of %d samples per request (max_count)", request.count,
-        limits_.max_count));
-  }
   job.sampler = std::make_shared<const Sampler>(job.tree.lookup.tree, job.tree.surface,
                                                 job.tree.density,
                                                 Sequence(request.sequence, request.count, request.seed));
