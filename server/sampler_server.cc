@@ -1,5 +1,6 @@
 #include "server/sampler_server.h"
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <sstream>
@@ -35,6 +36,26 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> Credentials(const Serve
   grpc::SslServerCredentialsOptions ssl;
   ssl.pem_key_cert_pairs.push_back({*key, *cert});
   return grpc::SslServerCredentials(ssl);
+}
+
+// TCP connections in state ESTABLISHED whose local port is `port`, from
+// /proc/net/tcp and tcp6 (0 where /proc is not readable).
+int EstablishedConnections(int port) {
+  int count = 0;
+  for (const char* path : {"/proc/net/tcp", "/proc/net/tcp6"}) {
+    std::ifstream in(path);
+    std::string line;
+    std::getline(in, line);  // header
+    while (std::getline(in, line)) {
+      std::istringstream fields(line);
+      std::string slot, local, remote, state;
+      fields >> slot >> local >> remote >> state;
+      const size_t colon = local.rfind(':');
+      if (colon == std::string::npos || state != "01") continue;  // 01 = ESTABLISHED
+      if (std::stoi(local.substr(colon + 1), nullptr, 16) == port) ++count;
+    }
+  }
+  return count;
 }
 
 }  // namespace
@@ -111,11 +132,16 @@ void SamplerServer::Shutdown(double grace_seconds, double drain_seconds) {
   if (health_server_) health_server_->Shutdown(deadline);
   server_->Wait();
   if (health_server_) health_server_->Wait();
-  // gRPC counts a call as done once its status is queued; up to a flow-control
-  // window of its last messages may still be on the way. Linger briefly so
-  // they reach the client before the transports close.
-  if (drain_seconds > 0) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int64_t>(drain_seconds * 1000)));
+  // gRPC counts a call as done once its status is queued: a slow client may
+  // still have a flow-control window or more of its last messages to read.
+  // Keep the transports up until the clients have hung up (their TCP
+  // connections to our port are gone), up to the grace deadline and at least
+  // `drain_seconds` more.
+  const auto drain_until = std::max(deadline, std::chrono::system_clock::now() +
+                                                  std::chrono::milliseconds(static_cast<int64_t>(drain_seconds * 1000)));
+  while (drain_seconds > 0 && EstablishedConnections(port_) > 0 &&
+         std::chrono::system_clock::now() < drain_until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   server_.reset();
   health_server_.reset();

@@ -32,8 +32,9 @@ class SamplerServer {
   int metrics_port() const;
 
   // Stops accepting, lets in-flight calls run up to `grace_seconds`, then
-  // cancels them; health turns NOT_SERVING first. Then waits `drain_seconds`
-  // for finished streams' last bytes to reach their clients.
+  // cancels them; health turns NOT_SERVING first. Then, so finished streams'
+  // last bytes reach slow clients, waits until no client connection remains,
+  // up to the grace deadline and at least `drain_seconds`.
   void Shutdown(double grace_seconds, double drain_seconds = 1.0);
 
   const TreeCache& cache() const { return *cache_; }
