@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <thread>
 
 #include "absl/strings/str_format.h"
 #include "core/status_macros.h"
@@ -48,7 +49,7 @@ SampleCursor::SampleCursor(std::shared_ptr<const Sampler> sampler, Region region
 
 absl::StatusOr<std::unique_ptr<SampleCursor>> SampleCursor::Create(
     std::shared_ptr<const Sampler> sampler, uint64_t begin, uint64_t end, const Region& region,
-    const SampleFields& fields) {
+    const SampleFields& fields, int threads) {
   const uint64_t count = sampler->sequence().count();
   if (begin > end || end > count) {
     return absl::InvalidArgumentError(absl::StrFormat(
@@ -58,6 +59,7 @@ absl::StatusOr<std::unique_ptr<SampleCursor>> SampleCursor::Create(
   }
   RETURN_IF_ERROR(region.Validate());
   auto cursor = std::unique_ptr<SampleCursor>(new SampleCursor(std::move(sampler), region, fields));
+  cursor->threads_ = std::max(1, threads);
   RETURN_IF_ERROR(cursor->PlanRegion(begin, end));
   return cursor;
 }
@@ -179,6 +181,18 @@ bool SampleCursor::done() const {
 }
 
 absl::StatusOr<size_t> SampleCursor::Next(size_t max, SampleBatch* batch) {
+  // Large batches inside one plain index range can be split over threads.
+  constexpr size_t kMinParallel = 8192;
+  if (threads_ > 1 && !use_order_ && region_.kind == Region::Kind::kAll && max >= kMinParallel &&
+      segment_ < segments_.size() && segments_[segment_].end - next_k_ >= max) {
+    const uint64_t k0 = next_k_;
+    RETURN_IF_ERROR(EmitParallel(k0, k0 + max, batch));
+    next_k_ += max;
+    if (next_k_ >= segments_[segment_].end && ++segment_ < segments_.size()) {
+      next_k_ = segments_[segment_].begin;
+    }
+    return max;
+  }
   size_t produced = 0;
   while (produced < max) {
     uint64_t k;
@@ -193,13 +207,38 @@ absl::StatusOr<size_t> SampleCursor::Next(size_t max, SampleBatch* batch) {
       }
     }
     bool kept = false;
-    RETURN_IF_ERROR(Emit(k, batch, &kept));
+    RETURN_IF_ERROR(Emit(k, cache_, batch, &kept));
     produced += kept;
   }
   return produced;
 }
 
-absl::Status SampleCursor::Emit(uint64_t k, SampleBatch* batch, bool* kept) {
+absl::Status SampleCursor::EmitParallel(uint64_t k0, uint64_t k1, SampleBatch* batch) {
+  const int n = threads_;
+  std::vector<SampleBatch> parts(n - 1);
+  std::vector<absl::Status> status(n);
+  std::vector<std::thread> workers;
+  auto bound = [&](int i) { return k0 + (k1 - k0) * i / n; };
+  for (int i = 1; i < n; ++i) {
+    workers.emplace_back([&, i] {
+      LeafCache cache;
+      bool kept;
+      for (uint64_t k = bound(i); k < bound(i + 1) && status[i].ok(); ++k) {
+        status[i] = Emit(k, cache, &parts[i - 1], &kept);
+      }
+    });
+  }
+  bool kept;
+  for (uint64_t k = bound(0); k < bound(1) && status[0].ok(); ++k) {
+    status[0] = Emit(k, cache_, batch, &kept);
+  }
+  for (auto& w : workers) w.join();
+  for (const absl::Status& st : status) RETURN_IF_ERROR(st);
+  for (const SampleBatch& part : parts) batch->Append(part);
+  return absl::OkStatus();
+}
+
+absl::Status SampleCursor::Emit(uint64_t k, LeafCache& cache, SampleBatch* batch, bool* kept) const {
   const Sampler& sampler = *sampler_;
   const CurveTree& tree = sampler.tree();
   const Curve& curve = tree.curve();
@@ -209,8 +248,8 @@ absl::Status SampleCursor::Emit(uint64_t k, SampleBatch* batch, bool* kept) {
   // forward from the last one before falling back to a full binary search.
   size_t l = SIZE_MAX;
   const auto& ends = tree.mass_ends();
-  if (cached_leaf_ != SIZE_MAX && m >= tree.mass_begin(cached_leaf_)) {
-    size_t lo = cached_leaf_, step = 1, hi = lo;
+  if (cache.leaf != SIZE_MAX && m >= tree.mass_begin(cache.leaf)) {
+    size_t lo = cache.leaf, step = 1, hi = lo;
     while (hi < ends.size() && ends[hi] <= m) {
       lo = hi + 1;
       hi = lo + step;
@@ -221,9 +260,9 @@ absl::Status SampleCursor::Emit(uint64_t k, SampleBatch* batch, bool* kept) {
     if (l >= ends.size()) l = SIZE_MAX;
   }
   if (l == SIZE_MAX) l = sampler.LeafForMass(m);
-  if (l != cached_leaf_) {
-    cached_cell_ = tree.LeafCell(l);
-    cached_leaf_ = l;
+  if (l != cache.leaf) {
+    cache.cell = tree.LeafCell(l);
+    cache.leaf = l;
   }
   const double begin_mass = tree.mass_begin(l);
   const double t = std::clamp((m - begin_mass) / (tree.mass_end(l) - begin_mass), 0.0, 1.0);
@@ -233,11 +272,11 @@ absl::Status SampleCursor::Emit(uint64_t k, SampleBatch* batch, bool* kept) {
   const uint64_t scale = curve.PowW(levels);
   const uint64_t digits = std::min(static_cast<uint64_t>(t * static_cast<double>(scale)), scale - 1);
   uint64_t cx, cy;
-  int state = cached_cell_.state;
+  int state = cache.cell.state;
   curve.Descend(digits, levels, &cx, &cy, &state);
-  const double cell = cached_cell_.size / curve.PowG(levels);
-  const double u = cached_cell_.u0 + (static_cast<double>(cx) + 0.5) * cell;
-  const double v = cached_cell_.v0 + (static_cast<double>(cy) + 0.5) * cell;
+  const double cell = cache.cell.size / curve.PowG(levels);
+  const double u = cache.cell.u0 + (static_cast<double>(cx) + 0.5) * cell;
+  const double v = cache.cell.v0 + (static_cast<double>(cy) + 0.5) * cell;
 
   const bool need_jet = fields_.normal || fields_.density;
   SurfaceJet jet;

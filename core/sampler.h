@@ -63,10 +63,13 @@ class SampleCursor {
   // range by curve position first (cost O(n log n), n = end - begin).
   // Errors: INVALID_ARGUMENT for begin > end, end > count, or an empty region;
   // RESOURCE_EXHAUSTED is not raised here (the caller bounds count).
+  // `threads` > 1 lets Next() fill large batches of plain index ranges with
+  // that many threads; the samples and their order do not change.
   static absl::StatusOr<std::unique_ptr<SampleCursor>> Create(std::shared_ptr<const Sampler> sampler,
                                                               uint64_t begin, uint64_t end,
                                                               const Region& region,
-                                                              const SampleFields& fields);
+                                                              const SampleFields& fields,
+                                                              int threads = 1);
 
   // Appends up to `max` samples to `batch` (which it does not clear) and
   // returns how many; 0 once the cursor is exhausted. Errors: INVALID_ARGUMENT
@@ -76,9 +79,17 @@ class SampleCursor {
   bool done() const;
 
  private:
+  // The last leaf decoded, reused by consecutive samples; one per thread.
+  struct LeafCache {
+    size_t leaf = SIZE_MAX;
+    CurveTree::Cell cell{};
+  };
+
   SampleCursor(std::shared_ptr<const Sampler> sampler, Region region, SampleFields fields);
   absl::Status PlanRegion(uint64_t begin, uint64_t end);
-  absl::Status Emit(uint64_t k, SampleBatch* batch, bool* kept);
+  absl::Status Emit(uint64_t k, LeafCache& cache, SampleBatch* batch, bool* kept) const;
+  // Emits [k0, k1) (all kept: no region) split over threads_ threads.
+  absl::Status EmitParallel(uint64_t k0, uint64_t k1, SampleBatch* batch);
 
   struct Segment {
     uint64_t begin, end;
@@ -95,9 +106,8 @@ class SampleCursor {
   std::vector<uint64_t> order_;
   size_t order_pos_ = 0;
   bool use_order_ = false;
-  // The last leaf decoded, reused by consecutive samples.
-  size_t cached_leaf_ = SIZE_MAX;
-  CurveTree::Cell cached_cell_{};
+  LeafCache cache_;
+  int threads_ = 1;
 };
 
 }  // namespace sfc

@@ -45,6 +45,7 @@ struct EngineLimits {
   uint64_t max_count = 100'000'000;              // largest N
   uint64_t max_tree_leaves = uint64_t{1} << 24;  // per tree: 16 B a leaf, 256 MiB
   size_t max_spec_length = 4096;                 // surface/density spec, in characters
+  int generation_threads = 1;                    // threads filling one stream's large batches
 };
 
 }  // namespace sfc

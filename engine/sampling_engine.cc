@@ -99,7 +99,8 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request) 
   job.begin = range.first;
   job.end = range.second;
   ASSIGN_OR_RETURN(job.cursor,
-                   SampleCursor::Create(job.sampler, job.begin, job.end, request.region, request.fields));
+                   SampleCursor::Create(job.sampler, job.begin, job.end, request.region, request.fields,
+                                        limits_.generation_threads));
   return job;
 }
 

@@ -17,7 +17,12 @@ struct ServerOptions {
   std::string health_address = "127.0.0.1:50052";
   std::string metrics_address = "127.0.0.1:9464";  // Prometheus /metrics ("" = none)
 
-  EngineLimits limits;                         // max_count, max_tree_leaves, max_spec_length
+  // max_count, max_tree_leaves, max_spec_length, generation_threads (2 here).
+  EngineLimits limits = [] {
+    EngineLimits l;
+    l.generation_threads = 2;
+    return l;
+  }();
   uint64_t cache_bytes = uint64_t{1} << 30;    // tree cache budget, 1 GiB
   uint32_t max_concurrent_streams = 64;        // Sample streams at once; more are RESOURCE_EXHAUSTED
   uint32_t max_batch_size = 1 << 20;           // samples per message a client may ask for

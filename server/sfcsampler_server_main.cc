@@ -32,6 +32,10 @@ int main(int argc, char** argv) {
   app.add_option("--max-concurrent-streams", o.max_concurrent_streams, "Sample streams at once")
       ->capture_default_str();
   app.add_option("--max-batch-size", o.max_batch_size, "most samples per message")->capture_default_str();
+  app.add_option("--generation-threads", o.limits.generation_threads,
+                 "threads that fill one stream's batches (same samples, same order)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 64));
   app.add_option("--request-deadline", o.request_deadline_seconds, "longest a stream may run, seconds")
       ->capture_default_str();
   app.add_option("--shutdown-grace", o.shutdown_grace_seconds,

@@ -93,6 +93,25 @@ TEST(Sampler, RegionQueriesEqualTheFilteredFullSet) {
   }
 }
 
+TEST(Sampler, ThreadedBatchesHoldTheSameSamplesInTheSameOrder) {
+  const uint64_t n = 100000;
+  const auto s = MakeSetup("eight", "gaussian:floor=0.1", n);
+  auto sampler = MakeSampler(s, SequenceKind::kJittered, n, 6);
+  SampleFields fields;
+  fields.normal = fields.density = fields.curve_position = true;
+  const SampleBatch one = Collect(sampler, 17, n - 5, {}, fields, 20000);
+  for (int threads : {2, 3}) {
+    SampleBatch many;
+    auto cursor = *SampleCursor::Create(sampler, 17, n - 5, {}, fields, threads);
+    while (*cursor->Next(20000, &many) > 0) {
+    }
+    ExpectSameSamples(many, one);
+    EXPECT_EQ(many.nx, one.nx);
+    EXPECT_EQ(many.density, one.density);
+    EXPECT_EQ(many.curve_position, one.curve_position);
+  }
+}
+
 TEST(Sampler, SamplesLieOnTheSurfaceInsideTheParameterBox) {
   const uint64_t n = 4000;
   for (const char* surface : {"sphere:r=2", "whitney", "superellipsoid:reparam=1", "eight"}) {

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <iostream>
 #include <set>
+#include <thread>
 
 #include "CLI/CLI.hpp"
 #include "absl/strings/str_format.h"
@@ -157,7 +158,9 @@ int RunSample(const RequestFlags& flags, const std::string& format, bool ascii,
     return 0;
   }
   DirectTreeSource source;
-  SamplingEngine engine(EngineLimits{}, &source);
+  EngineLimits limits;
+  limits.generation_threads = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
+  SamplingEngine engine(limits, &source);
   auto job = engine.Start(*request);
   if (!job.ok()) return Fail(job.status());
   const double build_seconds =
