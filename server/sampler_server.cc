@@ -139,10 +139,17 @@ void SamplerServer::Shutdown(double grace_seconds, double drain_seconds) {
   // `drain_seconds` more.
   const auto drain_until = std::max(deadline, std::chrono::system_clock::now() +
                                                   std::chrono::milliseconds(static_cast<int64_t>(drain_seconds * 1000)));
+  const auto calls_done = std::chrono::system_clock::now();
+  const int open = EstablishedConnections(port_);
   while (drain_seconds > 0 && EstablishedConnections(port_) > 0 &&
          std::chrono::system_clock::now() < drain_until) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
+  spdlog::info("shutdown: calls done after {:.3f} s; {} client connections drained in {:.3f} s",
+               std::chrono::duration<double>(calls_done - (deadline - std::chrono::milliseconds(
+                                                                          static_cast<int64_t>(grace_seconds * 1000))))
+                   .count(),
+               open, std::chrono::duration<double>(std::chrono::system_clock::now() - calls_done).count());
   server_.reset();
   health_server_.reset();
 }
