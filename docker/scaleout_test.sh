@@ -85,4 +85,11 @@ for s in "${surfaces[@]}"; do
 done
 echo "after the kill: $stayed_hits of $stayed surviving keys still hit on their replica; $moved keys moved"
 [ "$stayed_hits" -eq "$stayed" ] || fail "keys of surviving replicas moved"
+# The proxy logs gRPC statuses, including a Trailers-Only error (a request
+# rejected before any sample: its status travels in the headers).
+timeout 10 "$cli" sample -q --server "$proxy" --surface klein -o /dev/null 2> /dev/null && fail "a bad surface was accepted"
+sleep 0.2
+grep -q 'grpc_status=-/3 ' "$dir/access.log" || fail "the proxy did not log the Trailers-Only INVALID_ARGUMENT"
+grep -q 'grpc_status=0/- ' "$dir/access.log" || fail "the proxy did not log OK statuses from trailers"
+echo "proxy log: gRPC status from trailers and from Trailers-Only responses"
 echo "scaleout_test: all checks passed"
