@@ -59,6 +59,10 @@ absl::StatusOr<Spec> ParseSpec(const std::string& kind, const std::vector<Catalo
             "%s \"%s\": \"%s\" is not a KEY=VALUE parameter it accepts; accepted: %s", kind, name,
             std::string(part), accepted.empty() ? "none" : absl::StrJoin(accepted, ", ")));
       }
+      if (spec.values.count(key)) {
+        return absl::InvalidArgumentError(
+            absl::StrFormat("%s \"%s\": the parameter %s is given twice", kind, name, key));
+      }
       spec.values[key] = std::string(absl::StripAsciiWhitespace(part.substr(eq + 1)));
     }
   }

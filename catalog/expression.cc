@@ -16,6 +16,9 @@ namespace {
 
 absl::Status ParserError(const std::string& what, const std::string& text,
                          const mu::Parser::exception_type& e) {
+  if (e.GetPos() < 0) {
+    return absl::InvalidArgumentError(absl::StrFormat("%s: %s (in \"%s\")", what, e.GetMsg(), text));
+  }
   return absl::InvalidArgumentError(absl::StrFormat(
       "%s: %s at position %d (token '%s') in \"%s\"", what, e.GetMsg(), e.GetPos(), e.GetToken(),
       text));

@@ -95,6 +95,8 @@ TEST(Engine, UnknownSurfaceDensityOrParameterIsInvalidArgument) {
               absl::StatusCode::kInvalidArgument, "accepted: r");
   ExpectError(StartWith("torus:r=-1", "uniform", 10).status(), absl::StatusCode::kInvalidArgument,
               "> 0");
+  ExpectError(StartWith("sphere:r=1;r=2", "uniform", 10).status(), absl::StatusCode::kInvalidArgument,
+              "given twice");
 }
 
 TEST(Engine, OverlongSpecIsInvalidArgument) {
