@@ -54,4 +54,27 @@ wait "$client" || fail "the in-flight stream did not survive a graceful shutdown
 wait "$pid" || fail "the server did not exit cleanly"
 pid=""
 grep -q "stopped" "$tmp/server.log" || fail "no shutdown log"
+# TLS and a bearer token: a second server with a self-signed certificate.
+openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=localhost \
+  -addext "subjectAltName=IP:127.0.0.1,DNS:localhost" \
+  -keyout "$tmp/key.pem" -out "$tmp/cert.pem" > /dev/null 2>&1 || fail "openssl could not make a certificate"
+echo "s3cret-token" > "$tmp/token"
+"$server" --address 127.0.0.1:0 --health-address 127.0.0.1:0 --metrics-address "" \
+  --tls-cert "$tmp/cert.pem" --tls-key "$tmp/key.pem" --token-file "$tmp/token" > "$tmp/tls.log" 2>&1 &
+pid=$!
+for _ in $(seq 100); do grep -q "listening" "$tmp/tls.log" && break; sleep 0.05; done
+tls_port=$(sed -n 's/.* port=\([0-9]*\) health_port=.*/\1/p' "$tmp/tls.log")
+tls_health=$(sed -n 's/.*health_port=\([0-9]*\).*/\1/p' "$tmp/tls.log")
+"$cli" sample --surface torus --count 1000 -q -o "$tmp/tls.csv" --server "127.0.0.1:$tls_port" \
+  --tls-roots "$tmp/cert.pem" --token-file "$tmp/token" || fail "TLS with the token"
+"$cli" sample --surface torus --count 1000 -q -o "$tmp/plain.csv"
+cmp -s "$tmp/tls.csv" "$tmp/plain.csv" || fail "TLS samples differ"
+"$cli" sample --surface torus --count 10 -q -o /dev/null --server "127.0.0.1:$tls_port" \
+  --tls-roots "$tmp/cert.pem" 2> "$tmp/noauth.err" && fail "a request without the token was served"
+grep -q UNAUTHENTICATED "$tmp/noauth.err" || fail "no UNAUTHENTICATED without the token"
+"$cli" sample --surface torus --count 10 -q -o /dev/null --server "127.0.0.1:$tls_port" \
+  --token-file "$tmp/token" 2> /dev/null && fail "a plaintext client reached the TLS port"
+[ "$("$cli" health --server "127.0.0.1:$tls_health")" = SERVING ] || fail "the probe port needs no TLS or token"
+kill -TERM "$pid"; wait "$pid" || true; pid=""
+
 echo "cli_server_test: all checks passed"

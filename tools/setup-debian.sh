@@ -14,6 +14,7 @@ packages=(
   libspdlog-dev                                  # server logs
   prometheus-cpp-dev                             # server metrics
   libcairo2-dev libpng-dev                       # pictures and plots
+  openssl                                        # a self-signed certificate for the TLS test
   nginx                                          # the consistent-hash gRPC proxy of the scale-out test
 )
 

@@ -395,7 +395,7 @@ int main(int argc, char** argv) {
   bool ascii = false, quiet = false;
   size_t batch_size = 65536;
 
-  CLI::App* sample = app.add_subcommand("sample", "sample a surface (in-process)");
+  CLI::App* sample = app.add_subcommand("sample", "sample a surface (in-process, or over the wire with --server)");
   sfc::AddTreeFlags(sample, &flags);
   sfc::AddSampleFlags(sample, &flags);
   sample->add_option("--format", format, "csv | ply")->capture_default_str();
