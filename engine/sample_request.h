@@ -46,6 +46,9 @@ struct EngineLimits {
   uint64_t max_tree_leaves = uint64_t{1} << 24;  // per tree: 16 B a leaf, 256 MiB
   size_t max_spec_length = 4096;                 // surface/density spec, in characters
   int generation_threads = 1;                    // threads filling one stream's large batches
+  // Sequences that are not monotone in k are sorted into curve order per
+  // request (16 bytes a sample): at most this many samples per request.
+  uint64_t max_sorted_range = uint64_t{1} << 24;
 };
 
 }  // namespace sfc

@@ -89,6 +89,13 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request) 
         "the %s sequence supports at most 2^32 samples", SequenceName(request.sequence)));
   }
   ASSIGN_OR_RETURN(const auto range, ResolveRange(request));
+  if (!Sequence(request.sequence, 1, 0).monotone() &&
+      range.second - range.first > limits_.max_sorted_range) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the %s sequence is sorted into curve order per request, so a request may cover at most "
+        "%d samples (max_sorted_range); ask for index ranges of that size",
+        SequenceName(request.sequence), limits_.max_sorted_range));
+  }
   RETURN_IF_ERROR(request.region.Validate());
   const uint64_t tree_count = request.tree_count == 0 ? request.count : request.tree_count;
   SamplingJob job;

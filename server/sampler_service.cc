@@ -191,6 +191,8 @@ grpc::Status SamplerService::GetCacheStats(grpc::ServerContext* context,
     response->set_max_batch_size(options_.max_batch_size);
     response->set_request_deadline_seconds(options_.request_deadline_seconds);
     response->set_active_streams(active_streams_.load());
+    response->set_max_sorted_range(options_.limits.max_sorted_range);
+    response->set_generation_threads(options_.limits.generation_threads);
   }
   metrics_->CountRequest("GetCacheStats", status.error_code());
   return status;

@@ -27,6 +27,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--max-spec-length", o.limits.max_spec_length, "longest surface or density spec, characters")
       ->capture_default_str();
+  app.add_option("--max-sorted-range", o.limits.max_sorted_range,
+                 "most samples per request for sequences sorted into curve order (random, "
+                 "vandercorput, progressive)")
+      ->capture_default_str();
   app.add_option("--cache-bytes", o.cache_bytes, "tree cache budget in bytes (LRU eviction)")
       ->capture_default_str();
   app.add_option("--max-concurrent-streams", o.max_concurrent_streams, "Sample streams at once")

@@ -127,6 +127,21 @@ TEST(Engine, BadRangeShardOrRegionIsInvalidArgument) {
   ExpectError(engine.Start(r).status(), absl::StatusCode::kInvalidArgument, "empty");
 }
 
+TEST(Engine, UnorderedSequencesAreBoundedPerRequest) {
+  DirectTreeSource source;
+  EngineLimits limits;
+  limits.max_sorted_range = 1000;
+  SamplingEngine engine(limits, &source);
+  SampleRequest r;
+  r.tree.surface = "plane";
+  r.count = 5000;
+  r.sequence = SequenceKind::kRandom;
+  ExpectError(engine.Start(r).status(), absl::StatusCode::kInvalidArgument, "max_sorted_range");
+  r.begin = 1000;
+  r.end = 2000;
+  EXPECT_TRUE(engine.Start(r).ok());
+}
+
 TEST(Engine, ShardsPartitionTheIndexRange) {
   SampleRequest r;
   r.count = 1001;
