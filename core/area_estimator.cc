@@ -27,19 +27,18 @@ double TriangleArea(const Vec3& a, const Vec3& b, const Vec3& c) {
 
 }  // namespace
 
-absl::StatusOr<DensityAt> EvaluateDensity(const Surface& surface, const Density& density, double u,
-                                          double v) {
-  // Curvatures and the normal are computed only for densities that read them:
-  // this is the tree build's innermost call.
-  const bool curvature = density.NeedsCurvature();
-  const SurfaceJet jet = surface.Jet(u, v, curvature ? 2 : 1);
+namespace {
+
+// delta and the area element from a jet at (u, v), checked.
+absl::StatusOr<DensityAt> DensityFromJet(const SurfaceJet& jet, const Density& density, double u,
+                                         double v) {
   if (!IsFinite(jet.p)) return NotFinite(u, v);
   SurfacePoint point;
   point.u = u;
   point.v = v;
   point.p = jet.p;
   double area_element;
-  if (curvature) {
+  if (density.NeedsCurvature()) {
     const SurfaceGeometry geo = GeometryOf(jet);
     point.normal = geo.normal;
     point.gaussian_curvature = geo.gaussian_curvature;
@@ -66,6 +65,39 @@ absl::StatusOr<DensityAt> EvaluateDensity(const Surface& surface, const Density&
         u, v));
   }
   return out;
+}
+
+}  // namespace
+
+absl::StatusOr<DensityAt> EvaluateDensity(const Surface& surface, const Density& density, double u,
+                                          double v) {
+  // Curvatures and the normal are computed only for densities that read them:
+  // this is the tree build's innermost call.
+  return DensityFromJet(surface.Jet(u, v, density.NeedsCurvature() ? 2 : 1), density, u, v);
+}
+
+absl::Status CellMassesOnGrid(const Surface& surface, const Density& density,
+                              AreaEstimator estimator, double u0, double v0, double h, int n,
+                              double* masses) {
+  if (estimator != AreaEstimator::kFirstFundamentalForm) {
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) {
+        ASSIGN_OR_RETURN(masses[i * n + j], CellMass(surface, density, estimator, u0 + i * h, v0 + j * h, h));
+      }
+    }
+    return absl::OkStatus();
+  }
+  double us[3], vs[3];
+  SurfaceJet jets[9];
+  for (int i = 0; i < n; ++i) us[i] = u0 + i * h + h / 2, vs[i] = v0 + i * h + h / 2;
+  surface.JetGrid(us, n, vs, n, density.NeedsCurvature() ? 2 : 1, jets);
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      ASSIGN_OR_RETURN(const DensityAt d, DensityFromJet(jets[i * n + j], density, us[i], vs[j]));
+      masses[i * n + j] = d.delta * d.area_element * h * h;
+    }
+  }
+  return absl::OkStatus();
 }
 
 absl::StatusOr<double> CellMass(const Surface& surface, const Density& density,

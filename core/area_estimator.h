@@ -41,6 +41,13 @@ absl::StatusOr<DensityAt> EvaluateDensity(const Surface& surface, const Density&
 absl::StatusOr<double> CellMass(const Surface& surface, const Density& density,
                                 AreaEstimator estimator, double u0, double v0, double h);
 
+// CellMass of the n x n cells of side h with lower-left corner (u0, v0):
+// masses[i * n + j] for the cell [u0 + i h, ..) x [v0 + j h, ..). Estimator
+// (c) evaluates the centres with Surface::JetGrid. REQUIRES: n <= 3.
+absl::Status CellMassesOnGrid(const Surface& surface, const Density& density,
+                              AreaEstimator estimator, double u0, double v0, double h, int n,
+                              double* masses);
+
 // Estimator (a) for the vertex `cur` with curve neighbours `prev` and `next`
 // (parameter points): the area of the mapped triangle times delta at the
 // parameter centroid. Zero when the three mapped vertices are collinear.

@@ -31,6 +31,22 @@ class Sphere final : public Surface {
   SurfaceJet Jet(double u, double v, int order) const override {
     const double st = std::sin(kPi * u), ct = std::cos(kPi * u);
     const double sp = std::sin(2 * kPi * v), cp = std::cos(2 * kPi * v);
+    return JetFrom(st, ct, sp, cp, order);
+  }
+  void JetGrid(const double* us, int nu, const double* vs, int nv, int order,
+               SurfaceJet* out) const override {
+    double sp[9], cp[9];
+    if (nv > 9) return Surface::JetGrid(us, nu, vs, nv, order, out);
+    for (int j = 0; j < nv; ++j) sp[j] = std::sin(2 * kPi * vs[j]), cp[j] = std::cos(2 * kPi * vs[j]);
+    for (int i = 0; i < nu; ++i) {
+      const double st = std::sin(kPi * us[i]), ct = std::cos(kPi * us[i]);
+      for (int j = 0; j < nv; ++j) out[i * nv + j] = JetFrom(st, ct, sp[j], cp[j], order);
+    }
+  }
+
+ private:
+  // The jet from sin and cos of theta = pi u and phi = 2 pi v.
+  SurfaceJet JetFrom(double st, double ct, double sp, double cp, int order) const {
     SurfaceJet j;
     j.p = {r_ * st * cp, r_ * st * sp, r_ * ct};
     j.fu = Vec3{ct * cp, ct * sp, -st} * (kPi * r_);
@@ -43,7 +59,6 @@ class Sphere final : public Surface {
     return j;
   }
 
- private:
   const double r_;
 };
 

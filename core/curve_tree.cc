@@ -209,12 +209,14 @@ class CurveTree::Builder {
     const uint64_t span = curve_.Span(depth + 1);
     const double h = 1.0 / curve_.PowG(depth + 1);
     NoteDepth(depth + 1, (x * g + 0.5) * h, (y * g + 0.5) * h);
+    double masses[9];  // by grid position, [dx * g + dy]
+    RETURN_IF_ERROR(CellMassesOnGrid(surface_, density_, decision_estimator_, x * g * h, y * g * h, h,
+                                     g, masses));
     for (int c = 0; c < curve_.arity(); ++c) {
       const Curve::Child& ch = curve_.ChildOf(state, c);
       const uint64_t cx = x * g + ch.dx, cy = y * g + ch.dy;
       const uint64_t child_start = start + c * span;
-      ASSIGN_OR_RETURN(const double mass,
-                       CellMass(surface_, density_, decision_estimator_, cx * h, cy * h, h));
+      const double mass = masses[ch.dx * g + ch.dy];
       if (mass > limit_ && depth + 1 < options_.depth_cap) {
         RETURN_IF_ERROR(SplitForMass(depth + 1, child_start, cx, cy, ch.state));
         continue;

@@ -41,6 +41,13 @@ SurfaceJet Surface::Jet(double u, double v, int order) const {
   return jet;
 }
 
+void Surface::JetGrid(const double* us, int nu, const double* vs, int nv, int order,
+                      SurfaceJet* out) const {
+  for (int i = 0; i < nu; ++i) {
+    for (int j = 0; j < nv; ++j) out[i * nv + j] = Jet(us[i], vs[j], order);
+  }
+}
+
 SurfaceGeometry GeometryOf(const SurfaceJet& jet) {
   SurfaceGeometry geo;
   geo.e = Dot(jet.fu, jet.fu);

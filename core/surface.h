@@ -34,6 +34,13 @@ class Surface {
   // 1e-5), 2nd-order central differences for the second ones (h = 1e-4).
   // Stencils never leave the unit square. Surfaces with closed forms override.
   virtual SurfaceJet Jet(double u, double v, int order) const;
+
+  // Jets on the grid us[0..nu) x vs[0..nv): out[i * nv + j] = Jet(us[i], vs[j],
+  // order). Surfaces whose formula separates in u and v override it to share
+  // the work of a row or column (the tree build's inner loop); the default
+  // calls Jet.
+  virtual void JetGrid(const double* us, int nu, const double* vs, int nv, int order,
+                       SurfaceJet* out) const;
 };
 
 // First fundamental form, normal and curvatures at one point.
