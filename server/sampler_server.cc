@@ -38,9 +38,9 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> Credentials(const Serve
   return grpc::SslServerCredentials(ssl);
 }
 
-// TCP connections in state ESTABLISHED whose local port is `port`, from
-// /proc/net/tcp and tcp6 (0 where /proc is not readable).
-int EstablishedConnections(int port) {
+// TCP connections to local port `port` that still have data in their send
+// queue, from /proc/net/tcp and tcp6 (0 where /proc is not readable).
+int ConnectionsWithUnsentData(int port) {
   int count = 0;
   for (const char* path : {"/proc/net/tcp", "/proc/net/tcp6"}) {
     std::ifstream in(path);
@@ -48,11 +48,12 @@ int EstablishedConnections(int port) {
     std::getline(in, line);  // header
     while (std::getline(in, line)) {
       std::istringstream fields(line);
-      std::string slot, local, remote, state;
-      fields >> slot >> local >> remote >> state;
+      std::string slot, local, remote, state, queues;
+      fields >> slot >> local >> remote >> state >> queues;  // queues: "tx:rx", hex
       const size_t colon = local.rfind(':');
-      if (colon == std::string::npos || state != "01") continue;  // 01 = ESTABLISHED
-      if (std::stoi(local.substr(colon + 1), nullptr, 16) == port) ++count;
+      if (colon == std::string::npos || queues.empty()) continue;
+      if (std::stoi(local.substr(colon + 1), nullptr, 16) != port) continue;
+      if (std::stoul(queues.substr(0, queues.find(':')), nullptr, 16) > 0) ++count;
     }
   }
   return count;
@@ -78,6 +79,9 @@ absl::StatusOr<std::unique_ptr<SamplerServer>> SamplerServer::Start(const Server
   builder.RegisterService(server->service_.get());
   // Messages carry up to max_batch_size samples of up to 10 float64 columns.
   builder.SetMaxSendMessageSize(-1);
+  // Sync-server threads wake this often to notice shutdown (gRPC's default of
+  // 10 s would hold up a graceful stop by that long).
+  builder.SetSyncServerOption(grpc::ServerBuilder::SyncServerOption::CQ_TIMEOUT_MSEC, 200);
   server->server_ = builder.BuildAndStart();
   if (!server->server_ || server->port_ == 0) {
     return absl::UnavailableError(absl::StrFormat("cannot listen on %s", options.address));
@@ -88,6 +92,7 @@ absl::StatusOr<std::unique_ptr<SamplerServer>> SamplerServer::Start(const Server
     grpc::ServerBuilder health;
     health.AddListeningPort(options.health_address, grpc::InsecureServerCredentials(),
                             &server->health_port_);
+    health.SetSyncServerOption(grpc::ServerBuilder::SyncServerOption::CQ_TIMEOUT_MSEC, 200);
     server->health_server_ = health.BuildAndStart();
     if (!server->health_server_ || server->health_port_ == 0) {
       return absl::UnavailableError(absl::StrFormat("cannot listen on %s", options.health_address));
@@ -123,33 +128,41 @@ int SamplerServer::metrics_port() const {
 
 void SamplerServer::Shutdown(double grace_seconds, double drain_seconds) {
   if (!server_) return;
+  using Clock = std::chrono::system_clock;
+  const auto start = Clock::now();
+  const auto deadline = start + std::chrono::milliseconds(static_cast<int64_t>(grace_seconds * 1000));
+  const auto seconds_since = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
   server_->GetHealthCheckService()->SetServingStatus(false);
   if (health_server_) health_server_->GetHealthCheckService()->SetServingStatus(false);
-  const auto deadline =
-      std::chrono::system_clock::now() +
-      std::chrono::milliseconds(static_cast<int64_t>(grace_seconds * 1000));
-  server_->Shutdown(deadline);
-  if (health_server_) health_server_->Shutdown(deadline);
+
+  // 1. Refuse new work, let the streams in flight run to their end.
+  service_->StartDraining();
+  while (service_->active_streams() > 0 && Clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  const double streams_done = seconds_since(start);
+  // 2. gRPC counts a call done once its status is queued, and its Shutdown
+  // closes the transports, dropping what a slow reader has not taken yet. So
+  // wait while bytes are still leaving: until no connection to our port has
+  // had unsent data for 200 ms (or none is left), up to the grace deadline
+  // and at least `drain_seconds` after the streams ended.
+  const auto drain_until = std::max(deadline, Clock::now() + std::chrono::milliseconds(
+                                                                 static_cast<int64_t>(drain_seconds * 1000)));
+  auto quiet_since = Clock::now();
+  while (drain_seconds > 0 && Clock::now() < drain_until) {
+    if (ConnectionsWithUnsentData(port_) > 0) quiet_since = Clock::now();
+    if (Clock::now() - quiet_since >= std::chrono::milliseconds(200)) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  // 3. Close; anything still running past the deadline is cancelled.
+  server_->Shutdown(std::max(deadline, Clock::now()));
+  if (health_server_) health_server_->Shutdown(Clock::now());
   server_->Wait();
   if (health_server_) health_server_->Wait();
-  // gRPC counts a call as done once its status is queued: a slow client may
-  // still have a flow-control window or more of its last messages to read.
-  // Keep the transports up until the clients have hung up (their TCP
-  // connections to our port are gone), up to the grace deadline and at least
-  // `drain_seconds` more.
-  const auto drain_until = std::max(deadline, std::chrono::system_clock::now() +
-                                                  std::chrono::milliseconds(static_cast<int64_t>(drain_seconds * 1000)));
-  const auto calls_done = std::chrono::system_clock::now();
-  const int open = EstablishedConnections(port_);
-  while (drain_seconds > 0 && EstablishedConnections(port_) > 0 &&
-         std::chrono::system_clock::now() < drain_until) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  spdlog::info("shutdown: calls done after {:.3f} s; {} client connections drained in {:.3f} s",
-               std::chrono::duration<double>(calls_done - (deadline - std::chrono::milliseconds(
-                                                                          static_cast<int64_t>(grace_seconds * 1000))))
-                   .count(),
-               open, std::chrono::duration<double>(std::chrono::system_clock::now() - calls_done).count());
+  spdlog::info("shutdown: streams done after {:.3f} s, transports flushed and closed after {:.3f} s",
+               streams_done, seconds_since(start));
   server_.reset();
   health_server_.reset();
 }

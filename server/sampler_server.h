@@ -31,10 +31,10 @@ class SamplerServer {
   int health_port() const { return health_port_; }
   int metrics_port() const;
 
-  // Stops accepting, lets in-flight calls run up to `grace_seconds`, then
-  // cancels them; health turns NOT_SERVING first. Then, so finished streams'
-  // last bytes reach slow clients, waits until no client connection remains,
-  // up to the grace deadline and at least `drain_seconds`.
+  // Graceful stop: health turns NOT_SERVING and new calls get UNAVAILABLE;
+  // streams in flight run on for up to `grace_seconds` and then wait (at least
+  // `drain_seconds`, up to the grace deadline) until their last bytes have left;
+  // then the server closes, cancelling whatever still runs.
   void Shutdown(double grace_seconds, double drain_seconds = 1.0);
 
   const TreeCache& cache() const { return *cache_; }

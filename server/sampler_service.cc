@@ -25,6 +25,10 @@ SamplerService::SamplerService(const ServerOptions& options, TreeCache* cache, S
     : options_(options), cache_(cache), metrics_(metrics), engine_(options.limits, cache) {}
 
 grpc::Status SamplerService::CheckToken(const grpc::ServerContext& context) const {
+  if (draining_.load()) {
+    return grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                        "the server is shutting down; retry on another replica or later");
+  }
   if (options_.token.empty()) return grpc::Status::OK;
   const auto& md = context.client_metadata();
   auto it = md.find("authorization");

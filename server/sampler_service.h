@@ -38,6 +38,8 @@ class SamplerService final : public ::sfcsampler::v1::Sampler::Service {
                              ::sfcsampler::v1::CacheStats* response) override;
 
   uint32_t active_streams() const { return active_streams_.load(); }
+  // From now on new calls get UNAVAILABLE ("shutting down"); streams in flight go on.
+  void StartDraining() { draining_.store(true); }
 
  private:
   grpc::Status CheckToken(const grpc::ServerContext& context) const;
@@ -52,6 +54,7 @@ class SamplerService final : public ::sfcsampler::v1::Sampler::Service {
   const SamplingEngine engine_;
 
   std::atomic<uint32_t> active_streams_{0};
+  std::atomic<bool> draining_{false};
 };
 
 }  // namespace sfc

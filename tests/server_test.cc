@@ -341,6 +341,32 @@ TEST(Server, ATokenIsRequiredWhenSetButHealthStaysOpen) {
   EXPECT_TRUE(Fetch(*authorised, Request("sphere", 10)).ok());
 }
 
+TEST(Server, AGracefulShutdownFinishesStreamsAndTurnsNewCallsAway) {
+  ClientOptions co;
+  co.batch_size = 1000;
+  co.max_resumes = 0;
+  Running r = StartServer(LoopbackOptions(), co);
+  const SampleRequest request = Request("sphere", 300000, 3);
+  std::thread stopper;
+  absl::Status refused;
+  uint64_t received = 0;
+  auto result = r.client->Sample(request, [&](const v1::StreamHeader&, const SampleBatch& b) {
+    received += b.size();
+    if (!stopper.joinable()) {
+      stopper = std::thread([&] { r.server->Shutdown(30, 1); });
+      // Wait until the server has started draining, then ask for more.
+      while (r.client->CheckHealth().value_or(false)) std::this_thread::sleep_for(milliseconds(5));
+      refused = Fetch(*r.client, Request("torus", 10)).status();
+    }
+    std::this_thread::sleep_for(milliseconds(1));  // a slow reader
+    return absl::OkStatus();
+  });
+  stopper.join();
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_EQ(received, 300000u);
+  ExpectStatus(refused, absl::StatusCode::kUnavailable, "shutting down");
+}
+
 TEST(Server, Float32PayloadsCarryTheSameSamplesRounded) {
   ClientOptions co;
   co.precision = v1::PRECISION_FLOAT32;
