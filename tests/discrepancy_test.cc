@@ -138,8 +138,20 @@ TEST(ReferenceSets, JitteredPutsOnePointInEachEqualAreaStratum) {
   for (uint64_t n : {16u, 24u, 1000u}) {
     const auto pts = JitteredSquare(n, 1);
     ASSERT_EQ(pts.size(), n);
-    // Star discrepancy of a jittered set is far below a random set's.
-    EXPECT_LT(StarDiscrepancy(pts), 4.0 / std::sqrt(static_cast<double>(n)));
+    // The strata: floor(sqrt n) rows, the first n % rows of them one cell
+    // longer, each row as tall as its share of the n equal-area cells.
+    const uint64_t rows = static_cast<uint64_t>(std::sqrt(static_cast<double>(n)));
+    std::set<std::pair<uint64_t, uint64_t>> occupied;
+    double y0 = 0;
+    for (uint64_t r = 0; r < rows; ++r) {
+      const uint64_t cells = n / rows + (r < n % rows ? 1 : 0);
+      const double height = static_cast<double>(cells) / n;
+      for (const auto& p : pts) {
+        if (p.y >= y0 && p.y < y0 + height) occupied.insert({r, static_cast<uint64_t>(p.x * cells)});
+      }
+      y0 += height;
+    }
+    EXPECT_EQ(occupied.size(), n) << "every stratum holds exactly one of the n points";
   }
 }
 
