@@ -8,16 +8,9 @@
 namespace sfc {
 namespace {
 
-absl::Status NotFinite(double u, double v) {
-  return absl::InvalidArgumentError(absl::StrFormat(
-      "the surface is not finite (NaN or infinity) at (u,v) = (%.17g, %.17g); fix its formula or "
-      "parameter box so it is defined everywhere on the box",
-      u, v));
-}
-
 absl::StatusOr<Vec3> FinitePoint(const Surface& surface, double u, double v) {
   const Vec3 p = surface.Point(u, v);
-  if (!IsFinite(p)) return NotFinite(u, v);
+  if (!IsFinite(p)) return SurfaceNotFiniteError(u, v);
   return p;
 }
 
@@ -32,7 +25,7 @@ namespace {
 // delta and the area element from a jet at (u, v), checked.
 absl::StatusOr<DensityAt> DensityFromJet(const SurfaceJet& jet, const Density& density, double u,
                                          double v) {
-  if (!IsFinite(jet.p)) return NotFinite(u, v);
+  if (!IsFinite(jet.p)) return SurfaceNotFiniteError(u, v);
   SurfacePoint point;
   point.u = u;
   point.v = v;
@@ -68,6 +61,13 @@ absl::StatusOr<DensityAt> DensityFromJet(const SurfaceJet& jet, const Density& d
 }
 
 }  // namespace
+
+absl::Status SurfaceNotFiniteError(double u, double v) {
+  return absl::InvalidArgumentError(absl::StrFormat(
+      "the surface is not finite (NaN or infinity) at (u,v) = (%.17g, %.17g); fix its formula or "
+      "parameter box so it is defined everywhere on the box",
+      u, v));
+}
 
 absl::StatusOr<DensityAt> EvaluateDensity(const Surface& surface, const Density& density, double u,
                                           double v) {

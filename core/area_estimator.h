@@ -26,6 +26,9 @@ enum class AreaEstimator {
 std::string_view AreaEstimatorName(AreaEstimator e);  // "triangle", "square", "fff", "quadrature"
 std::optional<AreaEstimator> AreaEstimatorFromName(std::string_view name);
 
+// INVALID_ARGUMENT saying the surface is not finite at (u, v) and what to fix.
+absl::Status SurfaceNotFiniteError(double u, double v);
+
 // delta and the area element at one parameter point.
 struct DensityAt {
   Vec3 p;

@@ -56,19 +56,14 @@ class CurveTree::Builder {
     const size_t n = starts_.size();
     std::vector<double> cu(n), cv(n);
     for (size_t l = 0; l < n; ++l) {
-      const uint64_t end = l + 1 < n ? starts_[l + 1] : curve_.Span(0);
-      const int depth = curve_.DepthOfSpan(end - starts_[l]);
-      uint64_t x, y;
-      int state = Curve::kRootState;
-      curve_.Descend(starts_[l] / curve_.Span(depth), depth, &x, &y, &state);
-      const double h = 1.0 / curve_.PowG(depth);
-      cu[l] = (x + 0.5) * h;
-      cv[l] = (y + 0.5) * h;
+      const CurveTree::Cell cell = CellOf(l);
+      cu[l] = cell.u0 + cell.size / 2;
+      cv[l] = cell.v0 + cell.size / 2;
     }
     masses_.resize(n);
     if (n < 3) {
       for (size_t l = 0; l < n; ++l) {
-        const CurveTree::Cell cell = CellOf(starts_[l], l + 1 < n ? starts_[l + 1] : curve_.Span(0));
+        const CurveTree::Cell cell = CellOf(l);
         ASSIGN_OR_RETURN(masses_[l], CellMass(surface_, density_, AreaEstimator::kFirstFundamentalForm,
                                               cell.u0, cell.v0, cell.size));
       }
@@ -104,9 +99,7 @@ class CurveTree::Builder {
         RETURN_IF_ERROR(Keep(prev.starts_[l], s));
         continue;
       }
-      const uint64_t x = static_cast<uint64_t>(std::llround(cell.u0 / cell.size));
-      const uint64_t y = static_cast<uint64_t>(std::llround(cell.v0 / cell.size));
-      RETURN_IF_ERROR(SplitForMass(cell.depth, prev.starts_[l], x, y, cell.state));
+      RETURN_IF_ERROR(SplitForMass(cell.depth, prev.starts_[l], cell.x, cell.y, cell.state));
     }
     return absl::OkStatus();
   }
@@ -193,10 +186,7 @@ class CurveTree::Builder {
         const double u = u0 + i * (h / 2), v = v0 + j * (h / 2);
         const Vec3 p = (i == 1 && j == 1) ? c : surface_.Point(u, v);
         if (!IsFinite(p)) {
-          return absl::InvalidArgumentError(absl::StrFormat(
-              "the surface is not finite (NaN or infinity) at (u,v) = (%.17g, %.17g); fix its "
-              "formula or parameter box so it is defined everywhere on the box",
-              u, v));
+          return SurfaceNotFiniteError(u, v);
         }
         spread = std::max(spread, Norm(p - c));
       }
@@ -264,13 +254,10 @@ class CurveTree::Builder {
     deepest_v_ = v;
   }
 
-  CurveTree::Cell CellOf(uint64_t start, uint64_t end) const {
-    const int depth = curve_.DepthOfSpan(end - start);
-    uint64_t x, y;
-    int state = Curve::kRootState;
-    curve_.Descend(start / curve_.Span(depth), depth, &x, &y, &state);
-    const double h = 1.0 / curve_.PowG(depth);
-    return {x * h, y * h, h, depth, state};
+  // The cell of leaf l of starts_.
+  CurveTree::Cell CellOf(size_t l) const {
+    return CurveTree::CellOfRange(curve_, starts_[l],
+                                  l + 1 < starts_.size() ? starts_[l + 1] : curve_.Span(0));
   }
 
   const Surface& surface_;
@@ -312,10 +299,7 @@ absl::StatusOr<CurveTreeOptions> ResolveOptions(const Surface& surface, CurveTre
         const double u = static_cast<double>(i) / kGrid, v = static_cast<double>(j) / kGrid;
         const Vec3 p = surface.Point(u, v);
         if (!IsFinite(p)) {
-          return absl::InvalidArgumentError(absl::StrFormat(
-              "the surface is not finite (NaN or infinity) at (u,v) = (%.17g, %.17g); fix its "
-              "formula or parameter box so it is defined everywhere on the box",
-              u, v));
+          return SurfaceNotFiniteError(u, v);
         }
         lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
         hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
@@ -384,13 +368,17 @@ absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Refined(const Surfac
   return std::shared_ptr<const CurveTree>(std::move(tree));
 }
 
-CurveTree::Cell CurveTree::LeafCell(size_t l) const {
-  const int depth = leaf_depth(l);
+CurveTree::Cell CurveTree::CellOfRange(const Curve& curve, uint64_t start, uint64_t end) {
+  const int depth = curve.DepthOfSpan(end - start);
   uint64_t x, y;
   int state = Curve::kRootState;
-  curve_->Descend(curve_->Prefix(starts_[l], depth), depth, &x, &y, &state);
-  const double h = 1.0 / curve_->PowG(depth);
-  return {x * h, y * h, h, depth, state};
+  curve.Descend(curve.Prefix(start, depth), depth, &x, &y, &state);
+  const double h = 1.0 / curve.PowG(depth);
+  return {x * h, y * h, h, depth, state, x, y};
+}
+
+CurveTree::Cell CurveTree::LeafCell(size_t l) const {
+  return CellOfRange(*curve_, starts_[l], leaf_end(l));
 }
 
 size_t CurveTree::LeafAt(uint64_t index) const {

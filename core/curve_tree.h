@@ -104,11 +104,13 @@ class CurveTree {
   double total_mass() const { return mass_end_.back(); }
   double base_mass() const { return base_mass_; }
 
-  // The leaf's parameter cell [u0, u0+size) x [v0, v0+size) and orientation.
+  // The leaf's parameter cell [u0, u0+size) x [v0, v0+size), its position
+  // (x, y) among the g^depth x g^depth cells of its depth, and orientation.
   struct Cell {
     double u0, v0, size;
     int depth;
     int state;
+    uint64_t x, y;
   };
   Cell LeafCell(size_t l) const;
   // Index of the leaf containing curve index `index`.
@@ -124,6 +126,8 @@ class CurveTree {
  private:
   class Builder;
   CurveTree() = default;
+  // The cell covering curve indices [start, end). REQUIRES: a cell's range.
+  static Cell CellOfRange(const Curve& curve, uint64_t start, uint64_t end);
   void ComputeDepthRange();
 
   const Curve* curve_ = nullptr;

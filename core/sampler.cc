@@ -126,8 +126,7 @@ absl::Status SampleCursor::PlanRegion(uint64_t begin, uint64_t end) {
         const double u = u0 + i * (h / 2), v = v0 + j * (h / 2);
         pts[3 * i + j] = surface.Point(u, v);
         if (!IsFinite(pts[3 * i + j])) {
-          return absl::InvalidArgumentError(absl::StrFormat(
-              "the surface is not finite (NaN or infinity) at (u,v) = (%.17g, %.17g)", u, v));
+          return SurfaceNotFiniteError(u, v);
         }
       }
     }
@@ -174,10 +173,6 @@ absl::Status SampleCursor::PlanRegion(uint64_t begin, uint64_t end) {
   RETURN_IF_ERROR(visit(0, 0, 0, 0, Curve::kRootState));
   if (!segments_.empty()) next_k_ = segments_[0].begin;
   return absl::OkStatus();
-}
-
-bool SampleCursor::done() const {
-  return use_order_ ? order_pos_ >= order_.size() : segment_ >= segments_.size();
 }
 
 absl::StatusOr<size_t> SampleCursor::Next(size_t max, SampleBatch* batch) {

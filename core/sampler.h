@@ -37,7 +37,6 @@ class Sampler {
   const Surface& surface() const { return *surface_; }
   const Density& density() const { return *density_; }
   const Sequence& sequence() const { return sequence_; }
-  const std::shared_ptr<const CurveTree>& tree_ptr() const { return tree_; }
 
   // q_k S_M: sample k's mass coordinate along the curve.
   double MassCoordinate(uint64_t k) const { return sequence_.At(k) * tree_->total_mass(); }
@@ -75,8 +74,6 @@ class SampleCursor {
   // returns how many; 0 once the cursor is exhausted. Errors: INVALID_ARGUMENT
   // when the surface or density is not finite at a sample.
   absl::StatusOr<size_t> Next(size_t max, SampleBatch* batch);
-
-  bool done() const;
 
  private:
   // The last leaf decoded, reused by consecutive samples; one per thread.

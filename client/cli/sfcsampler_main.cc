@@ -32,31 +32,6 @@ int Fail(const absl::Status& status) {
   return status.code() == absl::StatusCode::kInvalidArgument ? 2 : 1;
 }
 
-void PrintPrecision(const PrecisionReport& report) {
-  if (report.geometry_capped_leaves == 0 && report.mass_capped_leaves == 0) return;
-  std::fprintf(stderr,
-               "warning: the depth cap stopped splits the tests still wanted (paper Sect. 5.3): "
-               "%llu leaves for flatness, %llu for mass\n",
-               static_cast<unsigned long long>(report.geometry_capped_leaves),
-               static_cast<unsigned long long>(report.mass_capped_leaves));
-  for (const DepthCapHit& h : report.worst) {
-    std::fprintf(stderr, "  %s test at cell u in [%.9g, %.9g], v in [%.9g, %.9g]: %.6g vs limit %.6g (x%.3g)\n",
-                 h.test == DepthCapHit::Test::kGeometry ? "flatness" : "mass", h.u0, h.u0 + h.size,
-                 h.v0, h.v0 + h.size, h.measured, h.limit, h.measured / h.limit);
-  }
-}
-
-void PrintTree(const PreparedTree& t, double seconds) {
-  const CurveTree& tree = *t.lookup.tree;
-  std::fprintf(stderr,
-               "tree %s: %zu leaves, depth %d..%d, %zu bytes (%zu per leaf), tolerance %.6g, built "
-               "in %.3f s\n",
-               t.key.HexWithGrade(t.grade).c_str(), tree.leaf_count(), tree.min_depth(),
-               tree.max_depth(), tree.leaf_count() * CurveTree::kBytesPerLeaf,
-               CurveTree::kBytesPerLeaf, tree.options().tolerance, seconds);
-  PrintPrecision(tree.precision());
-}
-
 // Where to run: in-process (server empty) or over the wire.
 struct Connection {
   std::string server;      // host:port; "" = embedded
@@ -85,6 +60,8 @@ absl::StatusOr<std::unique_ptr<SamplerClient>> Connect(const Connection& c, uint
   return SamplerClient::Connect(options);
 }
 
+// The tree summary and any depth-cap warnings, on stderr; the same for the
+// embedded mode (converted with ToProto) and the wire.
 void PrintTreeInfo(const ::sfcsampler::v1::TreeInfo& t) {
   std::fprintf(stderr, "tree %s (%s): %llu leaves, depth %d..%d, %llu bytes, tolerance %.6g\n",
                t.key_with_grade().c_str(),
@@ -98,11 +75,19 @@ void PrintTreeInfo(const ::sfcsampler::v1::TreeInfo& t) {
                  static_cast<unsigned long long>(t.flatness_capped_leaves()),
                  static_cast<unsigned long long>(t.mass_capped_leaves()));
     for (const auto& w : t.warnings()) {
-      std::fprintf(stderr, "  %s test at cell u in [%.9g, %.9g], v in [%.9g, %.9g]: %.6g vs limit %.6g\n",
+      std::fprintf(stderr,
+                   "  %s test at cell u in [%.9g, %.9g], v in [%.9g, %.9g]: %.6g vs limit %.6g (x%.3g)\n",
                    w.test().c_str(), w.u0(), w.u0() + w.size(), w.v0(), w.v0() + w.size(),
-                   w.measured(), w.limit());
+                   w.measured(), w.limit(), w.measured() / w.limit());
     }
   }
+}
+
+void PrintTree(const PreparedTree& tree, double seconds) {
+  ::sfcsampler::v1::TreeInfo info;
+  ToProto(tree, &info);
+  PrintTreeInfo(info);
+  std::fprintf(stderr, "tree ready in %.3f s\n", seconds);
 }
 
 int RunSample(const RequestFlags& flags, const std::string& format, bool ascii,
