@@ -34,10 +34,12 @@ absl::Status LeafBudgetError(uint64_t max_leaves) {
 // Holds what one build or refinement pass needs; not thread-safe, one per call.
 class CurveTree::Builder {
  public:
-  Builder(const Surface& surface, const Density& density, const CurveTreeOptions& options)
+  Builder(const Surface& surface, const Density& density, const CurveTreeOptions& options,
+          const BuildControl& control)
       : surface_(surface),
         density_(density),
         options_(options),
+        control_(control),
         curve_(Curve::Get(options.curve)),
         // Trees with the triangle estimator decide splits with (c): (a) needs
         // neighbours that do not exist yet while a cell is being split.
@@ -151,6 +153,7 @@ class CurveTree::Builder {
 
  private:
   absl::Status Geometric(int depth, uint64_t start, uint64_t x, uint64_t y, int state) {
+    RETURN_IF_ERROR(Checkpoint());
     const double h = 1.0 / curve_.PowG(depth);
     const double u0 = x * h, v0 = y * h;
     NoteDepth(depth, u0 + h / 2, v0 + h / 2);
@@ -195,6 +198,7 @@ class CurveTree::Builder {
   }
 
   absl::Status SplitForMass(int depth, uint64_t start, uint64_t x, uint64_t y, int state) {
+    RETURN_IF_ERROR(Checkpoint());
     const int g = curve_.grid();
     const uint64_t span = curve_.Span(depth + 1);
     const double h = 1.0 / curve_.PowG(depth + 1);
@@ -247,6 +251,15 @@ class CurveTree::Builder {
     return absl::OkStatus();
   }
 
+  // Asks the caller whether to go on, every BuildControl::kCheckInterval cells.
+  absl::Status Checkpoint() {
+    if (!control_.check || ++cells_since_check_ < BuildControl::kCheckInterval) {
+      return absl::OkStatus();
+    }
+    cells_since_check_ = 0;
+    return control_.check();
+  }
+
   void NoteDepth(int depth, double u, double v) {
     if (depth <= deepest_) return;
     deepest_ = depth;
@@ -263,6 +276,8 @@ class CurveTree::Builder {
   const Surface& surface_;
   const Density& density_;
   const CurveTreeOptions& options_;
+  const BuildControl& control_;
+  uint64_t cells_since_check_ = 0;
   const Curve& curve_;
   const AreaEstimator decision_estimator_;
   double limit_ = 0;
@@ -326,7 +341,8 @@ int CurveTree::GradeFor(uint64_t count) {
 absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Build(const Surface& surface,
                                                                   const Density& density,
                                                                   const CurveTreeOptions& options,
-                                                                  int grade) {
+                                                                  int grade,
+                                                                  const BuildControl& control) {
   if (grade < 0 || grade > 62) {
     return absl::InvalidArgumentError(absl::StrFormat("tree grade must be in [0, 62], got %d", grade));
   }
@@ -334,17 +350,18 @@ absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Build(const Surface&
   auto tree = std::shared_ptr<CurveTree>(new CurveTree());
   tree->curve_ = &Curve::Get(resolved.curve);
   tree->options_ = resolved;
-  Builder builder(surface, density, tree->options_);
+  Builder builder(surface, density, tree->options_, control);
   RETURN_IF_ERROR(builder.BuildGeometric());
   RETURN_IF_ERROR(builder.Finish(tree.get()));
   tree->base_mass_ = tree->total_mass();
   if (grade == 0) return std::shared_ptr<const CurveTree>(std::move(tree));
-  return tree->Refined(surface, density, grade);
+  return tree->Refined(surface, density, grade, control);
 }
 
 absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Refined(const Surface& surface,
                                                                     const Density& density,
-                                                                    int grade) const {
+                                                                    int grade,
+                                                                    const BuildControl& control) const {
   if (grade < grade_ || grade > 62) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "cannot refine a grade-%d tree to grade %d; grades only grow, up to 62", grade_, grade));
@@ -352,7 +369,7 @@ absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Refined(const Surfac
   // The copy is private until returned, so the passes may update it in place.
   auto tree = std::shared_ptr<CurveTree>(new CurveTree(*this));
   for (int g = grade_ + 1; g <= grade; ++g) {
-    Builder builder(surface, density, tree->options_);
+    Builder builder(surface, density, tree->options_, control);
     builder.set_report(tree->precision_);
     if (builder.PassSplits(*tree, g)) {
       RETURN_IF_ERROR(builder.RefinePass(*tree, g));

@@ -25,6 +25,7 @@
 #define SFCSAMPLER_CORE_CURVE_TREE_H_
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -59,6 +60,15 @@ struct DepthCapHit {
   double limit = 0;                 // the tolerance a, or the grade's mass limit
 };
 
+// Lets the caller stop a build or refinement that is no longer wanted (its
+// client went away, its deadline passed, the server is shutting down).
+// `check` is called at least every kCheckInterval cell evaluations; a non-OK
+// status it returns aborts the build, which then returns that status.
+struct BuildControl {
+  std::function<absl::Status()> check;  // empty: never stop
+  static constexpr uint64_t kCheckInterval = 4096;
+};
+
 struct PrecisionReport {
   uint64_t geometry_capped_leaves = 0;
   uint64_t mass_capped_leaves = 0;
@@ -74,14 +84,16 @@ class CurveTree {
   static absl::StatusOr<std::shared_ptr<const CurveTree>> Build(const Surface& surface,
                                                                 const Density& density,
                                                                 const CurveTreeOptions& options,
-                                                                int grade);
+                                                                int grade,
+                                                                const BuildControl& control = {});
 
   // The grade-`grade` tree made by refining this one: only the leaves that
   // fail the finer mass test are evaluated. REQUIRES: the surface and density
   // this tree was built from; grade >= this->grade().
   absl::StatusOr<std::shared_ptr<const CurveTree>> Refined(const Surface& surface,
                                                            const Density& density,
-                                                           int grade) const;
+                                                           int grade,
+                                                           const BuildControl& control = {}) const;
 
   // The smallest grade fine enough for `count` samples: ceil(log2(count)).
   static int GradeFor(uint64_t count);
