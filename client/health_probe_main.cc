@@ -5,9 +5,9 @@
 //   sfcsampler-health-probe [--address 127.0.0.1:50052] [--timeout 2] [--service NAME]
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 
+#include "CLI/CLI.hpp"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "grpcpp/client_context.h"
 #include "grpcpp/create_channel.h"
@@ -15,18 +15,17 @@
 int main(int argc, char** argv) {
   std::string address = "127.0.0.1:50052", service;
   double timeout = 2;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string flag = argv[i];
-    if (flag == "--address") {
-      address = argv[i + 1];
-    } else if (flag == "--timeout") {
-      timeout = std::atof(argv[i + 1]);
-    } else if (flag == "--service") {
-      service = argv[i + 1];
-    } else {
-      std::fprintf(stderr, "usage: %s [--address HOST:PORT] [--timeout SECONDS] [--service NAME]\n", argv[0]);
-      return 2;
-    }
+  CLI::App app{"sfcsampler-health-probe: exit 0 when the server is SERVING, 1 when not, 2 when it cannot tell"};
+  app.add_option("--address", address, "host:port of the health listener")->capture_default_str();
+  app.add_option("--timeout", timeout, "seconds to wait for the answer")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--service", service, "service name to check (\"\" = the whole server)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // Usage errors are "cannot tell" (2), like an unreachable server.
+    return app.exit(e) == 0 ? 0 : 2;
   }
   auto stub = grpc::health::v1::Health::NewStub(grpc::CreateChannel(address, grpc::InsecureChannelCredentials()));
   grpc::ClientContext context;

@@ -19,6 +19,37 @@ namespace {
 
 namespace v1 = ::sfcsampler::v1;
 
+absl::StatusOr<std::string> ReadPem(const std::string& path, const char* what) {
+  std::ifstream in(path);
+  if (!in) return absl::InvalidArgumentError(absl::StrFormat("cannot read %s \"%s\"", what, path));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// FAILED_PRECONDITION when a resumed stream's header says it comes from
+// another tree, algorithm version or seed than the stream it continues.
+absl::Status CheckResumedHeader(const v1::StreamHeader& first, const v1::StreamHeader& resumed,
+                                uint64_t received) {
+  auto differs = [&](const char* what, const std::string& a, const std::string& b) {
+    return absl::FailedPreconditionError(absl::StrFormat(
+        "the stream was resumed on a server whose %s is %s, but it began with %s: the samples would "
+        "mix two different sets, so the %d received so far are the only valid ones; restart the "
+        "whole request (or pin it to servers of one release)",
+        what, b, a, received));
+  };
+  if (first.algorithm_version() != resumed.algorithm_version()) {
+    return differs("algorithm version", first.algorithm_version(), resumed.algorithm_version());
+  }
+  if (first.tree().key_with_grade() != resumed.tree().key_with_grade()) {
+    return differs("tree key", first.tree().key_with_grade(), resumed.tree().key_with_grade());
+  }
+  if (first.seed() != resumed.seed()) {
+    return differs("seed", std::to_string(first.seed()), std::to_string(resumed.seed()));
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 SamplerClient::SamplerClient(const ClientOptions& options, std::shared_ptr<grpc::Channel> channel)
@@ -29,14 +60,20 @@ absl::StatusOr<std::unique_ptr<SamplerClient>> SamplerClient::Connect(const Clie
   if (options.tls) {
     grpc::SslCredentialsOptions ssl;
     if (!options.tls_root_certs_file.empty()) {
-      std::ifstream in(options.tls_root_certs_file);
-      if (!in) {
-        return absl::InvalidArgumentError(
-            absl::StrFormat("cannot read TLS roots \"%s\"", options.tls_root_certs_file));
-      }
-      std::stringstream ss;
-      ss << in.rdbuf();
-      ssl.pem_root_certs = ss.str();
+      auto roots = ReadPem(options.tls_root_certs_file, "TLS roots");
+      if (!roots.ok()) return roots.status();
+      ssl.pem_root_certs = *roots;
+    }
+    if (options.tls_cert_file.empty() != options.tls_key_file.empty()) {
+      return absl::InvalidArgumentError("a client certificate needs both --tls-cert and --tls-key");
+    }
+    if (!options.tls_cert_file.empty()) {
+      auto cert = ReadPem(options.tls_cert_file, "the client certificate");
+      if (!cert.ok()) return cert.status();
+      auto key = ReadPem(options.tls_key_file, "the client key");
+      if (!key.ok()) return key.status();
+      ssl.pem_cert_chain = *cert;
+      ssl.pem_private_key = *key;
     }
     credentials = grpc::SslCredentials(ssl);
   } else {
@@ -109,6 +146,14 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& request
       if (response.has_header() && !have_header) {
         summary.header = response.header();
         have_header = true;
+      } else if (response.has_header()) {
+        // A resumed stream must continue the same set: same tree, same
+        // algorithm, same seed (a rolling upgrade could mix two sets).
+        if (absl::Status s = CheckResumedHeader(summary.header, response.header(), summary.received);
+            !s.ok()) {
+          callback_error = s;
+          break;
+        }
       }
       batch.Clear();
       if (absl::Status s = AppendFromProto(response.batch(), request.fields, &batch); !s.ok()) {

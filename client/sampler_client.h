@@ -5,7 +5,10 @@
 // (RST_STREAM, when the replica behind it died) it resumes from the first
 // index not yet received, so the
 // callback sees every sample exactly once; anything short of the full set is
-// an error that says how many samples arrived. Every call carries the
+// an error that says how many samples arrived. A resumed stream must come
+// from the same tree key, algorithm version and seed as the first, or the
+// call fails with FAILED_PRECONDITION (a rolling upgrade would otherwise mix
+// two sets). Every call carries the
 // x-surface-key header (the tree key) for consistent-hash proxies.
 //
 // Thread-safety: a SamplerClient may be used from several threads at once.
@@ -29,11 +32,12 @@ struct ClientOptions {
   std::string token;                       // bearer token; "" = none
   bool tls = false;                        // use TLS ...
   std::string tls_root_certs_file;         // ... trusting these roots ("" = system roots)
+  std::string tls_cert_file, tls_key_file; // client certificate and key for mutual TLS ("" = none)
   int max_resumes = 5;                     // resumes per Sample() call
   double resume_backoff_seconds = 0.2;     // first wait; doubles each time
   double deadline_seconds = 0;             // per RPC; 0 = none
   ::sfcsampler::v1::Precision precision = ::sfcsampler::v1::PRECISION_FLOAT64;
-  uint32_t batch_size = 65536;             // samples per message
+  uint32_t batch_size = 0;                 // samples per message; 0 = the server chooses
 };
 
 struct StreamSummary {

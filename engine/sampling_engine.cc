@@ -9,7 +9,8 @@ namespace sfc {
 SamplingEngine::SamplingEngine(EngineLimits limits, TreeSource* source)
     : limits_(limits), source_(source) {}
 
-absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint64_t count) const {
+absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint64_t count,
+                                                     const BuildControl& caller) const {
   if (count == 0) return absl::InvalidArgumentError("count must be >= 1");
   if (count > limits_.max_count) {
     return absl::InvalidArgumentError(absl::StrFormat(
@@ -36,13 +37,15 @@ absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint6
   prepared.surface = surface.surface;
   prepared.density = density.density;
   TreeFactory factory;
-  factory.build = [&](int grade) {
-    return CurveTree::Build(*prepared.surface, *prepared.density, options, grade);
+  factory.build = [surface = prepared.surface, density = prepared.density, options](
+                      int grade, const BuildControl& control) {
+    return CurveTree::Build(*surface, *density, options, grade, control);
   };
-  factory.refine = [&](const CurveTree& coarser, int grade) {
-    return coarser.Refined(*prepared.surface, *prepared.density, grade);
+  factory.refine = [surface = prepared.surface, density = prepared.density](
+                       const CurveTree& coarser, int grade, const BuildControl& control) {
+    return coarser.Refined(*surface, *density, grade, control);
   };
-  ASSIGN_OR_RETURN(prepared.lookup, source_->Get(prepared.key, prepared.grade, factory));
+  ASSIGN_OR_RETURN(prepared.lookup, source_->Get(prepared.key, prepared.grade, factory, caller));
   return prepared;
 }
 
@@ -73,7 +76,8 @@ absl::StatusOr<std::pair<uint64_t, uint64_t>> SamplingEngine::ResolveRange(
   return std::make_pair(request.begin, end);
 }
 
-absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request) const {
+absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
+                                                  const BuildControl& caller) const {
   if (request.count == 0) return absl::InvalidArgumentError("count must be >= 1");
   if (request.count > limits_.max_count) {
     // Checked before any tree is built for it.
@@ -97,9 +101,16 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request) 
         SequenceName(request.sequence), limits_.max_sorted_range));
   }
   RETURN_IF_ERROR(request.region.Validate());
+  if (request.tree_count != 0 && request.tree_count < request.count) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "tree_count %d is below count %d: the tree must be sized for at least the whole set "
+        "(leave tree_count 0 to size it for count, or set it to the final size of a progressive "
+        "set)",
+        request.tree_count, request.count));
+  }
   const uint64_t tree_count = request.tree_count == 0 ? request.count : request.tree_count;
   SamplingJob job;
-  ASSIGN_OR_RETURN(job.tree, Prepare(request.tree, tree_count));
+  ASSIGN_OR_RETURN(job.tree, Prepare(request.tree, tree_count, caller));
   job.sampler = std::make_shared<const Sampler>(job.tree.lookup.tree, job.tree.surface,
                                                 job.tree.density,
                                                 Sequence(request.sequence, request.count, request.seed));

@@ -43,11 +43,15 @@ class SamplingEngine {
   // The tree for `spec`, fine enough for `count` samples. Errors:
   // INVALID_ARGUMENT (bad spec, count 0 or above max_count, surface or density
   // errors), RESOURCE_EXHAUSTED (tree budget).
-  absl::StatusOr<PreparedTree> Prepare(const TreeSpec& spec, uint64_t count) const;
+  // `caller.check` is asked while the tree is built or waited for; its non-OK
+  // status (client gone, deadline) ends the call with that status.
+  absl::StatusOr<PreparedTree> Prepare(const TreeSpec& spec, uint64_t count,
+                                       const BuildControl& caller = {}) const;
 
   // Validates `request` and opens its cursor. Errors as Prepare, plus
-  // INVALID_ARGUMENT for a bad range, shard or region.
-  absl::StatusOr<SamplingJob> Start(const SampleRequest& request) const;
+  // INVALID_ARGUMENT for a bad range, shard, region or tree_count.
+  absl::StatusOr<SamplingJob> Start(const SampleRequest& request,
+                                    const BuildControl& caller = {}) const;
 
   // The index range [begin, end) a request selects (before its region).
   static absl::StatusOr<std::pair<uint64_t, uint64_t>> ResolveRange(const SampleRequest& request);

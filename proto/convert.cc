@@ -1,5 +1,8 @@
 #include "proto/convert.h"
 
+#include <algorithm>
+#include <cstdint>
+
 #include "absl/strings/str_format.h"
 #include "core/status_macros.h"
 
@@ -185,6 +188,19 @@ void ToProto(const SampleBatch& b, const SampleFields& fields, v1::Precision pre
   } else {
     PutColumns(b, fields, out->mutable_f64());
   }
+}
+
+uint32_t MaxSamplesPerMessage(const SampleFields& fields, v1::Precision precision,
+                              bool indices_listed, size_t reserved_bytes, size_t max_message_bytes) {
+  const size_t columns = 5 + (fields.normal ? 3 : 0) + (fields.density ? 1 : 0) +
+                         (fields.curve_position ? 1 : 0);
+  const size_t width = precision == v1::PRECISION_FLOAT32 ? sizeof(float) : sizeof(double);
+  const size_t per_sample = columns * width + (indices_listed ? sizeof(uint64_t) : 0);
+  // Each packed column costs a tag and a length (at most 1 + 5 bytes); the
+  // batch's own fields and the two message wrappers at most 64 more.
+  const size_t fixed = reserved_bytes + 6 * (columns + 1) + 64;
+  if (max_message_bytes <= fixed) return 0;
+  return static_cast<uint32_t>(std::min<size_t>((max_message_bytes - fixed) / per_sample, UINT32_MAX));
 }
 
 absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fields, SampleBatch* out) {

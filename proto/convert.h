@@ -28,6 +28,14 @@ v1::SampleRequest ToProto(const SampleRequest& request);
 // are sent as first_index alone.
 void ToProto(const SampleBatch& batch, const SampleFields& fields, v1::Precision precision,
              v1::SampleBatch* out);
+// The largest number of samples one SampleResponse may carry so that it
+// serialises to at most `max_message_bytes`, given the requested columns,
+// precision, whether the batch lists its indices (regions and sequences not
+// in index order do) and `reserved_bytes` for the stream header. 0 when not
+// even one sample fits.
+uint32_t MaxSamplesPerMessage(const SampleFields& fields, v1::Precision precision,
+                              bool indices_listed, size_t reserved_bytes, size_t max_message_bytes);
+
 // Appends the samples of `in` to `out`. DATA_LOSS when a column has the
 // wrong length or a requested column is missing.
 absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fields, SampleBatch* out);

@@ -51,6 +51,18 @@ class CacheStatsCollector final : public prometheus::Collectable {
     add("sfcsampler_cache_entries", "Cached trees", T::Gauge, s.entries);
     add("sfcsampler_cache_budget_bytes", "The cache's memory budget", T::Gauge,
         cache_->budget_bytes());
+    add("sfcsampler_builds_running", "Tree builds running now", T::Gauge, s.builds_running);
+    add("sfcsampler_builds_queued", "Tree builds waiting for a builder thread", T::Gauge,
+        s.builds_queued);
+    add("sfcsampler_builds_stopped_total",
+        "Tree builds stopped because every request left, or by shutdown", T::Counter,
+        s.builds_stopped);
+    add("sfcsampler_builds_failed_total", "Tree builds that ended with an error", T::Counter,
+        s.builds_failed);
+    add("sfcsampler_builds_rejected_total", "Misses turned away because the build queue was full",
+        T::Counter, s.builds_rejected);
+    add("sfcsampler_build_failure_hits_total", "Requests answered from a remembered failed build",
+        T::Counter, s.failure_hits);
     return out;
   }
 
@@ -70,6 +82,11 @@ ServerMetrics::ServerMetrics() : registry_(std::make_shared<prometheus::Registry
                   .Help("Samples written to clients")
                   .Register(*registry_)
                   .Add({});
+  stalled_streams_ = &prometheus::BuildCounter()
+                          .Name("sfcsampler_stalled_streams_total")
+                          .Help("Streams cut because the client read nothing for the write timeout")
+                          .Register(*registry_)
+                          .Add({});
   active_streams_ = &prometheus::BuildGauge()
                          .Name("sfcsampler_active_streams")
                          .Help("Sample streams in progress")

@@ -31,12 +31,16 @@ class ServerMetrics {
   void StreamStarted() { active_streams_->Increment(); }
   void StreamEnded() { active_streams_->Decrement(); }
   void ObserveBuild(double seconds) { build_seconds_->Observe(seconds); }
+  // A stream cut because its reader took nothing for the write timeout.
+  void CountStalledStream() { stalled_streams_->Increment(); }
   double samples_streamed() const { return samples_->Value(); }
+  double stalled_streams() const { return stalled_streams_->Value(); }
 
  private:
   std::shared_ptr<prometheus::Registry> registry_;
   prometheus::Family<prometheus::Counter>* requests_;
   prometheus::Counter* samples_;
+  prometheus::Counter* stalled_streams_;
   prometheus::Gauge* active_streams_;
   prometheus::Histogram* build_seconds_;
 };

@@ -11,6 +11,7 @@
 #include "grpcpp/health_check_service_interface.h"
 #include "grpcpp/security/server_credentials.h"
 #include "grpcpp/server_builder.h"
+#include "server/token_auth.h"
 #include "spdlog/spdlog.h"
 
 namespace sfc {
@@ -24,8 +25,15 @@ absl::StatusOr<std::string> ReadFile(const std::string& path) {
   return ss.str();
 }
 
+// The main port's credentials: TLS (mutual with a client CA) when configured,
+// with the token checked by an AuthMetadataProcessor; else plaintext.
 absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> Credentials(const ServerOptions& o) {
-  if (o.tls_cert_file.empty() && o.tls_key_file.empty()) return grpc::InsecureServerCredentials();
+  if (o.tls_cert_file.empty() && o.tls_key_file.empty()) {
+    if (!o.tls_client_ca_file.empty()) {
+      return absl::InvalidArgumentError("--tls-client-ca needs TLS: give --tls-cert and --tls-key too");
+    }
+    return grpc::InsecureServerCredentials();
+  }
   if (o.tls_cert_file.empty() || o.tls_key_file.empty()) {
     return absl::InvalidArgumentError("TLS needs both --tls-cert and --tls-key");
   }
@@ -35,7 +43,31 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> Credentials(const Serve
   if (!key.ok()) return key.status();
   grpc::SslServerCredentialsOptions ssl;
   ssl.pem_key_cert_pairs.push_back({*key, *cert});
-  return grpc::SslServerCredentials(ssl);
+  if (!o.tls_client_ca_file.empty()) {
+    auto ca = ReadFile(o.tls_client_ca_file);
+    if (!ca.ok()) return ca.status();
+    ssl.pem_root_certs = *ca;
+    ssl.client_certificate_request = GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY;
+  }
+  auto credentials = grpc::SslServerCredentials(ssl);
+  if (!o.token.empty()) credentials->SetAuthMetadataProcessor(std::make_shared<TokenAuthProcessor>(o.token));
+  return credentials;
+}
+
+absl::Status Validate(const ServerOptions& o) {
+  if (o.max_message_bytes < (64u << 10)) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "--max-message-bytes must be at least 65536 (a header and a batch must fit), got %d",
+        o.max_message_bytes));
+  }
+  if (!(o.write_timeout_seconds > 0)) {
+    return absl::InvalidArgumentError("--write-timeout must be > 0 seconds");
+  }
+  if (o.max_concurrent_builds < 1 || o.max_queued_builds < 0 || !(o.failure_ttl_seconds >= 0)) {
+    return absl::InvalidArgumentError(
+        "--max-concurrent-builds must be >= 1, --max-queued-builds and --failure-ttl >= 0");
+  }
+  return absl::OkStatus();
 }
 
 // TCP connections to local port `port` that still have data in their send
@@ -62,23 +94,31 @@ int ConnectionsWithUnsentData(int port) {
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<SamplerServer>> SamplerServer::Start(const ServerOptions& options) {
+  if (absl::Status s = Validate(options); !s.ok()) return s;
+  auto credentials = Credentials(options);
+  if (!credentials.ok()) return credentials.status();
+  const bool tls = !options.tls_cert_file.empty();
+
   auto server = std::unique_ptr<SamplerServer>(new SamplerServer());
   server->metrics_ = std::make_unique<ServerMetrics>();
   ServerMetrics* metrics = server->metrics_.get();
-  server->cache_ = std::make_unique<TreeCache>(options.cache_bytes,
+  TreeCacheOptions cache_options;
+  cache_options.budget_bytes = options.cache_bytes;
+  cache_options.max_concurrent_builds = options.max_concurrent_builds;
+  cache_options.max_queued_builds = options.max_queued_builds;
+  cache_options.failure_ttl_seconds = options.failure_ttl_seconds;
+  server->cache_ = std::make_unique<TreeCache>(cache_options,
                                                [metrics](double s) { metrics->ObserveBuild(s); });
-  server->service_ = std::make_unique<SamplerService>(options, server->cache_.get(), metrics);
-
-  auto credentials = Credentials(options);
-  if (!credentials.ok()) return credentials.status();
+  server->service_ = std::make_unique<SamplerService>(options, server->cache_.get(), metrics,
+                                                      /*token_checked_by_transport=*/tls);
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
   builder.AddListeningPort(options.address, *credentials, &server->port_);
   builder.RegisterService(server->service_.get());
-  // Messages carry up to max_batch_size samples of up to 10 float64 columns.
-  builder.SetMaxSendMessageSize(-1);
+  // Batches are sized to fit; this is the backstop.
+  builder.SetMaxSendMessageSize(static_cast<int>(options.max_message_bytes));
   // Sync-server threads wake this often to notice shutdown (gRPC's default of
   // 10 s would hold up a graceful stop by that long).
   builder.SetSyncServerOption(grpc::ServerBuilder::SyncServerOption::CQ_TIMEOUT_MSEC, 200);
@@ -110,9 +150,9 @@ absl::StatusOr<std::unique_ptr<SamplerServer>> SamplerServer::Start(const Server
     server->exposer_->RegisterCollectable(metrics->registry());
     server->exposer_->RegisterCollectable(server->cache_collector_);
   }
-  spdlog::info("listening address={} port={} health_port={} metrics_port={} tls={} token={}",
-               options.address, server->port_, server->health_port_, server->metrics_port(),
-               !options.tls_cert_file.empty(), !options.token.empty());
+  spdlog::info("listening address={} port={} health_port={} metrics_port={} tls={} mutual_tls={} token={}",
+               options.address, server->port_, server->health_port_, server->metrics_port(), tls,
+               !options.tls_client_ca_file.empty(), !options.token.empty());
   return server;
 }
 
@@ -156,7 +196,9 @@ void SamplerServer::Shutdown(double grace_seconds, double drain_seconds) {
     if (Clock::now() - quiet_since >= std::chrono::milliseconds(200)) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
-  // 3. Close; anything still running past the deadline is cancelled.
+  // 3. Close; builds still running stop at their next check, and anything
+  // still running past the deadline is cancelled.
+  cache_->Stop();
   server_->Shutdown(std::max(deadline, Clock::now()));
   if (health_server_) health_server_->Shutdown(Clock::now());
   server_->Wait();

@@ -19,24 +19,48 @@ double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
+// A request's own check while its tree is built or waited for: the client
+// is gone, or the server's request deadline has passed.
+BuildControl RequestControl(const grpc::ServerContext* context, Clock::time_point deadline,
+                            double deadline_seconds) {
+  return BuildControl{[context, deadline, deadline_seconds]() -> absl::Status {
+    if (context->IsCancelled()) {
+      return absl::CancelledError("the client cancelled the request or its deadline passed");
+    }
+    if (Clock::now() > deadline) {
+      return absl::DeadlineExceededError(absl::StrFormat(
+          "the tree was still being built when the server's request deadline of %g s passed; "
+          "retry later (the build goes on while other requests wait for it) or ask for fewer "
+          "samples",
+          deadline_seconds));
+    }
+    return absl::OkStatus();
+  }};
+}
+
 }  // namespace
 
-SamplerService::SamplerService(const ServerOptions& options, TreeCache* cache, ServerMetrics* metrics)
-    : options_(options), cache_(cache), metrics_(metrics), engine_(options.limits, cache) {}
+SamplerService::SamplerService(const ServerOptions& options, TreeCache* cache, ServerMetrics* metrics,
+                               bool token_checked_by_transport)
+    : options_(options),
+      cache_(cache),
+      metrics_(metrics),
+      engine_(options.limits, cache),
+      authenticator_(options.token.empty() || token_checked_by_transport
+                         ? nullptr
+                         : std::make_unique<const TokenAuthenticator>(options.token)),
+      watchdog_(options.write_timeout_seconds) {}
 
-grpc::Status SamplerService::CheckToken(const grpc::ServerContext& context) const {
+grpc::Status SamplerService::Admit(const grpc::ServerContext& context) const {
   if (draining_.load()) {
     return grpc::Status(grpc::StatusCode::UNAVAILABLE,
                         "the server is shutting down; retry on another replica or later");
   }
-  if (options_.token.empty()) return grpc::Status::OK;
+  if (!authenticator_) return grpc::Status::OK;
   const auto& md = context.client_metadata();
   auto it = md.find("authorization");
-  const std::string expected = "Bearer " + options_.token;
-  if (it == md.end() || std::string(it->second.data(), it->second.size()) != expected) {
-    return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
-                        "this server needs the header \"authorization: Bearer <token>\" "
-                        "(sfcsampler --token-file)");
+  if (it == md.end() || !authenticator_->Matches(std::string_view(it->second.data(), it->second.size()))) {
+    return grpc::Status(grpc::StatusCode::UNAUTHENTICATED, TokenAuthenticator::kRefusal);
   }
   return grpc::Status::OK;
 }
@@ -45,7 +69,7 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
                                     grpc::ServerWriter<v1::SampleResponse>* writer) {
   const auto start = Clock::now();
   uint64_t sent = 0;
-  grpc::Status status = CheckToken(*context);
+  grpc::Status status = Admit(*context);
   if (status.ok()) {
     // Claim a stream slot; give it back on every path out.
     if (active_streams_.fetch_add(1) >= options_.max_concurrent_streams) {
@@ -73,22 +97,23 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
                                        grpc::ServerWriter<v1::SampleResponse>* writer,
                                        uint64_t* sent) {
   const auto start = Clock::now();
-  const uint32_t batch_size = request.batch_size() == 0 ? kDefaultBatchSize : request.batch_size();
-  if (batch_size > options_.max_batch_size) {
+  const auto deadline = start + std::chrono::duration_cast<Clock::duration>(
+                                    std::chrono::duration<double>(options_.request_deadline_seconds));
+  auto parsed = FromProto(request);
+  if (!parsed.ok()) return ToGrpcStatus(parsed.status());
+  if (request.batch_size() > options_.max_batch_size) {
     return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
                         absl::StrFormat("batch_size %d is above the server's limit of %d "
                                         "(max_batch_size)",
-                                        batch_size, options_.max_batch_size));
+                                        request.batch_size(), options_.max_batch_size));
   }
-  auto parsed = FromProto(request);
-  if (!parsed.ok()) return ToGrpcStatus(parsed.status());
-  auto job = engine_.Start(*parsed);
+  auto job = engine_.Start(*parsed, RequestControl(context, deadline, options_.request_deadline_seconds));
   if (!job.ok()) return ToGrpcStatus(job.status());
 
   v1::SampleResponse response;
   v1::StreamHeader* header = response.mutable_header();
   ToProto(job->tree, header->mutable_tree());
-  header->set_algorithm_version(kAlgorithmVersion);
+  header->set_algorithm_version(options_.algorithm_version);
   header->set_seed(parsed->seed);
   *header->mutable_request() = request;
   header->set_begin(job->begin);
@@ -97,19 +122,59 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
                                    ? static_cast<int64_t>(job->end - job->begin)
                                    : -1);
 
+  // Every message, the first with its header too, fits max_message_bytes.
+  const bool indices_listed =
+      parsed->region.kind != Region::Kind::kAll || !Sequence(parsed->sequence, 1, 0).monotone();
+  const uint32_t fits = MaxSamplesPerMessage(parsed->fields, request.precision(), indices_listed,
+                                             header->ByteSizeLong(), options_.max_message_bytes);
+  if (fits == 0) {
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                        absl::StrFormat("the stream header alone is %d bytes, more than the server's "
+                                        "max_message_bytes of %d; use shorter specs",
+                                        header->ByteSizeLong(), options_.max_message_bytes));
+  }
+  if (request.batch_size() > fits) {
+    return grpc::Status(
+        grpc::StatusCode::INVALID_ARGUMENT,
+        absl::StrFormat("batch_size %d with these columns makes messages larger than the server's "
+                        "max_message_bytes of %d; ask for at most %d samples a batch (or 0 to let "
+                        "the server choose)",
+                        request.batch_size(), options_.max_message_bytes, fits));
+  }
+  const uint32_t batch_size =
+      request.batch_size() == 0 ? std::min(kDefaultBatchSize, fits) : request.batch_size();
+
+  const auto watch = watchdog_.Start(context);
+  auto deadline_status = [&] {
+    return grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED,
+                        absl::StrFormat("the stream ran past the server's request deadline of %g s "
+                                        "after sending %d samples; resume after the last index "
+                                        "received",
+                                        options_.request_deadline_seconds, *sent));
+  };
+  // Why the stream ended early: the watchdog's cut also shows as a cancelled
+  // context.
+  auto cut_status = [&](const char* otherwise) {
+    switch (watch->reason()) {
+      case StreamWatchdog::Reason::kWriteTimeout:
+        metrics_->CountStalledStream();
+        return grpc::Status(
+            grpc::StatusCode::DEADLINE_EXCEEDED,
+            absl::StrFormat("the client read nothing for %g s (the server's write_timeout), so the "
+                            "stream was cut after %d samples; read faster or resume after the last "
+                            "index received",
+                            options_.write_timeout_seconds, *sent));
+      case StreamWatchdog::Reason::kNone:
+        break;
+    }
+    return grpc::Status(grpc::StatusCode::CANCELLED, otherwise);
+  };
+
   SampleBatch batch;
   bool first = true;
   while (true) {
-    if (context->IsCancelled()) {
-      return grpc::Status(grpc::StatusCode::CANCELLED, "the client cancelled the stream");
-    }
-    if (SecondsSince(start) > options_.request_deadline_seconds) {
-      return grpc::Status(
-          grpc::StatusCode::DEADLINE_EXCEEDED,
-          absl::StrFormat("the stream ran past the server's request deadline of %g s after "
-                          "sending %d samples; resume after the last index received",
-                          options_.request_deadline_seconds, *sent));
-    }
+    if (context->IsCancelled()) return cut_status("the client cancelled the stream");
+    if (Clock::now() > deadline) return deadline_status();
     batch.Clear();
     auto n = job->cursor->Next(batch_size, &batch);
     if (!n.ok()) {
@@ -120,9 +185,10 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
     if (*n == 0 && !first) break;
     response.mutable_batch()->Clear();
     ToProto(batch, parsed->fields, request.precision(), response.mutable_batch());
-    if (!writer->Write(response)) {
-      return grpc::Status(grpc::StatusCode::CANCELLED, "the client went away mid-stream");
-    }
+    watch->BeginWrite();
+    const bool written = writer->Write(response);
+    watch->EndWrite();
+    if (!written) return cut_status("the client went away mid-stream");
     *sent += *n;
     metrics_->AddSamples(*n);
     if (first) {
@@ -138,13 +204,16 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
 grpc::Status SamplerService::Prepare(grpc::ServerContext* context, const v1::PrepareRequest* request,
                                      v1::PrepareResponse* response) {
   const auto start = Clock::now();
-  grpc::Status status = CheckToken(*context);
+  grpc::Status status = Admit(*context);
   if (status.ok()) {
     auto spec = FromProto(request->tree());
     if (!spec.ok()) {
       status = ToGrpcStatus(spec.status());
     } else {
-      auto prepared = engine_.Prepare(*spec, request->count());
+      const auto deadline = start + std::chrono::duration_cast<Clock::duration>(
+                                        std::chrono::duration<double>(options_.request_deadline_seconds));
+      auto prepared = engine_.Prepare(*spec, request->count(),
+                                      RequestControl(context, deadline, options_.request_deadline_seconds));
       if (!prepared.ok()) {
         status = ToGrpcStatus(prepared.status());
       } else {
@@ -163,7 +232,7 @@ grpc::Status SamplerService::Prepare(grpc::ServerContext* context, const v1::Pre
 
 grpc::Status SamplerService::ListCatalog(grpc::ServerContext* context, const v1::ListCatalogRequest*,
                                          v1::ListCatalogResponse* response) {
-  grpc::Status status = CheckToken(*context);
+  grpc::Status status = Admit(*context);
   if (status.ok()) {
     for (const CatalogEntry& e : SurfaceCatalog()) ToProto(e, response->add_surfaces());
     for (const CatalogEntry& e : DensityCatalog()) ToProto(e, response->add_densities());
@@ -175,7 +244,7 @@ grpc::Status SamplerService::ListCatalog(grpc::ServerContext* context, const v1:
 
 grpc::Status SamplerService::GetCacheStats(grpc::ServerContext* context,
                                            const v1::GetCacheStatsRequest*, v1::CacheStats* response) {
-  grpc::Status status = CheckToken(*context);
+  grpc::Status status = Admit(*context);
   if (status.ok()) {
     const TreeCacheStats s = cache_->stats();
     response->set_hits(s.hits);
@@ -197,6 +266,17 @@ grpc::Status SamplerService::GetCacheStats(grpc::ServerContext* context,
     response->set_active_streams(active_streams_.load());
     response->set_max_sorted_range(options_.limits.max_sorted_range);
     response->set_generation_threads(options_.limits.generation_threads);
+    response->set_max_message_bytes(options_.max_message_bytes);
+    response->set_write_timeout_seconds(options_.write_timeout_seconds);
+    response->set_max_concurrent_builds(options_.max_concurrent_builds);
+    response->set_max_queued_builds(options_.max_queued_builds);
+    response->set_builds_running(s.builds_running);
+    response->set_builds_queued(s.builds_queued);
+    response->set_builds_stopped(s.builds_stopped);
+    response->set_builds_failed(s.builds_failed);
+    response->set_builds_rejected(s.builds_rejected);
+    response->set_failure_hits(s.failure_hits);
+    response->set_failure_ttl_seconds(options_.failure_ttl_seconds);
   }
   metrics_->CountRequest("GetCacheStats", status.error_code());
   return status;

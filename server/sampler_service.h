@@ -4,7 +4,10 @@
 // Sample streams use the synchronous API: each Write blocks until HTTP/2 flow
 // control accepts the message, so a slow reader holds at most one batch in
 // the server, and a cancelled or disconnected client makes the next Write
-// fail at once, which ends the stream and frees its cursor and tree.
+// fail at once, which ends the stream and frees its cursor and tree. A reader
+// that stops reading is cut after the write timeout (StreamWatchdog). Every
+// message stays within max_message_bytes: the batch size follows from the
+// requested columns.
 //
 // Thread-safety: thread-safe; gRPC calls it from many threads.
 #ifndef SFCSAMPLER_SERVER_SAMPLER_SERVICE_H_
@@ -16,6 +19,8 @@
 #include "engine/sampling_engine.h"
 #include "server/metrics.h"
 #include "server/server_options.h"
+#include "server/stream_watchdog.h"
+#include "server/token_auth.h"
 #include "server/tree_cache.h"
 #include "sfcsampler/v1/sampler.grpc.pb.h"
 
@@ -24,7 +29,10 @@ namespace sfc {
 class SamplerService final : public ::sfcsampler::v1::Sampler::Service {
  public:
   // `cache` and `metrics` are not owned and must outlive the service.
-  SamplerService(const ServerOptions& options, TreeCache* cache, ServerMetrics* metrics);
+  // `token_checked_by_transport`: an AuthMetadataProcessor already checks the
+  // token (TLS ports), so the service does not.
+  SamplerService(const ServerOptions& options, TreeCache* cache, ServerMetrics* metrics,
+                 bool token_checked_by_transport);
 
   grpc::Status Sample(grpc::ServerContext* context, const ::sfcsampler::v1::SampleRequest* request,
                       grpc::ServerWriter<::sfcsampler::v1::SampleResponse>* writer) override;
@@ -42,7 +50,8 @@ class SamplerService final : public ::sfcsampler::v1::Sampler::Service {
   void StartDraining() { draining_.store(true); }
 
  private:
-  grpc::Status CheckToken(const grpc::ServerContext& context) const;
+  // UNAVAILABLE while draining; UNAUTHENTICATED without the token.
+  grpc::Status Admit(const grpc::ServerContext& context) const;
   grpc::Status RunSample(grpc::ServerContext* context, const ::sfcsampler::v1::SampleRequest& request,
                          grpc::ServerWriter<::sfcsampler::v1::SampleResponse>* writer,
                          uint64_t* sent);
@@ -52,6 +61,9 @@ class SamplerService final : public ::sfcsampler::v1::Sampler::Service {
   TreeCache* const cache_;
   ServerMetrics* const metrics_;
   const SamplingEngine engine_;
+  // Set when the service itself checks the token (plaintext ports).
+  const std::unique_ptr<const TokenAuthenticator> authenticator_;
+  StreamWatchdog watchdog_;
 
   std::atomic<uint32_t> active_streams_{0};
   std::atomic<bool> draining_{false};

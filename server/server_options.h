@@ -24,15 +24,30 @@ struct ServerOptions {
     return l;
   }();
   uint64_t cache_bytes = uint64_t{1} << 30;    // tree cache budget, 1 GiB
+  int max_concurrent_builds = 2;               // tree builds at once (threads of the cache)
+  int max_queued_builds = 16;                  // builds waiting for those; more are RESOURCE_EXHAUSTED
+  double failure_ttl_seconds = 60;             // a failed build is remembered this long
   uint32_t max_concurrent_streams = 64;        // Sample streams at once; more are RESOURCE_EXHAUSTED
   uint32_t max_batch_size = 1 << 20;           // samples per message a client may ask for
+  // Largest message the server sends, in bytes; batches are sized to fit it.
+  // 4 MiB is what stock gRPC clients accept by default.
+  uint32_t max_message_bytes = 4 << 20;
   double request_deadline_seconds = 600;       // longest a Sample stream may run
+  // A stream whose write waits this long for a reader that does not read is
+  // cut and its slot freed.
+  double write_timeout_seconds = 30;
   double shutdown_grace_seconds = 10;          // SIGTERM: in-flight streams get this long
 
-  // Security: TLS when both files are set; a bearer token required on every
-  // sampler RPC when set (health checks stay open).
-  std::string tls_cert_file, tls_key_file;
+  // Security: TLS when both files are set; clients must then present a
+  // certificate signed by tls_client_ca_file when that is set (mutual TLS).
+  // A bearer token is required on every sampler RPC when set (health checks
+  // and reflection stay open).
+  std::string tls_cert_file, tls_key_file, tls_client_ca_file;
   std::string token;
+
+  // What streams report as their algorithm version. Only tests change it, to
+  // play a replica of another release in a rolling upgrade.
+  std::string algorithm_version = kAlgorithmVersion;
 };
 
 }  // namespace sfc

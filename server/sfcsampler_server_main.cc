@@ -36,6 +36,25 @@ int main(int argc, char** argv) {
   app.add_option("--max-concurrent-streams", o.max_concurrent_streams, "Sample streams at once")
       ->capture_default_str();
   app.add_option("--max-batch-size", o.max_batch_size, "most samples per message")->capture_default_str();
+  app.add_option("--max-message-bytes", o.max_message_bytes,
+                 "largest message sent, bytes; batches are sized to fit (4 MiB: what stock gRPC "
+                 "clients accept)")
+      ->capture_default_str();
+  app.add_option("--max-concurrent-builds", o.max_concurrent_builds, "tree builds at once")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 64));
+  app.add_option("--max-queued-builds", o.max_queued_builds,
+                 "tree builds that may wait for a builder; a miss past that is RESOURCE_EXHAUSTED")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--failure-ttl", o.failure_ttl_seconds,
+                 "seconds a failed tree build is remembered (its error is returned at once)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--write-timeout", o.write_timeout_seconds,
+                 "seconds a stream may wait for a client that reads nothing before it is cut")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--generation-threads", o.limits.generation_threads,
                  "threads that fill one stream's batches (same samples, same order)")
       ->capture_default_str()
@@ -47,6 +66,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--tls-cert", o.tls_cert_file, "PEM certificate chain; with --tls-key enables TLS");
   app.add_option("--tls-key", o.tls_key_file, "PEM private key");
+  app.add_option("--tls-client-ca", o.tls_client_ca_file,
+                 "PEM CA certificates; clients must present a certificate they signed (mutual TLS)");
   app.add_option("--token-file", token_file, "file holding the bearer token every sampler RPC must carry");
   app.add_option("--log-level", log_level, "trace | debug | info | warn | error")->capture_default_str();
   CLI11_PARSE(app, argc, argv);

@@ -1,72 +1,223 @@
 #include "server/tree_cache.h"
 
-#include <chrono>
+#include <new>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/time/time.h"
 
 namespace sfc {
+namespace {
 
-TreeCache::TreeCache(uint64_t budget_bytes, std::function<void(double)> on_build)
-    : budget_bytes_(budget_bytes), on_build_(std::move(on_build)) {}
+// How often a waiting request asks its own check (client gone, deadline).
+constexpr absl::Duration kWaitPoll = absl::Milliseconds(50);
 
-absl::StatusOr<TreeLookup> TreeCache::Get(const TreeKey& key, int grade, const TreeFactory& factory) {
+// Statuses that say the build was stopped, not that the tree cannot be built:
+// these are not remembered as failures.
+bool IsStop(const absl::Status& s) {
+  return absl::IsCancelled(s) || absl::IsUnavailable(s) || absl::IsDeadlineExceeded(s);
+}
+
+}  // namespace
+
+TreeCache::TreeCache(const TreeCacheOptions& options, std::function<void(double)> on_build)
+    : options_(options), on_build_(std::move(on_build)) {
+  const int threads = std::max(1, options_.max_concurrent_builds);
+  for (int i = 0; i < threads; ++i) builders_.emplace_back([this] { BuilderLoop(); });
+}
+
+TreeCache::~TreeCache() { Stop(); }
+
+absl::StatusOr<TreeLookup> TreeCache::Get(const TreeKey& key, int grade, const TreeFactory& factory,
+                                          const BuildControl& caller) {
   const std::string id = absl::StrCat(key.canonical, "#g", grade);
-  std::promise<Result> promise;
-  std::shared_future<Result> built_elsewhere;
-  std::shared_ptr<const CurveTree> coarser;
-  {
-    absl::MutexLock lock(&mu_);
+  absl::MutexLock lock(&mu_);
+  while (true) {
     if (auto it = entries_.find(id); it != entries_.end()) {
       lru_.splice(lru_.begin(), lru_, it->second.lru);
       ++stats_.hits;
       return TreeLookup{it->second.tree, true, false};
     }
+    if (stopping_) {
+      return absl::UnavailableError("the server is shutting down; retry on another replica or later");
+    }
+    if (auto it = failures_.find(id); it != failures_.end()) {
+      const double age = std::chrono::duration<double>(Clock::now() - it->second.when).count();
+      if (age < options_.failure_ttl_seconds) {
+        ++stats_.failure_hits;
+        const absl::Status& s = it->second.status;
+        return absl::Status(s.code(), absl::StrFormat("%s (this tree's build failed %.0f s ago; the "
+                                                      "server remembers failed builds for %g s)",
+                                                      s.message(), age, options_.failure_ttl_seconds));
+      }
+      failures_.erase(it);
+    }
+    std::shared_ptr<Job> job;
     if (auto it = pending_.find(id); it != pending_.end()) {
       ++stats_.waits;
-      built_elsewhere = it->second;
+      job = it->second;
     } else {
+      // Jobs in queue_ that an idle builder is about to take do not count.
+      const uint64_t idle = builders_.size() - stats_.builds_running;
+      if (queue_.size() >= static_cast<uint64_t>(options_.max_queued_builds) + idle) {
+        ++stats_.builds_rejected;
+        return absl::ResourceExhaustedError(absl::StrFormat(
+            "%d tree builds are running and %d more are queued, the server's limits "
+            "(max_concurrent_builds, max_queued_builds); retry later",
+            stats_.builds_running, queue_.size()));
+      }
       ++stats_.misses;
+      job = std::make_shared<Job>();
+      job->id = id;
+      job->canonical = key.canonical;
+      job->grade = grade;
+      job->factory = factory;
       if (auto g = grades_.find(key.canonical); g != grades_.end()) {
         auto below = g->second.lower_bound(grade);
         if (below != g->second.begin()) {
-          coarser = entries_.at(absl::StrCat(key.canonical, "#g", *std::prev(below))).tree;
+          job->coarser = entries_.at(absl::StrCat(key.canonical, "#g", *std::prev(below))).tree;
         }
       }
-      pending_.emplace(id, promise.get_future().share());
+      pending_.emplace(id, job);
+      queue_.push_back(job);
+    }
+    ++job->waiters;
+
+    // Wait for the job, asking the caller's own check now and then (outside
+    // the lock: it may be slow or take other locks).
+    while (!job->done) {
+      mu_.AwaitWithTimeout(absl::Condition(&job->done), kWaitPoll);
+      if (job->done || !caller.check) continue;
+      mu_.Unlock();
+      absl::Status still_wanted = caller.check();
+      mu_.Lock();
+      if (!still_wanted.ok() && !job->done) {
+        // A running build notices at its next check; a queued one goes now.
+        if (--job->waiters == 0 && !job->started) Forget(job);
+        return still_wanted;
+      }
+    }
+    --job->waiters;
+    // Joined a build just as every earlier waiter gave up on it: start over.
+    if (absl::IsCancelled(job->result.status())) continue;
+    if (!job->result.ok()) return job->result.status();
+    return TreeLookup{*job->result, false, job->coarser != nullptr};
+  }
+}
+
+void TreeCache::Forget(const std::shared_ptr<Job>& job) {
+  pending_.erase(job->id);
+  for (auto it = queue_.begin(); it != queue_.end(); ++it) {
+    if (*it == job) {
+      queue_.erase(it);
+      break;
     }
   }
-  if (built_elsewhere.valid()) {
-    const Result& tree = built_elsewhere.get();  // waits outside the lock
-    if (!tree.ok()) return tree.status();
-    return TreeLookup{*tree, false, false};
+  ++stats_.builds_stopped;
+}
+
+void TreeCache::BuilderLoop() {
+  while (true) {
+    std::shared_ptr<Job> job;
+    {
+      absl::MutexLock lock(&mu_);
+      auto has_work = [this]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { return stopping_ || !queue_.empty(); };
+      mu_.Await(absl::Condition(&has_work));
+      if (stopping_) return;
+      job = std::move(queue_.front());
+      queue_.pop_front();
+      job->started = true;
+      ++stats_.builds_running;
+    }
+    Run(*job);
   }
+}
 
-  const auto start = std::chrono::steady_clock::now();
-  Result tree = coarser ? factory.refine(*coarser, grade) : factory.build(grade);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+absl::Status TreeCache::BuildCheck(const Job& job) const {
+  absl::MutexLock lock(&mu_);
+  if (stopping_) {
+    return absl::UnavailableError("the server is shutting down; the tree build was stopped");
+  }
+  if (job.waiters == 0) {
+    return absl::CancelledError("every request waiting for this tree has gone; its build was stopped");
+  }
+  return absl::OkStatus();
+}
 
+void TreeCache::Run(Job& job) {
+  BuildControl control{[this, &job] { return BuildCheck(job); }};
+  const auto start = Clock::now();
+  Result result = absl::InternalError("the tree build did not run");
+  try {
+    result = job.coarser ? job.factory.refine(*job.coarser, job.grade, control)
+                         : job.factory.build(job.grade, control);
+  } catch (const std::bad_alloc&) {
+    result = absl::ResourceExhaustedError(
+        "the server ran out of memory building this tree; ask for fewer samples, a coarser "
+        "tolerance, or retry when the server is less busy");
+  } catch (const std::exception& e) {
+    result = absl::InternalError(absl::StrCat("the tree build failed: ", e.what()));
+  }
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   {
     absl::MutexLock lock(&mu_);
-    pending_.erase(id);
-    stats_.build_seconds += seconds;
-    if (tree.ok()) {
-      ++(coarser ? stats_.refinements : stats_.builds);
-      lru_.push_front(id);
-      const uint64_t bytes = (*tree)->bytes();
-      entries_.emplace(id, Entry{*tree, bytes, key.canonical, grade, lru_.begin()});
-      grades_[key.canonical].insert(grade);
-      stats_.bytes += bytes;
-      EvictOverBudget();
-    }
+    Finish(job, std::move(result), seconds);
   }
   if (on_build_) on_build_(seconds);
-  promise.set_value(tree);
-  if (!tree.ok()) return tree.status();
-  return TreeLookup{*std::move(tree), false, coarser != nullptr};
+}
+
+void TreeCache::Finish(Job& job, Result result, double seconds) {
+  --stats_.builds_running;
+  pending_.erase(job.id);
+  stats_.build_seconds += seconds;
+  if (result.ok()) {
+    ++(job.coarser ? stats_.refinements : stats_.builds);
+    lru_.push_front(job.id);
+    const uint64_t bytes = (*result)->bytes();
+    entries_.emplace(job.id, Entry{*result, bytes, job.canonical, job.grade, lru_.begin()});
+    grades_[job.canonical].insert(job.grade);
+    stats_.bytes += bytes;
+    EvictOverBudget();
+  } else if (IsStop(result.status())) {
+    ++stats_.builds_stopped;
+  } else {
+    ++stats_.builds_failed;
+    // Bounded: expired failures go first, then the oldest.
+    constexpr size_t kMaxFailures = 4096;
+    if (failures_.size() >= kMaxFailures) {
+      const auto now = Clock::now();
+      for (auto it = failures_.begin(); it != failures_.end();) {
+        const bool expired =
+            std::chrono::duration<double>(now - it->second.when).count() >= options_.failure_ttl_seconds;
+        it = expired ? failures_.erase(it) : std::next(it);
+      }
+      if (failures_.size() >= kMaxFailures) failures_.erase(failures_.begin());
+    }
+    if (options_.failure_ttl_seconds > 0) failures_[job.id] = Failure{result.status(), Clock::now()};
+  }
+  job.result = std::move(result);
+  job.done = true;
+}
+
+void TreeCache::Stop() {
+  {
+    absl::MutexLock lock(&mu_);
+    stopping_ = true;
+    for (const std::shared_ptr<Job>& job : queue_) {
+      pending_.erase(job->id);
+      job->result = absl::UnavailableError("the server is shutting down; retry on another replica or later");
+      job->done = true;
+      ++stats_.builds_stopped;
+    }
+    queue_.clear();
+  }
+  for (std::thread& t : builders_) {
+    if (t.joinable()) t.join();
+  }
 }
 
 void TreeCache::EvictOverBudget() {
-  while (stats_.bytes > budget_bytes_ && !lru_.empty()) {
+  while (stats_.bytes > options_.budget_bytes && !lru_.empty()) {
     auto it = entries_.find(lru_.back());
     stats_.bytes -= it->second.bytes;
     auto grades = grades_.find(it->second.canonical);
@@ -82,6 +233,7 @@ TreeCacheStats TreeCache::stats() const {
   absl::MutexLock lock(&mu_);
   TreeCacheStats s = stats_;
   s.entries = entries_.size();
+  s.builds_queued = queue_.size();
   return s;
 }
 

@@ -75,6 +75,38 @@ grep -q UNAUTHENTICATED "$tmp/noauth.err" || fail "no UNAUTHENTICATED without th
 "$cli" sample --surface torus --count 10 -q -o /dev/null --server "127.0.0.1:$tls_port" \
   --token-file "$tmp/token" 2> /dev/null && fail "a plaintext client reached the TLS port"
 [ "$("$cli" health --server "127.0.0.1:$tls_health")" = SERVING ] || fail "the probe port needs no TLS or token"
+[ "$("$cli" health --server "127.0.0.1:$tls_port" --tls-roots "$tmp/cert.pem")" = SERVING ] \
+  || fail "health on the TLS port needs no token (the auth processor lets it through)"
+echo "s3cret-tokeX" > "$tmp/wrong"
+"$cli" sample --surface torus --count 10 -q -o /dev/null --server "127.0.0.1:$tls_port" \
+  --tls-roots "$tmp/cert.pem" --token-file "$tmp/wrong" 2> "$tmp/wrong.err" && fail "a wrong token was served"
+grep -q UNAUTHENTICATED "$tmp/wrong.err" || fail "no UNAUTHENTICATED for a wrong token"
+kill -TERM "$pid"; wait "$pid" || true; pid=""
+
+# Mutual TLS: a CA signs the server's and a client's certificate; the server
+# serves only clients that present one.
+openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=test-ca -keyout "$tmp/ca.key" \
+  -out "$tmp/ca.pem" > /dev/null 2>&1 || fail "openssl could not make a CA"
+sign() {  # sign NAME SUBJECT [EXTENSIONS]
+  openssl req -newkey rsa:2048 -nodes -subj "$2" -keyout "$tmp/$1.key" -out "$tmp/$1.csr" > /dev/null 2>&1
+  printf '%s\n' "${3:-basicConstraints=CA:FALSE}" > "$tmp/$1.ext"
+  openssl x509 -req -in "$tmp/$1.csr" -CA "$tmp/ca.pem" -CAkey "$tmp/ca.key" -CAcreateserial -days 1 \
+    -extfile "$tmp/$1.ext" -out "$tmp/$1.pem" > /dev/null 2>&1 || fail "openssl could not sign $1"
+}
+sign server /CN=localhost "subjectAltName=IP:127.0.0.1,DNS:localhost"
+sign client /CN=sfcsampler-test-client
+"$server" --address 127.0.0.1:0 --health-address "" --metrics-address "" \
+  --tls-cert "$tmp/server.pem" --tls-key "$tmp/server.key" --tls-client-ca "$tmp/ca.pem" > "$tmp/mtls.log" 2>&1 &
+pid=$!
+for _ in $(seq 100); do grep -q "listening" "$tmp/mtls.log" && break; sleep 0.05; done
+grep -q "mutual_tls=true" "$tmp/mtls.log" || fail "the server did not report mutual TLS"
+mtls_port=$(sed -n 's/.* port=\([0-9]*\) health_port=.*/\1/p' "$tmp/mtls.log")
+"$cli" sample --surface torus --count 1000 -q -o "$tmp/mtls.csv" --server "127.0.0.1:$mtls_port" \
+  --tls-roots "$tmp/ca.pem" --tls-cert "$tmp/client.pem" --tls-key "$tmp/client.key" \
+  || fail "mutual TLS with a client certificate"
+cmp -s "$tmp/mtls.csv" "$tmp/plain.csv" || fail "mutual-TLS samples differ"
+"$cli" sample --surface torus --count 10 -q -o /dev/null --server "127.0.0.1:$mtls_port" \
+  --tls-roots "$tmp/ca.pem" 2> /dev/null && fail "a client without a certificate was served"
 kill -TERM "$pid"; wait "$pid" || true; pid=""
 
 echo "cli_server_test: all checks passed"

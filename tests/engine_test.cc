@@ -127,6 +127,20 @@ TEST(Engine, BadRangeShardOrRegionIsInvalidArgument) {
   ExpectError(engine.Start(r).status(), absl::StatusCode::kInvalidArgument, "empty");
 }
 
+TEST(Engine, ATreeSizedForFewerSamplesThanTheSetIsRefused) {
+  DirectTreeSource source;
+  SamplingEngine engine({}, &source);
+  SampleRequest r;
+  r.tree.surface = "plane";
+  r.count = 5000;
+  r.tree_count = 4999;
+  ExpectError(engine.Start(r).status(), absl::StatusCode::kInvalidArgument, "tree_count");
+  r.tree_count = 5000;
+  EXPECT_TRUE(engine.Start(r).ok());
+  r.tree_count = 0;  // sized for count
+  EXPECT_TRUE(engine.Start(r).ok());
+}
+
 TEST(Engine, UnorderedSequencesAreBoundedPerRequest) {
   DirectTreeSource source;
   EngineLimits limits;

@@ -4,9 +4,11 @@
 // flow control, cancellation, and every bad input's status code.
 #include <atomic>
 #include <chrono>
+#include <functional>
 #include <thread>
 
 #include "client/sampler_client.h"
+#include "grpcpp/create_channel.h"
 #include "gtest/gtest.h"
 #include "server/sampler_server.h"
 
@@ -68,6 +70,11 @@ void ExpectEqual(const SampleBatch& a, const SampleBatch& b) {
   EXPECT_EQ(a.x, b.x);
   EXPECT_EQ(a.y, b.y);
   EXPECT_EQ(a.z, b.z);
+}
+
+void ExpectStatus(const absl::Status& s, absl::StatusCode code, const std::string& mentions) {
+  EXPECT_EQ(s.code(), code) << s;
+  EXPECT_NE(s.message().find(mentions), std::string::npos) << s.message() << " should mention " << mentions;
 }
 
 TEST(Server, ShardsJoinToTheFullSetInOrder) {
@@ -138,6 +145,37 @@ TEST(Server, TheClientResumesAcrossAServerRestart) {
   EXPECT_GE(result->resumes, 1);
   EXPECT_EQ(got.index, reference->index);
   EXPECT_EQ(got.u, reference->u);
+}
+
+TEST(Server, AResumeOnAServerOfAnotherReleaseFailsInsteadOfMixingSets) {
+  ServerOptions options = LoopbackOptions();
+  options.algorithm_version = "sfcsampler-older-release";
+  auto server = *SamplerServer::Start(options);
+  const int port = server->port();
+  ClientOptions co;
+  co.target = "127.0.0.1:" + std::to_string(port);
+  co.batch_size = 1000;
+  co.resume_backoff_seconds = 0.3;
+  auto client = *SamplerClient::Connect(co);
+  std::unique_ptr<SamplerServer> upgraded;
+  uint64_t received = 0;
+  bool restarted = false;
+  auto result = client->Sample(Request("sphere", 200000, 8), [&](const v1::StreamHeader&, const SampleBatch& b) {
+    received += b.size();
+    if (!restarted && received >= 50000) {
+      // The replica is replaced by one of the current release mid-stream.
+      restarted = true;
+      std::thread([&] {
+        server->Shutdown(0, 0);
+        ServerOptions current = LoopbackOptions();
+        current.address = "127.0.0.1:" + std::to_string(port);
+        upgraded = *SamplerServer::Start(current);
+      }).join();
+    }
+    return absl::OkStatus();
+  });
+  ExpectStatus(result.status(), absl::StatusCode::kFailedPrecondition, "algorithm version");
+  ExpectStatus(result.status(), absl::StatusCode::kFailedPrecondition, "sfcsampler-older-release");
 }
 
 TEST(Server, EmbeddedAndWireSamplesAreIdentical) {
@@ -259,9 +297,158 @@ TEST(Server, ACancelledStreamIsFreedAtOnce) {
   EXPECT_LT(r.server->metrics().samples_streamed(), 1'000'000.0);
 }
 
-void ExpectStatus(const absl::Status& s, absl::StatusCode code, const std::string& mentions) {
-  EXPECT_EQ(s.code(), code) << s;
-  EXPECT_NE(s.message().find(mentions), std::string::npos) << s.message() << " should mention " << mentions;
+
+// A request whose tree takes many seconds to build (a flatness tolerance far
+// below the surface's size splits to the leaf budget) unless stopped.
+SampleRequest HeavyBuild(const std::string& surface = "torus") {
+  SampleRequest r = Request(surface, 1000);
+  r.tree.options.tolerance = 1e-9;
+  return r;
+}
+
+// Waits up to `seconds` for `done`; true if it came.
+bool Within(double seconds, const std::function<bool()>& done) {
+  const auto until = std::chrono::steady_clock::now() + milliseconds(static_cast<int>(seconds * 1000));
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > until) return false;
+    std::this_thread::sleep_for(milliseconds(10));
+  }
+  return true;
+}
+
+TEST(Server, ABuildNobodyWaitsForAnyMoreStopsAndFreesItsSlot) {
+  Running r = StartServer(LoopbackOptions());
+  ClientOptions co;
+  co.target = "127.0.0.1:" + std::to_string(r.server->port());
+  co.deadline_seconds = 0.5;
+  auto impatient = *SamplerClient::Connect(co);
+  const auto start = std::chrono::steady_clock::now();
+  ExpectStatus(Fetch(*impatient, HeavyBuild()).status(), absl::StatusCode::kDeadlineExceeded, "");
+  EXPECT_LT(std::chrono::steady_clock::now() - start, milliseconds(3000));
+  // The server notices the client is gone, stops the build, frees the slot.
+  EXPECT_TRUE(Within(5, [&] {
+    const TreeCacheStats s = r.server->cache().stats();
+    return s.builds_running == 0 && r.server->service().active_streams() == 0;
+  }));
+  const TreeCacheStats s = r.server->cache().stats();
+  EXPECT_EQ(s.builds_stopped, 1u);
+  EXPECT_EQ(s.builds, 0u);
+  EXPECT_EQ(s.builds_failed, 0u);  // a stopped build is not remembered as a failure
+}
+
+TEST(Server, AWaiterLeavesAtItsOwnDeadlineWhileTheBuildGoesOnForOthers) {
+  Running r = StartServer(LoopbackOptions());
+  absl::Status patient_status;
+  std::atomic<bool> stop_patient{false};
+  // The patient client cancels from its callback... which never runs during
+  // the build, so it gets a deadline long enough to outlive the impatient one.
+  ClientOptions pc;
+  pc.target = "127.0.0.1:" + std::to_string(r.server->port());
+  pc.deadline_seconds = 3;
+  auto patient = *SamplerClient::Connect(pc);
+  std::thread first([&] { patient_status = Fetch(*patient, HeavyBuild()).status(); });
+  ASSERT_TRUE(Within(5, [&] { return r.server->cache().stats().builds_running == 1; }));
+
+  ClientOptions ic = pc;
+  ic.deadline_seconds = 0.3;
+  auto impatient = *SamplerClient::Connect(ic);
+  ExpectStatus(Fetch(*impatient, HeavyBuild()).status(), absl::StatusCode::kDeadlineExceeded, "");
+  // The impatient client joined the same build and left it; the build goes on.
+  EXPECT_EQ(r.server->cache().stats().waits, 1u);
+  EXPECT_EQ(r.server->cache().stats().builds_running, 1u);
+  first.join();
+  EXPECT_EQ(patient_status.code(), absl::StatusCode::kDeadlineExceeded) << patient_status;
+  EXPECT_TRUE(Within(5, [&] { return r.server->cache().stats().builds_running == 0; }));
+}
+
+TEST(Server, BuildsBeyondTheQueueAreTurnedAwayAndNamedTheLimit) {
+  ServerOptions options = LoopbackOptions();
+  options.max_concurrent_builds = 1;
+  options.max_queued_builds = 0;
+  Running r = StartServer(options);
+  ClientOptions co;
+  co.target = "127.0.0.1:" + std::to_string(r.server->port());
+  co.deadline_seconds = 2;
+  auto client = *SamplerClient::Connect(co);
+  std::thread first([&] { (void)Fetch(*client, HeavyBuild("torus")); });
+  ASSERT_TRUE(Within(5, [&] { return r.server->cache().stats().builds_running == 1; }));
+  ExpectStatus(Fetch(*r.client, HeavyBuild("sphere")).status(), absl::StatusCode::kResourceExhausted,
+               "max_queued_builds");
+  // A cached tree needs no builder: it is still served.
+  first.join();
+  EXPECT_EQ(r.server->cache().stats().builds_rejected, 1u);
+  auto stats = r.client->GetCacheStats();
+  ASSERT_TRUE(stats.ok());
+  EXPECT_EQ(stats->max_concurrent_builds(), 1u);
+  EXPECT_EQ(stats->max_queued_builds(), 0u);
+}
+
+TEST(Server, AFailedBuildIsRememberedAndNotRepeated) {
+  ServerOptions options = LoopbackOptions();
+  options.limits.max_tree_leaves = 1000;
+  Running r = StartServer(options);
+  SampleRequest fine = Request("torus", 1000);
+  fine.tree.options.tolerance = 1e-6;  // needs far more than 1000 leaves
+  ExpectStatus(Fetch(*r.client, fine).status(), absl::StatusCode::kResourceExhausted, "max_leaves");
+  const absl::Status again = Fetch(*r.client, fine).status();
+  ExpectStatus(again, absl::StatusCode::kResourceExhausted, "max_leaves");
+  ExpectStatus(again, absl::StatusCode::kResourceExhausted, "remembers failed builds");
+  const TreeCacheStats s = r.server->cache().stats();
+  EXPECT_EQ(s.builds_failed, 1u);
+  EXPECT_EQ(s.failure_hits, 1u);
+  EXPECT_EQ(s.misses, 1u);
+}
+
+TEST(Server, ShutdownStopsARunningBuild) {
+  ClientOptions co;
+  co.max_resumes = 0;  // see the server's answer, not a retry
+  Running r = StartServer(LoopbackOptions(), co);
+  absl::Status status;
+  std::thread waiting([&] { status = Fetch(*r.client, HeavyBuild()).status(); });
+  ASSERT_TRUE(Within(5, [&] { return r.server->cache().stats().builds_running == 1; }));
+  const auto start = std::chrono::steady_clock::now();
+  r.server->Shutdown(0.2, 0);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, milliseconds(3000));
+  waiting.join();
+  ExpectStatus(status, absl::StatusCode::kUnavailable, "shutting down");
+}
+
+TEST(Server, AStockClientReceivesEveryColumnWithinItsDefaultMessageLimit) {
+  Running r = StartServer(LoopbackOptions());
+  // A plain generated stub on a default channel: 4 MiB receive limit.
+  auto channel = grpc::CreateChannel("127.0.0.1:" + std::to_string(r.server->port()),
+                                     grpc::InsecureChannelCredentials());
+  auto stub = v1::Sampler::NewStub(channel);
+  v1::SampleRequest request;
+  request.mutable_tree()->set_surface("torus");
+  request.mutable_tree()->set_density("gaussian:floor=0.1");
+  request.set_count(300000);
+  request.set_normals(true);
+  request.set_density(true);
+  request.set_curve_position(true);
+  grpc::ClientContext context;
+  auto reader = stub->Sample(&context, request);
+  v1::SampleResponse response;
+  uint64_t samples = 0;
+  size_t largest = 0;
+  while (reader->Read(&response)) {
+    samples += response.batch().size();
+    largest = std::max(largest, response.ByteSizeLong());
+  }
+  const grpc::Status status = reader->Finish();
+  EXPECT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(samples, 300000u);
+  EXPECT_LE(largest, size_t{4} << 20);
+  EXPECT_GT(largest, size_t{2} << 20);  // batches are as large as fit, not tiny
+
+  // Asking for more than fits names the cap and the largest batch that fits.
+  ClientOptions co;
+  co.target = "127.0.0.1:" + std::to_string(r.server->port());
+  co.batch_size = 100000;
+  auto client = *SamplerClient::Connect(co);
+  SampleRequest all = Request("torus", 300000);
+  all.fields.normal = all.fields.density = all.fields.curve_position = true;
+  ExpectStatus(Fetch(*client, all).status(), absl::StatusCode::kInvalidArgument, "max_message_bytes");
 }
 
 TEST(Server, EveryBadInputGetsItsStatusCode) {
@@ -320,11 +507,42 @@ TEST(Server, TheServerDeadlineEndsLongStreams) {
   ClientOptions co;
   co.batch_size = 100;
   Running r = StartServer(options, co);
-  auto result = r.client->Sample(Request("sphere", 1'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
-    std::this_thread::sleep_for(milliseconds(20));
+  // A tree that builds at once (the plane needs few leaves when each may
+  // carry many samples), and a stream that runs past the deadline.
+  SampleRequest long_stream = Request("plane", 4'000'000);
+  long_stream.tree.options.rho = 1e6;
+  auto result = r.client->Sample(long_stream, [&](const v1::StreamHeader&, const SampleBatch&) {
+    std::this_thread::sleep_for(milliseconds(2));
     return absl::OkStatus();
   });
   ExpectStatus(result.status(), absl::StatusCode::kDeadlineExceeded, "resume after the last index");
+}
+
+TEST(Server, AReaderThatStopsReadingIsCutAndFreesItsSlot) {
+  ServerOptions options = LoopbackOptions();
+  options.write_timeout_seconds = 0.3;
+  options.max_concurrent_streams = 1;
+  ClientOptions co;
+  co.batch_size = 16384;
+  Running r = StartServer(options, co);
+  std::atomic<bool> freed{false};
+  std::atomic<double> stalled{0};
+  auto result = r.client->Sample(Request("plane", 4'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
+    // Stop reading: the server's writes block on flow control. Its slot
+    // must come free while this client still holds the stream open.
+    const auto until = std::chrono::steady_clock::now() + milliseconds(5000);
+    while (std::chrono::steady_clock::now() < until && !freed) {
+      freed = r.server->service().active_streams() == 0;
+      std::this_thread::sleep_for(milliseconds(10));
+    }
+    stalled = r.server->metrics().stalled_streams();
+    return absl::OkStatus();
+  });
+  EXPECT_TRUE(freed) << "the stalled stream still held its slot after 5 s";
+  EXPECT_EQ(stalled.load(), 1.0);
+  EXPECT_FALSE(result.ok());
+  // The slot serves the next client at once.
+  EXPECT_TRUE(Fetch(*r.client, Request("torus", 1000)).ok());
 }
 
 TEST(Server, ATokenIsRequiredWhenSetButHealthStaysOpen) {

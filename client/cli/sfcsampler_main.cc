@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <set>
 #include <thread>
@@ -38,13 +39,16 @@ struct Connection {
   std::string token_file;  // bearer token
   bool tls = false;
   std::string tls_roots;
+  std::string tls_cert, tls_key;  // client certificate for mutual TLS
 };
 
 absl::StatusOr<std::unique_ptr<SamplerClient>> Connect(const Connection& c, uint32_t batch_size) {
   ClientOptions options;
   options.target = c.server;
-  options.tls = c.tls || !c.tls_roots.empty();
+  options.tls = c.tls || !c.tls_roots.empty() || !c.tls_cert.empty();
   options.tls_root_certs_file = c.tls_roots;
+  options.tls_cert_file = c.tls_cert;
+  options.tls_key_file = c.tls_key;
   options.batch_size = batch_size;
   if (!c.token_file.empty()) {
     std::FILE* f = std::fopen(c.token_file.c_str(), "r");
@@ -161,7 +165,7 @@ int RunSample(const RequestFlags& flags, const std::string& format, bool ascii,
   uint64_t done = 0;
   while (true) {
     batch.Clear();
-    auto n = job->cursor->Next(batch_size, &batch);
+    auto n = job->cursor->Next(batch_size == 0 ? 65536 : batch_size, &batch);
     if (!n.ok()) return Fail(n.status());
     if (*n == 0) break;
     if (auto s = (*writer)->Write(batch); !s.ok()) return Fail(s);
@@ -273,8 +277,12 @@ int RunEval(const EvalFlags& f) {
   const std::string tables = SlopeTables(Slopes(*rows));
   std::printf("N = 2^l and 2^l + 2^(l-1), l = %d..%d, seed %llu\n\n%s", options.l_min,
               options.l_max, static_cast<unsigned long long>(options.seed), tables.c_str());
-  std::string mkdir = "mkdir -p '" + f.out_dir + "'";
-  if (std::system(mkdir.c_str()) != 0) return Fail(absl::UnavailableError("cannot create " + f.out_dir));
+  std::error_code mkdir_error;
+  std::filesystem::create_directories(f.out_dir, mkdir_error);
+  if (mkdir_error) {
+    return Fail(absl::UnavailableError(
+        absl::StrFormat("cannot create the folder \"%s\": %s", f.out_dir, mkdir_error.message())));
+  }
   auto write = [&](const std::string& name, const std::string& text) {
     std::FILE* out = std::fopen((f.out_dir + "/" + name).c_str(), "w");
     if (!out) return false;
@@ -375,10 +383,13 @@ int main(int argc, char** argv) {
     cmd->add_option("--token-file", conn.token_file, "file with the server's bearer token");
     cmd->add_flag("--tls", conn.tls, "connect with TLS (system roots)");
     cmd->add_option("--tls-roots", conn.tls_roots, "PEM roots to trust for TLS (implies --tls)");
+    cmd->add_option("--tls-cert", conn.tls_cert,
+                    "PEM client certificate for servers that require mutual TLS (implies --tls)");
+    cmd->add_option("--tls-key", conn.tls_key, "PEM private key of --tls-cert");
   };
   std::string format = "csv", output = "-";
   bool ascii = false, quiet = false;
-  size_t batch_size = 65536;
+  size_t batch_size = 0;
 
   CLI::App* sample = app.add_subcommand("sample", "sample a surface (in-process, or over the wire with --server)");
   sfc::AddTreeFlags(sample, &flags);
@@ -386,7 +397,11 @@ int main(int argc, char** argv) {
   sample->add_option("--format", format, "csv | ply")->capture_default_str();
   sample->add_flag("--ascii", ascii, "write ASCII PLY instead of binary little-endian");
   sample->add_option("--output,-o", output, "output file, - for stdout")->capture_default_str();
-  sample->add_option("--batch-size", batch_size, "samples per batch")->capture_default_str()->check(CLI::Range(1, 1 << 24));
+  sample->add_option("--batch-size", batch_size,
+                     "samples per batch; 0 = 65536 in-process, or as many as fit the server's "
+                     "max_message_bytes (a larger value is refused with the largest that fits)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1 << 24));
   sample->add_flag("--quiet,-q", quiet, "no summary on stderr");
   add_connection(sample);
 
