@@ -5,6 +5,7 @@
 set -euo pipefail
 cli="$1"
 server="$2"
+probe="$3"
 tmp=$(mktemp -d)
 pid=""
 cleanup() { [ -n "$pid" ] && kill "$pid" 2>/dev/null; rm -rf "$tmp"; }
@@ -23,6 +24,12 @@ addr="127.0.0.1:$port"
 
 [ "$("$cli" health --server "$addr")" = SERVING ] || fail "health on the main port"
 [ "$("$cli" health --server "127.0.0.1:$health")" = SERVING ] || fail "health on the probe port"
+[ "$("$probe" --address "127.0.0.1:$health" --timeout 2)" = SERVING ] || fail "the health probe"
+set +e
+"$probe" --address "127.0.0.1:$health" --bogus 1 > /dev/null 2>&1; [ $? -eq 2 ] || fail "the probe's unknown flag should exit 2"
+"$probe" --address "127.0.0.1:$health" --timeout -1 > /dev/null 2>&1; [ $? -eq 2 ] || fail "the probe's bad timeout should exit 2"
+"$probe" --address "127.0.0.1:1" --timeout 0.5 > /dev/null 2>&1; [ $? -eq 2 ] || fail "an unreachable server should exit 2"
+set -e
 
 for args in "--surface torus --density gaussian:floor=0.1 --count 20000 --seed 4" \
             "--surface sphere --count 20000 --region box:0,0,0,1,1,1 --normals --curve-position" \

@@ -45,4 +45,10 @@ for f in discrepancy.csv slopes.md plane-rectangular.svg plane-triangular.png sp
 done
 "$cli" render --surface torus --count 2000 --what samples -o "$tmp/t.png" 2> /dev/null
 [ "$(head -c 4 "$tmp/t.png" | tail -c 3)" = "PNG" ] || fail "render PNG"
+
+# eval's output folder is made by the program, not a shell: any name works.
+odd="$tmp/it's a \$(folder) with spaces"
+"$cli" eval --setting fast --out-dir "$odd" > /dev/null 2>&1 || fail "eval into a folder with quotes and spaces"
+[ -s "$odd/discrepancy.csv" ] || fail "eval wrote no discrepancy.csv into the odd folder"
+[ ! -e "$tmp/it" ] || fail "the folder name was split by a shell"
 echo "cli_test: all checks passed"

@@ -14,6 +14,7 @@ packages=(
   libspdlog-dev                                  # server logs
   prometheus-cpp-dev                             # server metrics
   libcairo2-dev libpng-dev                       # pictures and plots
+  libssl-dev                                     # constant-time token comparison (CRYPTO_memcmp)
   openssl                                        # a self-signed certificate for the TLS test
   nginx                                          # the consistent-hash gRPC proxy of the scale-out test
 )
