@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_format.h"
 #include "catalog/catalog.h"
+#include "engine/model_source.h"
 #include "engine/tree_key.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "grpcpp/client_context.h"
@@ -254,6 +255,61 @@ absl::StatusOr<v1::CacheStats> SamplerClient::GetCacheStats() {
   const grpc::Status status = stub_->GetCacheStats(&context, {}, &response);
   if (!status.ok()) return FromGrpcStatus(status);
   return response;
+}
+
+absl::StatusOr<v1::ModelInfo> SamplerClient::UploadModel(const std::string& format,
+                                                         const std::string& name,
+                                                         const std::string& bytes) {
+  constexpr size_t kChunk = size_t{1} << 20;  // well under every message limit
+  grpc::ClientContext context;
+  Decorate(&context, "");
+  v1::ModelInfo info;
+  auto writer = stub_->UploadModel(&context, &info);
+  v1::ModelChunk chunk;
+  chunk.set_format(format);
+  chunk.set_name(name);
+  size_t offset = 0;
+  do {
+    const size_t n = std::min(kChunk, bytes.size() - offset);
+    chunk.set_data(bytes.substr(offset, n));
+    offset += n;
+    // A failed write means the server ended the call early: Finish says why.
+    if (!writer->Write(chunk)) break;
+    chunk.clear_format();
+    chunk.clear_name();
+  } while (offset < bytes.size());
+  writer->WritesDone();
+  const grpc::Status status = writer->Finish();
+  if (!status.ok()) return FromGrpcStatus(status);
+  return info;
+}
+
+absl::StatusOr<std::string> SamplerClient::EnsureModel(const std::string& spec) {
+  auto parsed = ParseModelSpec(spec);
+  if (!parsed.ok()) return parsed.status();
+  if (!parsed->has_value()) return spec;
+  const ModelSpec& model_spec = **parsed;
+  std::string sha256 = model_spec.sha256;
+  StoredModel local;
+  if (sha256.empty()) {
+    FileModelSource files;
+    auto read = files.Resolve(model_spec);
+    if (!read.ok()) return read.status();
+    local = *std::move(read);
+    sha256 = local.sha256;
+  }
+  v1::FindModelRequest find;
+  find.set_sha256(sha256);
+  find.set_format(std::string(ModelFormatName(model_spec.format)));
+  grpc::ClientContext context;
+  Decorate(&context, "");
+  v1::ModelInfo info;
+  const grpc::Status found = stub_->FindModel(&context, find, &info);
+  if (found.ok()) return info.spec();
+  if (found.error_code() != grpc::StatusCode::NOT_FOUND || !local.bytes) return FromGrpcStatus(found);
+  auto uploaded = UploadModel(find.format(), local.name, *local.bytes);
+  if (!uploaded.ok()) return uploaded.status();
+  return uploaded->spec();
 }
 
 absl::StatusOr<bool> SamplerClient::CheckHealth(const std::string& service) {

@@ -58,6 +58,17 @@ class SamplerClient {
   absl::StatusOr<::sfcsampler::v1::PrepareResponse> Prepare(const TreeSpec& spec, uint64_t count);
   absl::StatusOr<::sfcsampler::v1::ListCatalogResponse> ListCatalog();
   absl::StatusOr<::sfcsampler::v1::CacheStats> GetCacheStats();
+
+  // Makes the model `spec` names available on the server and returns its
+  // wire spec "FORMAT:sha256=<hex>": a "FORMAT:FILE" spec's file is read
+  // here, and uploaded only if the server does not hold its bytes already
+  // (FindModel first); a "FORMAT:sha256=..." spec is checked with FindModel. A
+  // spec that names no model (a catalogue surface) comes back unchanged.
+  absl::StatusOr<std::string> EnsureModel(const std::string& spec);
+  // Uploads `bytes` as a model of `format` ("step", "obj", ...).
+  absl::StatusOr<::sfcsampler::v1::ModelInfo> UploadModel(const std::string& format,
+                                                          const std::string& name,
+                                                          const std::string& bytes);
   // grpc.health.v1 Check of `service` ("" = the whole server): true when SERVING.
   absl::StatusOr<bool> CheckHealth(const std::string& service = "");
 

@@ -109,15 +109,17 @@ absl::StatusOr<std::unique_ptr<SamplerServer>> SamplerServer::Start(const Server
   cache_options.failure_ttl_seconds = options.failure_ttl_seconds;
   server->cache_ = std::make_unique<TreeCache>(cache_options,
                                                [metrics](double s) { metrics->ObserveBuild(s); });
-  server->service_ = std::make_unique<SamplerService>(options, server->cache_.get(), metrics,
-                                                      /*token_checked_by_transport=*/tls);
+  server->models_ = std::make_unique<ModelStore>(options.model_bytes, options.max_model_bytes);
+  server->service_ = std::make_unique<SamplerService>(options, server->cache_.get(), server->models_.get(),
+                                                      metrics, /*token_checked_by_transport=*/tls);
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
   builder.AddListeningPort(options.address, *credentials, &server->port_);
   builder.RegisterService(server->service_.get());
-  // Batches are sized to fit; this is the backstop.
+  // Batches are sized to fit; this is the backstop. Uploads come in chunks
+  // of 1 MiB, requests are small: the default 4 MiB receive limit holds.
   builder.SetMaxSendMessageSize(static_cast<int>(options.max_message_bytes));
   // Sync-server threads wake this often to notice shutdown (gRPC's default of
   // 10 s would hold up a graceful stop by that long).

@@ -13,6 +13,7 @@
 #include "grpcpp/server.h"
 #include "prometheus/exposer.h"
 #include "server/metrics.h"
+#include "server/model_store.h"
 #include "server/sampler_service.h"
 #include "server/server_options.h"
 #include "server/tree_cache.h"
@@ -38,6 +39,7 @@ class SamplerServer {
   void Shutdown(double grace_seconds, double drain_seconds = 1.0);
 
   const TreeCache& cache() const { return *cache_; }
+  const ModelStore& models() const { return *models_; }
   const SamplerService& service() const { return *service_; }
   const ServerMetrics& metrics() const { return *metrics_; }
 
@@ -46,6 +48,7 @@ class SamplerServer {
 
   std::unique_ptr<ServerMetrics> metrics_;
   std::unique_ptr<TreeCache> cache_;
+  std::unique_ptr<ModelStore> models_;
   std::unique_ptr<SamplerService> service_;
   std::unique_ptr<grpc::Server> server_;
   std::unique_ptr<grpc::Server> health_server_;

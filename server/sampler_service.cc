@@ -40,10 +40,11 @@ BuildControl RequestControl(const grpc::ServerContext* context, Clock::time_poin
 
 }  // namespace
 
-SamplerService::SamplerService(const ServerOptions& options, TreeCache* cache, ServerMetrics* metrics,
-                               bool token_checked_by_transport)
+SamplerService::SamplerService(const ServerOptions& options, TreeCache* cache, ModelStore* models,
+                               ServerMetrics* metrics, bool token_checked_by_transport)
     : options_(options),
       cache_(cache),
+      models_(models),
       metrics_(metrics),
       engine_(options.limits, cache),
       authenticator_(options.token.empty() || token_checked_by_transport
@@ -277,8 +278,101 @@ grpc::Status SamplerService::GetCacheStats(grpc::ServerContext* context,
     response->set_builds_rejected(s.builds_rejected);
     response->set_failure_hits(s.failure_hits);
     response->set_failure_ttl_seconds(options_.failure_ttl_seconds);
+    const ModelStoreStats m = models_->stats();
+    response->set_models(m.models);
+    response->set_model_bytes(m.bytes);
+    response->set_model_budget_bytes(models_->budget_bytes());
+    response->set_max_model_bytes(models_->max_model_bytes());
+    response->set_model_uploads(m.uploads);
+    response->set_model_evictions(m.evictions);
   }
   metrics_->CountRequest("GetCacheStats", status.error_code());
+  return status;
+}
+
+static void ToProto(const StoredModel& model, bool already, v1::ModelInfo* out) {
+  out->set_sha256(model.sha256);
+  out->set_format(std::string(ModelFormatName(model.format)));
+  out->set_bytes(model.bytes->size());
+  out->set_already_stored(already);
+  out->set_spec(model.Spec());
+}
+
+grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
+                                         grpc::ServerReader<v1::ModelChunk>* reader,
+                                         v1::ModelInfo* response) {
+  const auto start = Clock::now();
+  grpc::Status status = Admit(*context);
+  std::string name, bytes;
+  std::optional<ModelFormat> format;
+  if (status.ok()) {
+    v1::ModelChunk chunk;
+    bool first = true;
+    while (status.ok() && reader->Read(&chunk)) {
+      if (first) {
+        name = chunk.name();
+        format = ModelFormatFromName(chunk.format());
+        if (!format) {
+          status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                                absl::StrFormat("unknown model format \"%s\"; use step, iges, nurbs, "
+                                                "obj or ply",
+                                                chunk.format()));
+        }
+        first = false;
+      }
+      if (bytes.size() + chunk.data().size() > models_->max_model_bytes()) {
+        // Stop reading now: the rest would only be thrown away.
+        models_->CountRejected();
+        status = grpc::Status(
+            grpc::StatusCode::RESOURCE_EXHAUSTED,
+            absl::StrFormat("the model \"%s\" is larger than this server's max_model_bytes of %d; "
+                            "simplify or split it, or ask the operator to raise the limit",
+                            name, models_->max_model_bytes()));
+      } else {
+        bytes += chunk.data();
+      }
+    }
+    if (status.ok() && first) {
+      status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, "the upload carried no model");
+    }
+  }
+  if (status.ok()) {
+    bool already = false;
+    auto stored = models_->Put(*format, std::move(bytes), name, &already);
+    if (stored.ok()) {
+      ToProto(*stored, already, response);
+    } else {
+      status = ToGrpcStatus(stored.status());
+    }
+  }
+  metrics_->CountRequest("UploadModel", status.error_code());
+  spdlog::info("rpc=UploadModel peer={} name=\"{}\" bytes={} sha256={} already={} seconds={:.3f} code={} msg=\"{}\"",
+               context->peer(), name, response->bytes(), response->sha256(), response->already_stored(),
+               SecondsSince(start), static_cast<int>(status.error_code()), status.error_message());
+  return status;
+}
+
+grpc::Status SamplerService::FindModel(grpc::ServerContext* context, const v1::FindModelRequest* request,
+                                       v1::ModelInfo* response) {
+  grpc::Status status = Admit(*context);
+  if (status.ok()) {
+    const std::string format = request->format().empty() ? "step" : request->format();
+    auto spec = ParseModelSpec(absl::StrFormat("%s:sha256=%s", format, request->sha256()));
+    if (!spec.ok()) {
+      status = ToGrpcStatus(spec.status());
+    } else if (!spec->has_value()) {
+      status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                            absl::StrFormat("unknown model format \"%s\"", format));
+    } else {
+      auto found = models_->Resolve(**spec);
+      if (found.ok()) {
+        ToProto(*found, true, response);
+      } else {
+        status = ToGrpcStatus(found.status());
+      }
+    }
+  }
+  metrics_->CountRequest("FindModel", status.error_code());
   return status;
 }
 

@@ -18,6 +18,7 @@
 
 #include "engine/sampling_engine.h"
 #include "server/metrics.h"
+#include "server/model_store.h"
 #include "server/server_options.h"
 #include "server/stream_watchdog.h"
 #include "server/token_auth.h"
@@ -28,11 +29,11 @@ namespace sfc {
 
 class SamplerService final : public ::sfcsampler::v1::Sampler::Service {
  public:
-  // `cache` and `metrics` are not owned and must outlive the service.
+  // `cache`, `models` and `metrics` are not owned and must outlive the service.
   // `token_checked_by_transport`: an AuthMetadataProcessor already checks the
   // token (TLS ports), so the service does not.
-  SamplerService(const ServerOptions& options, TreeCache* cache, ServerMetrics* metrics,
-                 bool token_checked_by_transport);
+  SamplerService(const ServerOptions& options, TreeCache* cache, ModelStore* models,
+                 ServerMetrics* metrics, bool token_checked_by_transport);
 
   grpc::Status Sample(grpc::ServerContext* context, const ::sfcsampler::v1::SampleRequest* request,
                       grpc::ServerWriter<::sfcsampler::v1::SampleResponse>* writer) override;
@@ -44,6 +45,11 @@ class SamplerService final : public ::sfcsampler::v1::Sampler::Service {
   grpc::Status GetCacheStats(grpc::ServerContext* context,
                              const ::sfcsampler::v1::GetCacheStatsRequest* request,
                              ::sfcsampler::v1::CacheStats* response) override;
+  grpc::Status UploadModel(grpc::ServerContext* context,
+                           grpc::ServerReader<::sfcsampler::v1::ModelChunk>* reader,
+                           ::sfcsampler::v1::ModelInfo* response) override;
+  grpc::Status FindModel(grpc::ServerContext* context, const ::sfcsampler::v1::FindModelRequest* request,
+                         ::sfcsampler::v1::ModelInfo* response) override;
 
   uint32_t active_streams() const { return active_streams_.load(); }
   // From now on new calls get UNAVAILABLE ("shutting down"); streams in flight go on.
@@ -59,6 +65,7 @@ class SamplerService final : public ::sfcsampler::v1::Sampler::Service {
   // Constant after construction.
   const ServerOptions options_;
   TreeCache* const cache_;
+  ModelStore* const models_;
   ServerMetrics* const metrics_;
   const SamplingEngine engine_;
   // Set when the service itself checks the token (plaintext ports).

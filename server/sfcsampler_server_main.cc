@@ -33,6 +33,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--cache-bytes", o.cache_bytes, "tree cache budget in bytes (LRU eviction)")
       ->capture_default_str();
+  app.add_option("--model-bytes", o.model_bytes, "uploaded models kept, bytes (LRU eviction)")
+      ->capture_default_str();
+  app.add_option("--max-model-bytes", o.max_model_bytes, "largest model one upload may carry, bytes")
+      ->capture_default_str();
   app.add_option("--max-concurrent-streams", o.max_concurrent_streams, "Sample streams at once")
       ->capture_default_str();
   app.add_option("--max-batch-size", o.max_batch_size, "most samples per message")->capture_default_str();

@@ -4,10 +4,12 @@
 // flow control, cancellation, and every bad input's status code.
 #include <atomic>
 #include <chrono>
+#include <fstream>
 #include <functional>
 #include <thread>
 
 #include "client/sampler_client.h"
+#include "engine/model_source.h"
 #include "grpcpp/create_channel.h"
 #include "gtest/gtest.h"
 #include "server/sampler_server.h"
@@ -543,6 +545,36 @@ TEST(Server, AReaderThatStopsReadingIsCutAndFreesItsSlot) {
   EXPECT_FALSE(result.ok());
   // The slot serves the next client at once.
   EXPECT_TRUE(Fetch(*r.client, Request("torus", 1000)).ok());
+}
+
+TEST(Server, AModelIsUploadedOnceAndNamedByItsHash) {
+  ServerOptions options = LoopbackOptions();
+  options.max_model_bytes = 3 << 20;
+  Running r = StartServer(options);
+  const std::string path = ::testing::TempDir() + "/server_test_model.obj";
+  std::string content;
+  for (int i = 0; i < 200000; ++i) content += "v " + std::to_string(i) + " 0 0\n";  // > 1 MiB: several chunks
+  std::ofstream(path) << content;
+  auto spec = r.client->EnsureModel("obj:" + path);
+  ASSERT_TRUE(spec.ok()) << spec.status();
+  EXPECT_EQ(*spec, "obj:sha256=" + Sha256Hex(content));
+  // Again, by path or by hash: found, not sent again.
+  EXPECT_EQ(*r.client->EnsureModel("obj:" + path), *spec);
+  EXPECT_EQ(*r.client->EnsureModel(*spec), *spec);
+  EXPECT_EQ(r.server->models().stats().uploads, 1u);
+  EXPECT_EQ(r.server->models().stats().already_stored, 0u);
+  auto stats = *r.client->GetCacheStats();
+  EXPECT_EQ(stats.models(), 1u);
+  EXPECT_EQ(stats.model_bytes(), content.size());
+  EXPECT_EQ(stats.max_model_bytes(), options.max_model_bytes);
+  // Unknown hashes and oversized models say what to do.
+  ExpectStatus(r.client->EnsureModel("obj:sha256=" + std::string(64, '0')).status(),
+               absl::StatusCode::kNotFound, "upload it again");
+  ExpectStatus(r.client->UploadModel("ply", "huge.ply", std::string(4 << 20, 'x')).status(),
+               absl::StatusCode::kResourceExhausted, "max_model_bytes");
+  ExpectStatus(r.client->UploadModel("dwg", "a.dwg", "x").status(), absl::StatusCode::kInvalidArgument,
+               "unknown model format");
+  EXPECT_EQ(r.server->models().stats().rejected, 1u);
 }
 
 TEST(Server, ATokenIsRequiredWhenSetButHealthStaysOpen) {

@@ -1,0 +1,81 @@
+#include "server/model_store.h"
+
+#include "absl/strings/str_format.h"
+
+namespace sfc {
+
+ModelStore::ModelStore(uint64_t budget_bytes, uint64_t max_model_bytes)
+    : budget_bytes_(budget_bytes), max_model_bytes_(max_model_bytes) {}
+
+absl::StatusOr<StoredModel> ModelStore::Put(ModelFormat format, std::string bytes,
+                                            const std::string& name, bool* already) {
+  if (bytes.size() > max_model_bytes_ || bytes.size() > budget_bytes_) {
+    CountRejected();
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "the model \"%s\" is %d bytes, more than this server takes (max_model_bytes %d, model "
+        "budget %d); simplify or split it, or ask the operator to raise the limit",
+        name, bytes.size(), std::min(max_model_bytes_, budget_bytes_), budget_bytes_));
+  }
+  StoredModel model;
+  model.format = format;
+  model.sha256 = Sha256Hex(bytes);
+  model.name = name;
+  absl::MutexLock lock(&mu_);
+  if (auto it = entries_.find(model.sha256); it != entries_.end()) {
+    lru_.splice(lru_.begin(), lru_, it->second.lru);
+    ++stats_.already_stored;
+    if (already) *already = true;
+    StoredModel found = it->second.model;
+    found.format = format;  // the same bytes may be named under another format
+    return found;
+  }
+  if (already) *already = false;
+  model.bytes = std::make_shared<const std::string>(std::move(bytes));
+  stats_.bytes += model.bytes->size();
+  ++stats_.uploads;
+  lru_.push_front(model.sha256);
+  entries_.emplace(model.sha256, Entry{model, lru_.begin()});
+  while (stats_.bytes > budget_bytes_ && lru_.size() > 1) {
+    auto victim = entries_.find(lru_.back());
+    stats_.bytes -= victim->second.model.bytes->size();
+    entries_.erase(victim);
+    lru_.pop_back();
+    ++stats_.evictions;
+  }
+  return model;
+}
+
+absl::StatusOr<StoredModel> ModelStore::Resolve(const ModelSpec& spec) const {
+  if (spec.sha256.empty()) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "this server opens no files; upload the model first (sfcsampler upload, or --server with "
+        "%s:FILE uploads it for you) and name it %s:sha256=HASH",
+        ModelFormatName(spec.format), ModelFormatName(spec.format)));
+  }
+  absl::MutexLock lock(&mu_);
+  auto it = entries_.find(spec.sha256);
+  if (it == entries_.end()) {
+    return absl::NotFoundError(absl::StrFormat(
+        "no model with sha256 %s is stored on this server (never uploaded, or evicted for the "
+        "model budget); upload it again",
+        spec.sha256));
+  }
+  lru_.splice(lru_.begin(), lru_, it->second.lru);
+  StoredModel model = it->second.model;
+  model.format = spec.format;
+  return model;
+}
+
+void ModelStore::CountRejected() {
+  absl::MutexLock lock(&mu_);
+  ++stats_.rejected;
+}
+
+ModelStoreStats ModelStore::stats() const {
+  absl::MutexLock lock(&mu_);
+  ModelStoreStats s = stats_;
+  s.models = entries_.size();
+  return s;
+}
+
+}  // namespace sfc

@@ -1,0 +1,76 @@
+// The server's store of uploaded models (CAD files and meshes), keyed by the
+// SHA-256 of their bytes, so a model travels once and every job shares it
+// and its trees (SERVICE.md). The server never opens a path a client sends:
+// models reach it only through UploadModel.
+//
+// Bounded: one model may hold at most max_model_bytes (larger uploads are
+// RESOURCE_EXHAUSTED and stop being read at that point), and all models
+// together budget_bytes, past which the least recently used are evicted. A
+// request naming an evicted model gets NOT_FOUND that says to upload it again;
+// a tree or stream that uses a model keeps its bytes alive.
+//
+// Thread-safety: thread-safe.
+#ifndef SFCSAMPLER_SERVER_MODEL_STORE_H_
+#define SFCSAMPLER_SERVER_MODEL_STORE_H_
+
+#include <list>
+#include <string>
+#include <unordered_map>
+
+#include "absl/base/thread_annotations.h"
+#include "absl/synchronization/mutex.h"
+#include "engine/model_source.h"
+
+namespace sfc {
+
+struct ModelStoreStats {
+  uint64_t models = 0;
+  uint64_t bytes = 0;
+  uint64_t uploads = 0;          // accepted uploads
+  uint64_t already_stored = 0;   // uploads whose bytes were stored already
+  uint64_t rejected = 0;         // uploads past max_model_bytes
+  uint64_t evictions = 0;
+};
+
+class ModelStore final : public ModelSource {
+ public:
+  ModelStore(uint64_t budget_bytes, uint64_t max_model_bytes);
+
+  // Stores `bytes` as a model of `format` (or finds it stored). `already`
+  // says whether it was. RESOURCE_EXHAUSTED past max_model_bytes or the
+  // budget.
+  absl::StatusOr<StoredModel> Put(ModelFormat format, std::string bytes, const std::string& name,
+                                  bool* already = nullptr) ABSL_LOCKS_EXCLUDED(mu_);
+
+  // sha256 references only; a path is INVALID_ARGUMENT (the server opens no
+  // client paths), an unknown hash NOT_FOUND.
+  absl::StatusOr<StoredModel> Resolve(const ModelSpec& spec) const override ABSL_LOCKS_EXCLUDED(mu_);
+
+  // Counts an upload turned away for its size (the service stops reading it
+  // before Put).
+  void CountRejected() ABSL_LOCKS_EXCLUDED(mu_);
+
+  ModelStoreStats stats() const ABSL_LOCKS_EXCLUDED(mu_);
+  uint64_t budget_bytes() const { return budget_bytes_; }
+  uint64_t max_model_bytes() const { return max_model_bytes_; }
+
+ private:
+  struct Entry {
+    StoredModel model;
+    std::list<std::string>::iterator lru;
+  };
+
+  // Constant after construction.
+  const uint64_t budget_bytes_;
+  const uint64_t max_model_bytes_;
+
+  mutable absl::Mutex mu_;
+  // sha256 -> model; a model stored under two formats keeps the first.
+  mutable std::unordered_map<std::string, Entry> entries_ ABSL_GUARDED_BY(mu_);
+  mutable std::list<std::string> lru_ ABSL_GUARDED_BY(mu_);  // front: most recently used
+  ModelStoreStats stats_ ABSL_GUARDED_BY(mu_);
+};
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_SERVER_MODEL_STORE_H_
