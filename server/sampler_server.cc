@@ -184,6 +184,13 @@ void SamplerServer::Shutdown(double grace_seconds, double drain_seconds) {
   while (service_->active_streams() > 0 && Clock::now() < deadline) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
+  // Streams still waiting for a tree build end at once when the builds stop
+  // (UNAVAILABLE, "shutting down"); give their status a moment to leave.
+  cache_->Stop();
+  const auto builds_stopped = Clock::now() + std::chrono::milliseconds(500);
+  while (service_->active_streams() > 0 && Clock::now() < builds_stopped) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
   const double streams_done = seconds_since(start);
   // 2. gRPC counts a call done once its status is queued, and its Shutdown
   // closes the transports, dropping what a slow reader has not taken yet. So
@@ -198,9 +205,7 @@ void SamplerServer::Shutdown(double grace_seconds, double drain_seconds) {
     if (Clock::now() - quiet_since >= std::chrono::milliseconds(200)) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
-  // 3. Close; builds still running stop at their next check, and anything
-  // still running past the deadline is cancelled.
-  cache_->Stop();
+  // 3. Close; anything still running past the deadline is cancelled.
   server_->Shutdown(std::max(deadline, Clock::now()));
   if (health_server_) health_server_->Shutdown(Clock::now());
   server_->Wait();
