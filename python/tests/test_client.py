@@ -1,0 +1,123 @@
+"""sfcsampler.Client against a real loopback sfcsampler-server: the same
+numbers as the embedded path and the CLI, resumes, and errors that carry the
+server's status code and message."""
+
+import os
+import re
+import subprocess
+import tempfile
+import time
+
+import numpy as np
+import pytest
+
+import sfcsampler
+from conftest import SERVER, assert_same, cli_columns
+from test_embedded import CASES
+
+
+@pytest.mark.parametrize("kwargs,flags", CASES)
+def test_same_numbers_as_cli_and_embedded(server, kwargs, flags):
+    with sfcsampler.Client(server) as client:
+        remote = client.sample(**kwargs)
+    assert_same(remote, cli_columns(*flags, "--server", server))
+    embedded = sfcsampler.sample(**kwargs)
+    for name, column in embedded.columns().items():
+        assert np.array_equal(getattr(remote, name), column), name
+    assert remote.tree["key"] == embedded.tree["key"]
+
+
+def test_float32_and_batches(server):
+    with sfcsampler.Client(server, batch_size=4096) as client:
+        parts = list(client.batches(surface="torus", count=10000, precision="float32"))
+        assert [len(p) for p in parts] == [4096, 4096, 1808]
+        x = np.concatenate([p.x for p in parts])
+    assert x.dtype == np.float32
+    assert np.array_equal(x, sfcsampler.sample(surface="torus", count=10000, precision="float32").x)
+
+
+def test_empty_region(server):
+    with sfcsampler.Client(server) as client:
+        s = client.sample(surface="sphere", count=1000, region="box:5,5,5,6,6,6")
+    assert len(s) == 0 and s.x.dtype == np.float64
+
+
+def test_server_errors_carry_code_and_message(server):
+    with sfcsampler.Client(server) as client:
+        with pytest.raises(sfcsampler.InvalidArgumentError) as info:
+            client.sample(surface="expr:x=u;y=v;z=", count=10)
+        assert info.value.code == "INVALID_ARGUMENT" and "received 0 samples" in info.value.message
+        with pytest.raises(sfcsampler.InvalidArgumentError) as info:
+            client.sample(count=10**9)
+        assert "max_count" in info.value.message
+        # Caught before the wire, by the same parser as the CLI's.
+        with pytest.raises(sfcsampler.InvalidArgumentError):
+            client.sample(sequence="sobol")
+
+
+def test_prepare_then_sample_hits_the_cache(server):
+    with sfcsampler.Client(server) as client:
+        tree = client.prepare(surface="monkey_saddle", count=30000)
+        s = client.sample(surface="monkey_saddle", count=30000)
+        assert s.tree["cache_hit"] and s.tree["key"] == tree["key"]
+        assert client.cache_stats()["hits"] >= 1
+        assert "sphere" in {e["name"] for e in client.catalog()["surfaces"]}
+
+
+def test_unreachable_server_is_unavailable():
+    with sfcsampler.Client("127.0.0.1:1", max_resumes=1, resume_backoff=0.01, timeout=5) as client:
+        with pytest.raises(sfcsampler.UnavailableError) as info:
+            client.sample(count=10)
+    assert info.value.code == "UNAVAILABLE"
+
+
+def _start_server(port, log):
+    return subprocess.Popen([SERVER, "--address", f"127.0.0.1:{port}", "--health-address", "127.0.0.1:0",
+                             "--metrics-address", "127.0.0.1:0", "--shutdown-grace", "0"],
+                            stdout=log, stderr=log)
+
+
+def _wait_listening(log_path):
+    for _ in range(200):
+        m = re.search(r" port=(\d+) health_port=", open(log_path).read())
+        if m:
+            return int(m.group(1))
+        time.sleep(0.05)
+    raise AssertionError(open(log_path).read())
+
+
+@pytest.mark.parametrize("sequence", ["jittered", "random"])
+def test_resumes_after_the_server_restarts(sequence):
+    # Kill the server mid-stream and start a new one on the same port: the
+    # client resumes (monotone sets from the next index, others by skipping)
+    # and the result equals the uninterrupted set.
+    request = dict(surface="sphere", count=400000, sequence=sequence)
+    expected = sfcsampler.sample(**request)
+    with tempfile.TemporaryDirectory() as tmp:
+        log_path = os.path.join(tmp, "a.log")
+        with open(log_path, "w") as log:
+            first = _start_server(0, log)
+        port = _wait_listening(log_path)
+        second = None
+        try:
+            client = sfcsampler.Client(f"127.0.0.1:{port}", batch_size=1000, resume_backoff=0.5)
+            parts = []
+            for i, part in enumerate(client.batches(**request)):
+                parts.append(part)
+                if i == 5:
+                    first.kill()
+                    first.wait()
+                    with open(os.path.join(tmp, "b.log"), "w") as log:
+                        second = _start_server(port, log)
+            assert client.resumes >= 1
+            got = np.concatenate([p.x for p in parts])
+            index = np.concatenate([p.index for p in parts])
+            client.close()
+        finally:
+            for p in (first, second):
+                if p and p.poll() is None:
+                    p.kill()
+                    p.wait()
+    assert second is not None
+    assert np.array_equal(index, expected.index)
+    assert np.array_equal(got, expected.x)

@@ -1,0 +1,127 @@
+"""sfcsampler.sample() (pybind11, in-process) against the CLI: the same
+request gives the same numbers; bad input raises clear exceptions."""
+
+import threading
+import warnings
+
+import numpy as np
+import pytest
+
+import sfcsampler
+from conftest import assert_same, cli_columns
+
+# (Python keywords, the same request as CLI flags)
+CASES = [
+    (dict(surface="torus", density="gaussian:floor=0.1", count=20000, seed=4),
+     ["--surface", "torus", "--density", "gaussian:floor=0.1", "--count", "20000", "--seed", "4"]),
+    (dict(surface="sphere", count=20000, region="box:0,0,0,1,1,1", normals=True, curve_position=True),
+     ["--surface", "sphere", "--count", "20000", "--region", "box:0,0,0,1,1,1", "--normals",
+      "--curve-position"]),
+    (dict(surface="plane", density="expr:u+v", count=5000, sequence="progressive", shard=(1, 3),
+          density_column=True),
+     ["--surface", "plane", "--density", "expr:u+v", "--count", "5000", "--sequence", "progressive",
+      "--shard", "1/3", "--density-column"]),
+    (dict(surface="eight", curve="peano", count=3000, begin=1000, end=2500, sequence="random"),
+     ["--surface", "eight", "--curve", "peano", "--count", "3000", "--begin", "1000", "--end", "2500",
+      "--sequence", "random"]),
+]
+
+
+@pytest.mark.parametrize("kwargs,flags", CASES)
+def test_same_numbers_as_cli(kwargs, flags):
+    assert_same(sfcsampler.sample(**kwargs), cli_columns(*flags))
+
+
+def test_batches_concatenate_to_the_whole_set():
+    whole = sfcsampler.sample(surface="torus", count=50000, normals=True)
+    parts = list(sfcsampler.batches(surface="torus", count=50000, normals=True, batch_size=7000))
+    assert [len(p) for p in parts] == [7000] * 7 + [1000]
+    for name in ("index", "x", "nz"):
+        assert np.array_equal(np.concatenate([getattr(p, name) for p in parts]), getattr(whole, name))
+
+
+def test_float32_is_the_float64_set_rounded():
+    full = sfcsampler.sample(surface="torus", count=10000)
+    half = sfcsampler.sample(surface="torus", count=10000, precision="float32")
+    assert half.x.dtype == np.float32 and half.index.dtype == np.uint64
+    assert np.array_equal(half.x, full.x.astype(np.float32))
+    assert np.array_equal(half.index, full.index)
+
+
+def test_arrays_own_their_buffers_without_a_copy():
+    s = sfcsampler.sample(count=1000)
+    # The buffer belongs to a capsule (the C++ vector), not to a NumPy copy.
+    assert not s.x.flags.owndata and type(s.x.base).__name__ == "PyCapsule"
+    s.x[0] = 42.0  # writable, and it outlives the call
+    assert s.x[0] == 42.0
+
+
+def test_deterministic_and_independent_of_threads():
+    a = sfcsampler.sample(surface="eight", count=100000, threads=1)
+    b = sfcsampler.sample(surface="eight", count=100000, threads=3)
+    assert np.array_equal(a.x, b.x) and np.array_equal(a.index, b.index)
+
+
+def test_sampler_reuses_its_tree():
+    sampler = sfcsampler.Sampler(max_trees=2)
+    first = sampler.sample(surface="torus", count=10000)
+    second = sampler.sample(surface="torus", count=10000, seed=2)
+    assert not first.tree["cache_hit"] and second.tree["cache_hit"]
+    assert second.tree["key"] == first.tree["key"]
+    assert np.array_equal(second.x, sfcsampler.sample(surface="torus", count=10000, seed=2).x)
+
+
+def test_gil_is_released_while_sampling():
+    # Another Python thread keeps running while a large request fills.
+    ticks = []
+    stop = threading.Event()
+
+    def tick():
+        while not stop.is_set():
+            ticks.append(1)
+            stop.wait(0.001)
+
+    t = threading.Thread(target=tick)
+    t.start()
+    before = len(ticks)
+    sfcsampler.sample(surface="torus", count=2_000_000, threads=1)
+    during = len(ticks) - before
+    stop.set()
+    t.join()
+    assert during > 10
+
+
+@pytest.mark.parametrize("kwargs,code,words", [
+    (dict(surface="nope"), "INVALID_ARGUMENT", "unknown surface"),
+    (dict(count=0), "INVALID_ARGUMENT", "count must be >= 1"),
+    (dict(curve="zigzag"), "INVALID_ARGUMENT", "--curve must be"),
+    (dict(shard="3/2"), "INVALID_ARGUMENT", "shard index 3"),
+    (dict(region="disc:1"), "INVALID_ARGUMENT", "--region takes"),
+    (dict(begin=10, end=5), "INVALID_ARGUMENT", "index range"),
+    (dict(surface="expr:x=u;y=v;z=log(u-1)"), "INVALID_ARGUMENT", ""),
+    (dict(precision="float16"), "INVALID_ARGUMENT", "precision"),
+])
+def test_bad_input_raises_a_clear_error(kwargs, code, words):
+    with pytest.raises(sfcsampler.InvalidArgumentError) as info:
+        sfcsampler.sample(**kwargs)
+    assert info.value.code == code and info.value.code_value == 3
+    assert words in info.value.message
+    assert isinstance(info.value, ValueError)
+
+
+def test_unknown_keyword_is_a_type_error():
+    with pytest.raises(TypeError):
+        sfcsampler.sample(surfce="sphere")
+
+
+def test_depth_cap_warns():
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        sfcsampler.sample(surface="sphere", count=100000, depth_cap=4)
+    assert any(issubclass(w.category, sfcsampler.DepthCapWarning) for w in caught)
+
+
+def test_catalog_lists_the_builtin_surfaces():
+    names = {s["name"] for s in sfcsampler.surfaces()}
+    assert {"sphere", "torus", "expr"} <= names
+    assert "gaussian" in {d["name"] for d in sfcsampler.densities()}
