@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import sfcsampler
-from conftest import SERVER, assert_same, cli_columns
+from conftest import CLI, SERVER, assert_same, cli_columns, run_cli
 from test_embedded import CASES
 
 
@@ -121,3 +121,20 @@ def test_resumes_after_the_server_restarts(sequence):
     assert second is not None
     assert np.array_equal(index, expected.index)
     assert np.array_equal(got, expected.x)
+
+
+def test_cli_over_the_wire_float32_npy_is_the_embedded_file(server, tmp_path):
+    args = ["sample", "--surface", "torus", "--density", "mean:floor=0.1", "--count", "30000", "--format",
+            "npy", "--precision", "float32", "-q", "-o"]
+    run_cli(*args, str(tmp_path / "embedded.npy"))
+    run_cli(*args, str(tmp_path / "wire.npy"), "--server", server)
+    assert (tmp_path / "embedded.npy").read_bytes() == (tmp_path / "wire.npy").read_bytes()
+
+
+def test_cli_render_over_the_wire(server, tmp_path):
+    run_cli("render", "--surface", "torus", "--count", "2000", "--size", "200", "-o", str(tmp_path / "t.png"),
+            "--server", server)
+    assert (tmp_path / "t.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    failed = subprocess.run([CLI, "render", "--what", "curve", "--server", server, "-o",
+                             str(tmp_path / "c.png")], capture_output=True, text=True)
+    assert failed.returncode != 0 and "FAILED_PRECONDITION" in failed.stderr

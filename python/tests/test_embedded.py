@@ -1,6 +1,7 @@
 """sfcsampler.sample() (pybind11, in-process) against the CLI: the same
 request gives the same numbers; bad input raises clear exceptions."""
 
+import subprocess
 import threading
 import warnings
 
@@ -8,7 +9,7 @@ import numpy as np
 import pytest
 
 import sfcsampler
-from conftest import assert_same, cli_columns
+from conftest import CLI, assert_same, cli_columns, run_cli
 
 # (Python keywords, the same request as CLI flags)
 CASES = [
@@ -125,3 +126,49 @@ def test_catalog_lists_the_builtin_surfaces():
     names = {s["name"] for s in sfcsampler.surfaces()}
     assert {"sphere", "torus", "expr"} <= names
     assert "gaussian" in {d["name"] for d in sfcsampler.densities()}
+
+
+# The CLI details: --format npy, --precision float32, -q and --no-warnings.
+
+def test_cli_npy_loads_as_the_same_samples(tmp_path):
+    path = tmp_path / "t.npy"
+    run_cli("sample", "--surface", "torus", "--count", "20000", "--normals", "--density-column",
+            "--format", "npy", "-q", "-o", str(path))
+    loaded = np.load(path)
+    s = sfcsampler.sample(surface="torus", count=20000, normals=True, density_column=True)
+    assert loaded.dtype.names == tuple(s.columns())
+    for name in loaded.dtype.names:
+        assert np.array_equal(loaded[name], getattr(s, name)), name
+
+
+def test_cli_npy_of_a_region_counts_its_samples(tmp_path):
+    path = tmp_path / "r.npy"
+    run_cli("sample", "--surface", "sphere", "--count", "20000", "--region", "uv:0,0.3,0,1",
+            "--format", "npy", "-q", "-o", str(path))
+    s = sfcsampler.sample(surface="sphere", count=20000, region="uv:0,0.3,0,1")
+    assert np.array_equal(np.load(path)["u"], s.u) and 0 < len(s) < 20000
+
+
+def test_cli_float32_is_the_embedded_float32(tmp_path):
+    path = tmp_path / "f.npy"
+    run_cli("sample", "--surface", "eight", "--count", "5000", "--precision", "float32", "--format", "npy",
+            "-q", "-o", str(path))
+    loaded = np.load(path)
+    s = sfcsampler.sample(surface="eight", count=5000, precision="float32")
+    assert loaded["x"].dtype == np.float32 and np.array_equal(loaded["x"], s.x)
+    # CSV in float32 prints the shortest text of each float.
+    text = run_cli("sample", "--surface", "eight", "--count", "5000", "--precision", "float32", "-q")
+    first = text.decode().splitlines()[1].split(",")
+    assert np.float32(first[3]) == s.x[0] and len(first[3]) <= 12
+
+
+def test_quiet_keeps_warnings_and_no_warnings_drops_them():
+    args = [CLI, "sample", "--surface", "sphere", "--count", "100000", "--depth-cap", "4", "-o", "/dev/null"]
+    quiet = subprocess.run(args + ["-q"], capture_output=True, text=True, check=True).stderr
+    assert "warning: the depth cap" in quiet and "tree " not in quiet
+    silent = subprocess.run(args + ["-q", "--no-warnings"], capture_output=True, text=True, check=True).stderr
+    assert silent == ""
+    # Not a terminal: no progress lines ('\r'), whatever the size.
+    loud = subprocess.run([CLI, "sample", "--count", "1000000", "-o", "/dev/null"], capture_output=True,
+                          text=True, check=True).stderr
+    assert "\r" not in loud and "samples written" in loud
