@@ -293,8 +293,34 @@ struct EvalFlags {
   uint64_t seed = 1;
 };
 
-int RunEval(const EvalFlags& f) {
+int RunEval(const EvalFlags& f, const Connection& conn) {
   ProtocolOptions options;
+  std::unique_ptr<SamplerClient> client;
+  if (!conn.server.empty()) {
+    // Our point sets come from the server; the reference sets and the
+    // discrepancies are computed here. The trees are the same, so are the sets.
+    auto connected = Connect(conn, 65536);
+    if (!connected.ok()) return Fail(connected.status());
+    client = *std::move(connected);
+    options.our_sets = [&client](const std::string& surface, const std::string& density,
+                                 const CurveTreeOptions& tree_options, uint64_t count,
+                                 uint64_t seed) -> absl::StatusOr<SampleBatch> {
+      SampleRequest request;
+      request.tree.surface = surface;
+      request.tree.density = density;
+      request.tree.options = tree_options;
+      request.sequence = SequenceKind::kJittered;
+      request.count = count;
+      request.seed = seed;
+      SampleBatch all;
+      RETURN_IF_ERROR(client->Sample(request, [&all](const ::sfcsampler::v1::StreamHeader&,
+                                                     const SampleBatch& batch) {
+        all.Append(batch);
+        return absl::OkStatus();
+      }).status());
+      return all;
+    };
+  }
   if (f.setting == "full") {
     options.l_max = 20;  // the paper: 40 sizes, 2 to 2^20 + 2^19 = 1572864
   } else if (f.setting != "fast") {
@@ -480,6 +506,7 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   eval->add_option("--out-dir", eval_flags.out_dir, "where the CSV, the slope tables and the plots go")->capture_default_str();
   eval->add_option("--seed", eval_flags.seed, "seed of the random and jittered sets")->capture_default_str();
+  add_connection(eval);
 
   sfc::RenderFlags render_flags;
   CLI::App* render = app.add_subcommand("render", "draw samples or the adaptive curve as a PNG");
@@ -497,7 +524,7 @@ int main(int argc, char** argv) {
   if (prepare->parsed()) return sfc::RunPrepare(flags, conn);
   if (cache->parsed()) return sfc::RunCache(conn);
   if (health->parsed()) return sfc::RunHealth(conn);
-  if (eval->parsed()) return sfc::RunEval(eval_flags);
+  if (eval->parsed()) return sfc::RunEval(eval_flags, conn);
   if (render->parsed()) return sfc::RunRender(flags, render_flags, conn);
   return sfc::RunSurfaces();
 }

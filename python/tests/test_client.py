@@ -138,3 +138,16 @@ def test_cli_render_over_the_wire(server, tmp_path):
     failed = subprocess.run([CLI, "render", "--what", "curve", "--server", server, "-o",
                              str(tmp_path / "c.png")], capture_output=True, text=True)
     assert failed.returncode != 0 and "FAILED_PRECONDITION" in failed.stderr
+
+
+def test_cli_eval_over_the_wire_gives_the_same_discrepancies(server, tmp_path):
+    # Our point sets come from the server, the rest is computed locally: the
+    # same trees give the same sets, so every discrepancy is the same.
+    def csv_without_timing(out_dir):
+        lines = (out_dir / "discrepancy.csv").read_text().splitlines()
+        return [line.rsplit(",", 1)[0] for line in lines]
+
+    local = run_cli("eval", "--l-max", "6", "--out-dir", str(tmp_path / "local"))
+    wire = run_cli("eval", "--l-max", "6", "--out-dir", str(tmp_path / "wire"), "--server", server)
+    assert local == wire and b"hilbert-jittered" in local
+    assert csv_without_timing(tmp_path / "local") == csv_without_timing(tmp_path / "wire")
