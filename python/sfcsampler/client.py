@@ -18,6 +18,7 @@ import grpc
 import numpy as np
 
 from sfcsampler import _core, _wire
+from sfcsampler._request import make_request
 from sfcsampler.errors import DataLossError, InvalidArgumentError, from_status
 from sfcsampler.samples import Samples, concatenate, warn_depth_cap
 from sfcsampler.v1 import sampler_pb2 as pb
@@ -143,7 +144,7 @@ class Client:
         if precision not in _PRECISIONS:
             raise InvalidArgumentError(3, "precision must be float64 or float32")
         batch_size = batch_size or self._batch_size
-        req = _core.Request(**request)
+        req = make_request(request)
         requested = [name for name, on in (("u", 1), ("v", 1), ("x", 1), ("y", 1), ("z", 1),
                                            ("nx", req.normals), ("ny", req.normals),
                                            ("nz", req.normals), ("density", req.density_column),
@@ -222,7 +223,7 @@ class Client:
             last = part
         dtype = np.float32 if precision == "float32" else np.float64
         if last is None:  # nothing in the region: an empty set, with the tree from a Prepare-free call
-            req = _core.Request(**request)
+            req = make_request(request)
             begin, end = req.index_range
             return Samples({}, {}, begin, end, req.seed, _core.ALGORITHM_VERSION, dtype)
         if len(parts) == 1:  # own the memory rather than view the message
@@ -231,7 +232,7 @@ class Client:
 
     def prepare(self, **request):
         """Builds (or finds in the server's cache) the request's tree; returns its summary."""
-        req = _core.Request(**request)
+        req = make_request(request)
         w = pb.PrepareRequest(count=req.tree_count or req.count)
         _tree_spec(req, w.tree)
         try:

@@ -3,6 +3,7 @@
 import numpy as np
 
 from sfcsampler import _core
+from sfcsampler._request import make_request
 from sfcsampler.samples import Samples, warn_depth_cap
 
 _ALL = 1 << 62  # "every remaining sample"
@@ -27,7 +28,7 @@ class Sampler:
         self._engine = _core.Engine(max_trees=max_trees, threads=threads)
 
     def _start(self, precision, request):
-        job = self._engine.start(_core.Request(**request), precision=precision)
+        job = self._engine.start(make_request(request), precision=precision)
         warn_depth_cap(job.tree, stacklevel=4)
         return job
 
@@ -50,7 +51,7 @@ class Sampler:
 
     def prepare(self, **request):
         """Builds (or finds) the request's tree, sized for tree_count or count; returns its summary."""
-        tree = self._engine.prepare(_core.Request(**request))
+        tree = self._engine.prepare(make_request(request))
         warn_depth_cap(tree, stacklevel=3)
         return tree
 

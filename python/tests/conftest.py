@@ -46,24 +46,35 @@ def assert_same(samples, columns):
         assert np.array_equal(got.view(np.uint8), expected.astype(got.dtype).view(np.uint8)), name
 
 
+def launch_server(log_path, *extra, port=0):
+    """Starts sfcsampler-server on 127.0.0.1:PORT (0 = a free port) with `extra`
+    flags, logging to log_path; returns (process, port) once it listens."""
+    with open(log_path, "w") as log:
+        proc = subprocess.Popen([SERVER, "--address", f"127.0.0.1:{port}", "--health-address", "127.0.0.1:0",
+                                 "--metrics-address", "127.0.0.1:0", *extra], stdout=log, stderr=log)
+    for _ in range(200):
+        match = re.search(r" port=(\d+) health_port=", open(log_path).read())
+        if match:
+            return proc, int(match.group(1))
+        if proc.poll() is not None:
+            break
+        time.sleep(0.05)
+    proc.kill()
+    raise AssertionError("the server did not start: " + open(log_path).read())
+
+
+def stop(proc):
+    if proc is not None and proc.poll() is None:
+        proc.terminate()
+        proc.wait(timeout=30)
+
+
 @pytest.fixture(scope="module")
 def server():
     """A loopback sfcsampler-server on free ports; yields its address."""
     with tempfile.TemporaryDirectory() as tmp:
-        log_path = os.path.join(tmp, "server.log")
-        with open(log_path, "w") as log:
-            proc = subprocess.Popen([SERVER, "--address", "127.0.0.1:0", "--health-address", "127.0.0.1:0",
-                                     "--metrics-address", "127.0.0.1:0"], stdout=log, stderr=log)
+        proc, port = launch_server(os.path.join(tmp, "server.log"))
         try:
-            port = None
-            for _ in range(200):
-                match = re.search(r" port=(\d+) health_port=", open(log_path).read())
-                if match:
-                    port = match.group(1)
-                    break
-                time.sleep(0.05)
-            assert port, open(log_path).read()
             yield f"127.0.0.1:{port}"
         finally:
-            proc.terminate()
-            proc.wait(timeout=30)
+            stop(proc)

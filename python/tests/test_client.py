@@ -3,16 +3,14 @@ numbers as the embedded path and the CLI, resumes, and errors that carry the
 server's status code and message."""
 
 import os
-import re
 import subprocess
 import tempfile
-import time
 
 import numpy as np
 import pytest
 
 import sfcsampler
-from conftest import CLI, SERVER, assert_same, cli_columns, run_cli
+from conftest import CLI, assert_same, cli_columns, launch_server, run_cli, stop
 from test_embedded import CASES
 
 
@@ -71,21 +69,6 @@ def test_unreachable_server_is_unavailable():
     assert info.value.code == "UNAVAILABLE"
 
 
-def _start_server(port, log):
-    return subprocess.Popen([SERVER, "--address", f"127.0.0.1:{port}", "--health-address", "127.0.0.1:0",
-                             "--metrics-address", "127.0.0.1:0", "--shutdown-grace", "0"],
-                            stdout=log, stderr=log)
-
-
-def _wait_listening(log_path):
-    for _ in range(200):
-        m = re.search(r" port=(\d+) health_port=", open(log_path).read())
-        if m:
-            return int(m.group(1))
-        time.sleep(0.05)
-    raise AssertionError(open(log_path).read())
-
-
 @pytest.mark.parametrize("sequence", ["jittered", "random"])
 def test_resumes_after_the_server_restarts(sequence):
     # Kill the server mid-stream and start a new one on the same port: the
@@ -94,10 +77,7 @@ def test_resumes_after_the_server_restarts(sequence):
     request = dict(surface="sphere", count=400000, sequence=sequence)
     expected = sfcsampler.sample(**request)
     with tempfile.TemporaryDirectory() as tmp:
-        log_path = os.path.join(tmp, "a.log")
-        with open(log_path, "w") as log:
-            first = _start_server(0, log)
-        port = _wait_listening(log_path)
+        first, port = launch_server(os.path.join(tmp, "a.log"), "--shutdown-grace", "0")
         second = None
         try:
             client = sfcsampler.Client(f"127.0.0.1:{port}", batch_size=1000, resume_backoff=0.5)
@@ -107,17 +87,14 @@ def test_resumes_after_the_server_restarts(sequence):
                 if i == 5:
                     first.kill()
                     first.wait()
-                    with open(os.path.join(tmp, "b.log"), "w") as log:
-                        second = _start_server(port, log)
+                    second, _ = launch_server(os.path.join(tmp, "b.log"), "--shutdown-grace", "0", port=port)
             assert client.resumes >= 1
             got = np.concatenate([p.x for p in parts])
             index = np.concatenate([p.index for p in parts])
             client.close()
         finally:
-            for p in (first, second):
-                if p and p.poll() is None:
-                    p.kill()
-                    p.wait()
+            stop(first)
+            stop(second)
     assert second is not None
     assert np.array_equal(index, expected.index)
     assert np.array_equal(got, expected.x)
@@ -151,3 +128,29 @@ def test_cli_eval_over_the_wire_gives_the_same_discrepancies(server, tmp_path):
     wire = run_cli("eval", "--l-max", "6", "--out-dir", str(tmp_path / "wire"), "--server", server)
     assert local == wire and b"hilbert-jittered" in local
     assert csv_without_timing(tmp_path / "local") == csv_without_timing(tmp_path / "wire")
+
+
+def test_tls_and_token(tmp_path):
+    cert, key = tmp_path / "cert.pem", tmp_path / "key.pem"
+    subprocess.run(["openssl", "req", "-x509", "-newkey", "rsa:2048", "-nodes", "-days", "1", "-subj",
+                    "/CN=localhost", "-addext", "subjectAltName=IP:127.0.0.1,DNS:localhost",
+                    "-keyout", str(key), "-out", str(cert)], capture_output=True, check=True)
+    (tmp_path / "token").write_text("s3cret-token\n")
+    proc, port = launch_server(tmp_path / "tls.log", "--tls-cert", str(cert), "--tls-key", str(key),
+                               "--token-file", str(tmp_path / "token"))
+    try:
+        target = f"127.0.0.1:{port}"
+        with sfcsampler.Client(target, token="s3cret-token", tls_roots=str(cert)) as client:
+            s = client.sample(surface="torus", count=1000)
+        assert np.array_equal(s.x, sfcsampler.sample(surface="torus", count=1000).x)
+        with sfcsampler.Client(target, tls_roots=str(cert)) as client:
+            with pytest.raises(sfcsampler.UnauthenticatedError) as info:
+                client.sample(count=10)
+            assert info.value.code == "UNAUTHENTICATED"
+        with sfcsampler.Client(target, token="s3cret-token", max_resumes=0, timeout=5) as client:
+            with pytest.raises(sfcsampler.Error):  # plaintext against TLS
+                client.sample(count=10)
+        with pytest.raises(sfcsampler.InvalidArgumentError, match="cannot read TLS roots"):
+            sfcsampler.Client(target, tls_roots=str(tmp_path / "missing.pem"))
+    finally:
+        stop(proc)

@@ -110,9 +110,13 @@ def test_bad_input_raises_a_clear_error(kwargs, code, words):
     assert isinstance(info.value, ValueError)
 
 
-def test_unknown_keyword_is_a_type_error():
-    with pytest.raises(TypeError):
+def test_unknown_keyword_or_wrong_type_is_a_type_error():
+    with pytest.raises(TypeError, match="unknown request keyword surfce"):
         sfcsampler.sample(surfce="sphere")
+    with pytest.raises(TypeError, match="count must be a non-negative int"):
+        sfcsampler.sample(count=-5)
+    with pytest.raises(TypeError, match="surface must be a str"):
+        sfcsampler.sample(surface=3)
 
 
 def test_depth_cap_warns():
