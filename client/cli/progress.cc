@@ -29,10 +29,12 @@ void Progress::StartPhase(const std::string& label) {
   ticker_ = std::thread([this, label] {
     const auto start = std::chrono::steady_clock::now();
     std::unique_lock<std::mutex> lock(mu_);
-    if (wake_.wait_for(lock, std::chrono::milliseconds(500), [this] { return !phase_running_; })) return;
+    if (wake_.wait_for(lock, std::chrono::milliseconds(500), [this] { return !phase_running_; }))
+      return;
     while (phase_running_) {
-      Draw(absl::StrFormat("%s... %.1f s", label,
-                           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()));
+      Draw(absl::StrFormat(
+          "%s... %.1f s", label,
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()));
       wake_.wait_for(lock, std::chrono::milliseconds(200), [this] { return !phase_running_; });
     }
   });
@@ -67,9 +69,11 @@ void Progress::Samples(uint64_t done, uint64_t total) {
   }
   last_draw_ = now;
   const double seconds = std::chrono::duration<double>(now - stream_start_).count();
-  const std::string rate = seconds > 0.05 ? absl::StrFormat(", %.1f M/s", done / seconds / 1e6) : "";
-  Draw(total ? absl::StrFormat("%d / %d samples (%.0f%%)%s", done, total, 100.0 * done / total, rate)
-             : absl::StrFormat("%d samples%s", done, rate));
+  const std::string rate =
+      seconds > 0.05 ? absl::StrFormat(", %.1f M/s", done / seconds / 1e6) : "";
+  Draw(total
+           ? absl::StrFormat("%d / %d samples (%.0f%%)%s", done, total, 100.0 * done / total, rate)
+           : absl::StrFormat("%d samples%s", done, rate));
 }
 
 void Progress::Done() {

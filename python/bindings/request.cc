@@ -95,46 +95,55 @@ Raises sfcsampler.InvalidArgumentError for malformed values.)doc")
            py::arg("estimator") = d.estimator, py::arg("tolerance") = d.tolerance,
            py::arg("depth_cap") = d.depth_cap, py::arg("rho") = d.rho, py::arg("count") = d.count,
            py::arg("seed") = d.seed, py::arg("sequence") = d.sequence,
-           py::arg("tree_count") = d.tree_count, py::arg("begin") = d.begin,
-           py::arg("end") = d.end, py::arg("shard") = py::none(), py::arg("region") = d.region,
+           py::arg("tree_count") = d.tree_count, py::arg("begin") = d.begin, py::arg("end") = d.end,
+           py::arg("shard") = py::none(), py::arg("region") = d.region,
            py::arg("normals") = d.normals, py::arg("density_column") = d.density_column,
            py::arg("curve_position") = d.curve_position)
       // The parsed request, field by field, for building the wire message.
       .def_property_readonly("surface", [](const PyRequest& r) { return r.request.tree.surface; })
       .def_property_readonly("density", [](const PyRequest& r) { return r.request.tree.density; })
-      .def_property_readonly("curve", [](const PyRequest& r) {
-        return std::string(CurveName(r.request.tree.options.curve));
-      })
-      .def_property_readonly("estimator", [](const PyRequest& r) {
-        return std::string(AreaEstimatorName(r.request.tree.options.estimator));
-      })
-      .def_property_readonly("tolerance", [](const PyRequest& r) { return r.request.tree.options.tolerance; })
-      .def_property_readonly("depth_cap", [](const PyRequest& r) { return r.request.tree.options.depth_cap; })
+      .def_property_readonly(
+          "curve",
+          [](const PyRequest& r) { return std::string(CurveName(r.request.tree.options.curve)); })
+      .def_property_readonly(
+          "estimator",
+          [](const PyRequest& r) {
+            return std::string(AreaEstimatorName(r.request.tree.options.estimator));
+          })
+      .def_property_readonly("tolerance",
+                             [](const PyRequest& r) { return r.request.tree.options.tolerance; })
+      .def_property_readonly("depth_cap",
+                             [](const PyRequest& r) { return r.request.tree.options.depth_cap; })
       .def_property_readonly("rho", [](const PyRequest& r) { return r.request.tree.options.rho; })
-      .def_property_readonly("sequence", [](const PyRequest& r) {
-        return std::string(SequenceName(r.request.sequence));
-      })
+      .def_property_readonly(
+          "sequence",
+          [](const PyRequest& r) { return std::string(SequenceName(r.request.sequence)); })
       .def_property_readonly("count", [](const PyRequest& r) { return r.request.count; })
       .def_property_readonly("seed", [](const PyRequest& r) { return r.request.seed; })
       .def_property_readonly("tree_count", [](const PyRequest& r) { return r.request.tree_count; })
       .def_property_readonly("begin", [](const PyRequest& r) { return r.request.begin; })
       .def_property_readonly("end", [](const PyRequest& r) { return r.request.end; })
-      .def_property_readonly("shard_index", [](const PyRequest& r) { return r.request.shard_index; })
-      .def_property_readonly("shard_count", [](const PyRequest& r) { return r.request.shard_count; })
-      .def_property_readonly("region", [](const PyRequest& r) -> py::object {
-        const Region& g = r.request.region;
-        switch (g.kind) {
-          case Region::Kind::kAll:
-            return py::none();
-          case Region::Kind::kParameterRect:
-            return py::make_tuple("uv", g.u0, g.u1, g.v0, g.v1);
-          case Region::Kind::kBox:
-            return py::make_tuple("box", g.lo.x, g.lo.y, g.lo.z, g.hi.x, g.hi.y, g.hi.z);
-        }
-        return py::none();
-      })
+      .def_property_readonly("shard_index",
+                             [](const PyRequest& r) { return r.request.shard_index; })
+      .def_property_readonly("shard_count",
+                             [](const PyRequest& r) { return r.request.shard_count; })
+      .def_property_readonly("region",
+                             [](const PyRequest& r) -> py::object {
+                               const Region& g = r.request.region;
+                               switch (g.kind) {
+                                 case Region::Kind::kAll:
+                                   return py::none();
+                                 case Region::Kind::kParameterRect:
+                                   return py::make_tuple("uv", g.u0, g.u1, g.v0, g.v1);
+                                 case Region::Kind::kBox:
+                                   return py::make_tuple("box", g.lo.x, g.lo.y, g.lo.z, g.hi.x,
+                                                         g.hi.y, g.hi.z);
+                               }
+                               return py::none();
+                             })
       .def_property_readonly("normals", [](const PyRequest& r) { return r.request.fields.normal; })
-      .def_property_readonly("density_column", [](const PyRequest& r) { return r.request.fields.density; })
+      .def_property_readonly("density_column",
+                             [](const PyRequest& r) { return r.request.fields.density; })
       .def_property_readonly("curve_position",
                              [](const PyRequest& r) { return r.request.fields.curve_position; })
       .def_property_readonly(

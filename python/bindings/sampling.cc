@@ -35,7 +35,8 @@ class RecentTreeSource final : public TreeSource {
  public:
   explicit RecentTreeSource(size_t capacity) : capacity_(capacity) {}
 
-  absl::StatusOr<TreeLookup> Get(const TreeKey& key, int grade, const TreeFactory& factory) override {
+  absl::StatusOr<TreeLookup> Get(const TreeKey& key, int grade,
+                                 const TreeFactory& factory) override {
     const std::string id = key.HexWithGrade(grade) + "|" + key.canonical;
     if (capacity_ > 0) {
       absl::MutexLock lock(&mu_);
@@ -93,14 +94,18 @@ py::dict TreeInfoDict(const PreparedTree& t) {
 
 std::vector<float> Narrow(const std::vector<double>& column) {
   std::vector<float> out(column.size());
-  std::transform(column.begin(), column.end(), out.begin(), [](double d) { return static_cast<float>(d); });
+  std::transform(column.begin(), column.end(), out.begin(),
+                 [](double d) { return static_cast<float>(d); });
   return out;
 }
 
 class PyJob {
  public:
   PyJob(SamplingJob job, const SampleRequest& request, bool float32)
-      : job_(std::move(job)), fields_(request.fields), float32_(float32), seed_(request.seed),
+      : job_(std::move(job)),
+        fields_(request.fields),
+        float32_(float32),
+        seed_(request.seed),
         region_(request.region.kind != Region::Kind::kAll) {}
 
   // Up to `max_samples` more samples as a dict of columns, or None once the
@@ -116,7 +121,8 @@ class PyJob {
       std::lock_guard<std::mutex> lock(mu_);
       // Reserve what a plain range will produce, so filling never reallocates.
       const uint64_t left = job_.end - job_.begin - std::min(job_.end - job_.begin, produced_);
-      const size_t reserve = static_cast<size_t>(std::min(max_samples, region_ ? uint64_t{1} << 16 : left));
+      const size_t reserve =
+          static_cast<size_t>(std::min(max_samples, region_ ? uint64_t{1} << 16 : left));
       batch.index.reserve(reserve);
       for (auto* c : Columns(&batch)) c->reserve(reserve);
       uint64_t got = 0;
@@ -138,7 +144,8 @@ class PyJob {
     }
     if (batch.size() == 0) return py::none();
     py::dict out;
-    static const char* const kNames[] = {"u", "v", "x", "y", "z", "nx", "ny", "nz", "density", "curve_position"};
+    static const char* const kNames[] = {"u",  "v",  "x",  "y",       "z",
+                                         "nx", "ny", "nz", "density", "curve_position"};
     out["index"] = ToNumpy(std::move(batch.index));
     auto columns = Columns(&batch);
     for (size_t i = 0; i < columns.size(); ++i) {
@@ -162,7 +169,8 @@ class PyJob {
 
  private:
   static std::array<std::vector<double>*, 10> Columns(SampleBatch* b) {
-    return {&b->u, &b->v, &b->x, &b->y, &b->z, &b->nx, &b->ny, &b->nz, &b->density, &b->curve_position};
+    return {&b->u,  &b->v,  &b->x,  &b->y,       &b->z,
+            &b->nx, &b->ny, &b->nz, &b->density, &b->curve_position};
   }
 
   std::mutex mu_;
@@ -176,7 +184,8 @@ class PyJob {
 
 class PyEngine {
  public:
-  PyEngine(size_t max_trees, int threads) : source_(max_trees), engine_(Limits(threads), &source_) {}
+  PyEngine(size_t max_trees, int threads)
+      : source_(max_trees), engine_(Limits(threads), &source_) {}
 
   std::unique_ptr<PyJob> Start(const PyRequest& r, const std::string& precision) {
     if (precision != "float64" && precision != "float32") {
@@ -208,7 +217,9 @@ class PyEngine {
   static EngineLimits Limits(int threads) {
     EngineLimits limits;
     limits.generation_threads =
-        threads > 0 ? threads : static_cast<int>(std::max(1u, std::min(4u, std::thread::hardware_concurrency())));
+        threads > 0
+            ? threads
+            : static_cast<int>(std::max(1u, std::min(4u, std::thread::hardware_concurrency())));
     return limits;
   }
 
@@ -226,7 +237,8 @@ void RegisterSampling(py::module_& m) {
            "Up to max_samples more samples as a dict of NumPy arrays (index: uint64; u, v, x, y, "
            "z and the requested optional columns: float64, or float32 when asked), or None once "
            "the set is exhausted. The GIL is released while the arrays are filled.")
-      .def_property_readonly("tree", &PyJob::Tree, "the curve tree's summary (the wire's TreeInfo fields)")
+      .def_property_readonly("tree", &PyJob::Tree,
+                             "the curve tree's summary (the wire's TreeInfo fields)")
       .def_property_readonly("begin", &PyJob::begin, "first index of the resolved range")
       .def_property_readonly("end", &PyJob::end, "one past the last index of the resolved range")
       .def_property_readonly("expected_samples", &PyJob::Expected,
@@ -242,7 +254,8 @@ max_trees: keep the curve trees of the last this many (surface, density,
 threads: threads filling one request's samples (0 = as the CLI: up to 4). The
   samples do not depend on it.)doc")
       .def(py::init<size_t, int>(), py::kw_only(), py::arg("max_trees") = 0, py::arg("threads") = 0)
-      .def("start", &PyEngine::Start, py::arg("request"), py::kw_only(), py::arg("precision") = "float64",
+      .def("start", &PyEngine::Start, py::arg("request"), py::kw_only(),
+           py::arg("precision") = "float64",
            "Validates the request, builds (or reuses) its tree and opens its job. Raises "
            "sfcsampler.InvalidArgumentError or ResourceExhaustedError with the engine's message.")
       .def("prepare", &PyEngine::Prepare, py::arg("request"),
