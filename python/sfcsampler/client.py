@@ -140,6 +140,12 @@ class Client:
         (each sample is yielded once); raises sfcsampler.Error subclasses with
         the server's status code and message.
         """
+        for part in self._stream(precision, batch_size, request):
+            if len(part):
+                yield part
+
+    def _stream(self, precision, batch_size, request):
+        """batches(), plus one empty Samples (with the tree) at the end when nothing arrived."""
         precision = precision or self._precision
         if precision not in _PRECISIONS:
             raise InvalidArgumentError(3, "precision must be float64 or float32")
@@ -212,23 +218,23 @@ class Client:
                 raise DataLossError(15, f"the server sent {sent} samples but {this_stream} arrived")
             if first is not None and first.expected_samples >= 0 and received != first.expected_samples:
                 raise DataLossError(15, f"expected {first.expected_samples} samples, received {received}")
+            if received == 0 and first is not None:  # e.g. a region with no samples
+                yield Samples({}, tree, first.begin, first.end, first.seed, first.algorithm_version,
+                              np.float32 if precision == "float32" else np.float64)
             return
 
     def sample(self, *, precision=None, batch_size=None, **request):
         """All the requested samples as one Samples: the same values as sfcsampler.sample()."""
         precision = precision or self._precision
-        parts, last = [], None
-        for part in self.batches(precision=precision, batch_size=batch_size, **request):
-            parts.append(part.columns())
-            last = part
-        dtype = np.float32 if precision == "float32" else np.float64
-        if last is None:  # nothing in the region: an empty set, with the tree from a Prepare-free call
-            req = make_request(request)
-            begin, end = req.index_range
-            return Samples({}, {}, begin, end, req.seed, _core.ALGORITHM_VERSION, dtype)
-        if len(parts) == 1:  # own the memory rather than view the message
-            parts = [{k: np.array(v) for k, v in parts[0].items()}]
-        return concatenate(parts, last.tree, last.begin, last.end, last.seed, last.algorithm_version, dtype)
+        parts = list(self._stream(precision, batch_size, request))
+        if not parts:
+            raise DataLossError(15, "the stream ended without a header or samples")
+        last = parts[-1]
+        columns = [p.columns() for p in parts if len(p)]
+        if len(columns) == 1:  # own the memory rather than view the message
+            columns = [{k: np.array(v) for k, v in columns[0].items()}]
+        return concatenate(columns, last.tree, last.begin, last.end, last.seed, last.algorithm_version,
+                           np.float32 if precision == "float32" else np.float64)
 
     def prepare(self, **request):
         """Builds (or finds in the server's cache) the request's tree; returns its summary."""

@@ -38,6 +38,7 @@ def test_empty_region(server):
     with sfcsampler.Client(server) as client:
         s = client.sample(surface="sphere", count=1000, region="box:5,5,5,6,6,6")
     assert len(s) == 0 and s.x.dtype == np.float64
+    assert s.tree["key"] == sfcsampler.sample(surface="sphere", count=1000).tree["key"]
 
 
 def test_server_errors_carry_code_and_message(server):
