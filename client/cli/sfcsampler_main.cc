@@ -234,7 +234,10 @@ int RunPrepare(const RequestFlags& flags, const Connection& conn) {
   if (!conn.server.empty()) {
     auto client = Connect(conn, 0);
     if (!client.ok()) return Fail(client.status());
+    Progress progress(true);
+    progress.StartPhase("waiting for " + conn.server + " to prepare the curve tree");
     auto response = (*client)->Prepare(*spec, flags.tree_count ? flags.tree_count : flags.count);
+    progress.Done();
     if (!response.ok()) return Fail(response.status());
     PrintTreeInfo(response->tree());
     std::fprintf(stderr, "prepared in %.3f s\n", response->seconds());
@@ -244,7 +247,10 @@ int RunPrepare(const RequestFlags& flags, const Connection& conn) {
   DirectTreeSource source;
   SamplingEngine engine(EngineLimits{}, &source);
   const auto start = std::chrono::steady_clock::now();
+  Progress progress(true);
+  progress.StartPhase("building the curve tree");
   auto prepared = engine.Prepare(*spec, flags.tree_count ? flags.tree_count : flags.count);
+  progress.Done();
   if (!prepared.ok()) return Fail(prepared.status());
   PrintTree(*prepared, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   std::printf("%s\n", prepared->key.HexWithGrade(prepared->grade).c_str());
