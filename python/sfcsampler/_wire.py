@@ -28,7 +28,19 @@ def _varint(buf, pos):
         shift += 7
 
 
-def _fields(buf):
+def encode_varint(value):
+    out = bytearray()
+    while True:
+        byte = value & 0x7F
+        value >>= 7
+        if value:
+            out.append(byte | 0x80)
+        else:
+            out.append(byte)
+            return bytes(out)
+
+
+def fields(buf):
     """Yields (field number, wire type, value) where value is an int or a memoryview."""
     pos, end = 0, len(buf)
     while pos < end:
@@ -52,7 +64,7 @@ def _fields(buf):
 
 def _columns(buf, dtype):
     pieces = {}
-    for number, _, value in _fields(buf):
+    for number, _, value in fields(buf):
         if 1 <= number <= 10:  # packed or not, the bytes are the values
             pieces.setdefault(_COLUMN_NAMES[number], []).append(np.frombuffer(value, dtype=dtype))
     return {name: parts[0] if len(parts) == 1 else np.concatenate(parts) for name, parts in pieces.items()}
@@ -60,7 +72,7 @@ def _columns(buf, dtype):
 
 def _batch(buf, requested):
     first_index, size, index, columns = 0, 0, [], {}
-    for number, _, value in _fields(buf):
+    for number, _, value in fields(buf):
         if number == 1:
             first_index = value
         elif number == 2:
@@ -95,7 +107,7 @@ def decode_response(raw, requested):
     """
     buf = memoryview(raw)
     header, batch = None, {"index": np.empty(0, dtype=np.uint64)}
-    for number, wire_type, value in _fields(buf):
+    for number, wire_type, value in fields(buf):
         if number == 1 and wire_type == 2:
             header = sampler_pb2.StreamHeader.FromString(bytes(value))
         elif number == 2 and wire_type == 2:

@@ -63,6 +63,14 @@ def test_prepare_then_sample_hits_the_cache(server):
         assert "sphere" in {e["name"] for e in client.catalog()["surfaces"]}
 
 
+def test_health(server):
+    with sfcsampler.Client(server) as client:
+        assert client.health() is True
+        with pytest.raises(sfcsampler.Error) as info:
+            client.health(service="no.such.Service")
+        assert info.value.code == "NOT_FOUND"
+
+
 def test_unreachable_server_is_unavailable():
     with sfcsampler.Client("127.0.0.1:1", max_resumes=1, resume_backoff=0.01, timeout=5) as client:
         with pytest.raises(sfcsampler.UnavailableError) as info:
