@@ -2,8 +2,8 @@
 
 A SampleBatch's columns are packed repeated doubles (or floats) on the wire,
 so each column is one contiguous little-endian run of bytes: numpy.frombuffer
-reads it without creating a Python float per value, which the protobuf
-message API would. The StreamHeader (small, first message only) goes through
+reads it (one memcpy per column) without creating a Python float per value,
+which the protobuf message API would. The StreamHeader (small, first message only) goes through
 the generated sampler_pb2. Pure functions.
 """
 
@@ -67,7 +67,8 @@ def _columns(buf, dtype):
     for number, _, value in fields(buf):
         if 1 <= number <= 10:  # packed or not, the bytes are the values
             pieces.setdefault(_COLUMN_NAMES[number], []).append(np.frombuffer(value, dtype=dtype))
-    return {name: parts[0] if len(parts) == 1 else np.concatenate(parts) for name, parts in pieces.items()}
+    # Copies: writable arrays that do not keep the whole message alive.
+    return {name: parts[0].copy() if len(parts) == 1 else np.concatenate(parts) for name, parts in pieces.items()}
 
 
 def _batch(buf, requested):
@@ -84,7 +85,7 @@ def _batch(buf, requested):
         elif number == 5:
             columns = _columns(value, np.dtype("<f4"))
     if index:
-        index = np.concatenate(index) if len(index) > 1 else index[0]
+        index = np.concatenate(index) if len(index) > 1 else index[0].copy()
         if len(index) != size:
             raise DataLossError(15, f"a batch has {len(index)} indices for {size} samples")
     else:

@@ -183,6 +183,8 @@ class Client:
                                 f"({header.algorithm_version}), the first from {first.tree.key} "
                                 f"({first.algorithm_version}); the samples would not continue the set"))
                     n = len(columns["index"])
+                    if n and first is None:
+                        raise DataLossError(15, "samples arrived before the stream's header")
                     this_stream += n
                     if skip:
                         drop = min(skip, n)
@@ -231,8 +233,6 @@ class Client:
             raise DataLossError(15, "the stream ended without a header or samples")
         last = parts[-1]
         columns = [p.columns() for p in parts if len(p)]
-        if len(columns) == 1:  # own the memory rather than view the message
-            columns = [{k: np.array(v) for k, v in columns[0].items()}]
         return concatenate(columns, last.tree, last.begin, last.end, last.seed, last.algorithm_version,
                            np.float32 if precision == "float32" else np.float64)
 

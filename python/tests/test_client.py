@@ -32,6 +32,7 @@ def test_float32_and_batches(server):
         x = np.concatenate([p.x for p in parts])
     assert x.dtype == np.float32
     assert np.array_equal(x, sfcsampler.sample(surface="torus", count=10000, precision="float32").x)
+    assert parts[0].x.flags.writeable  # a copy, not a view of the message
 
 
 def test_empty_region(server):
