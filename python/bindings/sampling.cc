@@ -8,16 +8,15 @@
 // Thread-safety: an Engine may be used from several Python threads at once
 // (its tree source is locked); a Job serialises calls to next().
 #include <algorithm>
-#include <list>
-#include <map>
+#include <array>
 #include <mutex>
 #include <thread>
 
-#include "absl/synchronization/mutex.h"
 #include "core/curve.h"
 #include "engine/sampling_engine.h"
 #include "python/bindings/arrays.h"
 #include "python/bindings/errors.h"
+#include "python/bindings/recent_tree_source.h"
 #include "python/bindings/register.h"
 #include "python/bindings/request.h"
 
@@ -26,42 +25,6 @@ namespace py = pybind11;
 namespace sfc::python {
 
 namespace {
-
-// Keeps the last `capacity` trees (by key and grade), so repeated requests on
-// one surface skip the build, as the server's cache does. Exact matches only:
-// a different grade builds afresh. Two threads asking for the same new tree
-// at once may both build it (the result is the same tree).
-class RecentTreeSource final : public TreeSource {
- public:
-  explicit RecentTreeSource(size_t capacity) : capacity_(capacity) {}
-
-  absl::StatusOr<TreeLookup> Get(const TreeKey& key, int grade,
-                                 const TreeFactory& factory) override {
-    const std::string id = key.HexWithGrade(grade) + "|" + key.canonical;
-    if (capacity_ > 0) {
-      absl::MutexLock lock(&mu_);
-      for (auto it = recent_.begin(); it != recent_.end(); ++it) {
-        if (it->first == id) {
-          recent_.splice(recent_.begin(), recent_, it);
-          return TreeLookup{it->second, true, false};
-        }
-      }
-    }
-    auto tree = factory.build(grade);
-    if (!tree.ok()) return tree.status();
-    if (capacity_ > 0) {
-      absl::MutexLock lock(&mu_);
-      recent_.emplace_front(id, *tree);
-      while (recent_.size() > capacity_) recent_.pop_back();
-    }
-    return TreeLookup{*std::move(tree), false, false};
-  }
-
- private:
-  const size_t capacity_;
-  absl::Mutex mu_;
-  std::list<std::pair<std::string, std::shared_ptr<const CurveTree>>> recent_ ABSL_GUARDED_BY(mu_);
-};
 
 // The tree summary with the same names as the wire's TreeInfo message.
 py::dict TreeInfoDict(const PreparedTree& t) {

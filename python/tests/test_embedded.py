@@ -176,3 +176,20 @@ def test_quiet_keeps_warnings_and_no_warnings_drops_them():
     loud = subprocess.run([CLI, "sample", "--count", "1000000", "-o", "/dev/null"], capture_output=True,
                           text=True, check=True).stderr
     assert "\r" not in loud and "samples written" in loud
+
+
+def test_one_sampler_from_several_threads():
+    sampler = sfcsampler.Sampler(max_trees=2)
+    requests = [dict(surface="torus", count=200000, seed=seed) for seed in (1, 2, 3, 4)]
+    results = [None] * len(requests)
+
+    def work(i):
+        results[i] = sampler.sample(**requests[i])
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(len(requests))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for request, result in zip(requests, results):
+        assert np.array_equal(result.x, sfcsampler.sample(**request).x)
