@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cstring>
+#include <vector>
 
 #include "absl/strings/str_format.h"
 #include "core/status_macros.h"
@@ -9,7 +10,8 @@
 namespace sfc {
 namespace {
 
-void AppendDouble(std::string* out, double value) {
+template <typename T>
+void AppendShortest(std::string* out, T value) {
   char buf[32];
   const auto result = std::to_chars(buf, buf + sizeof(buf), value);
   out->append(buf, result.ptr);
@@ -38,8 +40,49 @@ absl::Status WriteAll(std::FILE* f, const std::string& data) {
 
 }  // namespace
 
-SampleWriter::SampleWriter(std::FILE* out, bool owns, OutputFormat format, const SampleFields& fields)
-    : out_(out), owns_(owns), format_(format), fields_(fields) {}
+SampleWriter::SampleWriter(std::FILE* out, bool owns, OutputFormat format, const SampleFields& fields,
+                           OutputPrecision precision)
+    : out_(out), owns_(owns), format_(format), fields_(fields), precision_(precision) {}
+
+void SampleWriter::AppendNumber(std::string* out, double value) const {
+  if (precision_ == OutputPrecision::kFloat32) {
+    AppendShortest(out, static_cast<float>(value));
+  } else {
+    AppendShortest(out, value);
+  }
+}
+
+void SampleWriter::AppendValue(std::string* out, double value) const {
+  if (precision_ == OutputPrecision::kFloat32) {
+    AppendBinary(out, static_cast<float>(value));
+  } else {
+    AppendBinary(out, value);
+  }
+}
+
+// NPY format 1.0: magic, version, a little-endian uint16 header length, and a
+// Python dict literal padded with spaces and a newline so the data starts at
+// a multiple of 64 bytes (numpy/lib/format.py).
+std::string SampleWriter::NpyHeader(uint64_t count) const {
+  const char* f = precision_ == OutputPrecision::kFloat32 ? "'<f4'" : "'<f8'";
+  std::string descr = "[('index', '<u8')";
+  std::vector<const char*> names = {"u", "v", "x", "y", "z"};
+  if (fields_.normal) names.insert(names.end(), {"nx", "ny", "nz"});
+  if (fields_.density) names.push_back("density");
+  if (fields_.curve_position) names.push_back("curve_position");
+  for (const char* name : names) descr += absl::StrFormat(", ('%s', %s)", name, f);
+  descr += "]";
+  std::string dict =
+      absl::StrFormat("{'descr': %s, 'fortran_order': False, 'shape': (%d,), }", descr, count);
+  const size_t unpadded = 10 + dict.size() + 1;
+  dict.append((64 - unpadded % 64) % 64, ' ');
+  dict += '\n';
+  std::string h = "\x93NUMPY";
+  h += '\x01';
+  h += '\x00';
+  AppendBinary(&h, static_cast<uint16_t>(dict.size()));
+  return h + dict;
+}
 
 SampleWriter::~SampleWriter() {
   if (staging_) std::fclose(staging_);
@@ -48,13 +91,13 @@ SampleWriter::~SampleWriter() {
 
 absl::StatusOr<std::unique_ptr<SampleWriter>> SampleWriter::Open(
     const std::string& path, OutputFormat format, const SampleFields& fields,
-    std::optional<uint64_t> expected_count) {
+    std::optional<uint64_t> expected_count, OutputPrecision precision) {
   std::FILE* f = path == "-" ? stdout : std::fopen(path.c_str(), "wb");
   if (!f) {
     return absl::InvalidArgumentError(
         absl::StrFormat("cannot open \"%s\" for writing: %s", path, std::strerror(errno)));
   }
-  auto writer = std::unique_ptr<SampleWriter>(new SampleWriter(f, path != "-", format, fields));
+  auto writer = std::unique_ptr<SampleWriter>(new SampleWriter(f, path != "-", format, fields, precision));
   writer->expected_ = expected_count;
   if (format == OutputFormat::kCsv) {
     RETURN_IF_ERROR(writer->WriteHeader(0));
@@ -62,7 +105,9 @@ absl::StatusOr<std::unique_ptr<SampleWriter>> SampleWriter::Open(
     RETURN_IF_ERROR(writer->WriteHeader(*expected_count));
   } else {
     writer->staging_ = std::tmpfile();
-    if (!writer->staging_) return absl::InternalError("cannot create a temporary file for PLY output");
+    if (!writer->staging_) {
+      return absl::InternalError("cannot create a temporary file for PLY or NPY output");
+    }
   }
   return writer;
 }
@@ -77,15 +122,25 @@ absl::Status SampleWriter::WriteHeader(uint64_t count) {
     h += "\n";
     return WriteAll(out_, h);
   }
+  if (format_ == OutputFormat::kNpy) {
+    if (NpyHeader(count).size() > 65535 + 10) return absl::InternalError("NPY header too long");
+    return WriteAll(out_, NpyHeader(count));
+  }
   h = "ply\n";
   h += format_ == OutputFormat::kPlyAscii ? "format ascii 1.0\n" : "format binary_little_endian 1.0\n";
   h += "comment sfcsampler samples in curve order\n";
   h += absl::StrFormat("element vertex %d\n", count);
-  h += "property double x\nproperty double y\nproperty double z\n";
-  if (fields_.normal) h += "property double nx\nproperty double ny\nproperty double nz\n";
-  h += "property double u\nproperty double v\nproperty uint index\n";
-  if (fields_.density) h += "property double density\n";
-  if (fields_.curve_position) h += "property double curve_position\n";
+  const char* type = precision_ == OutputPrecision::kFloat32 ? "float" : "double";
+  auto property = [&](const char* name) { h += absl::StrFormat("property %s %s\n", type, name); };
+  for (const char* name : {"x", "y", "z"}) property(name);
+  if (fields_.normal) {
+    for (const char* name : {"nx", "ny", "nz"}) property(name);
+  }
+  property("u");
+  property("v");
+  h += "property uint index\n";
+  if (fields_.density) property("density");
+  if (fields_.curve_position) property("curve_position");
   h += "end_header\n";
   return WriteAll(out_, h);
 }
@@ -95,42 +150,52 @@ absl::Status SampleWriter::WriteRows(std::FILE* to, const SampleBatch& b) {
   for (size_t i = 0; i < b.size(); ++i) {
     if (format_ == OutputFormat::kCsv) {
       AppendUint(&buffer_, b.index[i]);
-      for (double d : {b.u[i], b.v[i], b.x[i], b.y[i], b.z[i]}) buffer_ += ',', AppendDouble(&buffer_, d);
+      for (double d : {b.u[i], b.v[i], b.x[i], b.y[i], b.z[i]}) buffer_ += ',', AppendNumber(&buffer_, d);
       if (fields_.normal) {
-        for (double d : {b.nx[i], b.ny[i], b.nz[i]}) buffer_ += ',', AppendDouble(&buffer_, d);
+        for (double d : {b.nx[i], b.ny[i], b.nz[i]}) buffer_ += ',', AppendNumber(&buffer_, d);
       }
-      if (fields_.density) buffer_ += ',', AppendDouble(&buffer_, b.density[i]);
-      if (fields_.curve_position) buffer_ += ',', AppendDouble(&buffer_, b.curve_position[i]);
+      if (fields_.density) buffer_ += ',', AppendNumber(&buffer_, b.density[i]);
+      if (fields_.curve_position) buffer_ += ',', AppendNumber(&buffer_, b.curve_position[i]);
       buffer_ += '\n';
+    } else if (format_ == OutputFormat::kNpy) {
+      // One packed record per sample, fields in the header's order.
+      AppendBinary(&buffer_, b.index[i]);
+      for (double d : {b.u[i], b.v[i], b.x[i], b.y[i], b.z[i]}) AppendValue(&buffer_, d);
+      if (fields_.normal) {
+        for (double d : {b.nx[i], b.ny[i], b.nz[i]}) AppendValue(&buffer_, d);
+      }
+      if (fields_.density) AppendValue(&buffer_, b.density[i]);
+      if (fields_.curve_position) AppendValue(&buffer_, b.curve_position[i]);
     } else if (format_ == OutputFormat::kPlyAscii) {
       std::string row;
-      for (double d : {b.x[i], b.y[i], b.z[i]}) AppendDouble(&row, d), row += ' ';
+      for (double d : {b.x[i], b.y[i], b.z[i]}) AppendNumber(&row, d), row += ' ';
       if (fields_.normal) {
-        for (double d : {b.nx[i], b.ny[i], b.nz[i]}) AppendDouble(&row, d), row += ' ';
+        for (double d : {b.nx[i], b.ny[i], b.nz[i]}) AppendNumber(&row, d), row += ' ';
       }
-      AppendDouble(&row, b.u[i]), row += ' ';
-      AppendDouble(&row, b.v[i]), row += ' ';
+      AppendNumber(&row, b.u[i]), row += ' ';
+      AppendNumber(&row, b.v[i]), row += ' ';
       AppendUint(&row, b.index[i]);
-      if (fields_.density) row += ' ', AppendDouble(&row, b.density[i]);
-      if (fields_.curve_position) row += ' ', AppendDouble(&row, b.curve_position[i]);
+      if (fields_.density) row += ' ', AppendNumber(&row, b.density[i]);
+      if (fields_.curve_position) row += ' ', AppendNumber(&row, b.curve_position[i]);
       buffer_ += row + '\n';
     } else {
-      for (double d : {b.x[i], b.y[i], b.z[i]}) AppendBinary(&buffer_, d);
+      for (double d : {b.x[i], b.y[i], b.z[i]}) AppendValue(&buffer_, d);
       if (fields_.normal) {
-        for (double d : {b.nx[i], b.ny[i], b.nz[i]}) AppendBinary(&buffer_, d);
+        for (double d : {b.nx[i], b.ny[i], b.nz[i]}) AppendValue(&buffer_, d);
       }
-      AppendBinary(&buffer_, b.u[i]);
-      AppendBinary(&buffer_, b.v[i]);
+      AppendValue(&buffer_, b.u[i]);
+      AppendValue(&buffer_, b.v[i]);
       AppendBinary(&buffer_, static_cast<uint32_t>(b.index[i]));
-      if (fields_.density) AppendBinary(&buffer_, b.density[i]);
-      if (fields_.curve_position) AppendBinary(&buffer_, b.curve_position[i]);
+      if (fields_.density) AppendValue(&buffer_, b.density[i]);
+      if (fields_.curve_position) AppendValue(&buffer_, b.curve_position[i]);
     }
   }
   return WriteAll(to, buffer_);
 }
 
 absl::Status SampleWriter::Write(const SampleBatch& batch) {
-  if (format_ != OutputFormat::kCsv && !batch.index.empty() && batch.index.back() > UINT32_MAX) {
+  const bool ply = format_ == OutputFormat::kPlyBinary || format_ == OutputFormat::kPlyAscii;
+  if (ply && !batch.index.empty() && batch.index.back() > UINT32_MAX) {
     return absl::InvalidArgumentError("PLY stores the sample index as uint32; use CSV for indices >= 2^32");
   }
   RETURN_IF_ERROR(WriteRows(staging_ ? staging_ : out_, batch));

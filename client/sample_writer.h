@@ -1,10 +1,14 @@
-// Writes sample batches as CSV or PLY (binary little-endian or ASCII).
+// Writes sample batches as CSV, PLY (binary little-endian or ASCII) or NumPy's
+// .npy format.
 //
 // CSV starts with the header index,u,v,x,y,z, then the optional columns
 // nx,ny,nz, density, curve_position. Numbers are written in the shortest form
-// that reads back to the same double, so output is byte-identical for the
-// same samples. PLY has one vertex element with x y z (double), the optional
-// normals, u v (double) and index (uint32); MeshLab and CloudCompare read it.
+// that reads back to the same double (or float, in float32 precision), so
+// output is byte-identical for the same samples. PLY has one vertex element
+// with x y z (double or float), the optional normals, u v and index (uint32);
+// MeshLab and CloudCompare read it. NPY (format 1.0) holds a 1-D structured
+// array with the CSV's columns as fields (index '<u8', the rest '<f8' or
+// '<f4'): numpy.load(path)['x'].
 //
 // Thread-compatible: one writer per output.
 #ifndef SFCSAMPLER_CLIENT_SAMPLE_WRITER_H_
@@ -20,17 +24,21 @@
 
 namespace sfc {
 
-enum class OutputFormat { kCsv, kPlyBinary, kPlyAscii };
+enum class OutputFormat { kCsv, kPlyBinary, kPlyAscii, kNpy };
+
+// Width of the floating-point columns in the file. Float32 rounds each double
+// to the nearest float (as the wire's PRECISION_FLOAT32 does), so a float32
+// file is the same from a float64 or a float32 stream.
+enum class OutputPrecision { kFloat64, kFloat32 };
 
 class SampleWriter {
  public:
   // Opens `path` ("-" = stdout). `expected_count` is the exact number of
   // samples when known; PLY output without it is staged in a temporary file
-  // so the header can carry the count.
-  static absl::StatusOr<std::unique_ptr<SampleWriter>> Open(const std::string& path,
-                                                            OutputFormat format,
-                                                            const SampleFields& fields,
-                                                            std::optional<uint64_t> expected_count);
+  // so the header can carry the count (likewise NPY).
+  static absl::StatusOr<std::unique_ptr<SampleWriter>> Open(
+      const std::string& path, OutputFormat format, const SampleFields& fields,
+      std::optional<uint64_t> expected_count, OutputPrecision precision = OutputPrecision::kFloat64);
   ~SampleWriter();
 
   absl::Status Write(const SampleBatch& batch);
@@ -40,15 +48,20 @@ class SampleWriter {
   uint64_t written() const { return written_; }
 
  private:
-  SampleWriter(std::FILE* out, bool owns, OutputFormat format, const SampleFields& fields);
+  SampleWriter(std::FILE* out, bool owns, OutputFormat format, const SampleFields& fields,
+               OutputPrecision precision);
   absl::Status WriteHeader(uint64_t count);
   absl::Status WriteRows(std::FILE* to, const SampleBatch& batch);
+  std::string NpyHeader(uint64_t count) const;
+  void AppendNumber(std::string* out, double value) const;  // shortest text
+  void AppendValue(std::string* out, double value) const;   // little-endian binary
 
   std::FILE* out_;
   bool owns_;
   std::FILE* staging_ = nullptr;  // PLY with unknown count
   OutputFormat format_;
   SampleFields fields_;
+  OutputPrecision precision_;
   std::optional<uint64_t> expected_;
   uint64_t written_ = 0;
   std::string buffer_;

@@ -40,14 +40,20 @@ const std::map<std::string, double>& PaperSphere() {
 }
 
 // Our sampler: trees by grade, each refined from the previous one, as the
-// server's cache does.
+// server's cache does; or the sets from `remote` when it is set.
 class OurSampler {
  public:
+  // `surface_spec` and `density_spec` are the catalogue specs of `surface`
+  // and `density`, for `remote`.
   OurSampler(std::shared_ptr<const Surface> surface, CurveTreeOptions options,
-             std::shared_ptr<const Density> density = MakeUniformDensity())
-      : surface_(std::move(surface)), density_(std::move(density)), options_(options) {}
+             std::shared_ptr<const Density> density, std::string surface_spec,
+             std::string density_spec, PointSetSource remote)
+      : surface_(std::move(surface)), density_(std::move(density)), options_(options),
+        surface_spec_(std::move(surface_spec)), density_spec_(std::move(density_spec)),
+        remote_(std::move(remote)) {}
 
   absl::StatusOr<SampleBatch> Sample(uint64_t n, uint64_t seed) {
+    if (remote_) return remote_(surface_spec_, density_spec_, options_, n, seed);
     const int grade = CurveTree::GradeFor(n);
     if (!tree_ || tree_->grade() != grade) {
       if (tree_ && tree_->grade() < grade) {
@@ -71,6 +77,8 @@ class OurSampler {
   std::shared_ptr<const Surface> surface_;
   std::shared_ptr<const Density> density_;
   CurveTreeOptions options_;
+  std::string surface_spec_, density_spec_;
+  PointSetSource remote_;
   std::shared_ptr<const CurveTree> tree_;
 };
 
@@ -164,12 +172,17 @@ absl::StatusOr<std::vector<ProtocolRow>> RunProtocol(const ProtocolOptions& opti
   int done = 0;
   std::vector<ProtocolRow> rows;
   std::shared_ptr<const Surface> unit_square = MakePlane(), unit_sphere = MakeSphere(1);
+  std::shared_ptr<const Density> uniform = MakeUniformDensity();
 
   for (const std::string& method : plane) {
     std::unique_ptr<OurSampler> ours;
-    if (method == "hilbert-jittered") ours = std::make_unique<OurSampler>(unit_square, CurveOptions(CurveType::kHilbert, AreaEstimator::kFirstFundamentalForm));
-    if (method == "hilbert2-jittered") ours = std::make_unique<OurSampler>(unit_square, CurveOptions(CurveType::kHilbert2, AreaEstimator::kFirstFundamentalForm));
-    if (method == "peano-jittered") ours = std::make_unique<OurSampler>(unit_square, CurveOptions(CurveType::kPeano, AreaEstimator::kFirstFundamentalForm));
+    auto on_square = [&](CurveType curve) {
+      return std::make_unique<OurSampler>(unit_square, CurveOptions(curve, AreaEstimator::kFirstFundamentalForm),
+                                          uniform, "plane", "uniform", options.our_sets);
+    };
+    if (method == "hilbert-jittered") ours = on_square(CurveType::kHilbert);
+    if (method == "hilbert2-jittered") ours = on_square(CurveType::kHilbert2);
+    if (method == "peano-jittered") ours = on_square(CurveType::kPeano);
     for (uint64_t n : sizes) {
       const auto start = std::chrono::steady_clock::now();
       std::vector<Point2> pts;
@@ -202,9 +215,13 @@ absl::StatusOr<std::vector<ProtocolRow>> RunProtocol(const ProtocolOptions& opti
   }
   for (const std::string& method : sphere) {
     std::unique_ptr<OurSampler> ours;
-    if (method == "hilbert-jittered-fff") ours = std::make_unique<OurSampler>(unit_sphere, CurveOptions(CurveType::kHilbert, AreaEstimator::kFirstFundamentalForm));
-    if (method == "hilbert-jittered-triangle") ours = std::make_unique<OurSampler>(unit_sphere, CurveOptions(CurveType::kHilbert, AreaEstimator::kTriangle));
-    if (method == "hilbert-jittered-quadrature") ours = std::make_unique<OurSampler>(unit_sphere, CurveOptions(CurveType::kHilbert, AreaEstimator::kQuadrature));
+    auto on_sphere = [&](AreaEstimator estimator) {
+      return std::make_unique<OurSampler>(unit_sphere, CurveOptions(CurveType::kHilbert, estimator), uniform,
+                                          "sphere", "uniform", options.our_sets);
+    };
+    if (method == "hilbert-jittered-fff") ours = on_sphere(AreaEstimator::kFirstFundamentalForm);
+    if (method == "hilbert-jittered-triangle") ours = on_sphere(AreaEstimator::kTriangle);
+    if (method == "hilbert-jittered-quadrature") ours = on_sphere(AreaEstimator::kQuadrature);
     for (uint64_t n : sizes) {
       const auto start = std::chrono::steady_clock::now();
       std::vector<Vec3> pts;
@@ -249,7 +266,7 @@ absl::StatusOr<std::vector<ProtocolRow>> RunProtocol(const ProtocolOptions& opti
         return cells[std::lround(u0 * kGrid) * kGrid + std::lround(v0 * kGrid)];
       };
       OurSampler ours(surface.surface, CurveOptions(CurveType::kHilbert, AreaEstimator::kFirstFundamentalForm),
-                      density.density);
+                      density.density, c.surface, c.density, options.our_sets);
       for (const char* method : {"random", "hilbert-jittered"}) {
         for (uint64_t n : sizes) {
           const auto start = std::chrono::steady_clock::now();

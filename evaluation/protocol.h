@@ -14,8 +14,18 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/curve_tree.h"
+#include "core/sample_batch.h"
 
 namespace sfc {
+
+// Where our sampler's point sets come from when they are not made in-process:
+// the jittered set of `count` samples (seed `seed`) on the catalogue specs
+// `surface` and `density` with tree `options`, all of it, in curve order
+// (e.g. from a server, `sfcsampler eval --server`).
+using PointSetSource = std::function<absl::StatusOr<SampleBatch>(
+    const std::string& surface, const std::string& density, const CurveTreeOptions& options,
+    uint64_t count, uint64_t seed)>;
 
 struct ProtocolOptions {
   int l_min = 1;
@@ -27,6 +37,7 @@ struct ProtocolOptions {
   int star_corners = 2048;    // see StarDiscrepancy
   int triangle_grid = 256;    // see TriangleDiscrepancy
   int sphere_triangles = 128; // see SphericalTriangleDiscrepancy
+  PointSetSource our_sets;    // empty: our sets are made in-process
 };
 
 // One point set's discrepancies; absent measures do not apply to its domain.

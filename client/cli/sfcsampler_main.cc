@@ -12,12 +12,14 @@
 #include "CLI/CLI.hpp"
 #include "absl/strings/str_format.h"
 #include "catalog/catalog.h"
+#include "client/cli/progress.h"
 #include "client/cli/request_flags.h"
 #include "client/sample_writer.h"
 #include "client/sampler_client.h"
 #include "core/area_estimator.h"
 #include "core/curve.h"
 #include "core/sequence.h"
+#include "core/status_macros.h"
 #include "engine/sampling_engine.h"
 #include "evaluation/plot.h"
 #include "evaluation/protocol.h"
@@ -42,8 +44,11 @@ struct Connection {
   std::string tls_cert, tls_key;  // client certificate for mutual TLS
 };
 
-absl::StatusOr<std::unique_ptr<SamplerClient>> Connect(const Connection& c, uint32_t batch_size) {
+absl::StatusOr<std::unique_ptr<SamplerClient>> Connect(
+    const Connection& c, uint32_t batch_size,
+    v1::Precision precision = v1::PRECISION_FLOAT64) {
   ClientOptions options;
+  options.precision = precision;
   options.target = c.server;
   options.tls = c.tls || !c.tls_roots.empty() || !c.tls_cert.empty();
   options.tls_root_certs_file = c.tls_roots;
@@ -64,14 +69,25 @@ absl::StatusOr<std::unique_ptr<SamplerClient>> Connect(const Connection& c, uint
   return SamplerClient::Connect(options);
 }
 
-// The tree summary and any depth-cap warnings, on stderr; the same for the
+// What `sample` prints on stderr: -q drops the summary and the progress
+// lines, --no-warnings the depth-cap warnings (which -q keeps: they say the
+// samples' density is only approximate somewhere).
+struct Verbosity {
+  bool quiet = false;
+  bool no_warnings = false;
+};
+
+// The tree summary and the depth-cap warnings, on stderr; the same for the
 // embedded mode (converted with ToProto) and the wire.
-void PrintTreeInfo(const ::sfcsampler::v1::TreeInfo& t) {
-  std::fprintf(stderr, "tree %s (%s): %llu leaves, depth %d..%d, %llu bytes, tolerance %.6g\n",
-               t.key_with_grade().c_str(),
-               t.cache_hit() ? "cache hit" : t.refined() ? "refined from cache" : "built",
-               static_cast<unsigned long long>(t.leaves()), t.min_depth(), t.max_depth(),
-               static_cast<unsigned long long>(t.bytes()), t.tolerance());
+void PrintTreeInfo(const ::sfcsampler::v1::TreeInfo& t, const Verbosity& verbosity = {}) {
+  if (!verbosity.quiet) {
+    std::fprintf(stderr, "tree %s (%s): %llu leaves, depth %d..%d, %llu bytes, tolerance %.6g\n",
+                 t.key_with_grade().c_str(),
+                 t.cache_hit() ? "cache hit" : t.refined() ? "refined from cache" : "built",
+                 static_cast<unsigned long long>(t.leaves()), t.min_depth(), t.max_depth(),
+                 static_cast<unsigned long long>(t.bytes()), t.tolerance());
+  }
+  if (verbosity.no_warnings) return;
   if (t.flatness_capped_leaves() || t.mass_capped_leaves()) {
     std::fprintf(stderr,
                  "warning: the depth cap stopped splits the tests still wanted (paper Sect. 5.3): "
@@ -87,102 +103,131 @@ void PrintTreeInfo(const ::sfcsampler::v1::TreeInfo& t) {
   }
 }
 
-void PrintTree(const PreparedTree& tree, double seconds) {
+void PrintTree(const PreparedTree& tree, double seconds, const Verbosity& verbosity = {}) {
   ::sfcsampler::v1::TreeInfo info;
   ToProto(tree, &info);
-  PrintTreeInfo(info);
-  std::fprintf(stderr, "tree ready in %.3f s\n", seconds);
+  PrintTreeInfo(info, verbosity);
+  if (!verbosity.quiet) std::fprintf(stderr, "tree ready in %.3f s\n", seconds);
 }
 
-int RunSample(const RequestFlags& flags, const std::string& format, bool ascii,
-              const std::string& output, size_t batch_size, bool quiet, const Connection& conn) {
-  auto request = ToSampleRequest(flags);
-  if (!request.ok()) return Fail(request.status());
-  OutputFormat out_format;
-  if (format == "csv") {
-    out_format = OutputFormat::kCsv;
-  } else if (format == "ply") {
-    out_format = ascii ? OutputFormat::kPlyAscii : OutputFormat::kPlyBinary;
-  } else {
-    return Fail(absl::InvalidArgumentError("--format must be csv or ply"));
-  }
+struct OutputFlags {
+  std::string format = "csv";
+  bool ascii = false;
+  std::string output = "-";
+  size_t batch_size = 0;  // 0: 65536 in-process, the server's choice over the wire
+  std::string precision = "float64";
+};
+
+// Every sample of `request`, in curve order, from the server or in-process,
+// to `on_batch`. The tree summary goes to stderr per `verbosity`; `progress`
+// shows the build and the stream. Used by `sample` and `render`.
+absl::Status StreamSamples(const SampleRequest& request, const Connection& conn, size_t batch_size,
+                           v1::Precision precision, const Verbosity& verbosity, Progress* progress,
+                           const std::function<absl::Status(std::optional<uint64_t> expected,
+                                                            const SampleBatch&)>& on_batch,
+                           std::string* provenance) {
   const auto start = std::chrono::steady_clock::now();
   if (!conn.server.empty()) {
-    auto client = Connect(conn, static_cast<uint32_t>(batch_size));
-    if (!client.ok()) return Fail(client.status());
-    std::unique_ptr<SampleWriter> writer;
-    const bool progress = !quiet && isatty(STDERR_FILENO);
-    auto summary = (*client)->Sample(
-        *request, [&](const ::sfcsampler::v1::StreamHeader& header, const SampleBatch& batch) {
-          if (!writer) {
-            if (!quiet) PrintTreeInfo(header.tree());
-            std::optional<uint64_t> expected;
-            if (header.expected_samples() >= 0) expected = header.expected_samples();
-            auto opened = SampleWriter::Open(output, out_format, request->fields, expected);
-            if (!opened.ok()) return opened.status();
-            writer = *std::move(opened);
+    ASSIGN_OR_RETURN(auto client, Connect(conn, static_cast<uint32_t>(batch_size), precision));
+    uint64_t done = 0;
+    progress->StartPhase("waiting for " + conn.server + " (it may be building the curve tree)");
+    ASSIGN_OR_RETURN(
+        const StreamSummary summary,
+        client->Sample(request, [&](const ::sfcsampler::v1::StreamHeader& header, const SampleBatch& batch) {
+          if (done == 0) {
+            progress->EndPhase();
+            PrintTreeInfo(header.tree(), verbosity);
           }
-          if (progress && header.end() - header.begin() >= 1'000'000) {
-            std::fprintf(stderr, "\r%llu / %llu samples",
-                         static_cast<unsigned long long>(writer->written() + batch.size()),
-                         static_cast<unsigned long long>(header.end() - header.begin()));
-          }
-          return writer->Write(batch);
-        });
-    if (progress) std::fprintf(stderr, "\n");
-    if (!summary.ok()) return Fail(summary.status());
-    if (!writer) {  // a region with no samples: still write a valid, empty file
-      auto opened = SampleWriter::Open(output, out_format, request->fields, std::nullopt);
-      if (!opened.ok()) return Fail(opened.status());
-      writer = *std::move(opened);
-    }
-    if (auto s = writer->Finish(); !s.ok()) return Fail(s);
-    if (!quiet) {
-      std::fprintf(stderr, "%llu samples written to %s in %.3f s from %s (%s, seed %llu, %d resumes)\n",
-                   static_cast<unsigned long long>(writer->written()), output.c_str(),
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
-                   conn.server.c_str(), summary->header.algorithm_version().c_str(),
-                   static_cast<unsigned long long>(request->seed), summary->resumes);
-    }
-    return 0;
+          std::optional<uint64_t> expected;
+          if (header.expected_samples() >= 0) expected = header.expected_samples();
+          done += batch.size();
+          progress->Samples(done, expected.value_or(0));
+          return on_batch(expected, batch);
+        }));
+    progress->Done();
+    *provenance = absl::StrFormat("from %s (%s, seed %d, %d resumes)", conn.server,
+                                  summary.header.algorithm_version(), request.seed, summary.resumes);
+    return absl::OkStatus();
   }
   DirectTreeSource source;
   EngineLimits limits;
   limits.generation_threads = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
   SamplingEngine engine(limits, &source);
-  auto job = engine.Start(*request);
-  if (!job.ok()) return Fail(job.status());
-  const double build_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!quiet) PrintTree(job->tree, build_seconds);
-
+  progress->StartPhase("building the curve tree");
+  auto job = engine.Start(request);
+  progress->EndPhase();
+  RETURN_IF_ERROR(job.status());
+  PrintTree(job->tree, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+            verbosity);
   std::optional<uint64_t> expected;
-  if (request->region.kind == Region::Kind::kAll) expected = job->end - job->begin;
-  auto writer = SampleWriter::Open(output, out_format, request->fields, expected);
-  if (!writer.ok()) return Fail(writer.status());
+  if (request.region.kind == Region::Kind::kAll) expected = job->end - job->begin;
   SampleBatch batch;
-  const bool progress = !quiet && isatty(STDERR_FILENO) && job->end - job->begin >= 1'000'000;
   uint64_t done = 0;
   while (true) {
     batch.Clear();
-    auto n = job->cursor->Next(batch_size == 0 ? 65536 : batch_size, &batch);
-    if (!n.ok()) return Fail(n.status());
-    if (*n == 0) break;
-    if (auto s = (*writer)->Write(batch); !s.ok()) return Fail(s);
-    done += *n;
-    if (progress) {
-      std::fprintf(stderr, "\r%llu / %llu samples", static_cast<unsigned long long>(done),
-                   static_cast<unsigned long long>(job->end - job->begin));
-    }
+    ASSIGN_OR_RETURN(const size_t n, job->cursor->Next(batch_size == 0 ? 65536 : batch_size, &batch));
+    if (n == 0) break;
+    RETURN_IF_ERROR(on_batch(expected, batch));
+    done += n;
+    progress->Samples(done, expected.value_or(0));
   }
-  if (progress) std::fprintf(stderr, "\n");
-  if (auto s = (*writer)->Finish(); !s.ok()) return Fail(s);
-  if (!quiet) {
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::fprintf(stderr, "%llu samples written to %s in %.3f s (%s, seed %llu)\n",
-                 static_cast<unsigned long long>((*writer)->written()), output.c_str(), seconds,
-                 kAlgorithmVersion, static_cast<unsigned long long>(request->seed));
+  progress->Done();
+  *provenance = absl::StrFormat("(%s, seed %d)", kAlgorithmVersion, request.seed);
+  return absl::OkStatus();
+}
+
+absl::StatusOr<OutputPrecision> ParsePrecision(const std::string& text) {
+  if (text == "float64") return OutputPrecision::kFloat64;
+  if (text == "float32") return OutputPrecision::kFloat32;
+  return absl::InvalidArgumentError("--precision must be float64 or float32");
+}
+
+int RunSample(const RequestFlags& flags, const OutputFlags& out, const Verbosity& verbosity,
+              const Connection& conn) {
+  auto request = ToSampleRequest(flags);
+  if (!request.ok()) return Fail(request.status());
+  OutputFormat out_format;
+  if (out.format == "csv") {
+    out_format = OutputFormat::kCsv;
+  } else if (out.format == "ply") {
+    out_format = out.ascii ? OutputFormat::kPlyAscii : OutputFormat::kPlyBinary;
+  } else if (out.format == "npy") {
+    out_format = OutputFormat::kNpy;
+  } else {
+    return Fail(absl::InvalidArgumentError("--format must be csv, ply or npy"));
+  }
+  auto precision = ParsePrecision(out.precision);
+  if (!precision.ok()) return Fail(precision.status());
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<SampleWriter> writer;
+  Progress progress(!verbosity.quiet);
+  std::string provenance;
+  // Float32 output asks the server for float32 columns: half the bytes, and
+  // the same file (the writer rounds doubles to floats the same way).
+  absl::Status status = StreamSamples(
+      *request, conn, out.batch_size,
+      *precision == OutputPrecision::kFloat32 ? v1::PRECISION_FLOAT32 : v1::PRECISION_FLOAT64,
+      verbosity, &progress,
+      [&](std::optional<uint64_t> expected, const SampleBatch& batch) {
+        if (!writer) {
+          ASSIGN_OR_RETURN(writer, SampleWriter::Open(out.output, out_format, request->fields,
+                                                      expected, *precision));
+        }
+        return writer->Write(batch);
+      },
+      &provenance);
+  if (!status.ok()) return Fail(status);
+  if (!writer) {  // a region with no samples: still write a valid, empty file
+    auto opened = SampleWriter::Open(out.output, out_format, request->fields, std::nullopt, *precision);
+    if (!opened.ok()) return Fail(opened.status());
+    writer = *std::move(opened);
+  }
+  if (auto s = writer->Finish(); !s.ok()) return Fail(s);
+  if (!verbosity.quiet) {
+    std::fprintf(stderr, "%llu samples written to %s in %.3f s %s\n",
+                 static_cast<unsigned long long>(writer->written()), out.output.c_str(),
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+                 provenance.c_str());
   }
   return 0;
 }
@@ -193,7 +238,10 @@ int RunPrepare(const RequestFlags& flags, const Connection& conn) {
   if (!conn.server.empty()) {
     auto client = Connect(conn, 0);
     if (!client.ok()) return Fail(client.status());
+    Progress progress(true);
+    progress.StartPhase("waiting for " + conn.server + " to prepare the curve tree");
     auto response = (*client)->Prepare(*spec, flags.tree_count ? flags.tree_count : flags.count);
+    progress.Done();
     if (!response.ok()) return Fail(response.status());
     PrintTreeInfo(response->tree());
     std::fprintf(stderr, "prepared in %.3f s\n", response->seconds());
@@ -203,7 +251,10 @@ int RunPrepare(const RequestFlags& flags, const Connection& conn) {
   DirectTreeSource source;
   SamplingEngine engine(EngineLimits{}, &source);
   const auto start = std::chrono::steady_clock::now();
+  Progress progress(true);
+  progress.StartPhase("building the curve tree");
   auto prepared = engine.Prepare(*spec, flags.tree_count ? flags.tree_count : flags.count);
+  progress.Done();
   if (!prepared.ok()) return Fail(prepared.status());
   PrintTree(*prepared, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   std::printf("%s\n", prepared->key.HexWithGrade(prepared->grade).c_str());
@@ -252,8 +303,34 @@ struct EvalFlags {
   uint64_t seed = 1;
 };
 
-int RunEval(const EvalFlags& f) {
+int RunEval(const EvalFlags& f, const Connection& conn) {
   ProtocolOptions options;
+  std::unique_ptr<SamplerClient> client;
+  if (!conn.server.empty()) {
+    // Our point sets come from the server; the reference sets and the
+    // discrepancies are computed here. The trees are the same, so are the sets.
+    auto connected = Connect(conn, 0);
+    if (!connected.ok()) return Fail(connected.status());
+    client = *std::move(connected);
+    options.our_sets = [&client](const std::string& surface, const std::string& density,
+                                 const CurveTreeOptions& tree_options, uint64_t count,
+                                 uint64_t seed) -> absl::StatusOr<SampleBatch> {
+      SampleRequest request;
+      request.tree.surface = surface;
+      request.tree.density = density;
+      request.tree.options = tree_options;
+      request.sequence = SequenceKind::kJittered;
+      request.count = count;
+      request.seed = seed;
+      SampleBatch all;
+      RETURN_IF_ERROR(client->Sample(request, [&all](const ::sfcsampler::v1::StreamHeader&,
+                                                     const SampleBatch& batch) {
+        all.Append(batch);
+        return absl::OkStatus();
+      }).status());
+      return all;
+    };
+  }
   if (f.setting == "full") {
     options.l_max = 20;  // the paper: 40 sizes, 2 to 2^20 + 2^19 = 1572864
   } else if (f.setting != "fast") {
@@ -323,7 +400,7 @@ struct RenderFlags {
   std::string output = "render.png";
 };
 
-int RunRender(const RequestFlags& flags, const RenderFlags& r) {
+int RunRender(const RequestFlags& flags, const RenderFlags& r, const Connection& conn) {
   auto request = ToSampleRequest(flags);
   if (!request.ok()) return Fail(request.status());
   View view;
@@ -333,30 +410,46 @@ int RunRender(const RequestFlags& flags, const RenderFlags& r) {
     return Fail(absl::InvalidArgumentError("--view takes AZIMUTH,ELEVATION in degrees, e.g. 35,25"));
   }
   request->fields.normal = true;
-  DirectTreeSource source;
-  SamplingEngine engine(EngineLimits{}, &source);
-  auto job = engine.Start(*request);
-  if (!job.ok()) return Fail(job.status());
   absl::Status status;
   if (r.what == "curve" || r.what == "param-curve") {
+    if (!conn.server.empty()) {
+      // The wire carries samples, not trees.
+      return Fail(absl::FailedPreconditionError(
+          "--what curve and param-curve draw the curve tree, which stays on the server; run them "
+          "without --server (the tree is the same), or draw samples"));
+    }
+    DirectTreeSource source;
+    SamplingEngine engine(EngineLimits{}, &source);
+    auto job = engine.Start(*request);
+    if (!job.ok()) return Fail(job.status());
     const CurveTree& tree = *job->tree.lookup.tree;
     status = r.what == "curve" ? RenderCurve(tree, *job->tree.surface, view, r.output)
                                : RenderParameterCurve(tree, view, r.output);
+    if (status.ok()) {
+      std::fprintf(stderr, "wrote %s (%s, %zu leaves)\n", r.output.c_str(), r.what.c_str(), tree.leaf_count());
+    }
   } else if (r.what == "samples" || r.what == "param-samples") {
     SampleBatch all;
-    while (true) {
-      auto n = job->cursor->Next(1 << 16, &all);
-      if (!n.ok()) return Fail(n.status());
-      if (*n == 0) break;
-    }
+    Progress progress(true);
+    std::string provenance;
+    status = StreamSamples(
+        *request, conn, /*batch_size=*/0, v1::PRECISION_FLOAT64, Verbosity{true, false}, &progress,
+        [&](std::optional<uint64_t>, const SampleBatch& batch) {
+          all.Append(batch);
+          return absl::OkStatus();
+        },
+        &provenance);
+    if (!status.ok()) return Fail(status);
     status = r.what == "samples" ? RenderSamples(all, view, r.output)
                                  : RenderParameterSamples(all, view, r.output);
+    if (status.ok()) {
+      std::fprintf(stderr, "wrote %s (%s, %zu samples %s)\n", r.output.c_str(), r.what.c_str(), all.size(),
+                   provenance.c_str());
+    }
   } else {
     return Fail(absl::InvalidArgumentError("--what must be samples, curve, param-samples or param-curve"));
   }
   if (!status.ok()) return Fail(status);
-  std::fprintf(stderr, "wrote %s (%s, %zu leaves)\n", r.output.c_str(), r.what.c_str(),
-               job->tree.lookup.tree->leaf_count());
   return 0;
 }
 
@@ -387,22 +480,28 @@ int main(int argc, char** argv) {
                     "PEM client certificate for servers that require mutual TLS (implies --tls)");
     cmd->add_option("--tls-key", conn.tls_key, "PEM private key of --tls-cert");
   };
-  std::string format = "csv", output = "-";
-  bool ascii = false, quiet = false;
-  size_t batch_size = 0;
+  sfc::OutputFlags out;
+  sfc::Verbosity verbosity;
 
   CLI::App* sample = app.add_subcommand("sample", "sample a surface (in-process, or over the wire with --server)");
   sfc::AddTreeFlags(sample, &flags);
   sfc::AddSampleFlags(sample, &flags);
-  sample->add_option("--format", format, "csv | ply")->capture_default_str();
-  sample->add_flag("--ascii", ascii, "write ASCII PLY instead of binary little-endian");
-  sample->add_option("--output,-o", output, "output file, - for stdout")->capture_default_str();
-  sample->add_option("--batch-size", batch_size,
+  sample->add_option("--format", out.format, "csv | ply | npy (numpy.load gives a structured array)")
+      ->capture_default_str();
+  sample->add_flag("--ascii", out.ascii, "write ASCII PLY instead of binary little-endian");
+  sample->add_option("--output,-o", out.output, "output file, - for stdout")->capture_default_str();
+  sample->add_option("--batch-size", out.batch_size,
                      "samples per batch; 0 = 65536 in-process, or as many as fit the server's "
                      "max_message_bytes (a larger value is refused with the largest that fits)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1 << 24));
-  sample->add_flag("--quiet,-q", quiet, "no summary on stderr");
+  sample->add_option("--precision", out.precision,
+                     "float64 | float32: width of the float columns (float32 halves the file and the "
+                     "wire; values are the float64 ones rounded)")
+      ->capture_default_str();
+  sample->add_flag("--quiet,-q", verbosity.quiet,
+                   "no summary and no progress on stderr (depth-cap warnings still show)");
+  sample->add_flag("--no-warnings", verbosity.no_warnings, "do not print the depth-cap warnings");
   add_connection(sample);
 
   CLI::App* prepare = app.add_subcommand("prepare", "build (warm) a curve tree and print its key and statistics");
@@ -428,6 +527,7 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   eval->add_option("--out-dir", eval_flags.out_dir, "where the CSV, the slope tables and the plots go")->capture_default_str();
   eval->add_option("--seed", eval_flags.seed, "seed of the random and jittered sets")->capture_default_str();
+  add_connection(eval);
 
   sfc::RenderFlags render_flags;
   CLI::App* render = app.add_subcommand("render", "draw samples or the adaptive curve as a PNG");
@@ -438,13 +538,14 @@ int main(int argc, char** argv) {
   render->add_option("--size", render_flags.size, "picture width and height in pixels")->capture_default_str();
   render->add_option("--title", render_flags.title, "caption");
   render->add_option("--output,-o", render_flags.output, "PNG file")->capture_default_str();
+  add_connection(render);
 
   CLI11_PARSE(app, argc, argv);
-  if (sample->parsed()) return sfc::RunSample(flags, format, ascii, output, batch_size, quiet, conn);
+  if (sample->parsed()) return sfc::RunSample(flags, out, verbosity, conn);
   if (prepare->parsed()) return sfc::RunPrepare(flags, conn);
   if (cache->parsed()) return sfc::RunCache(conn);
   if (health->parsed()) return sfc::RunHealth(conn);
-  if (eval->parsed()) return sfc::RunEval(eval_flags);
-  if (render->parsed()) return sfc::RunRender(flags, render_flags);
+  if (eval->parsed()) return sfc::RunEval(eval_flags, conn);
+  if (render->parsed()) return sfc::RunRender(flags, render_flags, conn);
   return sfc::RunSurfaces();
 }

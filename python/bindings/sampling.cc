@@ -1,0 +1,229 @@
+// sfcsampler._core.Engine and Job: the embedded sampler. An Engine is the
+// CLI's SamplingEngine (engine/sampling_engine.h) over an in-process tree
+// source; a Job is one request's cursor, filling NumPy arrays batch by batch.
+// The C++ work (tree build, sample generation, float32 narrowing) runs with
+// the GIL released, and the filled vectors become the arrays' buffers
+// without a copy (python/bindings/arrays.h).
+//
+// Thread-safety: an Engine may be used from several Python threads at once
+// (its tree source is locked); a Job serialises calls to next().
+#include <algorithm>
+#include <array>
+#include <mutex>
+#include <thread>
+
+#include "core/curve.h"
+#include "engine/sampling_engine.h"
+#include "python/bindings/arrays.h"
+#include "python/bindings/errors.h"
+#include "python/bindings/recent_tree_source.h"
+#include "python/bindings/register.h"
+#include "python/bindings/request.h"
+
+namespace py = pybind11;
+
+namespace sfc::python {
+
+namespace {
+
+// The tree summary with the same names as the wire's TreeInfo message.
+py::dict TreeInfoDict(const PreparedTree& t) {
+  const CurveTree& tree = *t.lookup.tree;
+  py::dict d;
+  d["key"] = t.key.Hex();
+  d["key_with_grade"] = t.key.HexWithGrade(t.grade);
+  d["canonical"] = t.key.canonical;
+  d["grade"] = t.grade;
+  d["cache_hit"] = t.lookup.cache_hit;
+  d["refined"] = t.lookup.refined;
+  d["leaves"] = static_cast<uint64_t>(tree.leaf_count());
+  d["bytes"] = static_cast<uint64_t>(tree.bytes());
+  d["min_depth"] = tree.min_depth();
+  d["max_depth"] = tree.max_depth();
+  d["tolerance"] = tree.options().tolerance;
+  d["flatness_capped_leaves"] = tree.precision().geometry_capped_leaves;
+  d["mass_capped_leaves"] = tree.precision().mass_capped_leaves;
+  py::list warnings;
+  for (const DepthCapHit& h : tree.precision().worst) {
+    py::dict w;
+    w["test"] = h.test == DepthCapHit::Test::kGeometry ? "flatness" : "mass";
+    w["u0"] = h.u0, w["v0"] = h.v0, w["size"] = h.size;
+    w["measured"] = h.measured, w["limit"] = h.limit;
+    warnings.append(w);
+  }
+  d["warnings"] = warnings;
+  return d;
+}
+
+std::vector<float> Narrow(const std::vector<double>& column) {
+  std::vector<float> out(column.size());
+  std::transform(column.begin(), column.end(), out.begin(),
+                 [](double d) { return static_cast<float>(d); });
+  return out;
+}
+
+class PyJob {
+ public:
+  PyJob(SamplingJob job, const SampleRequest& request, bool float32)
+      : job_(std::move(job)),
+        fields_(request.fields),
+        float32_(float32),
+        seed_(request.seed),
+        region_(request.region.kind != Region::Kind::kAll) {}
+
+  // Up to `max_samples` more samples as a dict of columns, or None once the
+  // job is exhausted.
+  py::object Next(uint64_t max_samples) {
+    if (max_samples == 0) {
+      throw StatusException(absl::InvalidArgumentError("max_samples must be >= 1"));
+    }
+    SampleBatch batch;
+    std::vector<float> narrowed[10];
+    {
+      py::gil_scoped_release release;
+      std::lock_guard<std::mutex> lock(mu_);
+      // Reserve what a plain range will produce, so filling never reallocates.
+      const uint64_t left = job_.end - job_.begin - std::min(job_.end - job_.begin, produced_);
+      const size_t reserve =
+          static_cast<size_t>(std::min(max_samples, region_ ? uint64_t{1} << 16 : left));
+      batch.index.reserve(reserve);
+      for (auto* c : Columns(&batch)) c->reserve(reserve);
+      uint64_t got = 0;
+      while (got < max_samples) {
+        // A region may drop samples, so ask for what is still wanted.
+        auto n = job_.cursor->Next(static_cast<size_t>(max_samples - got), &batch);
+        ThrowIfError(n.status());
+        if (*n == 0) break;
+        got += *n;
+      }
+      produced_ += got;
+      if (float32_) {
+        auto columns = Columns(&batch);
+        for (size_t i = 0; i < columns.size(); ++i) {
+          narrowed[i] = Narrow(*columns[i]);
+          std::vector<double>().swap(*columns[i]);
+        }
+      }
+    }
+    if (batch.size() == 0) return py::none();
+    py::dict out;
+    static const char* const kNames[] = {"u",  "v",  "x",  "y",       "z",
+                                         "nx", "ny", "nz", "density", "curve_position"};
+    out["index"] = ToNumpy(std::move(batch.index));
+    auto columns = Columns(&batch);
+    for (size_t i = 0; i < columns.size(); ++i) {
+      if (float32_) {
+        if (!narrowed[i].empty()) out[kNames[i]] = ToNumpy(std::move(narrowed[i]));
+      } else if (!columns[i]->empty()) {
+        out[kNames[i]] = ToNumpy(std::move(*columns[i]));
+      }
+    }
+    return out;
+  }
+
+  py::dict Tree() const { return TreeInfoDict(job_.tree); }
+  uint64_t begin() const { return job_.begin; }
+  uint64_t end() const { return job_.end; }
+  py::object Expected() const {
+    if (region_) return py::none();
+    return py::int_(job_.end - job_.begin);
+  }
+  uint64_t seed() const { return seed_; }
+
+ private:
+  static std::array<std::vector<double>*, 10> Columns(SampleBatch* b) {
+    return {&b->u,  &b->v,  &b->x,  &b->y,       &b->z,
+            &b->nx, &b->ny, &b->nz, &b->density, &b->curve_position};
+  }
+
+  std::mutex mu_;
+  SamplingJob job_;
+  const SampleFields fields_;
+  const bool float32_;
+  const uint64_t seed_;
+  const bool region_;
+  uint64_t produced_ = 0;
+};
+
+class PyEngine {
+ public:
+  PyEngine(size_t max_trees, int threads)
+      : source_(max_trees), engine_(Limits(threads), &source_) {}
+
+  std::unique_ptr<PyJob> Start(const PyRequest& r, const std::string& precision) {
+    if (precision != "float64" && precision != "float32") {
+      throw StatusException(absl::InvalidArgumentError("precision must be float64 or float32"));
+    }
+    absl::StatusOr<SamplingJob> job;
+    {
+      py::gil_scoped_release release;
+      job = engine_.Start(r.request);
+    }
+    ThrowIfError(job.status());
+    return std::make_unique<PyJob>(*std::move(job), r.request, precision == "float32");
+  }
+
+  py::dict Prepare(const PyRequest& r) {
+    absl::StatusOr<PreparedTree> tree;
+    {
+      py::gil_scoped_release release;
+      const SampleRequest& q = r.request;
+      tree = engine_.Prepare(q.tree, q.tree_count ? q.tree_count : q.count);
+    }
+    ThrowIfError(tree.status());
+    return TreeInfoDict(*tree);
+  }
+
+ private:
+  // The CLI's embedded limits (client/cli/sfcsampler_main.cc): the server's
+  // defaults, with up to four generation threads.
+  static EngineLimits Limits(int threads) {
+    EngineLimits limits;
+    limits.generation_threads =
+        threads > 0
+            ? threads
+            : static_cast<int>(std::max(1u, std::min(4u, std::thread::hardware_concurrency())));
+    return limits;
+  }
+
+  RecentTreeSource source_;
+  SamplingEngine engine_;
+};
+
+}  // namespace
+
+void RegisterSampling(py::module_& m) {
+  m.attr("ALGORITHM_VERSION") = kAlgorithmVersion;
+
+  py::class_<PyJob>(m, "Job", "One request's samples, in curve order; made by Engine.start().")
+      .def("next", &PyJob::Next, py::arg("max_samples"),
+           "Up to max_samples more samples as a dict of NumPy arrays (index: uint64; u, v, x, y, "
+           "z and the requested optional columns: float64, or float32 when asked), or None once "
+           "the set is exhausted. The GIL is released while the arrays are filled.")
+      .def_property_readonly("tree", &PyJob::Tree,
+                             "the curve tree's summary (the wire's TreeInfo fields)")
+      .def_property_readonly("begin", &PyJob::begin, "first index of the resolved range")
+      .def_property_readonly("end", &PyJob::end, "one past the last index of the resolved range")
+      .def_property_readonly("expected_samples", &PyJob::Expected,
+                             "how many samples the job yields; None for a region request")
+      .def_property_readonly("seed", &PyJob::seed);
+
+  py::class_<PyEngine>(m, "Engine", R"doc(
+The embedded sampler: the same engine as `sfcsampler sample` without --server.
+
+max_trees: keep the curve trees of the last this many (surface, density,
+  options, grade) combinations, so repeated requests skip the build (0 = build
+  every time, as the CLI does).
+threads: threads filling one request's samples (0 = as the CLI: up to 4). The
+  samples do not depend on it.)doc")
+      .def(py::init<size_t, int>(), py::kw_only(), py::arg("max_trees") = 0, py::arg("threads") = 0)
+      .def("start", &PyEngine::Start, py::arg("request"), py::kw_only(),
+           py::arg("precision") = "float64",
+           "Validates the request, builds (or reuses) its tree and opens its job. Raises "
+           "sfcsampler.InvalidArgumentError or ResourceExhaustedError with the engine's message.")
+      .def("prepare", &PyEngine::Prepare, py::arg("request"),
+           "Builds (or reuses) the request's tree, sized for tree_count (or count), and returns "
+           "its summary.");
+}
+
+}  // namespace sfc::python

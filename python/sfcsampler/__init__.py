@@ -1,0 +1,33 @@
+"""sfcsampler: density-controlled, low-discrepancy samples on parametric surfaces.
+
+The method of Quinn, Langbein, Martin and Elber (GMP 2006): a jittered 1D
+sequence placed along an adaptive space-filling curve. Two ways in, one
+result:
+
+    import sfcsampler
+    s = sfcsampler.sample(surface="torus", density="gaussian:floor=0.05", count=10**6)
+    s.x, s.y, s.z, s.u, s.v, s.index          # NumPy arrays, in curve order
+
+    with sfcsampler.Client("127.0.0.1:50051") as c:
+        t = c.sample(surface="torus", density="gaussian:floor=0.05", count=10**6)
+    # the same values as s
+
+The keywords are `sfcsampler sample`'s flags; the same request gives the same
+numbers as the CLI, embedded or from a server. Errors are sfcsampler.Error
+subclasses carrying the status code and message.
+"""
+
+from sfcsampler._core import ALGORITHM_VERSION, densities, surfaces
+from sfcsampler.client import Client
+from sfcsampler.embedded import Sampler, batches, prepare, sample
+from sfcsampler.errors import (DataLossError, DeadlineExceededError, DepthCapWarning, Error,
+                               InvalidArgumentError, ResourceExhaustedError, UnauthenticatedError,
+                               UnavailableError)
+from sfcsampler.samples import Samples
+
+__all__ = [
+    "ALGORITHM_VERSION", "Client", "DataLossError", "DeadlineExceededError", "DepthCapWarning",
+    "Error", "InvalidArgumentError", "ResourceExhaustedError", "Samples", "Sampler",
+    "UnauthenticatedError", "UnavailableError", "batches", "densities", "prepare", "sample",
+    "surfaces",
+]

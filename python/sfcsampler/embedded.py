@@ -1,0 +1,97 @@
+"""The embedded sampler: the CLI's engine in this process, through pybind11."""
+
+import numpy as np
+
+from sfcsampler import _core
+from sfcsampler._request import make_request
+from sfcsampler.samples import Samples, warn_depth_cap
+
+_ALL = 1 << 62  # "every remaining sample"
+
+
+def _dtype(precision):
+    return np.float32 if precision == "float32" else np.float64
+
+
+class Sampler:
+    """An embedded sampler that keeps recent curve trees.
+
+    Sampler(max_trees=4, threads=0): `max_trees` trees (by surface, density,
+    options and grade) stay built between calls, so a second request on the
+    same surface and count skips the build; `threads` fill one request (0 =
+    as the CLI: up to 4; the samples never depend on it). Thread-safe.
+
+    The request keywords are `sfcsampler sample`'s flags (see sample()).
+    """
+
+    def __init__(self, max_trees=4, threads=0):
+        self._engine = _core.Engine(max_trees=max_trees, threads=threads)
+
+    def _start(self, precision, request):
+        job = self._engine.start(make_request(request), precision=precision)
+        warn_depth_cap(job.tree, stacklevel=4)
+        return job
+
+    def sample(self, *, precision="float64", **request):
+        """All the requested samples as one Samples (no copy of the filled buffers)."""
+        job = self._start(precision, request)
+        columns = job.next(_ALL) or {}
+        return Samples(columns, job.tree, job.begin, job.end, job.seed, _core.ALGORITHM_VERSION,
+                       _dtype(precision))
+
+    def batches(self, *, batch_size=65536, precision="float64", **request):
+        """Yields the requested samples as Samples of at most batch_size each, in curve order."""
+        job = self._start(precision, request)
+        while True:
+            columns = job.next(batch_size)
+            if columns is None:
+                return
+            yield Samples(columns, job.tree, job.begin, job.end, job.seed, _core.ALGORITHM_VERSION,
+                          _dtype(precision))
+
+    def prepare(self, **request):
+        """Builds (or finds) the request's tree, sized for tree_count or count; returns its summary."""
+        tree = self._engine.prepare(make_request(request))
+        warn_depth_cap(tree, stacklevel=3)
+        return tree
+
+
+def sample(*, precision="float64", threads=0, **request):
+    """Samples a surface in this process and returns NumPy arrays.
+
+    The keywords are `sfcsampler sample`'s flags without the dashes ('-' as
+    '_') and with the same defaults, and the same request gives the same
+    numbers as the CLI, the server and Client.sample():
+
+      surface="sphere", density="uniform"   catalogue specs ("torus:R=2;r=0.5",
+                                            "gaussian:floor=0.05", "expr:u+v")
+      count=10000, seed=1                   N, the size of the whole set
+      curve="hilbert"                       hilbert | hilbert2 | peano
+      sequence="jittered"                   jittered | equal | random |
+                                            vandercorput | progressive
+      estimator="fff", tolerance=0, depth_cap=0, rho=1.0, tree_count=0
+      begin=0, end=0                        the index range [begin, end) (0 = count)
+      shard=None                            "i/K" or (i, K)
+      region=""                             "uv:U0,U1,V0,V1" or "box:X0,Y0,Z0,X1,Y1,Z1"
+      normals=False, density_column=False, curve_position=False
+      precision="float64"                   or "float32" (half the memory)
+      threads=0                             threads filling the arrays (0 = up to 4)
+
+    Returns a sfcsampler.Samples (columns index, u, v, x, y, z, ...). Raises
+    sfcsampler.InvalidArgumentError (a ValueError) for bad input and warns
+    (DepthCapWarning) when the depth cap limited the tree. The GIL is released
+    while the tree is built and the arrays are filled. Builds the tree every
+    call; use a Sampler to keep it.
+    """
+    return Sampler(max_trees=0, threads=threads).sample(precision=precision, **request)
+
+
+def batches(*, batch_size=65536, precision="float64", threads=0, **request):
+    """Like sample(), but yields Samples of at most batch_size samples each."""
+    return Sampler(max_trees=0, threads=threads).batches(batch_size=batch_size, precision=precision,
+                                                          **request)
+
+
+def prepare(**request):
+    """The summary (dict) of the curve tree a request would use, after building it."""
+    return Sampler(max_trees=0).prepare(**request)

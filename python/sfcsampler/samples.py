@@ -1,0 +1,93 @@
+"""Samples: one request's points as NumPy columns (structure of arrays)."""
+
+import warnings
+
+import numpy as np
+
+from sfcsampler.errors import DepthCapWarning
+
+COLUMNS = ("index", "u", "v", "x", "y", "z", "nx", "ny", "nz", "density", "curve_position")
+
+
+class Samples:
+    """Samples in curve order, as NumPy arrays.
+
+    index (uint64): each sample's index k in the set; u, v: unit-square
+    parameters; x, y, z: the surface point; nx, ny, nz, density,
+    curve_position when asked for, else None. Float columns are float64, or
+    float32 with precision="float32". `tree` is the curve tree's summary
+    (the wire's TreeInfo fields as a dict); `begin`, `end` the resolved index
+    range; `seed` and `algorithm_version` identify the set.
+    """
+
+    def __init__(self, columns, tree, begin, end, seed, algorithm_version, dtype=np.float64):
+        for name in COLUMNS:
+            value = columns.get(name)
+            if value is None and name in ("index", "u", "v", "x", "y", "z"):
+                value = np.empty(0, dtype=np.uint64 if name == "index" else dtype)
+            setattr(self, name, value)
+        self.tree = tree
+        self.begin = begin
+        self.end = end
+        self.seed = seed
+        self.algorithm_version = algorithm_version
+
+    def __len__(self):
+        return len(self.index)
+
+    def __repr__(self):
+        present = [c for c in COLUMNS if getattr(self, c) is not None]
+        return (f"Samples({len(self)} samples, indices [{self.begin}, {self.end}), "
+                f"tree {self.tree.get('key_with_grade')}, columns {', '.join(present)})")
+
+    @property
+    def points(self):
+        """An (N, 3) array of x, y, z (a copy: the columns are stored separately)."""
+        return np.column_stack((self.x, self.y, self.z))
+
+    @property
+    def normals(self):
+        """An (N, 3) array of nx, ny, nz (a copy), or None without normals=True."""
+        if self.nx is None:
+            return None
+        return np.column_stack((self.nx, self.ny, self.nz))
+
+    @property
+    def uv(self):
+        """An (N, 2) array of u, v (a copy)."""
+        return np.column_stack((self.u, self.v))
+
+    def columns(self):
+        """The present columns as a dict name -> array, in output order."""
+        return {c: getattr(self, c) for c in COLUMNS if getattr(self, c) is not None}
+
+
+def concatenate(parts, tree, begin, end, seed, algorithm_version, dtype):
+    """One Samples from batches of column dicts (copies each column once)."""
+    parts = [p for p in parts if p]
+    if len(parts) == 1:
+        columns = parts[0]
+    else:
+        columns = {}
+        for name in COLUMNS:
+            pieces = [p[name] for p in parts if name in p]
+            if pieces:
+                columns[name] = np.concatenate(pieces)
+    return Samples(columns, tree, begin, end, seed, algorithm_version, dtype)
+
+
+def warn_depth_cap(tree, stacklevel=3):
+    """Warns (DepthCapWarning) when the depth cap stopped splits; the CLI prints the same."""
+    flat = tree.get("flatness_capped_leaves", 0)
+    mass = tree.get("mass_capped_leaves", 0)
+    if flat or mass:
+        worst = tree.get("warnings") or []
+        where = ""
+        if worst:
+            w = worst[0]
+            where = (f"; worst: {w['test']} test at u in [{w['u0']:.9g}, {w['u0'] + w['size']:.9g}],"
+                     f" v in [{w['v0']:.9g}, {w['v0'] + w['size']:.9g}]:"
+                     f" {w['measured']:.6g} vs limit {w['limit']:.6g}")
+        warnings.warn(DepthCapWarning(
+            f"the depth cap stopped splits the tests still wanted (paper Sect. 5.3): {flat} leaves"
+            f" for flatness, {mass} for mass{where}"), stacklevel=stacklevel)

@@ -1,0 +1,166 @@
+"""sfcsampler.Client against a real loopback sfcsampler-server: the same
+numbers as the embedded path and the CLI, resumes, and errors that carry the
+server's status code and message."""
+
+import os
+import subprocess
+import tempfile
+
+import numpy as np
+import pytest
+
+import sfcsampler
+from conftest import CLI, assert_same, cli_columns, launch_server, run_cli, stop
+from test_embedded import CASES
+
+
+@pytest.mark.parametrize("kwargs,flags", CASES)
+def test_same_numbers_as_cli_and_embedded(server, kwargs, flags):
+    with sfcsampler.Client(server) as client:
+        remote = client.sample(**kwargs)
+    assert_same(remote, cli_columns(*flags, "--server", server))
+    embedded = sfcsampler.sample(**kwargs)
+    for name, column in embedded.columns().items():
+        assert np.array_equal(getattr(remote, name), column), name
+    assert remote.tree["key"] == embedded.tree["key"]
+
+
+def test_float32_and_batches(server):
+    with sfcsampler.Client(server, batch_size=4096) as client:
+        parts = list(client.batches(surface="torus", count=10000, precision="float32"))
+        assert [len(p) for p in parts] == [4096, 4096, 1808]
+        x = np.concatenate([p.x for p in parts])
+    assert x.dtype == np.float32
+    assert np.array_equal(x, sfcsampler.sample(surface="torus", count=10000, precision="float32").x)
+    assert parts[0].x.flags.writeable  # a copy, not a view of the message
+
+
+def test_empty_region(server):
+    with sfcsampler.Client(server) as client:
+        s = client.sample(surface="sphere", count=1000, region="box:5,5,5,6,6,6")
+    assert len(s) == 0 and s.x.dtype == np.float64
+    assert s.tree["key"] == sfcsampler.sample(surface="sphere", count=1000).tree["key"]
+
+
+def test_server_errors_carry_code_and_message(server):
+    with sfcsampler.Client(server) as client:
+        with pytest.raises(sfcsampler.InvalidArgumentError) as info:
+            client.sample(surface="expr:x=u;y=v;z=", count=10)
+        assert info.value.code == "INVALID_ARGUMENT" and "received 0 samples" in info.value.message
+        with pytest.raises(sfcsampler.InvalidArgumentError) as info:
+            client.sample(count=10**9)
+        assert "max_count" in info.value.message
+        # Caught before the wire, by the same parser as the CLI's.
+        with pytest.raises(sfcsampler.InvalidArgumentError):
+            client.sample(sequence="sobol")
+
+
+def test_prepare_then_sample_hits_the_cache(server):
+    with sfcsampler.Client(server) as client:
+        tree = client.prepare(surface="monkey_saddle", count=30000)
+        s = client.sample(surface="monkey_saddle", count=30000)
+        assert s.tree["cache_hit"] and s.tree["key"] == tree["key"]
+        assert client.cache_stats()["hits"] >= 1
+        assert "sphere" in {e["name"] for e in client.catalog()["surfaces"]}
+
+
+def test_health(server):
+    with sfcsampler.Client(server) as client:
+        assert client.health() is True
+        with pytest.raises(sfcsampler.Error) as info:
+            client.health(service="no.such.Service")
+        assert info.value.code == "NOT_FOUND"
+
+
+def test_unreachable_server_is_unavailable():
+    with sfcsampler.Client("127.0.0.1:1", max_resumes=1, resume_backoff=0.01, timeout=5) as client:
+        with pytest.raises(sfcsampler.UnavailableError) as info:
+            client.sample(count=10)
+    assert info.value.code == "UNAVAILABLE"
+
+
+@pytest.mark.parametrize("sequence", ["jittered", "random"])
+def test_resumes_after_the_server_restarts(sequence):
+    # Kill the server mid-stream and start a new one on the same port: the
+    # client resumes (monotone sets from the next index, others by skipping)
+    # and the result equals the uninterrupted set.
+    request = dict(surface="sphere", count=400000, sequence=sequence)
+    expected = sfcsampler.sample(**request)
+    with tempfile.TemporaryDirectory() as tmp:
+        first, port = launch_server(os.path.join(tmp, "a.log"), "--shutdown-grace", "0")
+        second = None
+        try:
+            client = sfcsampler.Client(f"127.0.0.1:{port}", batch_size=1000, resume_backoff=0.5)
+            parts = []
+            for i, part in enumerate(client.batches(**request)):
+                parts.append(part)
+                if i == 5:
+                    first.kill()
+                    first.wait()
+                    second, _ = launch_server(os.path.join(tmp, "b.log"), "--shutdown-grace", "0", port=port)
+            assert client.resumes >= 1
+            got = np.concatenate([p.x for p in parts])
+            index = np.concatenate([p.index for p in parts])
+            client.close()
+        finally:
+            stop(first)
+            stop(second)
+    assert second is not None
+    assert np.array_equal(index, expected.index)
+    assert np.array_equal(got, expected.x)
+
+
+def test_cli_over_the_wire_float32_npy_is_the_embedded_file(server, tmp_path):
+    args = ["sample", "--surface", "torus", "--density", "mean:floor=0.1", "--count", "30000", "--format",
+            "npy", "--precision", "float32", "-q", "-o"]
+    run_cli(*args, str(tmp_path / "embedded.npy"))
+    run_cli(*args, str(tmp_path / "wire.npy"), "--server", server)
+    assert (tmp_path / "embedded.npy").read_bytes() == (tmp_path / "wire.npy").read_bytes()
+
+
+def test_cli_render_over_the_wire(server, tmp_path):
+    run_cli("render", "--surface", "torus", "--count", "2000", "--size", "200", "-o", str(tmp_path / "t.png"),
+            "--server", server)
+    assert (tmp_path / "t.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    failed = subprocess.run([CLI, "render", "--what", "curve", "--server", server, "-o",
+                             str(tmp_path / "c.png")], capture_output=True, text=True)
+    assert failed.returncode != 0 and "FAILED_PRECONDITION" in failed.stderr
+
+
+def test_cli_eval_over_the_wire_gives_the_same_discrepancies(server, tmp_path):
+    # Our point sets come from the server, the rest is computed locally: the
+    # same trees give the same sets, so every discrepancy is the same.
+    def csv_without_timing(out_dir):
+        lines = (out_dir / "discrepancy.csv").read_text().splitlines()
+        return [line.rsplit(",", 1)[0] for line in lines]
+
+    local = run_cli("eval", "--l-max", "6", "--out-dir", str(tmp_path / "local"))
+    wire = run_cli("eval", "--l-max", "6", "--out-dir", str(tmp_path / "wire"), "--server", server)
+    assert local == wire and b"hilbert-jittered" in local
+    assert csv_without_timing(tmp_path / "local") == csv_without_timing(tmp_path / "wire")
+
+
+def test_tls_and_token(tmp_path):
+    cert, key = tmp_path / "cert.pem", tmp_path / "key.pem"
+    subprocess.run(["openssl", "req", "-x509", "-newkey", "rsa:2048", "-nodes", "-days", "1", "-subj",
+                    "/CN=localhost", "-addext", "subjectAltName=IP:127.0.0.1,DNS:localhost",
+                    "-keyout", str(key), "-out", str(cert)], capture_output=True, check=True)
+    (tmp_path / "token").write_text("s3cret-token\n")
+    proc, port = launch_server(tmp_path / "tls.log", "--tls-cert", str(cert), "--tls-key", str(key),
+                               "--token-file", str(tmp_path / "token"))
+    try:
+        target = f"127.0.0.1:{port}"
+        with sfcsampler.Client(target, token="s3cret-token", tls_roots=str(cert)) as client:
+            s = client.sample(surface="torus", count=1000)
+        assert np.array_equal(s.x, sfcsampler.sample(surface="torus", count=1000).x)
+        with sfcsampler.Client(target, tls_roots=str(cert)) as client:
+            with pytest.raises(sfcsampler.UnauthenticatedError) as info:
+                client.sample(count=10)
+            assert info.value.code == "UNAUTHENTICATED"
+        with sfcsampler.Client(target, token="s3cret-token", max_resumes=0, timeout=5) as client:
+            with pytest.raises(sfcsampler.Error):  # plaintext against TLS
+                client.sample(count=10)
+        with pytest.raises(sfcsampler.InvalidArgumentError, match="cannot read TLS roots"):
+            sfcsampler.Client(target, tls_roots=str(tmp_path / "missing.pem"))
+    finally:
+        stop(proc)
