@@ -119,8 +119,14 @@ SampleRequest SamplerClient::Shard(SampleRequest request, uint64_t i, uint64_t k
   return request;
 }
 
-absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& request,
+absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
                                                     const BatchCallback& on_batch) {
+  // A model file travels once: the server gets its bytes if it lacks them,
+  // and the request names them by hash.
+  SampleRequest request = asked;
+  auto surface = EnsureModel(asked.tree.surface);
+  if (!surface.ok()) return surface.status();
+  request.tree.surface = *std::move(surface);
   const std::string key = SurfaceKey(request.tree);
   const bool monotone = Sequence(request.sequence, 1, 0).monotone();
   StreamSummary summary;
@@ -227,7 +233,11 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& request
   }
 }
 
-absl::StatusOr<v1::PrepareResponse> SamplerClient::Prepare(const TreeSpec& spec, uint64_t count) {
+absl::StatusOr<v1::PrepareResponse> SamplerClient::Prepare(const TreeSpec& asked, uint64_t count) {
+  TreeSpec spec = asked;
+  auto surface = EnsureModel(asked.surface);
+  if (!surface.ok()) return surface.status();
+  spec.surface = *std::move(surface);
   v1::PrepareRequest request;
   *request.mutable_tree() = ToProto(spec);
   request.set_count(count);

@@ -53,6 +53,8 @@ class SamplerClient {
   using BatchCallback =
       std::function<absl::Status(const ::sfcsampler::v1::StreamHeader&, const SampleBatch&)>;
   // Streams `request`; a callback error cancels the stream and is returned.
+  // A surface naming a model file ("step:part.step") is uploaded first if the
+  // server lacks it (EnsureModel) and named by its hash.
   absl::StatusOr<StreamSummary> Sample(const SampleRequest& request, const BatchCallback& on_batch);
 
   absl::StatusOr<::sfcsampler::v1::PrepareResponse> Prepare(const TreeSpec& spec, uint64_t count);

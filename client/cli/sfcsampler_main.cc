@@ -20,6 +20,7 @@
 #include "core/curve.h"
 #include "core/sequence.h"
 #include "core/status_macros.h"
+#include "engine/model_source.h"
 #include "engine/sampling_engine.h"
 #include "evaluation/plot.h"
 #include "evaluation/protocol.h"
@@ -295,6 +296,26 @@ int RunHealth(const Connection& conn) {
   return *serving ? 0 : 1;
 }
 
+// Uploads model files the server lacks and prints their wire specs, one a line.
+int RunUpload(const std::vector<std::string>& specs, const Connection& conn) {
+  if (conn.server.empty()) return Fail(absl::FailedPreconditionError("upload needs --server HOST:PORT"));
+  auto client = Connect(conn, 0);
+  if (!client.ok()) return Fail(client.status());
+  for (const std::string& spec : specs) {
+    auto parsed = ParseModelSpec(spec);
+    if (!parsed.ok()) return Fail(parsed.status());
+    if (!parsed->has_value()) {
+      return Fail(absl::InvalidArgumentError(absl::StrFormat(
+          "\"%s\" names no model file; write FORMAT:FILE with FORMAT step, iges, nurbs, obj or ply",
+          spec)));
+    }
+    auto wire = (*client)->EnsureModel(spec);
+    if (!wire.ok()) return Fail(wire.status());
+    std::printf("%s\n", wire->c_str());
+  }
+  return 0;
+}
+
 struct EvalFlags {
   std::string setting = "fast";
   int l_min = 0, l_max = 0;
@@ -512,6 +533,12 @@ int main(int argc, char** argv) {
   add_connection(cache);
   CLI::App* health = app.add_subcommand("health", "check the server's grpc.health.v1 status");
   add_connection(health);
+  std::vector<std::string> upload_specs;
+  CLI::App* upload = app.add_subcommand(
+      "upload", "send model files to the server once (only if it lacks them) and print FORMAT:sha256=HASH "
+                "specs that any job can name; sample and prepare with --server do this by themselves");
+  upload->add_option("models", upload_specs, "FORMAT:FILE, FORMAT one of step iges nurbs obj ply")->required();
+  add_connection(upload);
 
   app.add_subcommand("surfaces", "list the surfaces, densities, curves and sequences with their formulas");
 
@@ -545,6 +572,7 @@ int main(int argc, char** argv) {
   if (prepare->parsed()) return sfc::RunPrepare(flags, conn);
   if (cache->parsed()) return sfc::RunCache(conn);
   if (health->parsed()) return sfc::RunHealth(conn);
+  if (upload->parsed()) return sfc::RunUpload(upload_specs, conn);
   if (eval->parsed()) return sfc::RunEval(eval_flags, conn);
   if (render->parsed()) return sfc::RunRender(flags, render_flags, conn);
   return sfc::RunSurfaces();
