@@ -109,7 +109,8 @@ class ExpressionSurface final : public Surface {
 
   Vec3 Point(double u, double v) const override {
     const double uv[2] = {u0_ + u * du_, v0_ + v * dv_};
-    return {x_->Evaluate(uv), y_->Evaluate(uv), z_->Evaluate(uv)};
+    TrigCache trig;
+    return {x_->Evaluate(uv, &trig), y_->Evaluate(uv, &trig), z_->Evaluate(uv, &trig)};
   }
 
   SurfaceJet Jet(double u, double v, int order) const override {
@@ -130,7 +131,8 @@ class ExpressionSurface final : public Surface {
   template <typename D>
   SurfaceJet JetOf(double u, double v) const {
     const D uv[2] = {D::Affine(u0_ + u * du_, du_, 0), D::Affine(v0_ + v * dv_, 0, dv_)};
-    const D x = x_->Evaluate(uv), y = y_->Evaluate(uv), z = z_->Evaluate(uv);
+    TrigCache trig;
+    const D x = x_->Evaluate(uv, &trig), y = y_->Evaluate(uv, &trig), z = z_->Evaluate(uv, &trig);
     SurfaceJet jet;
     jet.p = {x.v, y.v, z.v};
     jet.fu = {x.d[0], y.d[0], z.d[0]};

@@ -25,6 +25,9 @@ inline double SignOf(double x) { return x < 0 ? -1 : x > 0 ? 1 : 0; }
 inline double RintOf(double x) { return std::floor(x + 0.5); }
 inline double MinOf(double a, double b) { return b < a ? b : a; }  // std::min
 inline double MaxOf(double a, double b) { return a < b ? b : a; }  // std::max
+// sin and cos of x in one library call. Every path (double, dual, constant
+// folding) takes sin and cos from here, so they agree bit for bit.
+inline void SinCosOf(double x, double* s, double* c) { ::sincos(x, s, c); }
 
 // kOrder 1: value and gradient. kOrder 2: also the Hessian.
 template <int kOrder>
@@ -32,12 +35,12 @@ struct Dual {
   static_assert(kOrder == 1 || kOrder == 2, "orders 1 and 2");
   double v;     // value
   double d[2];  // d/du, d/dv
-  double h[3];  // d2/du2, d2/dudv, d2/dv2 (order 2 only; left unset otherwise)
+  double h[kOrder == 2 ? 3 : 1];  // d2/du2, d2/dudv, d2/dv2 (order 2 only)
 
   static Dual Constant(double c) {
     Dual r;
     r.v = c, r.d[0] = r.d[1] = 0;
-    if (kOrder == 2) r.h[0] = r.h[1] = r.h[2] = 0;
+    if constexpr (kOrder == 2) r.h[0] = r.h[1] = r.h[2] = 0;
     return r;
   }
   // value + du * (u - u_0) + dv * (v - v_0): an affine function of (u, v).
@@ -47,7 +50,10 @@ struct Dual {
     return r;
   }
   bool IsConstant() const {
-    return d[0] == 0 && d[1] == 0 && (kOrder == 1 || (h[0] == 0 && h[1] == 0 && h[2] == 0));
+    if constexpr (kOrder == 2) {
+      if (h[0] != 0 || h[1] != 0 || h[2] != 0) return false;
+    }
+    return d[0] == 0 && d[1] == 0;
   }
 };
 
@@ -60,7 +66,7 @@ Dual<N> Chain(const Dual<N>& a, double f0, double f1, double f2) {
   Dual<N> r;
   r.v = f0;
   r.d[0] = f1 * a.d[0], r.d[1] = f1 * a.d[1];
-  if (N == 2) {
+  if constexpr (N == 2) {
     r.h[0] = f1 * a.h[0] + f2 * a.d[0] * a.d[0];
     r.h[1] = f1 * a.h[1] + f2 * a.d[0] * a.d[1];
     r.h[2] = f1 * a.h[2] + f2 * a.d[1] * a.d[1];
@@ -75,7 +81,7 @@ Dual<N> Chain2(const Dual<N>& a, const Dual<N>& b, double f0, double fa, double 
   Dual<N> r;
   r.v = f0;
   for (int i = 0; i < 2; ++i) r.d[i] = fa * a.d[i] + fb * b.d[i];
-  if (N == 2) {
+  if constexpr (N == 2) {
     const int ii[3] = {0, 0, 1}, jj[3] = {0, 1, 1};
     for (int k = 0; k < 3; ++k) {
       const int i = ii[k], j = jj[k];
@@ -91,7 +97,7 @@ Dual<N> operator+(const Dual<N>& a, const Dual<N>& b) {
   Dual<N> r;
   r.v = a.v + b.v;
   r.d[0] = a.d[0] + b.d[0], r.d[1] = a.d[1] + b.d[1];
-  if (N == 2) r.h[0] = a.h[0] + b.h[0], r.h[1] = a.h[1] + b.h[1], r.h[2] = a.h[2] + b.h[2];
+  if constexpr (N == 2) r.h[0] = a.h[0] + b.h[0], r.h[1] = a.h[1] + b.h[1], r.h[2] = a.h[2] + b.h[2];
   return r;
 }
 
@@ -100,7 +106,7 @@ Dual<N> operator-(const Dual<N>& a) {
   Dual<N> r;
   r.v = -a.v;
   r.d[0] = -a.d[0], r.d[1] = -a.d[1];
-  if (N == 2) r.h[0] = -a.h[0], r.h[1] = -a.h[1], r.h[2] = -a.h[2];
+  if constexpr (N == 2) r.h[0] = -a.h[0], r.h[1] = -a.h[1], r.h[2] = -a.h[2];
   return r;
 }
 
@@ -109,7 +115,7 @@ Dual<N> operator-(const Dual<N>& a, const Dual<N>& b) {
   Dual<N> r;
   r.v = a.v - b.v;
   r.d[0] = a.d[0] - b.d[0], r.d[1] = a.d[1] - b.d[1];
-  if (N == 2) r.h[0] = a.h[0] - b.h[0], r.h[1] = a.h[1] - b.h[1], r.h[2] = a.h[2] - b.h[2];
+  if constexpr (N == 2) r.h[0] = a.h[0] - b.h[0], r.h[1] = a.h[1] - b.h[1], r.h[2] = a.h[2] - b.h[2];
   return r;
 }
 
@@ -119,7 +125,7 @@ Dual<N> operator*(const Dual<N>& a, const Dual<N>& b) {
   r.v = a.v * b.v;
   r.d[0] = a.d[0] * b.v + a.v * b.d[0];
   r.d[1] = a.d[1] * b.v + a.v * b.d[1];
-  if (N == 2) {
+  if constexpr (N == 2) {
     r.h[0] = a.h[0] * b.v + 2 * a.d[0] * b.d[0] + a.v * b.h[0];
     r.h[1] = a.h[1] * b.v + a.d[0] * b.d[1] + a.d[1] * b.d[0] + a.v * b.h[1];
     r.h[2] = a.h[2] * b.v + 2 * a.d[1] * b.d[1] + a.v * b.h[2];
@@ -134,7 +140,7 @@ Dual<N> MulAdd(const Dual<N>& a, double c, double k) {
   Dual<N> r;
   r.v = a.v * c + k;
   r.d[0] = a.d[0] * c, r.d[1] = a.d[1] * c;
-  if (N == 2) r.h[0] = a.h[0] * c, r.h[1] = a.h[1] * c, r.h[2] = a.h[2] * c;
+  if constexpr (N == 2) r.h[0] = a.h[0] * c, r.h[1] = a.h[1] * c, r.h[2] = a.h[2] * c;
   return r;
 }
 
@@ -155,7 +161,8 @@ Dual<N> Pow(const Dual<N>& a, const Dual<N>& b) {
     const double n = b.v;
     if (n == 0) return Dual<N>::Constant(value);
     const double f1 = n * std::pow(a.v, n - 1);
-    const double f2 = N == 2 ? (n == 1 ? 0 : n * (n - 1) * std::pow(a.v, n - 2)) : 0;
+    double f2 = 0;
+    if constexpr (N == 2) f2 = n == 1 ? 0 : n * (n - 1) * std::pow(a.v, n - 2);
     return Chain(a, value, f1, f2);
   }
   const double ln = std::log(a.v);
@@ -165,15 +172,26 @@ Dual<N> Pow(const Dual<N>& a, const Dual<N>& b) {
                 pb1 * (1 + b.v * ln), value * ln * ln);
 }
 
+// sin(a) and cos(a) given s = sin(a.v) and c = cos(a.v).
 template <int N>
-Dual<N> Sin(const Dual<N>& a) {
-  const double s = std::sin(a.v), c = std::cos(a.v);
+Dual<N> SinFrom(const Dual<N>& a, double s, double c) {
   return Chain(a, s, c, -s);
 }
 template <int N>
-Dual<N> Cos(const Dual<N>& a) {
-  const double s = std::sin(a.v), c = std::cos(a.v);
+Dual<N> CosFrom(const Dual<N>& a, double s, double c) {
   return Chain(a, c, -s, -c);
+}
+template <int N>
+Dual<N> Sin(const Dual<N>& a) {
+  double s, c;
+  SinCosOf(a.v, &s, &c);
+  return SinFrom(a, s, c);
+}
+template <int N>
+Dual<N> Cos(const Dual<N>& a) {
+  double s, c;
+  SinCosOf(a.v, &s, &c);
+  return CosFrom(a, s, c);
 }
 template <int N>
 Dual<N> Tan(const Dual<N>& a) {

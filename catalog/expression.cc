@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <type_traits>
 
 #include "absl/strings/str_cat.h"
@@ -103,8 +104,16 @@ constexpr Builtin kBuiltins[] = {
 
 // ---- Plain-double semantics; the dual numbers' values use the same calls.
 
-double Sin(double x) { return std::sin(x); }
-double Cos(double x) { return std::cos(x); }
+double Sin(double x) {
+  double s, c;
+  SinCosOf(x, &s, &c);
+  return s;
+}
+double Cos(double x) {
+  double s, c;
+  SinCosOf(x, &s, &c);
+  return c;
+}
 double Tan(double x) { return std::tan(x); }
 double Asin(double x) { return std::asin(x); }
 double Acos(double x) { return std::acos(x); }
@@ -221,6 +230,18 @@ Interval VarSquare(const Interval& x) { return Square(x); }
 Interval VarCube(const Interval& x) { return Cube(x); }
 Interval VarFourth(const Interval& x) { return Fourth(x); }
 
+// sin or cos of x from s = sin(x) and c = cos(x) (the cached path).
+double TrigFrom(bool sine, double, double s, double c) { return sine ? s : c; }
+template <int N>
+Dual<N> TrigFrom(bool sine, const Dual<N>& x, double s, double c) {
+  return sine ? SinFrom(x, s, c) : CosFrom(x, s, c);
+}
+double ValueOf(double x) { return x; }
+template <int N>
+double ValueOf(const Dual<N>& x) {
+  return x.v;
+}
+
 // Hull of the two branches of an undecided condition; only intervals have
 // undecided conditions.
 double Union(double a, double) { return a; }
@@ -318,7 +339,8 @@ using Instruction = Expression::Instruction;
 // Runs code[begin, end) on the stack st (top at sp). An undecided condition
 // (intervals only) runs both branches and keeps the hull of their results.
 template <typename T>
-void Execute(const Instruction* code, int begin, int end, T* st, int& sp, const T* vars) {
+void Execute(const Instruction* code, int begin, int end, T* st, int& sp, const T* vars,
+             TrigCache* cache) {
   for (int pc = begin; pc < end; ++pc) {
     const Instruction& in = code[pc];
     switch (in.op) {
@@ -380,6 +402,14 @@ void Execute(const Instruction* code, int begin, int end, T* st, int& sp, const 
         --sp, st[sp] = Or(st[sp], st[sp + 1]);
         break;
       case Op::kFunc:
+        if constexpr (!std::is_same_v<T, Interval>) {
+          if (cache != nullptr && (in.fn == Fn::kSin || in.fn == Fn::kCos)) {
+            double s, c;
+            cache->SinCos(ValueOf(st[sp]), &s, &c);
+            st[sp] = TrigFrom(in.fn == Fn::kSin, st[sp], s, c);
+            break;
+          }
+        }
         st[sp] = Apply(in.fn, st[sp]);
         break;
       case Op::kAtan2:
@@ -398,9 +428,9 @@ void Execute(const Instruction* code, int begin, int end, T* st, int& sp, const 
           pc = in.arg;  // the kElse; the loop steps into the else-branch
         } else if (t == Truth::kUnknown) {
           const int else_pc = in.arg, endif_pc = code[else_pc].arg;
-          Execute(code, pc + 1, else_pc, st, sp, vars);
+          Execute(code, pc + 1, else_pc, st, sp, vars, cache);
           const T then_value = st[sp--];
-          Execute(code, else_pc + 1, endif_pc, st, sp, vars);
+          Execute(code, else_pc + 1, endif_pc, st, sp, vars, cache);
           st[sp] = Union(then_value, st[sp]);
           pc = endif_pc;
         }
@@ -416,10 +446,10 @@ void Execute(const Instruction* code, int begin, int end, T* st, int& sp, const 
 }
 
 template <typename T>
-T Run(const std::vector<Instruction>& code, const T* vars) {
+T Run(const std::vector<Instruction>& code, const T* vars, TrigCache* cache = nullptr) {
   T st[kMaxStack];
   int sp = -1;
-  Execute(code.data(), 0, static_cast<int>(code.size()), st, sp, vars);
+  Execute(code.data(), 0, static_cast<int>(code.size()), st, sp, vars, cache);
   return st[0];
 }
 
@@ -672,6 +702,31 @@ double Expression::Evaluate(const double* values) const { return Run(code_, valu
 Dual1 Expression::Evaluate(const Dual1* values) const { return Run(code_, values); }
 Dual2 Expression::Evaluate(const Dual2* values) const { return Run(code_, values); }
 Interval Expression::Evaluate(const Interval* values) const { return Run(code_, values); }
+double Expression::Evaluate(const double* values, TrigCache* cache) const {
+  return Run(code_, values, cache);
+}
+Dual1 Expression::Evaluate(const Dual1* values, TrigCache* cache) const {
+  return Run(code_, values, cache);
+}
+Dual2 Expression::Evaluate(const Dual2* values, TrigCache* cache) const {
+  return Run(code_, values, cache);
+}
+
+void TrigCache::SinCos(double x, double* s, double* c) {
+  uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);  // -0.0 and 0.0 differ in sin
+  for (int i = 0; i < size_; ++i) {
+    if (bits_[i] == bits) {
+      *s = sin_[i], *c = cos_[i];
+      return;
+    }
+  }
+  SinCosOf(x, s, c);
+  const int slot = next_;
+  next_ = (next_ + 1) % kSize;
+  size_ = std::max(size_, slot + 1);
+  bits_[slot] = bits, sin_[slot] = *s, cos_[slot] = *c;
+}
 
 absl::StatusOr<double> EvaluateConstant(const std::string& what, const std::string& text) {
   auto expr = Expression::Compile(what, text, {});

@@ -4,6 +4,7 @@
 #include "catalog/expression.h"
 
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <string>
 #include <thread>
@@ -286,6 +287,27 @@ TEST(Expression, IntervalsEncloseEveryPointValue) {
               << text << " = " << value << " at " << x[0] << "," << x[1] << " outside ["
               << bound.lo << ", " << bound.hi << "]";
         }
+      }
+    }
+  }
+}
+
+// Sharing sin and cos between the expressions of a point changes no bit.
+TEST(Expression, TrigCacheChangesNothing) {
+  auto x = CompileUV("sin(_pi*u)*cos(2*_pi*v)");
+  auto y = CompileUV("sin(_pi*u)*sin(2*_pi*v) + cos(-u*0)");
+  auto z = CompileUV("cos(_pi*u) + sin(u*0) - sin(-u*0) + sin(v)^2");
+  for (double u : {0.0, 0.1, 0.5, 0.77}) {
+    for (double v : {0.0, 0.3, 0.9}) {
+      const double p[2] = {u, v};
+      const Dual2 d[2] = {Dual2::Affine(u, 1, 0), Dual2::Affine(v, 0, 1)};
+      TrigCache a, b;
+      for (const Expression* e : {x.get(), y.get(), z.get()}) {
+        const double plain = e->Evaluate(p);
+        const double cached = e->Evaluate(p, &a);
+        EXPECT_EQ(std::memcmp(&plain, &cached, sizeof plain), 0) << e->text();
+        const Dual2 dp = e->Evaluate(d), dc = e->Evaluate(d, &b);
+        EXPECT_EQ(std::memcmp(&dp, &dc, sizeof dp), 0) << e->text();
       }
     }
   }
