@@ -114,7 +114,22 @@ class ExpressionSurface final : public Surface {
   }
 
   SurfaceJet Jet(double u, double v, int order) const override {
-    return order >= 2 ? JetOf<Dual2>(u, v) : JetOf<Dual1>(u, v);
+    TrigCache trig;
+    return order >= 2 ? JetOf<Dual2>(u, v, &trig) : JetOf<Dual1>(u, v, &trig);
+  }
+
+  // One TrigCache for the whole grid: sin and cos of an argument that
+  // depends on u alone (or v alone) are computed once per row (or column),
+  // as the built-ins' JetGrid does.
+  void JetGrid(const double* us, int nu, const double* vs, int nv, int order,
+               SurfaceJet* out) const override {
+    TrigCache trig;
+    for (int i = 0; i < nu; ++i) {
+      for (int j = 0; j < nv; ++j) {
+        out[i * nv + j] =
+            order >= 2 ? JetOf<Dual2>(us[i], vs[j], &trig) : JetOf<Dual1>(us[i], vs[j], &trig);
+      }
+    }
   }
 
   std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override {
@@ -129,10 +144,9 @@ class ExpressionSurface final : public Surface {
   // Derivatives with respect to the unit-square parameters: the native
   // parameters are u0_ + u du_ and v0_ + v dv_.
   template <typename D>
-  SurfaceJet JetOf(double u, double v) const {
+  SurfaceJet JetOf(double u, double v, TrigCache* trig) const {
     const D uv[2] = {D::Affine(u0_ + u * du_, du_, 0), D::Affine(v0_ + v * dv_, 0, dv_)};
-    TrigCache trig;
-    const D x = x_->Evaluate(uv, &trig), y = y_->Evaluate(uv, &trig), z = z_->Evaluate(uv, &trig);
+    const D x = x_->Evaluate(uv, trig), y = y_->Evaluate(uv, trig), z = z_->Evaluate(uv, trig);
     SurfaceJet jet;
     jet.p = {x.v, y.v, z.v};
     jet.fu = {x.d[0], y.d[0], z.d[0]};

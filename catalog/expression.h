@@ -41,11 +41,11 @@
 
 namespace sfc {
 
-// sin and cos of the last few distinct arguments of one evaluation point, so
-// that the expressions of a surface point (x, y and z often share sin(pi u)
-// or take both sin and cos of 2 pi v) pay one sincos per argument, as the
-// built-ins do. Results are bit-identical with or without it. Use one per
-// point and thread; it is a few hundred bytes on the stack.
+// sin and cos of the last few distinct arguments, so that the expressions of
+// a surface point (x, y and z often share sin(pi u) or take both sin and cos
+// of 2 pi v), or of a small grid of points, pay one sincos per argument, as
+// the built-ins do. Results are bit-identical with or without it. Use one per
+// point or grid and thread; it is a few hundred bytes on the stack.
 class TrigCache {
  public:
   // sin(x) and cos(x) (SinCosOf), computed at most once per distinct x.

@@ -75,6 +75,29 @@ TEST(ExpressionSurface, DerivativesMatchTheBuiltInsClosedForms) {
   }
 }
 
+// JetGrid shares sin and cos over the grid and still equals Jet at each
+// point, bit for bit.
+TEST(ExpressionSurface, JetGridEqualsJetAtEachPoint) {
+  for (const Pair& pair : kPairs) {
+    auto expr = MakeSurface(pair.expr);
+    ASSERT_TRUE(expr.ok());
+    const double us[3] = {0.1, 0.35, 0.6}, vs[3] = {0.2, 0.45, 0.95};
+    for (int order : {1, 2}) {
+      SurfaceJet grid[9];
+      expr->surface->JetGrid(us, 3, vs, 3, order, grid);
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+          const SurfaceJet one = expr->surface->Jet(us[i], vs[j], order);
+          const SurfaceJet& g = grid[i * 3 + j];
+          EXPECT_TRUE(g.p == one.p && g.fu == one.fu && g.fv == one.fv && g.fuu == one.fuu &&
+                      g.fuv == one.fuv && g.fvv == one.fvv)
+              << pair.expr;
+        }
+      }
+    }
+  }
+}
+
 // f(u, v) = 0 identically: its value, gradient and Hessian vanish, which
 // checks the rules of different functions against each other.
 TEST(Dual, IdentitiesHaveZeroDerivatives) {
