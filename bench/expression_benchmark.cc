@@ -3,7 +3,7 @@
 //
 // Each row is cold: the surface is made from its spec, the tree built and all
 // samples of the set (or of the region) read, as a first request does. The
-// time is the median of `repeats` runs. Run it on one core:
+// time is the median of `repeats` runs, the two columns run alternately. Run it on one core:
 //   taskset -c 0 ./build/bench/expression_benchmark [N] [repeats]
 // (defaults N = 1000000, repeats = 3).
 #include <algorithm>
@@ -67,13 +67,9 @@ Timing Cold(const std::string& surface, const std::string& density, uint64_t n,
   return t;
 }
 
-Timing Median(int repeats, const std::string& surface, const std::string& density, uint64_t n,
-              const Region& region = {}, const SampleFields& fields = {}) {
-  std::vector<Timing> runs;
-  for (int i = 0; i < repeats; ++i) runs.push_back(Cold(surface, density, n, region, fields));
-  std::sort(runs.begin(), runs.end(),
-            [](const Timing& a, const Timing& b) { return a.seconds < b.seconds; });
-  return runs[runs.size() / 2];
+double MedianOf(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
 }
 
 int Run(uint64_t n, int repeats) {
@@ -95,10 +91,14 @@ int Run(uint64_t n, int repeats) {
       {"sphere, gaussian density (order 2)", "gaussian:floor=0.1", with_density},
   };
   for (const Row& row : rows) {
-    const Timing b = Median(repeats, "sphere", row.density, n, {}, row.fields);
-    const Timing e = Median(repeats, kExprSphere, row.density, n, {}, row.fields);
-    std::printf("%-34s %12.3f %12.3f %8.2f\n", row.name, b.seconds, e.seconds,
-                e.seconds / b.seconds);
+    // Alternate the two so that both see the same load on a shared machine.
+    std::vector<double> b, e;
+    for (int i = 0; i < repeats; ++i) {
+      b.push_back(Cold("sphere", row.density, n, {}, row.fields).seconds);
+      e.push_back(Cold(kExprSphere, row.density, n, {}, row.fields).seconds);
+    }
+    const double mb = MedianOf(b), me = MedianOf(e);
+    std::printf("%-34s %12.3f %12.3f %8.2f\n", row.name, mb, me, me / mb);
   }
 
   // Box regions on z = sin(8 pi u), from one built tree: the planner skips
@@ -142,9 +142,8 @@ int Run(uint64_t n, int repeats) {
       seconds.push_back(
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     }
-    std::sort(seconds.begin(), seconds.end());
     std::printf("%-34s %12llu %12.4f\n", box.name, static_cast<unsigned long long>(samples),
-                seconds[seconds.size() / 2]);
+                MedianOf(seconds));
   }
   return 0;
 }
