@@ -96,6 +96,12 @@ TEST(RegionRequest, ThreeByThreeCurvesHoldExactlyTheFilteredSamples) {
     auto sampler = MakeSampler(s, SequenceKind::kJittered, n, 4);
     const SampleBatch full = Collect(sampler, 0, n);
     EXPECT_GT(CheckRandomRegions(sampler, full, n, 30, 8), 15);
+    // Rectangles on the curve's own cell edges, 1/3 and 2/3 rounded.
+    for (const Region& r : {Region::ParameterRect(1.0 / 3, 2.0 / 3, 1.0 / 3, 2.0 / 3),
+                            Region::ParameterRect(0, 1.0 / 9, 0, 1),
+                            Region::ParameterRect(2.0 / 3, 1, 4.0 / 9, 5.0 / 9)}) {
+      ExpectSameSamples(Collect(sampler, 0, n, r), Filter(full, r));
+    }
   }
 }
 
