@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <map>
+#include <type_traits>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -97,18 +98,67 @@ absl::Status Positive(const std::string& what, double value) {
   return absl::InvalidArgumentError(absl::StrFormat("%s must be > 0, got %g", what, value));
 }
 
-// x(u,v), y(u,v), z(u,v) over the native box [u0,u1] x [v0,v1].
+// x(u,v), y(u,v), z(u,v) over the native box [u0,u1] x [v0,v1]. Point uses
+// the plain-double program, Jet the dual-number one (exact derivatives, value
+// bit-identical to Point), Bound the interval one.
 class ExpressionSurface final : public Surface {
  public:
   ExpressionSurface(std::unique_ptr<Expression> x, std::unique_ptr<Expression> y,
                     std::unique_ptr<Expression> z, double u0, double u1, double v0, double v1)
       : x_(std::move(x)), y_(std::move(y)), z_(std::move(z)), u0_(u0), du_(u1 - u0), v0_(v0), dv_(v1 - v0) {}
+
   Vec3 Point(double u, double v) const override {
     const double uv[2] = {u0_ + u * du_, v0_ + v * dv_};
-    return {x_->Evaluate(uv), y_->Evaluate(uv), z_->Evaluate(uv)};
+    TrigCache trig;
+    return {x_->Evaluate(uv, &trig), y_->Evaluate(uv, &trig), z_->Evaluate(uv, &trig)};
+  }
+
+  SurfaceJet Jet(double u, double v, int order) const override {
+    TrigCache trig;
+    return order >= 2 ? JetOf<Dual2>(u, v, &trig) : JetOf<Dual1>(u, v, &trig);
+  }
+
+  // One TrigCache for the whole grid: sin and cos of an argument that
+  // depends on u alone (or v alone) are computed once per row (or column),
+  // as the built-ins' JetGrid does.
+  void JetGrid(const double* us, int nu, const double* vs, int nv, int order,
+               SurfaceJet* out) const override {
+    TrigCache trig;
+    for (int i = 0; i < nu; ++i) {
+      for (int j = 0; j < nv; ++j) {
+        out[i * nv + j] =
+            order >= 2 ? JetOf<Dual2>(us[i], vs[j], &trig) : JetOf<Dual1>(us[i], vs[j], &trig);
+      }
+    }
+  }
+
+  std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override {
+    // The same operations as Point's u0_ + u * du_, on intervals.
+    const Interval uv[2] = {
+        Interval::Point(u0_) + Interval::Of(u0, u1) * Interval::Point(du_),
+        Interval::Point(v0_) + Interval::Of(v0, v1) * Interval::Point(dv_)};
+    return BoxOf(x_->Evaluate(uv), y_->Evaluate(uv), z_->Evaluate(uv));
   }
 
  private:
+  // Derivatives with respect to the unit-square parameters: the native
+  // parameters are u0_ + u du_ and v0_ + v dv_.
+  template <typename D>
+  SurfaceJet JetOf(double u, double v, TrigCache* trig) const {
+    const D uv[2] = {D::Affine(u0_ + u * du_, du_, 0), D::Affine(v0_ + v * dv_, 0, dv_)};
+    const D x = x_->Evaluate(uv, trig), y = y_->Evaluate(uv, trig), z = z_->Evaluate(uv, trig);
+    SurfaceJet jet;
+    jet.p = {x.v, y.v, z.v};
+    jet.fu = {x.d[0], y.d[0], z.d[0]};
+    jet.fv = {x.d[1], y.d[1], z.d[1]};
+    if constexpr (std::is_same_v<D, Dual2>) {
+      jet.fuu = {x.h[0], y.h[0], z.h[0]};
+      jet.fuv = {x.h[1], y.h[1], z.h[1]};
+      jet.fvv = {x.h[2], y.h[2], z.h[2]};
+    }
+    return jet;
+  }
+
   const std::unique_ptr<Expression> x_, y_, z_;
   const double u0_, du_, v0_, dv_;
 };

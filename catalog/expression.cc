@@ -1,99 +1,742 @@
 #include "catalog/expression.h"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <type_traits>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "absl/strings/strip.h"
 #include "muParser.h"
 
 namespace sfc {
-
-struct Expression::Parser {
-  mu::Parser parser;
-  std::vector<double> values;
-};
-
 namespace {
 
-absl::Status ParserError(const std::string& what, const std::string& text,
-                         const mu::Parser::exception_type& e) {
-  if (e.GetPos() < 0) {
-    return absl::InvalidArgumentError(absl::StrFormat("%s: %s (in \"%s\")", what, e.GetMsg(), text));
+// The value stack of one evaluation lives on the caller's stack; Compile()
+// rejects programs that need more.
+constexpr int kMaxStack = 64;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kE = 2.71828182845904523536;
+
+enum class Fn : uint8_t {
+  kNone,
+  kNeg,
+  kSin,
+  kCos,
+  kTan,
+  kAsin,
+  kAcos,
+  kAtan,
+  kSinh,
+  kCosh,
+  kTanh,
+  kAsinh,
+  kAcosh,
+  kAtanh,
+  kLog2,
+  kLog10,
+  kLog,
+  kExp,
+  kSqrt,
+  kSign,
+  kRint,
+  kAbs,
+};
+
+enum class Op : uint8_t {
+  kConst,       // push a
+  kVar,         // push x = vars[arg]
+  kVarMulAdd,   // push x * a + b (muparser's cmVARMUL)
+  kVarSquare,   // push x * x
+  kVarCube,     // push (x * x) * x
+  kVarFourth,   // push ((x * x) * x) * x
+  kAdd,         // binary operators pop b, then a, and push a op b
+  kSub,
+  kMul,
+  kDiv,
+  kPow,
+  kLess,
+  kGreater,
+  kLessEqual,
+  kGreaterEqual,
+  kEqual,
+  kNotEqual,
+  kAnd,
+  kOr,
+  kFunc,   // top = fn(top)
+  kAtan2,  // pop x, then y; push atan2(y, x)
+  kSum,    // pop arg values, push their sum (muparser's order)
+  kAvg,
+  kMin,
+  kMax,
+  kIf,     // pop the condition; when false continue after the kElse at arg
+  kElse,   // end of the taken then-branch: continue after the kEndIf at arg
+  kEndIf,  // end of an else-branch
+};
+
+// The functions we define in muparser. The callback's user-data pointer
+// points into this table, which is how a cmFUNC token is recognised.
+struct Builtin {
+  const char* name;
+  Op op;
+  Fn fn;
+  int arity;  // -1: any number >= 1
+};
+
+constexpr Builtin kBuiltins[] = {
+    {"sin", Op::kFunc, Fn::kSin, 1},       {"cos", Op::kFunc, Fn::kCos, 1},
+    {"tan", Op::kFunc, Fn::kTan, 1},       {"asin", Op::kFunc, Fn::kAsin, 1},
+    {"acos", Op::kFunc, Fn::kAcos, 1},     {"atan", Op::kFunc, Fn::kAtan, 1},
+    {"atan2", Op::kAtan2, Fn::kNone, 2},   {"sinh", Op::kFunc, Fn::kSinh, 1},
+    {"cosh", Op::kFunc, Fn::kCosh, 1},     {"tanh", Op::kFunc, Fn::kTanh, 1},
+    {"asinh", Op::kFunc, Fn::kAsinh, 1},   {"acosh", Op::kFunc, Fn::kAcosh, 1},
+    {"atanh", Op::kFunc, Fn::kAtanh, 1},   {"log2", Op::kFunc, Fn::kLog2, 1},
+    {"log10", Op::kFunc, Fn::kLog10, 1},   {"log", Op::kFunc, Fn::kLog, 1},
+    {"ln", Op::kFunc, Fn::kLog, 1},        {"exp", Op::kFunc, Fn::kExp, 1},
+    {"sqrt", Op::kFunc, Fn::kSqrt, 1},     {"sign", Op::kFunc, Fn::kSign, 1},
+    {"rint", Op::kFunc, Fn::kRint, 1},     {"abs", Op::kFunc, Fn::kAbs, 1},
+    {"sum", Op::kSum, Fn::kNone, -1},      {"avg", Op::kAvg, Fn::kNone, -1},
+    {"min", Op::kMin, Fn::kNone, -1},      {"max", Op::kMax, Fn::kNone, -1},
+};
+
+// ---- Plain-double semantics; the dual numbers' values use the same calls.
+
+double Sin(double x) {
+  double s, c;
+  SinCosOf(x, &s, &c);
+  return s;
+}
+double Cos(double x) {
+  double s, c;
+  SinCosOf(x, &s, &c);
+  return c;
+}
+double Tan(double x) { return std::tan(x); }
+double Asin(double x) { return std::asin(x); }
+double Acos(double x) { return std::acos(x); }
+double Atan(double x) { return std::atan(x); }
+double Atan2(double y, double x) { return std::atan2(y, x); }
+double Sinh(double x) { return std::sinh(x); }
+double Cosh(double x) { return std::cosh(x); }
+double Tanh(double x) { return std::tanh(x); }
+double Asinh(double x) { return std::asinh(x); }
+double Acosh(double x) { return std::acosh(x); }
+double Atanh(double x) { return std::atanh(x); }
+double Log2(double x) { return std::log2(x); }
+double Log10(double x) { return std::log10(x); }
+double Log(double x) { return std::log(x); }
+double Exp(double x) { return std::exp(x); }
+double Sqrt(double x) { return std::sqrt(x); }
+double Sign(double x) { return SignOf(x); }
+double Rint(double x) { return RintOf(x); }
+double Abs(double x) { return AbsOf(x); }
+double Pow(double a, double b) { return std::pow(a, b); }
+double Min(double a, double b) { return MinOf(a, b); }
+double Max(double a, double b) { return MaxOf(a, b); }
+
+// ---- What differs between the number types: constants, conditions and
+// comparisons, and the muparser fused opcodes.
+
+template <typename T>
+T Constant(double c);
+template <>
+double Constant<double>(double c) {
+  return c;
+}
+template <>
+Dual1 Constant<Dual1>(double c) {
+  return Dual1::Constant(c);
+}
+template <>
+Dual2 Constant<Dual2>(double c) {
+  return Dual2::Constant(c);
+}
+template <>
+Interval Constant<Interval>(double c) {
+  return Interval::Point(c);
+}
+
+// muparser takes the then-branch unless the condition == 0 (NaN is true).
+Truth Condition(double x) { return x == 0 ? Truth::kFalse : Truth::kTrue; }
+template <int N>
+Truth Condition(const Dual<N>& x) {
+  return Condition(x.v);
+}
+Truth Condition(const Interval& x) { return TruthOf(x); }
+
+double Lt(double a, double b) { return a < b; }
+double Le(double a, double b) { return a <= b; }
+double Eq(double a, double b) { return a == b; }
+double Ne(double a, double b) { return a != b; }
+double And(double a, double b) { return a && b; }
+double Or(double a, double b) { return a || b; }
+template <int N>
+Dual<N> Lt(const Dual<N>& a, const Dual<N>& b) {
+  return Dual<N>::Constant(a.v < b.v);
+}
+template <int N>
+Dual<N> Le(const Dual<N>& a, const Dual<N>& b) {
+  return Dual<N>::Constant(a.v <= b.v);
+}
+template <int N>
+Dual<N> Eq(const Dual<N>& a, const Dual<N>& b) {
+  return Dual<N>::Constant(a.v == b.v);
+}
+template <int N>
+Dual<N> Ne(const Dual<N>& a, const Dual<N>& b) {
+  return Dual<N>::Constant(a.v != b.v);
+}
+template <int N>
+Dual<N> And(const Dual<N>& a, const Dual<N>& b) {
+  return Dual<N>::Constant(a.v && b.v);
+}
+template <int N>
+Dual<N> Or(const Dual<N>& a, const Dual<N>& b) {
+  return Dual<N>::Constant(a.v || b.v);
+}
+Interval Lt(const Interval& a, const Interval& b) { return Less(a, b); }
+Interval Le(const Interval& a, const Interval& b) { return LessEqual(a, b); }
+Interval Eq(const Interval& a, const Interval& b) { return Equal(a, b); }
+Interval Ne(const Interval& a, const Interval& b) { return NotEqual(a, b); }
+Interval And(const Interval& a, const Interval& b) { return LogicalAnd(a, b); }
+Interval Or(const Interval& a, const Interval& b) { return LogicalOr(a, b); }
+
+double VarMulAdd(double x, double a, double b) { return x * a + b; }
+template <int N>
+Dual<N> VarMulAdd(const Dual<N>& x, double a, double b) {
+  return MulAdd(x, a, b);
+}
+Interval VarMulAdd(const Interval& x, double a, double b) {
+  return x * Interval::Point(a) + Interval::Point(b);
+}
+
+// x*x, (x*x)*x, ((x*x)*x)*x; intervals use the dependency-aware forms.
+template <typename T>
+T VarSquare(const T& x) {
+  return x * x;
+}
+template <typename T>
+T VarCube(const T& x) {
+  return (x * x) * x;
+}
+template <typename T>
+T VarFourth(const T& x) {
+  return ((x * x) * x) * x;
+}
+Interval VarSquare(const Interval& x) { return Square(x); }
+Interval VarCube(const Interval& x) { return Cube(x); }
+Interval VarFourth(const Interval& x) { return Fourth(x); }
+
+// sin or cos of x from s = sin(x) and c = cos(x) (the cached path).
+double TrigFrom(bool sine, double, double s, double c) { return sine ? s : c; }
+template <int N>
+Dual<N> TrigFrom(bool sine, const Dual<N>& x, double s, double c) {
+  return sine ? SinFrom(x, s, c) : CosFrom(x, s, c);
+}
+double ValueOf(double x) { return x; }
+template <int N>
+double ValueOf(const Dual<N>& x) {
+  return x.v;
+}
+
+// Hull of the two branches of an undecided condition; only intervals have
+// undecided conditions.
+double Union(double a, double) { return a; }
+template <int N>
+Dual<N> Union(const Dual<N>& a, const Dual<N>&) {
+  return a;
+}
+Interval Union(const Interval& a, const Interval& b) { return Hull(a, b); }
+
+template <typename T>
+T Apply(Fn fn, const T& x) {
+  switch (fn) {
+    case Fn::kNeg:
+      return -x;
+    case Fn::kSin:
+      return Sin(x);
+    case Fn::kCos:
+      return Cos(x);
+    case Fn::kTan:
+      return Tan(x);
+    case Fn::kAsin:
+      return Asin(x);
+    case Fn::kAcos:
+      return Acos(x);
+    case Fn::kAtan:
+      return Atan(x);
+    case Fn::kSinh:
+      return Sinh(x);
+    case Fn::kCosh:
+      return Cosh(x);
+    case Fn::kTanh:
+      return Tanh(x);
+    case Fn::kAsinh:
+      return Asinh(x);
+    case Fn::kAcosh:
+      return Acosh(x);
+    case Fn::kAtanh:
+      return Atanh(x);
+    case Fn::kLog2:
+      return Log2(x);
+    case Fn::kLog10:
+      return Log10(x);
+    case Fn::kLog:
+      return Log(x);
+    case Fn::kExp:
+      return Exp(x);
+    case Fn::kSqrt:
+      return Sqrt(x);
+    case Fn::kSign:
+      return Sign(x);
+    case Fn::kRint:
+      return Rint(x);
+    case Fn::kAbs:
+      return Abs(x);
+    case Fn::kNone:
+      break;
   }
-  return absl::InvalidArgumentError(absl::StrFormat(
-      "%s: %s at position %d (token '%s') in \"%s\"", what, e.GetMsg(), e.GetPos(), e.GetToken(),
-      text));
+  return x;  // unreachable: Compile() admits only the functions above
+}
+
+// sum, avg, min, max over args[0..n), in muparser's order of operations.
+template <typename T>
+T ApplyMulti(Op op, const T* args, int n) {
+  T r;
+  switch (op) {
+    case Op::kSum:
+    case Op::kAvg:
+      r = Constant<T>(0);
+      for (int i = 0; i < n; ++i) r = r + args[i];
+      return op == Op::kAvg ? r / Constant<T>(n) : r;
+    case Op::kMin:
+      r = args[0];
+      for (int i = 0; i < n; ++i) r = Min(r, args[i]);
+      return r;
+    default:  // kMax
+      r = args[0];
+      for (int i = 0; i < n; ++i) r = Max(r, args[i]);
+      return r;
+  }
 }
 
 }  // namespace
 
-Expression::Expression(std::string what, std::string text, std::vector<std::string> variables)
-    : what_(std::move(what)), text_(std::move(text)), variables_(std::move(variables)) {}
+struct Expression::Instruction {
+  Op op;
+  Fn fn;
+  int32_t arg;  // variable index, argument count or jump target
+  double a, b;  // constants
+};
+
+namespace {
+
+using Instruction = Expression::Instruction;
+
+// Runs code[begin, end) on the stack st (top at sp). An undecided condition
+// (intervals only) runs both branches and keeps the hull of their results.
+template <typename T>
+void Execute(const Instruction* code, int begin, int end, T* st, int& sp, const T* vars,
+             TrigCache* cache) {
+  for (int pc = begin; pc < end; ++pc) {
+    const Instruction& in = code[pc];
+    switch (in.op) {
+      case Op::kConst:
+        st[++sp] = Constant<T>(in.a);
+        break;
+      case Op::kVar:
+        st[++sp] = vars[in.arg];
+        break;
+      case Op::kVarMulAdd:
+        st[++sp] = VarMulAdd(vars[in.arg], in.a, in.b);
+        break;
+      case Op::kVarSquare:
+        st[++sp] = VarSquare(vars[in.arg]);
+        break;
+      case Op::kVarCube:
+        st[++sp] = VarCube(vars[in.arg]);
+        break;
+      case Op::kVarFourth:
+        st[++sp] = VarFourth(vars[in.arg]);
+        break;
+      case Op::kAdd:
+        --sp, st[sp] = st[sp] + st[sp + 1];
+        break;
+      case Op::kSub:
+        --sp, st[sp] = st[sp] - st[sp + 1];
+        break;
+      case Op::kMul:
+        --sp, st[sp] = st[sp] * st[sp + 1];
+        break;
+      case Op::kDiv:
+        --sp, st[sp] = st[sp] / st[sp + 1];
+        break;
+      case Op::kPow:
+        --sp, st[sp] = Pow(st[sp], st[sp + 1]);
+        break;
+      case Op::kLess:
+        --sp, st[sp] = Lt(st[sp], st[sp + 1]);
+        break;
+      case Op::kGreater:
+        --sp, st[sp] = Lt(st[sp + 1], st[sp]);
+        break;
+      case Op::kLessEqual:
+        --sp, st[sp] = Le(st[sp], st[sp + 1]);
+        break;
+      case Op::kGreaterEqual:
+        --sp, st[sp] = Le(st[sp + 1], st[sp]);
+        break;
+      case Op::kEqual:
+        --sp, st[sp] = Eq(st[sp], st[sp + 1]);
+        break;
+      case Op::kNotEqual:
+        --sp, st[sp] = Ne(st[sp], st[sp + 1]);
+        break;
+      case Op::kAnd:
+        --sp, st[sp] = And(st[sp], st[sp + 1]);
+        break;
+      case Op::kOr:
+        --sp, st[sp] = Or(st[sp], st[sp + 1]);
+        break;
+      case Op::kFunc:
+        if constexpr (!std::is_same_v<T, Interval>) {
+          if (cache != nullptr && (in.fn == Fn::kSin || in.fn == Fn::kCos)) {
+            double s, c;
+            cache->SinCos(ValueOf(st[sp]), &s, &c);
+            st[sp] = TrigFrom(in.fn == Fn::kSin, st[sp], s, c);
+            break;
+          }
+        }
+        st[sp] = Apply(in.fn, st[sp]);
+        break;
+      case Op::kAtan2:
+        --sp, st[sp] = Atan2(st[sp], st[sp + 1]);
+        break;
+      case Op::kSum:
+      case Op::kAvg:
+      case Op::kMin:
+      case Op::kMax:
+        sp -= in.arg - 1;
+        st[sp] = ApplyMulti(in.op, &st[sp], in.arg);
+        break;
+      case Op::kIf: {
+        const Truth t = Condition(st[sp--]);
+        if (t == Truth::kFalse) {
+          pc = in.arg;  // the kElse; the loop steps into the else-branch
+        } else if (t == Truth::kUnknown) {
+          const int else_pc = in.arg, endif_pc = code[else_pc].arg;
+          Execute(code, pc + 1, else_pc, st, sp, vars, cache);
+          const T then_value = st[sp--];
+          Execute(code, else_pc + 1, endif_pc, st, sp, vars, cache);
+          st[sp] = Union(then_value, st[sp]);
+          pc = endif_pc;
+        }
+        break;
+      }
+      case Op::kElse:
+        pc = in.arg;  // skip the else-branch
+        break;
+      case Op::kEndIf:
+        break;
+    }
+  }
+}
+
+template <typename T>
+T Run(const std::vector<Instruction>& code, const T* vars, TrigCache* cache = nullptr) {
+  T st[kMaxStack];
+  int sp = -1;
+  Execute(code.data(), 0, static_cast<int>(code.size()), st, sp, vars, cache);
+  return st[0];
+}
+
+// ---- muparser callbacks: used by muparser only to parse and to fold
+// constants, so they compute exactly what Run<double> computes.
+
+double CallUnary(void* data, double x) { return Apply(static_cast<const Builtin*>(data)->fn, x); }
+double CallAtan2(void*, double y, double x) { return Atan2(y, x); }
+double CallMulti(void* data, const double* args, int n) {
+  return ApplyMulti(static_cast<const Builtin*>(data)->op, args, n);
+}
+double Negate(double x) { return -x; }
+double Identity(double x) { return x; }
+
+absl::Status ParserError(const std::string& what, const std::string& text,
+                         const mu::Parser::exception_type& e) {
+  // Most of muparser's messages already say "at position N"; add the
+  // position only to those that do not.
+  std::string message(absl::StripSuffix(e.GetMsg(), "."));
+  if (message.find("position") == std::string::npos && e.GetPos() >= 0) {
+    absl::StrAppendFormat(&message, " at position %d", e.GetPos());
+  }
+  return absl::InvalidArgumentError(absl::StrFormat("%s: %s in \"%s\"", what, message, text));
+}
+
+absl::Status Unsupported(const std::string& what, const std::string& text,
+                         const std::string& construct) {
+  std::vector<std::string> names;
+  for (const Builtin& f : kBuiltins) names.push_back(f.name);
+  return absl::InvalidArgumentError(absl::StrFormat(
+      "%s: %s is not supported in \"%s\"; expressions use numbers, the variables, _pi, _e, "
+      "+ - * / ^, < > <= >= == !=, && ||, c ? a : b and the functions %s",
+      what, construct, text, absl::StrJoin(names, " ")));
+}
+
+// Translates muparser's bytecode into our program. `vars` is the array the
+// parser's variables point into.
+absl::StatusOr<std::vector<Instruction>> Translate(const mu::ParserByteCode& bytecode,
+                                                   const double* vars, int var_count,
+                                                   const std::string& what,
+                                                   const std::string& text) {
+  const mu::SToken* tokens = bytecode.GetBase();
+  const size_t size = bytecode.GetSize();
+  std::vector<Instruction> code;
+  int depth = 0, max_depth = 0;
+  // Open conditionals: the index of their kIf (then kElse) and the depth
+  // before the then-branch (then after it).
+  std::vector<std::pair<int, int>> open_if, open_else;
+  auto internal = [&](const char* why) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "%s: \"%s\" could not be compiled (%s); please report this expression", what, text, why));
+  };
+  auto var_index = [&](const double* p) { return p >= vars && p < vars + var_count ? p - vars : -1; };
+  auto emit = [&](Op op, int pops, int pushes, int32_t arg = 0, double a = 0, double b = 0,
+                  Fn fn = Fn::kNone) {
+    code.push_back({op, fn, arg, a, b});
+    depth += pushes - pops;
+    max_depth = std::max(max_depth, depth);
+  };
+  for (size_t i = 0; i < size && tokens[i].Cmd != mu::cmEND; ++i) {
+    const mu::SToken& t = tokens[i];
+    switch (t.Cmd) {
+      case mu::cmVAL:
+        emit(Op::kConst, 0, 1, 0, t.Val.data2);
+        continue;
+      case mu::cmVAR:
+      case mu::cmVARPOW2:
+      case mu::cmVARPOW3:
+      case mu::cmVARPOW4:
+      case mu::cmVARMUL: {
+        const int index = static_cast<int>(var_index(t.Val.ptr));
+        if (index < 0) return internal("a variable outside the known ones");
+        const Op op = t.Cmd == mu::cmVAR       ? Op::kVar
+                      : t.Cmd == mu::cmVARPOW2 ? Op::kVarSquare
+                      : t.Cmd == mu::cmVARPOW3 ? Op::kVarCube
+                      : t.Cmd == mu::cmVARPOW4 ? Op::kVarFourth
+                                               : Op::kVarMulAdd;
+        emit(op, 0, 1, index, t.Val.data, t.Val.data2);
+        continue;
+      }
+      case mu::cmLE:
+      case mu::cmGE:
+      case mu::cmNEQ:
+      case mu::cmEQ:
+      case mu::cmLT:
+      case mu::cmGT:
+      case mu::cmADD:
+      case mu::cmSUB:
+      case mu::cmMUL:
+      case mu::cmDIV:
+      case mu::cmPOW:
+      case mu::cmLAND:
+      case mu::cmLOR: {
+        static constexpr Op kBinary[] = {
+            Op::kLessEqual, Op::kGreaterEqual, Op::kNotEqual, Op::kEqual, Op::kLess,
+            Op::kGreater,   Op::kAdd,          Op::kSub,      Op::kMul,   Op::kDiv,
+            Op::kPow,       Op::kAnd,          Op::kOr};
+        if (depth < 2) return internal("an operator without two operands");
+        emit(kBinary[t.Cmd - mu::cmLE], 2, 1);
+        continue;
+      }
+      case mu::cmIF:
+        if (depth < 1) return internal("a condition without a value");
+        emit(Op::kIf, 1, 0);
+        open_if.push_back({static_cast<int>(code.size()) - 1, depth});
+        continue;
+      case mu::cmELSE: {
+        if (open_if.empty()) return internal("':' without '?'");
+        const auto [if_pc, depth_before] = open_if.back();
+        open_if.pop_back();
+        if (depth != depth_before + 1) return internal("a then-branch without one value");
+        code[if_pc].arg = static_cast<int32_t>(code.size());
+        emit(Op::kElse, 0, 0);
+        open_else.push_back({static_cast<int>(code.size()) - 1, depth});
+        depth = depth_before;
+        continue;
+      }
+      case mu::cmENDIF: {
+        if (open_else.empty()) return internal("an unmatched end of a conditional");
+        const auto [else_pc, depth_then] = open_else.back();
+        open_else.pop_back();
+        if (depth != depth_then) return internal("an else-branch without one value");
+        code[else_pc].arg = static_cast<int32_t>(code.size());
+        emit(Op::kEndIf, 0, 0);
+        continue;
+      }
+      case mu::cmFUNC: {
+        const int argc = t.Fun.argc;
+        const void* data = t.Fun.cb._pUserData;
+        if (data == nullptr) {  // the infix operators
+          if (argc != 1 || depth < 1) return internal("a malformed unary operator");
+          if (t.Fun.cb._pRawFun == reinterpret_cast<mu::erased_fun_type>(&Negate)) {
+            emit(Op::kFunc, 1, 1, 0, 0, 0, Fn::kNeg);
+          } else if (t.Fun.cb._pRawFun != reinterpret_cast<mu::erased_fun_type>(&Identity)) {
+            return internal("an unknown operator");
+          }
+          continue;
+        }
+        const Builtin* f = nullptr;
+        for (const Builtin& b : kBuiltins) {
+          if (&b == data) f = &b;
+        }
+        if (f == nullptr) return internal("an unknown function");
+        if (f->arity < 0) {
+          const int n = -argc;
+          if (n < 1 || depth < n) return internal("a malformed argument list");
+          emit(f->op, n, 1, n);
+        } else {
+          if (argc != f->arity || depth < argc) return internal("a malformed argument list");
+          emit(f->op, argc, 1, 0, 0, 0, f->fn);
+        }
+        continue;
+      }
+      case mu::cmASSIGN:
+        return Unsupported(what, text, "assignment (=)");
+      default:
+        return Unsupported(what, text, absl::StrFormat("muparser opcode %d", t.Cmd));
+    }
+  }
+  if (!open_if.empty() || !open_else.empty()) return internal("an unfinished conditional");
+  if (depth != 1) return internal("not exactly one result");
+  if (max_depth > kMaxStack) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "%s: \"%s\" needs %d pending values at once, more than the %d supported; split long "
+        "sums or nest less deeply",
+        what, text, max_depth, kMaxStack));
+  }
+  return code;
+}
+
+}  // namespace
+
+Expression::Expression(std::string text, std::vector<Instruction> code)
+    : text_(std::move(text)), code_(std::move(code)) {}
 
 Expression::~Expression() = default;
 
-absl::StatusOr<std::unique_ptr<Expression::Parser>> Expression::NewParser() const {
-  auto p = std::make_unique<Parser>();
-  p->values.assign(variables_.size(), 0.5);
-  try {
-    for (size_t i = 0; i < variables_.size(); ++i) p->parser.DefineVar(variables_[i], &p->values[i]);
-    p->parser.SetExpr(text_);
-    p->parser.Eval();  // parses now, so syntax errors surface here
-  } catch (const mu::Parser::exception_type& e) {
-    return ParserError(what_, text_, e);
-  }
-  return p;
-}
-
 absl::StatusOr<std::unique_ptr<Expression>> Expression::Compile(std::string what, std::string text,
                                                                 std::vector<std::string> variables) {
-  auto expr =
-      std::unique_ptr<Expression>(new Expression(std::move(what), std::move(text), std::move(variables)));
-  auto parser = expr->NewParser();
-  if (!parser.ok()) return parser.status();
-  absl::MutexLock lock(&expr->mu_);
-  expr->idle_.push_back(*std::move(parser));
-  return expr;
-}
-
-double Expression::Evaluate(const double* values) const {
-  std::unique_ptr<Parser> p;
-  {
-    absl::MutexLock lock(&mu_);
-    if (!idle_.empty()) {
-      p = std::move(idle_.back());
-      idle_.pop_back();
+  if (absl::StripAsciiWhitespace(text).empty()) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "%s is empty; write an expression%s", what,
+        variables.empty() ? "" : absl::StrCat(" in ", absl::StrJoin(variables, ", "))));
+  }
+  // Test values for the variables: the parse evaluates once, and the
+  // translation is checked against muparser at a few points below.
+  std::vector<double> values(variables.size(), 0.5);
+  mu::Parser parser;
+  try {
+    parser.ClearFun();
+    parser.ClearConst();
+    parser.ClearInfixOprt();
+    parser.ClearPostfixOprt();
+    parser.ClearOprt();
+    for (const Builtin& f : kBuiltins) {
+      void* data = const_cast<Builtin*>(&f);
+      if (f.op == Op::kFunc) {
+        parser.DefineFunUserData(f.name, &CallUnary, data);
+      } else if (f.op == Op::kAtan2) {
+        parser.DefineFunUserData(f.name, &CallAtan2, data);
+      } else {
+        parser.DefineFunUserData(f.name, &CallMulti, data);
+      }
     }
-  }
-  if (!p) {
-    auto fresh = NewParser();  // compiled once before, so this cannot fail
-    if (!fresh.ok()) return NAN;
-    p = *std::move(fresh);
-  }
-  double result;
-  try {
-    for (size_t i = 0; i < p->values.size(); ++i) p->values[i] = values[i];
-    result = p->parser.Eval();
-  } catch (const mu::Parser::exception_type&) {
-    result = NAN;
-  }
-  absl::MutexLock lock(&mu_);
-  idle_.push_back(std::move(p));
-  return result;
-}
-
-absl::StatusOr<double> EvaluateConstant(const std::string& what, const std::string& text) {
-  try {
-    mu::Parser parser;
+    parser.DefineInfixOprt("-", &Negate);
+    parser.DefineInfixOprt("+", &Identity);
+    parser.DefineConst("_pi", kPi);
+    parser.DefineConst("_e", kE);
+    for (size_t i = 0; i < variables.size(); ++i) parser.DefineVar(variables[i], &values[i]);
     parser.SetExpr(text);
-    const double value = parser.Eval();
-    if (!std::isfinite(value)) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("%s: \"%s\" is not a finite number", what, text));
+    parser.Eval();  // parses now, so syntax errors surface here
+    if (parser.GetNumResults() != 1) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "%s: \"%s\" has %d comma-separated results; give a single expression", what, text,
+          parser.GetNumResults()));
     }
-    return value;
   } catch (const mu::Parser::exception_type& e) {
     return ParserError(what, text, e);
   }
+  std::vector<Instruction> code;
+  {
+    auto translated =
+        Translate(parser.GetByteCode(), values.data(), static_cast<int>(values.size()), what, text);
+    if (!translated.ok()) return translated.status();
+    code = *std::move(translated);
+  }
+  // The translation must reproduce muparser bit for bit.
+  for (const double probe : {0.5, 0.2113248654, 0.7886751346}) {
+    for (size_t i = 0; i < values.size(); ++i) values[i] = probe + 0.0123 * i;
+    double theirs;
+    try {
+      theirs = parser.Eval();
+    } catch (const mu::Parser::exception_type& e) {
+      return ParserError(what, text, e);
+    }
+    const double ours = Run(code, values.data());
+    if (!(ours == theirs || (std::isnan(ours) && std::isnan(theirs)))) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "%s: \"%s\" could not be compiled faithfully (%.17g instead of %.17g); please report "
+          "this expression",
+          what, text, ours, theirs));
+    }
+  }
+  return std::unique_ptr<Expression>(new Expression(std::move(text), std::move(code)));
+}
+
+size_t Expression::program_size() const { return code_.size(); }
+
+double Expression::Evaluate(const double* values) const { return Run(code_, values); }
+Dual1 Expression::Evaluate(const Dual1* values) const { return Run(code_, values); }
+Dual2 Expression::Evaluate(const Dual2* values) const { return Run(code_, values); }
+Interval Expression::Evaluate(const Interval* values) const { return Run(code_, values); }
+double Expression::Evaluate(const double* values, TrigCache* cache) const {
+  return Run(code_, values, cache);
+}
+Dual1 Expression::Evaluate(const Dual1* values, TrigCache* cache) const {
+  return Run(code_, values, cache);
+}
+Dual2 Expression::Evaluate(const Dual2* values, TrigCache* cache) const {
+  return Run(code_, values, cache);
+}
+
+void TrigCache::SinCos(double x, double* s, double* c) {
+  uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);  // -0.0 and 0.0 differ in sin
+  for (int i = 0; i < size_; ++i) {
+    if (bits_[i] == bits) {
+      *s = sin_[i], *c = cos_[i];
+      return;
+    }
+  }
+  SinCosOf(x, s, c);
+  const int slot = next_;
+  next_ = (next_ + 1) % kSize;
+  size_ = std::max(size_, slot + 1);
+  bits_[slot] = bits, sin_[slot] = *s, cos_[slot] = *c;
+}
+
+absl::StatusOr<double> EvaluateConstant(const std::string& what, const std::string& text) {
+  auto expr = Expression::Compile(what, text, {});
+  if (!expr.ok()) return expr.status();
+  const double value = (*expr)->Evaluate(static_cast<const double*>(nullptr));
+  if (!std::isfinite(value)) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("%s: \"%s\" is not a finite number", what, text));
+  }
+  return value;
 }
 
 }  // namespace sfc

@@ -8,9 +8,18 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
+// Interval helpers for the Bound methods. Each Bound repeats its Point's
+// operations in the same order on intervals (core/interval.h), so the box
+// holds every point Point computes on the rectangle.
+Interval Pt(double x) { return Interval::Point(x); }
+Interval Range(double lo, double hi) { return Interval::Of(lo, hi); }
+
 class Plane final : public Surface {
  public:
   Vec3 Point(double u, double v) const override { return {u, v, 0}; }
+  std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override {
+    return Box3{{u0, v0, 0}, {u1, v1, 0}};
+  }
   SurfaceJet Jet(double u, double v, int) const override {
     SurfaceJet j;
     j.p = {u, v, 0};
@@ -27,6 +36,11 @@ class Sphere final : public Surface {
     const double st = std::sin(kPi * u), ct = std::cos(kPi * u);
     const double sp = std::sin(2 * kPi * v), cp = std::cos(2 * kPi * v);
     return {r_ * st * cp, r_ * st * sp, r_ * ct};
+  }
+  std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override {
+    const Interval a = Pt(kPi) * Range(u0, u1), b = Pt(2 * kPi) * Range(v0, v1);
+    const Interval st = Sin(a), ct = Cos(a), sp = Sin(b), cp = Cos(b);
+    return BoxOf(Pt(r_) * st * cp, Pt(r_) * st * sp, Pt(r_) * ct);
   }
   SurfaceJet Jet(double u, double v, int order) const override {
     const double st = std::sin(kPi * u), ct = std::cos(kPi * u);
@@ -70,6 +84,11 @@ class Torus final : public Surface {
     const double w = big_r_ + r_ * std::cos(b);
     return {w * std::cos(a), w * std::sin(a), r_ * std::sin(b)};
   }
+  std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override {
+    const Interval a = Pt(2 * kPi) * Range(u0, u1), b = Pt(2 * kPi) * Range(v0, v1);
+    const Interval w = Pt(big_r_) + Pt(r_) * Cos(b);
+    return BoxOf(w * Cos(a), w * Sin(a), Pt(r_) * Sin(b));
+  }
   SurfaceJet Jet(double u, double v, int order) const override {
     const double sa = std::sin(2 * kPi * u), ca = std::cos(2 * kPi * u);
     const double sb = std::sin(2 * kPi * v), cb = std::cos(2 * kPi * v);
@@ -97,6 +116,11 @@ class MonkeySaddle final : public Surface {
     const double s = 2 * u - 1, t = 2 * v - 1;
     return {s, t, s * s * s - 3 * s * t * t};
   }
+  std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override {
+    const Interval s = Pt(2) * Range(u0, u1) - Pt(1), t = Pt(2) * Range(v0, v1) - Pt(1);
+    // s * s * s is (s * s) * s: Cube; 3 * s * t * t is ((3 * s) * t) * t.
+    return BoxOf(s, t, Cube(s) - Pt(3) * s * t * t);
+  }
   SurfaceJet Jet(double u, double v, int order) const override {
     const double s = 2 * u - 1, t = 2 * v - 1;
     SurfaceJet j;
@@ -118,6 +142,11 @@ class EightSurface final : public Surface {
     const double a = 2 * kPi * u, b = kPi * v - kPi / 2;
     const double s2b = std::sin(2 * b);
     return {std::cos(a) * s2b, std::sin(a) * s2b, std::sin(b)};
+  }
+  std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override {
+    const Interval a = Pt(2 * kPi) * Range(u0, u1), b = Pt(kPi) * Range(v0, v1) - Pt(kPi / 2);
+    const Interval s2b = Sin(Pt(2) * b);
+    return BoxOf(Cos(a) * s2b, Sin(a) * s2b, Sin(b));
   }
   SurfaceJet Jet(double u, double v, int order) const override {
     const double a = 2 * kPi * u, b = kPi * v - kPi / 2;
@@ -143,6 +172,10 @@ class WhitneyUmbrella final : public Surface {
     const double s = 2 * u - 1, t = 2 * v - 1;
     return {s * t, s, t * t};
   }
+  std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override {
+    const Interval s = Pt(2) * Range(u0, u1) - Pt(1), t = Pt(2) * Range(v0, v1) - Pt(1);
+    return BoxOf(s * t, s, Square(t));
+  }
   SurfaceJet Jet(double u, double v, int order) const override {
     const double s = 2 * u - 1, t = 2 * v - 1;
     SurfaceJet j;
@@ -166,6 +199,12 @@ class Superellipsoid final : public Surface {
     const double cb = SignedPow(std::cos(b), e_), sb = SignedPow(std::sin(b), e_);
     return {ca * cb, ca * sb, sa};
   }
+  std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override {
+    const Interval a = AngleBound(u0, u1, -kPi / 2, 2), b = AngleBound(v0, v1, -kPi, 4);
+    const Interval ca = SignedPowBound(Cos(a)), sa = SignedPowBound(Sin(a));
+    const Interval cb = SignedPowBound(Cos(b)), sb = SignedPowBound(Sin(b));
+    return BoxOf(ca * cb, ca * sb, sa);
+  }
 
  private:
   // Maps x in [0,1] onto [start, start + pieces * pi/2], piecewise by quarter
@@ -177,6 +216,36 @@ class Superellipsoid final : public Surface {
     const double s = y - piece;
     const double s3 = s * s * s, r3 = (1 - s) * (1 - s) * (1 - s);
     return start + (piece + s3 / (s3 + r3)) * (kPi / 2);
+  }
+
+  // Encloses Angle(x, start, pieces) for x in [x0, x1]: Angle's operations on
+  // intervals, piece by piece.
+  Interval AngleBound(double x0, double x1, double start, int pieces) const {
+    const Interval x = Range(x0, x1);
+    if (!reparam_) return Pt(start) + x * Pt(pieces) * Pt(kPi / 2);
+    const Interval y = x * Pt(pieces);
+    const int first = std::clamp(static_cast<int>(y.lo), 0, pieces - 1);
+    const int last = std::clamp(static_cast<int>(y.hi), 0, pieces - 1);
+    Interval hull;
+    for (int piece = first; piece <= last; ++piece) {
+      // The y of this piece: static_cast<int>(y) == piece, or y up to pieces.
+      const double hi = piece == pieces - 1 ? y.hi : std::min(y.hi, piece + 1.0);
+      const Interval s = Range(std::max(y.lo, static_cast<double>(piece)), hi) - Pt(piece);
+      // s^3 / (s^3 + (1-s)^3) increases with s; computed as Angle computes it.
+      auto power_law = [](double t) {
+        const double t3 = t * t * t, r3 = (1 - t) * (1 - t) * (1 - t);
+        return t3 / (t3 + r3);
+      };
+      const Interval q = IncreasingImage(s, power_law(s.lo), power_law(s.hi));
+      const Interval angle = Pt(start) + (Pt(piece) + q) * Pt(kPi / 2);
+      hull = piece == first ? angle : Hull(hull, angle);
+    }
+    return hull;
+  }
+
+  // SignedPow(c, e_) for c in the interval: non-decreasing in c.
+  Interval SignedPowBound(const Interval& c) const {
+    return IncreasingImage(c, SignedPow(c.lo, e_), SignedPow(c.hi, e_));
   }
 
   const double e_;

@@ -13,10 +13,17 @@ absl::Status Region::Validate() const {
     case Kind::kParameterRect: {
       const bool finite = std::isfinite(u0) && std::isfinite(u1) && std::isfinite(v0) &&
                           std::isfinite(v1);
-      if (!finite || !(u0 < u1) || !(v0 < v1) || u1 <= 0 || u0 >= 1 || v1 <= 0 || v0 >= 1) {
+      if (!finite || !(u0 < u1) || !(v0 < v1)) {
         return absl::InvalidArgumentError(absl::StrFormat(
-            "the parameter rectangle [%g,%g] x [%g,%g] is empty: it needs u0 < u1, v0 < v1 and "
-            "an overlap with the unit square",
+            "the parameter rectangle [%g,%g] x [%g,%g] is empty: it needs finite bounds with "
+            "u0 < u1 and v0 < v1",
+            u0, u1, v0, v1));
+      }
+      if (u0 < 0 || u1 > 1 || v0 < 0 || v1 > 1) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "the parameter rectangle [%g,%g] x [%g,%g] leaves the unit square [0,1] x [0,1]; "
+            "parameters are unit-square coordinates, so it needs 0 <= u0 < u1 <= 1 and "
+            "0 <= v0 < v1 <= 1",
             u0, u1, v0, v1));
       }
       return absl::OkStatus();

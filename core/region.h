@@ -41,7 +41,8 @@ struct Region {
   }
 
   // INVALID_ARGUMENT for an empty or degenerate region (zero area or volume,
-  // a rectangle outside the unit square, or non-finite bounds).
+  // or non-finite bounds) and for a parameter rectangle that is not inside
+  // the unit square.
   absl::Status Validate() const;
 };
 

@@ -104,41 +104,34 @@ absl::Status SampleCursor::PlanRegion(uint64_t begin, uint64_t end) {
     }
   };
 
-  enum class Overlap { kNone, kPartial, kInside };
-  // Parameter cell against the region. For a 3D box the patch is bounded by
-  // the box of f at its 3x3 grid of points grown by the largest distance from
-  // its centre to them; this assumes a patch does not bulge further than that
-  // from its 9 points, which holds for cells fine enough to pass the paper's
-  // flatness test. Samples are always tested exactly, so the bound only
-  // prunes.
-  auto overlap = [&](double u0, double v0, double h) -> absl::StatusOr<Overlap> {
+  // How a parameter cell's samples relate to the region. kUnknown: the
+  // surface offers no bound, so every sample of the cell is tested.
+  enum class Overlap { kNone, kPartial, kInside, kUnknown };
+  // A sample's parameters are computed from its leaf's cell and may stray
+  // from the cell [u0, u0 + h] computed here by a few ulp (cell sides 3^-k
+  // are not exact in binary): cells are widened by this much.
+  constexpr double kParameterSlack = 1e-12;
+  // Parameter cell against the region. For a 3D box the cell's patch is
+  // enclosed by Surface::Bound, a proven box, so a cell is skipped only when
+  // none of its samples can lie in the region and taken whole only when all
+  // of them do. Emit still tests every sample it is handed.
+  auto overlap = [&](double u0, double v0, double h) -> Overlap {
+    const double cu0 = std::max(0.0, u0 - kParameterSlack);
+    const double cu1 = std::min(1.0, u0 + h + kParameterSlack);
+    const double cv0 = std::max(0.0, v0 - kParameterSlack);
+    const double cv1 = std::min(1.0, v0 + h + kParameterSlack);
     if (region_.kind == Region::Kind::kParameterRect) {
-      if (u0 > region_.u1 || u0 + h < region_.u0 || v0 > region_.v1 || v0 + h < region_.v0) {
+      if (cu0 > region_.u1 || cu1 < region_.u0 || cv0 > region_.v1 || cv1 < region_.v0) {
         return Overlap::kNone;
       }
-      const bool inside = u0 >= region_.u0 && u0 + h <= region_.u1 && v0 >= region_.v0 &&
-                          v0 + h <= region_.v1;
+      const bool inside =
+          cu0 >= region_.u0 && cu1 <= region_.u1 && cv0 >= region_.v0 && cv1 <= region_.v1;
       return inside ? Overlap::kInside : Overlap::kPartial;
     }
-    Vec3 pts[9];
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) {
-        const double u = u0 + i * (h / 2), v = v0 + j * (h / 2);
-        pts[3 * i + j] = surface.Point(u, v);
-        if (!IsFinite(pts[3 * i + j])) {
-          return SurfaceNotFiniteError(u, v);
-        }
-      }
-    }
-    Vec3 lo = pts[0], hi = pts[0];
-    double grow = 0;
-    for (const Vec3& p : pts) {
-      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-      grow = std::max(grow, Norm(p - pts[4]));
-    }
-    lo = lo - Vec3{grow, grow, grow};
-    hi = hi + Vec3{grow, grow, grow};
+    const std::optional<Box3> bound = surface.Bound(cu0, cu1, cv0, cv1);
+    if (!bound) return Overlap::kUnknown;
+    const Vec3& lo = bound->lo;
+    const Vec3& hi = bound->hi;
     const Vec3& rl = region_.lo;
     const Vec3& rh = region_.hi;
     if (lo.x > rh.x || hi.x < rl.x || lo.y > rh.y || hi.y < rl.y || lo.z > rh.z || hi.z < rl.z) {
@@ -150,15 +143,16 @@ absl::Status SampleCursor::PlanRegion(uint64_t begin, uint64_t end) {
   };
 
   // Walks the tree's cells in curve order, descending only where a cell
-  // straddles the region's boundary.
+  // straddles the region's boundary (cost: the samples taken plus the cells
+  // on the boundary, when the bounds are tight).
   std::function<absl::Status(int, uint64_t, uint64_t, uint64_t, int)> visit =
       [&](int depth, uint64_t start, uint64_t x, uint64_t y, int state) -> absl::Status {
     const size_t a = tree.LeafAt(start);
     const size_t b = tree.LeafAt(start + curve.Span(depth) - 1) + 1;
     const double h = 1.0 / curve.PowG(depth);
-    ASSIGN_OR_RETURN(const Overlap o, overlap(x * h, y * h, h));
+    const Overlap o = overlap(x * h, y * h, h);
     if (o == Overlap::kNone) return absl::OkStatus();
-    if (o == Overlap::kInside || b - a == 1) {
+    if (o != Overlap::kPartial || b - a == 1) {
       add_leaves(a, b);
       return absl::OkStatus();
     }

@@ -1,6 +1,7 @@
 #include "core/surface.h"
 
 #include <algorithm>
+#include <limits>
 
 namespace sfc {
 namespace {
@@ -47,6 +48,15 @@ void Surface::JetGrid(const double* us, int nu, const double* vs, int nv, int or
     for (int j = 0; j < nv; ++j) out[i * nv + j] = Jet(us[i], vs[j], order);
   }
 }
+
+Box3 BoxOf(const Interval& x, const Interval& y, const Interval& z) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  auto lo = [&](const Interval& i) { return i.maybe_nan ? -kInf : i.lo; };
+  auto hi = [&](const Interval& i) { return i.maybe_nan ? kInf : i.hi; };
+  return {{lo(x), lo(y), lo(z)}, {hi(x), hi(y), hi(z)}};
+}
+
+std::optional<Box3> Surface::Bound(double, double, double, double) const { return std::nullopt; }
 
 SurfaceGeometry GeometryOf(const SurfaceJet& jet) {
   SurfaceGeometry geo;

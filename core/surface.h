@@ -9,6 +9,9 @@
 #ifndef SFCSAMPLER_CORE_SURFACE_H_
 #define SFCSAMPLER_CORE_SURFACE_H_
 
+#include <optional>
+
+#include "core/interval.h"
 #include "core/vec3.h"
 
 namespace sfc {
@@ -20,6 +23,16 @@ struct SurfaceJet {
   Vec3 fuu, fuv, fvv;  // second derivatives; zero unless asked for (order 2)
 };
 
+// The axis-aligned box [lo.x, hi.x] x [lo.y, hi.y] x [lo.z, hi.z]; end points
+// may be infinite.
+struct Box3 {
+  Vec3 lo, hi;
+};
+
+// The box of three coordinate intervals; an interval that may be NaN spans
+// the whole axis.
+Box3 BoxOf(const Interval& x, const Interval& y, const Interval& z);
+
 class Surface {
  public:
   virtual ~Surface() = default;
@@ -28,7 +41,8 @@ class Surface {
   // a surface that is singular there; callers check (see IsFinite).
   virtual Vec3 Point(double u, double v) const = 0;
 
-  // Position and derivatives up to `order` (1 or 2). The default takes finite
+  // Position and derivatives up to `order` (1 or 2); p equals Point(u, v) bit
+  // for bit. The default takes finite
   // differences of Point(): 4th-order central differences for the first
   // derivatives (one-sided 2nd order within 2h of an edge, h = 1e-3 resp.
   // 1e-5), 2nd-order central differences for the second ones (h = 1e-4).
@@ -41,6 +55,14 @@ class Surface {
   // calls Jet.
   virtual void JetGrid(const double* us, int nu, const double* vs, int nv, int order,
                        SurfaceJet* out) const;
+
+  // A box that provably holds Point(u, v) for every (u, v) in the rectangle
+  // [u0,u1] x [v0,v1], as Point computes it in floating point (and as Jet's p,
+  // which equals it), and the exact real value of the same formula too:
+  // interval arithmetic widened for rounding (core/interval.h). nullopt when the surface cannot bound
+  // itself, which is the default; callers then test points one by one.
+  // REQUIRES: 0 <= u0 <= u1 <= 1 and 0 <= v0 <= v1 <= 1.
+  virtual std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const;
 };
 
 // First fundamental form, normal and curvatures at one point.

@@ -53,6 +53,30 @@ inline SampleBatch Collect(std::shared_ptr<const Sampler> sampler, uint64_t begi
   return all;
 }
 
+// The same samples, bit for bit, in the same order.
+inline void ExpectSameSamples(const SampleBatch& a, const SampleBatch& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a.index[i], b.index[i]) << i;
+    ASSERT_EQ(a.u[i], b.u[i]) << i;
+    ASSERT_EQ(a.v[i], b.v[i]) << i;
+    ASSERT_EQ(a.x[i], b.x[i]) << i;
+    ASSERT_EQ(a.y[i], b.y[i]) << i;
+    ASSERT_EQ(a.z[i], b.z[i]) << i;
+  }
+}
+
+// The samples of `full` inside `region`, in order.
+inline SampleBatch Filter(const SampleBatch& full, const Region& region) {
+  SampleBatch out;
+  for (size_t i = 0; i < full.size(); ++i) {
+    if (region.Contains(full.u[i], full.v[i], {full.x[i], full.y[i], full.z[i]})) {
+      out.AppendFrom(full, i, i + 1);
+    }
+  }
+  return out;
+}
+
 }  // namespace sfc::testing
 
 #endif  // SFCSAMPLER_TESTS_TEST_UTIL_H_
