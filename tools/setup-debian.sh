@@ -17,6 +17,9 @@ packages=(
   libssl-dev                                     # constant-time token comparison (CRYPTO_memcmp)
   openssl                                        # a self-signed certificate for the TLS test
   nginx                                          # the consistent-hash gRPC proxy of the scale-out test
+  libocct-foundation-dev libocct-modeling-data-dev  # OpenCASCADE: STEP/IGES faces, exact derivatives,
+  libocct-modeling-algorithms-dev libocct-data-exchange-dev  # trims, areas, test models (cad/)
+  libtbb-dev                                     # OpenCASCADE's CMake targets link libtbb.so
 )
 
 missing=()

@@ -1,0 +1,21 @@
+#include "cad/internal/kernel_messages.h"
+
+#include <Message.hxx>
+#include <Message_Messenger.hxx>
+#include <Message_Printer.hxx>
+#include <mutex>
+
+namespace sfc::cad {
+
+void SilenceKernelMessages() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    const Handle(Message_Messenger)& messenger = Message::DefaultMessenger();
+    const Message_SequenceOfPrinters printers = messenger->Printers();
+    for (Message_SequenceOfPrinters::Iterator it(printers); it.More(); it.Next()) {
+      messenger->RemovePrinter(it.Value());
+    }
+  });
+}
+
+}  // namespace sfc::cad
