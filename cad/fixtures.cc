@@ -26,7 +26,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "cad/internal/kernel_messages.h"
+#include "cad/internal/kernel_setup.h"
 #include "core/status_macros.h"
 
 namespace sfc::cad::fixtures {

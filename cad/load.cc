@@ -1,5 +1,10 @@
 #include "cad/load.h"
 
+// OCC_CATCH_SIGNALS converts faults only with this defined (as Debian's
+// OpenCASCADE was built); before any kernel header.
+#ifndef OCC_CONVERT_SIGNALS
+#define OCC_CONVERT_SIGNALS
+#endif
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -12,6 +17,7 @@
 #include <IGESControl_Reader.hxx>
 #include <Precision.hxx>
 #include <STEPControl_Reader.hxx>
+#include <Standard_ErrorHandler.hxx>
 #include <Standard_Failure.hxx>
 #include <TColStd_Array1OfInteger.hxx>
 #include <TColStd_Array1OfReal.hxx>
@@ -36,7 +42,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "absl/synchronization/mutex.h"
-#include "cad/internal/kernel_messages.h"
+#include "cad/internal/kernel_setup.h"
 #include "cad/internal/occ_face.h"
 #include "cad/nurbs_patch.h"
 #include "core/status_macros.h"
@@ -45,7 +51,7 @@ namespace sfc::cad {
 namespace {
 
 // The STEP and IGES readers share the kernel's global parameters
-// (Interface_Static) and its messenger.
+// (Interface_Static) and its messenger; one load at a time.
 absl::Mutex g_reader_mutex;
 
 absl::Status Invalid(ModelFormat format, absl::string_view name, absl::string_view what) {
@@ -121,9 +127,8 @@ class TempFile {
   std::error_code ignored_;
 };
 
+// REQUIRES: CheckStepFraming passed.
 absl::StatusOr<TopoDS_Shape> ReadStep(absl::string_view bytes, absl::string_view name) {
-  RETURN_IF_ERROR(CheckStepFraming(bytes, name));
-  absl::MutexLock lock(&g_reader_mutex);
   STEPControl_Reader reader;
   std::istringstream stream{std::string(bytes)};
   const std::string stream_name(name);
@@ -138,13 +143,10 @@ absl::StatusOr<TopoDS_Shape> ReadStep(absl::string_view bytes, absl::string_view
   return reader.OneShape();
 }
 
-absl::StatusOr<TopoDS_Shape> ReadIges(absl::string_view bytes, absl::string_view name) {
-  RETURN_IF_ERROR(CheckIgesFraming(bytes, name));
-  TempFile file;  // IGESControl_Reader reads only files
-  RETURN_IF_ERROR(file.Write(bytes));
-  absl::MutexLock lock(&g_reader_mutex);
+// Reads the IGES file at `path`, the private copy Load made of the bytes.
+absl::StatusOr<TopoDS_Shape> ReadIges(const std::string& path, absl::string_view name) {
   IGESControl_Reader reader;
-  const IFSelect_ReturnStatus status = reader.ReadFile(file.path().c_str());
+  const IFSelect_ReturnStatus status = reader.ReadFile(path.c_str());
   if (status == IFSelect_RetVoid)
     return Invalid(ModelFormat::kIges, name, "empty model: it has no entities");
   if (status != IFSelect_RetDone) {
@@ -263,8 +265,11 @@ absl::StatusOr<Face> MakeFace(const TopoDS_Face& face, int index, ModelFormat fo
               std::move(surface), std::move(trim));
 }
 
+// All the kernel work of Load. REQUIRES: g_reader_mutex held; for IGES,
+// `iges_path` holds the bytes.
 absl::StatusOr<std::shared_ptr<const Model>> LoadUnguarded(ModelFormat format,
                                                            absl::string_view bytes,
+                                                           const std::string& iges_path,
                                                            absl::string_view name,
                                                            const LoadOptions& options) {
   TopoDS_Shape shape;
@@ -274,7 +279,7 @@ absl::StatusOr<std::shared_ptr<const Model>> LoadUnguarded(ModelFormat format,
       break;
     }
     case ModelFormat::kIges: {
-      ASSIGN_OR_RETURN(shape, ReadIges(bytes, name));
+      ASSIGN_OR_RETURN(shape, ReadIges(iges_path, name));
       break;
     }
     case ModelFormat::kNurbs: {
@@ -292,6 +297,31 @@ absl::StatusOr<std::shared_ptr<const Model>> LoadUnguarded(ModelFormat format,
     faces.push_back(std::move(face));
   }
   return std::make_shared<const Model>(std::string(name), std::move(faces));
+}
+
+// LoadUnguarded with the kernel's exceptions, and the faults it turns into
+// exceptions (cad/internal/kernel_setup.h), as statuses. A fault abandons
+// the frames below without their destructors: it leaks the kernel's objects
+// of this load, nothing else (no lock or file of ours lives below here).
+absl::StatusOr<std::shared_ptr<const Model>> GuardedLoad(ModelFormat format,
+                                                         absl::string_view bytes,
+                                                         const std::string& iges_path,
+                                                         absl::string_view name,
+                                                         const LoadOptions& options) {
+  try {
+    OCC_CATCH_SIGNALS
+    return LoadUnguarded(format, bytes, iges_path, name, options);
+  } catch (const Standard_Failure& e) {
+    return Invalid(format, name,
+                   absl::StrCat("the kernel failed on it: ", e.GetMessageString(), " (",
+                                e.DynamicType()->Name(), ")"));
+  } catch (const std::bad_alloc&) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat(ModelFormatName(format), " file ", name, ": out of memory while reading it"));
+  } catch (const std::exception& e) {
+    return absl::InternalError(
+        absl::StrCat(ModelFormatName(format), " file ", name, ": ", e.what()));
+  }
 }
 
 }  // namespace
@@ -325,20 +355,21 @@ absl::StatusOr<std::shared_ptr<const Model>> Load(ModelFormat format, absl::stri
         absl::StrCat(absl::AsciiStrToUpper(ModelFormatName(format)), " file ", name, " has ",
                      bytes.size(), " bytes, above the limit of ", options.max_bytes, " bytes"));
   }
-  SilenceKernelMessages();
-  try {
-    return LoadUnguarded(format, bytes, name, options);
-  } catch (const Standard_Failure& e) {
-    return Invalid(format, name,
-                   absl::StrCat("the kernel failed on it: ", e.GetMessageString(), " (",
-                                e.DynamicType()->Name(), ")"));
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat(ModelFormatName(format), " file ", name, ": out of memory while reading it"));
-  } catch (const std::exception& e) {
-    return absl::InternalError(
-        absl::StrCat(ModelFormatName(format), " file ", name, ": ", e.what()));
+  // Checks without the kernel first; then our own resources (the temporary
+  // file, the lock) are taken outside GuardedLoad, whose signal guard skips
+  // destructors of the frames between the fault and itself.
+  std::string iges_path;
+  TempFile file;
+  if (format == ModelFormat::kStep) RETURN_IF_ERROR(CheckStepFraming(bytes, name));
+  if (format == ModelFormat::kIges) {
+    RETURN_IF_ERROR(CheckIgesFraming(bytes, name));
+    RETURN_IF_ERROR(file.Write(bytes));  // IGESControl_Reader reads only files
+    iges_path = file.path();
   }
+  SilenceKernelMessages();
+  ConvertKernelSignals();
+  absl::MutexLock lock(&g_reader_mutex);
+  return GuardedLoad(format, bytes, iges_path, name, options);
 }
 
 }  // namespace sfc::cad

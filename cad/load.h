@@ -8,7 +8,7 @@
 //
 // Thread-safety: Load may be called from many threads; the STEP and IGES
 // readers keep global state in the kernel, so those reads are serialised by
-// one process-wide mutex (NURBS patches are not).
+// one process-wide mutex (NURBS patches too: they are quick).
 #ifndef SFCSAMPLER_CAD_LOAD_H_
 #define SFCSAMPLER_CAD_LOAD_H_
 
@@ -46,7 +46,11 @@ struct LoadOptions {
 //                       weights, counts, NaN);
 //   INTERNAL            the kernel failed in an unexpected way (its
 //                       exception's message is passed on).
-// Never throws: the kernel's Standard_Failure is caught here.
+// Never throws: the kernel's Standard_Failure is caught here, and so is a
+// fault inside the kernel on malformed input (a null dereference in the IGES
+// reader), which the kernel's signal handlers turn into a Standard_Failure;
+// Load installs them for signals that have no handler yet
+// (cad/internal/kernel_setup.h). Such a fault leaks that load's kernel objects.
 absl::StatusOr<std::shared_ptr<const Model>> Load(ModelFormat format, absl::string_view bytes,
                                                   absl::string_view name,
                                                   const LoadOptions& options = {});

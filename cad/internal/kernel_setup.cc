@@ -1,8 +1,9 @@
-#include "cad/internal/kernel_messages.h"
+#include "cad/internal/kernel_setup.h"
 
 #include <Message.hxx>
 #include <Message_Messenger.hxx>
 #include <Message_Printer.hxx>
+#include <OSD.hxx>
 #include <mutex>
 
 namespace sfc::cad {
@@ -16,6 +17,12 @@ void SilenceKernelMessages() {
       messenger->RemovePrinter(it.Value());
     }
   });
+}
+
+void ConvertKernelSignals() {
+  static std::once_flag once;
+  // No floating-point traps: evaluation may produce NaN, which callers check.
+  std::call_once(once, [] { OSD::SetSignal(OSD_SignalMode_SetUnhandled, false); });
 }
 
 }  // namespace sfc::cad
