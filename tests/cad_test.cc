@@ -313,6 +313,46 @@ TEST(CadBoxWithHole, ClassifierAgreesWithPointsAndAreas) {
   EXPECT_GE(trimmed_faces, 2) << "the top and bottom faces have a hole";
 }
 
+// Random cells of every size, many near the trim: a cell called inside
+// (outside) holds no point the kernel puts out of (in) the face.
+TEST(CadBoxWithHole, RandomCellsOfAllSizesAreClassifiedSafely) {
+  auto model = LoadOk(Solid::kBoxWithHole, ModelFormat::kStep);
+  ASSERT_NE(model, nullptr);
+  std::mt19937_64 rng(11);
+  int decided = 0;
+  for (const Face& face : model->faces()) {
+    if (!face.trimmed()) continue;
+    for (int k = 0; k < 1500; ++k) {
+      const int depth = 2 + static_cast<int>(rng() % 11);
+      const int cells = 1 << depth;
+      double s0 = double(rng() % cells) / cells, t0 = double(rng() % cells) / cells;
+      if (k % 2 == 1) {
+        // A cell within a few cell widths of the hole, whose circle is
+        // centred in the face's square (the box's parameters start at a corner).
+        const double angle = 2 * kPi * double(rng() % 100000) / 100000;
+        const double offset = (double(rng() % 1000) / 1000 - 0.5) * 6.0 / cells;
+        const double s = 0.5 + (fixtures::kHoleRadius / fixtures::kBoxX + offset) * std::cos(angle);
+        const double t = 0.5 + (fixtures::kHoleRadius / fixtures::kBoxY + offset) * std::sin(angle);
+        s0 = std::clamp(std::floor(s * cells), 0.0, cells - 1.0) / cells;
+        t0 = std::clamp(std::floor(t * cells), 0.0, cells - 1.0) / cells;
+      }
+      const double s1 = s0 + 1.0 / cells, t1 = t0 + 1.0 / cells;
+      const CellState state = face.Classify(s0, s1, t0, t1);
+      if (state == CellState::kStraddles) continue;
+      ++decided;
+      for (int a = 0; a <= 2; ++a) {
+        for (int b = 0; b <= 2; ++b) {
+          const double s = s0 + (s1 - s0) * a / 2, t = t0 + (t1 - t0) * b / 2;
+          ASSERT_EQ(face.Contains(s, t), state == CellState::kInside)
+              << "face " << face.index() << " cell [" << s0 << ", " << s1 << "] x [" << t0 << ", "
+              << t1 << "] at (" << s << ", " << t << ")";
+        }
+      }
+    }
+  }
+  EXPECT_GT(decided, 2000);
+}
+
 // Refining a straddling cell ends in cells the boundary boxes leave alone.
 TEST(CadBoxWithHole, StraddlingCellsShrinkToTheBoundary) {
   auto model = LoadOk(Solid::kBoxWithHole, ModelFormat::kStep);
