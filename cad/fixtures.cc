@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <BRepAlgoAPI_Cut.hxx>
+#include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepFilletAPI_MakeFillet.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
@@ -56,6 +57,8 @@ TopoDS_Shape MakeSolid(Solid solid) {
               .Shape();
       return BRepAlgoAPI_Cut(rounded, drill).Shape();
     }
+    case Solid::kEdgeOnly:
+      return BRepBuilderAPI_MakeEdge(gp_Pnt(0, 0, 0), gp_Pnt(kBoxX, 0, 0)).Shape();
   }
   return {};
 }
@@ -78,6 +81,8 @@ std::string SolidName(Solid solid) {
       return "cylinder";
     case Solid::kBoxWithHole:
       return "box_with_hole";
+    case Solid::kEdgeOnly:
+      return "edge_only";
   }
   return "unknown";
 }

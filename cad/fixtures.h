@@ -34,9 +34,11 @@ inline constexpr double kHoleRadius = 5;
 inline constexpr double kPatchRadius = 2;
 inline constexpr double kPatchHeight = 3;
 
-enum class Solid { kSphere, kCylinder, kBoxWithHole };
+// kEdgeOnly is a single straight edge and no face (a model without faces,
+// for the error); WriteAll leaves it out.
+enum class Solid { kSphere, kCylinder, kBoxWithHole, kEdgeOnly };
 
-// "sphere", "cylinder", "box_with_hole".
+// "sphere", "cylinder", "box_with_hole", "edge_only".
 std::string SolidName(Solid solid);
 
 // The solid written as STEP or IGES (ModelFormat::kStep or kIges), as bytes.

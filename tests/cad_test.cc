@@ -494,6 +494,9 @@ TEST(CadErrors, MalformedStepAndIges) {
       "FILE_SCHEMA(('AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }'));\nENDSEC;\nDATA;\nENDSEC;\n"
       "END-ISO-10303-21;\n";
   ExpectInvalid(ModelFormat::kStep, empty_model, "empty.step", "empty model");
+  for (ModelFormat format : {ModelFormat::kStep, ModelFormat::kIges}) {
+    ExpectInvalid(format, Bytes(Solid::kEdgeOnly, format), "edge_only", "no faces");
+  }
   // Garbage inside a well-framed file.
   std::string mangled = step;
   const size_t data = mangled.find("DATA;");
