@@ -371,12 +371,34 @@ TEST(CadBoxWithHole, StraddlingCellsShrinkToTheBoundary) {
   }
 }
 
+// A 6 x 6 biquadratic patch with four spans per direction: evaluation moves
+// between spans all the time, so the kernel's B-spline span cache (mutable in
+// GeomAdaptor_Surface) would be rebuilt under another thread's feet if
+// adaptors were shared.
+std::string MultiSpanPatch() {
+  std::string text =
+      "sfcsampler-nurbs 1\ndegree 2 2\ncount 6 6\n"
+      "knots_u 0 0 0 0.25 0.5 0.75 1 1 1\nknots_v 0 0 0 0.2 0.5 0.7 1 1 1\n";
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) {
+      text += "pole " + std::to_string(i) + " " + std::to_string(j) + " " +
+              std::to_string((i * 7 + j * 3) % 5 * 0.3) + " " + std::to_string(1 + (i + j) % 3) +
+              "\n";
+    }
+  }
+  return text;
+}
+
 TEST(CadModel, ConcurrentEvaluationMatchesSerial) {
-  auto model = LoadOk(Solid::kBoxWithHole, ModelFormat::kStep);
-  ASSERT_NE(model, nullptr);
+  auto box = LoadOk(Solid::kBoxWithHole, ModelFormat::kStep);
+  ASSERT_NE(box, nullptr);
+  auto patch = Load(ModelFormat::kNurbs, MultiSpanPatch(), "spans.nurbs");
+  ASSERT_TRUE(patch.ok()) << patch.status();
+  std::vector<Face> faces = box->faces();
+  faces.push_back((*patch)->faces()[0]);
   const int n = 40;
   auto run = [&](std::vector<double>& out) {
-    for (const Face& face : model->faces()) {
+    for (const Face& face : faces) {
       for (int i = 0; i < n; ++i) {
         for (int j = 0; j < n; ++j) {
           const SurfaceJet jet = face.surface().Jet((i + 0.5) / n, (j + 0.5) / n, 2);
