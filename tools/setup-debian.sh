@@ -22,6 +22,9 @@ packages=(
   python3-grpcio python3-protobuf                # sfcsampler.Client: gRPC and the generated *_pb2.py
   python3-pytest                                 # the Python tests in the suite
   python3-matplotlib                             # the examples' plots (Monte Carlo error, torus picture)
+  libocct-foundation-dev libocct-modeling-data-dev  # OpenCASCADE: STEP/IGES faces, exact derivatives,
+  libocct-modeling-algorithms-dev libocct-data-exchange-dev  # trims, areas, test models (cad/)
+  libtbb-dev                                     # OpenCASCADE's CMake targets link libtbb.so
 )
 
 missing=()

@@ -1,0 +1,58 @@
+// Test models the project makes itself with OpenCASCADE (no binaries in the
+// repository): a sphere, a cylinder, and a box with a fillet and a through
+// hole, as STEP and IGES; and a NURBS patch in our text format. Their sizes
+// are constants here so tests can compare with exact formulas.
+//
+// Thread-safety: the writers share the kernel's global state; call from one
+// thread at a time.
+#ifndef SFCSAMPLER_CAD_FIXTURES_H_
+#define SFCSAMPLER_CAD_FIXTURES_H_
+
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "cad/load.h"
+
+namespace sfc::cad::fixtures {
+
+// A sphere of radius kSphereRadius about the origin.
+inline constexpr double kSphereRadius = 10;
+// A solid cylinder of radius kCylinderRadius and height kCylinderHeight on
+// the z axis, base at z = 0.
+inline constexpr double kCylinderRadius = 5;
+inline constexpr double kCylinderHeight = 20;
+// The box [0,kBoxX]x[0,kBoxY]x[0,kBoxZ], its vertical edge at (kBoxX, kBoxY)
+// rounded with radius kFilletRadius, and a hole of radius kHoleRadius along z
+// through (kBoxX/2, kBoxY/2).
+inline constexpr double kBoxX = 40, kBoxY = 30, kBoxZ = 20;
+inline constexpr double kFilletRadius = 3;
+inline constexpr double kHoleRadius = 5;
+// The NURBS patch: a quarter of a cylinder of radius kPatchRadius and height
+// kPatchHeight (an exact rational quadratic arc in u, linear in v), area
+// pi/2 kPatchRadius kPatchHeight.
+inline constexpr double kPatchRadius = 2;
+inline constexpr double kPatchHeight = 3;
+
+// kEdgeOnly is a single straight edge and no face (a model without faces,
+// for the error); WriteAll leaves it out.
+enum class Solid { kSphere, kCylinder, kBoxWithHole, kEdgeOnly };
+
+// "sphere", "cylinder", "box_with_hole", "edge_only".
+std::string SolidName(Solid solid);
+
+// The solid written as STEP or IGES (ModelFormat::kStep or kIges), as bytes.
+// INVALID_ARGUMENT for kNurbs; INTERNAL if the kernel fails.
+absl::StatusOr<std::string> SolidBytes(Solid solid, ModelFormat format);
+
+// The quarter-cylinder NURBS patch in our format (docs/NURBS_FORMAT.md).
+std::string NurbsPatchText();
+
+// Writes every fixture into `dir` (which must exist): sphere.step,
+// sphere.iges, cylinder.step, ..., box_with_hole.iges, quarter_cylinder.nurbs.
+// Returns the paths written.
+absl::StatusOr<std::vector<std::string>> WriteAll(const std::string& dir);
+
+}  // namespace sfc::cad::fixtures
+
+#endif  // SFCSAMPLER_CAD_FIXTURES_H_

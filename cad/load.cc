@@ -1,0 +1,375 @@
+#include "cad/load.h"
+
+// OCC_CATCH_SIGNALS converts faults only with this defined (as Debian's
+// OpenCASCADE was built); before any kernel header.
+#ifndef OCC_CONVERT_SIGNALS
+#define OCC_CONVERT_SIGNALS
+#endif
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <BRepAdaptor_Surface.hxx>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepGProp.hxx>
+#include <BRepTools.hxx>
+#include <GProp_GProps.hxx>
+#include <Geom_BSplineSurface.hxx>
+#include <IGESControl_Reader.hxx>
+#include <Precision.hxx>
+#include <STEPControl_Reader.hxx>
+#include <Standard_ErrorHandler.hxx>
+#include <Standard_Failure.hxx>
+#include <TColStd_Array1OfInteger.hxx>
+#include <TColStd_Array1OfReal.hxx>
+#include <TColStd_Array2OfReal.hxx>
+#include <TColgp_Array2OfPnt.hxx>
+#include <TopExp.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Face.hxx>
+#include <TopoDS_Shape.hxx>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <new>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "absl/synchronization/mutex.h"
+#include "cad/internal/kernel_setup.h"
+#include "cad/internal/occ_face.h"
+#include "cad/nurbs_patch.h"
+#include "core/status_macros.h"
+
+namespace sfc::cad {
+namespace {
+
+// The STEP and IGES readers share the kernel's global parameters
+// (Interface_Static) and its messenger; one load at a time.
+absl::Mutex g_reader_mutex;
+
+absl::Status Invalid(ModelFormat format, absl::string_view name, absl::string_view what) {
+  return absl::InvalidArgumentError(
+      absl::StrCat(absl::AsciiStrToUpper(ModelFormatName(format)), " file ", name, ": ", what));
+}
+
+// The text must open with the ISO 10303-21 header and end with its trailer:
+// a file cut short (an interrupted upload) lacks the trailer.
+absl::Status CheckStepFraming(absl::string_view bytes, absl::string_view name) {
+  absl::string_view text = absl::StripAsciiWhitespace(bytes);
+  if (!absl::StartsWith(text, "ISO-10303-21;")) {
+    return Invalid(ModelFormat::kStep, name,
+                   "not a STEP file (it does not start with 'ISO-10303-21;')");
+  }
+  if (!absl::EndsWith(text, "END-ISO-10303-21;")) {
+    return Invalid(ModelFormat::kStep, name,
+                   "truncated: it does not end with 'END-ISO-10303-21;' (was the file cut short?)");
+  }
+  return absl::OkStatus();
+}
+
+// IGES is 80-column records with the section letter in column 73; a complete
+// file starts with S or G and ends with its single Terminate (T) record.
+absl::Status CheckIgesFraming(absl::string_view bytes, absl::string_view name) {
+  std::vector<absl::string_view> lines = absl::StrSplit(bytes, '\n', absl::SkipWhitespace());
+  auto section = [](absl::string_view line) {
+    line = absl::StripTrailingAsciiWhitespace(line);
+    return line.size() >= 73 ? line[72] : '\0';
+  };
+  if (lines.empty() || (section(lines.front()) != 'S' && section(lines.front()) != 'G' &&
+                        section(lines.front()) != 'F' && section(lines.front()) != 'C')) {
+    return Invalid(ModelFormat::kIges, name, "not an IGES file (no Start section in column 73)");
+  }
+  if (section(lines.back()) != 'T') {
+    return Invalid(
+        ModelFormat::kIges, name,
+        "truncated: the last record is not the Terminate section (was the file cut short?)");
+  }
+  return absl::OkStatus();
+}
+
+// A private temporary file holding bytes, deleted when this goes.
+class TempFile {
+ public:
+  ~TempFile() {
+    if (!path_.empty()) std::filesystem::remove(path_, ignored_);
+  }
+  absl::Status Write(absl::string_view bytes) {
+    std::string pattern =
+        (std::filesystem::temp_directory_path(ignored_) / "sfc-cad-XXXXXX.igs").string();
+    const int fd = mkstemps(pattern.data(), 4);  // mode 0600
+    if (fd < 0)
+      return absl::InternalError(absl::StrCat("cannot create a temporary file in ", pattern));
+    path_ = pattern;
+    size_t done = 0;
+    while (done < bytes.size()) {
+      const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+      if (n <= 0) {
+        ::close(fd);
+        return absl::InternalError(absl::StrCat("cannot write the temporary file ", path_));
+      }
+      done += static_cast<size_t>(n);
+    }
+    if (::close(fd) != 0)
+      return absl::InternalError(absl::StrCat("cannot close the temporary file ", path_));
+    return absl::OkStatus();
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  std::error_code ignored_;
+};
+
+// REQUIRES: CheckStepFraming passed.
+absl::StatusOr<TopoDS_Shape> ReadStep(absl::string_view bytes, absl::string_view name) {
+  STEPControl_Reader reader;
+  std::istringstream stream{std::string(bytes)};
+  const std::string stream_name(name);
+  const IFSelect_ReturnStatus status = reader.ReadStream(stream_name.c_str(), stream);
+  if (status == IFSelect_RetVoid)
+    return Invalid(ModelFormat::kStep, name, "empty model: it has no entities");
+  if (status != IFSelect_RetDone) {
+    return Invalid(ModelFormat::kStep, name,
+                   "the STEP reader rejected it (syntax or structure errors)");
+  }
+  reader.TransferRoots();
+  return reader.OneShape();
+}
+
+// Reads the IGES file at `path`, the private copy Load made of the bytes.
+absl::StatusOr<TopoDS_Shape> ReadIges(const std::string& path, absl::string_view name) {
+  IGESControl_Reader reader;
+  const IFSelect_ReturnStatus status = reader.ReadFile(path.c_str());
+  if (status == IFSelect_RetVoid)
+    return Invalid(ModelFormat::kIges, name, "empty model: it has no entities");
+  if (status != IFSelect_RetDone) {
+    return Invalid(ModelFormat::kIges, name,
+                   "the IGES reader rejected it (syntax or structure errors)");
+  }
+  reader.TransferRoots();
+  return reader.OneShape();
+}
+
+absl::StatusOr<TopoDS_Shape> ReadNurbs(absl::string_view bytes, absl::string_view name) {
+  ASSIGN_OR_RETURN(NurbsPatch patch, ParseNurbsPatch(bytes, name));
+  TColgp_Array2OfPnt poles(1, patch.count_u, 1, patch.count_v);
+  TColStd_Array2OfReal weights(1, patch.count_u, 1, patch.count_v);
+  for (int i = 0; i < patch.count_u; ++i) {
+    for (int j = 0; j < patch.count_v; ++j) {
+      const NurbsPatch::Pole& p = patch.poles[static_cast<size_t>(i) * patch.count_v + j];
+      poles.SetValue(i + 1, j + 1, gp_Pnt(p.x, p.y, p.z));
+      weights.SetValue(i + 1, j + 1, p.w);
+    }
+  }
+  // Full knot vectors -> distinct knots and multiplicities.
+  auto split = [](const std::vector<double>& flat, std::vector<double>& knots,
+                  std::vector<int>& mults) {
+    for (double k : flat) {
+      if (!knots.empty() && knots.back() == k) {
+        ++mults.back();
+      } else {
+        knots.push_back(k);
+        mults.push_back(1);
+      }
+    }
+  };
+  std::vector<double> ku, kv;
+  std::vector<int> mu, mv;
+  split(patch.knots_u, ku, mu);
+  split(patch.knots_v, kv, mv);
+  auto real_array = [](const std::vector<double>& x) {
+    TColStd_Array1OfReal a(1, static_cast<int>(x.size()));
+    for (size_t i = 0; i < x.size(); ++i) a.SetValue(static_cast<int>(i) + 1, x[i]);
+    return a;
+  };
+  auto int_array = [](const std::vector<int>& x) {
+    TColStd_Array1OfInteger a(1, static_cast<int>(x.size()));
+    for (size_t i = 0; i < x.size(); ++i) a.SetValue(static_cast<int>(i) + 1, x[i]);
+    return a;
+  };
+  Handle(Geom_BSplineSurface) surface =
+      new Geom_BSplineSurface(poles, weights, real_array(ku), real_array(kv), int_array(mu),
+                              int_array(mv), patch.degree_u, patch.degree_v);
+  BRepBuilderAPI_MakeFace make(surface, Precision::Confusion());
+  if (!make.IsDone())
+    return Invalid(ModelFormat::kNurbs, name, "the kernel could not make a face of the patch");
+  return TopoDS_Shape(make.Face());
+}
+
+FaceType TypeOf(GeomAbs_SurfaceType type) {
+  switch (type) {
+    case GeomAbs_Plane:
+      return FaceType::kPlane;
+    case GeomAbs_Cylinder:
+      return FaceType::kCylinder;
+    case GeomAbs_Cone:
+      return FaceType::kCone;
+    case GeomAbs_Sphere:
+      return FaceType::kSphere;
+    case GeomAbs_Torus:
+      return FaceType::kTorus;
+    case GeomAbs_BezierSurface:
+      return FaceType::kBezier;
+    case GeomAbs_BSplineSurface:
+      return FaceType::kBSpline;
+    case GeomAbs_SurfaceOfRevolution:
+      return FaceType::kRevolution;
+    case GeomAbs_SurfaceOfExtrusion:
+      return FaceType::kExtrusion;
+    case GeomAbs_OffsetSurface:
+      return FaceType::kOffset;
+    default:
+      return FaceType::kOther;
+  }
+}
+
+absl::StatusOr<Face> MakeFace(const TopoDS_Face& face, int index, ModelFormat format,
+                              absl::string_view name, const LoadOptions& options) {
+  auto bad = [&](absl::string_view what) {
+    return Invalid(format, name, absl::StrCat("face ", index, " ", what));
+  };
+  ParameterBox box;
+  BRepTools::UVBounds(face, box.u0, box.u1, box.v0, box.v1);
+  for (double x : {box.u0, box.u1, box.v0, box.v1}) {
+    if (!std::isfinite(x) || Precision::IsInfinite(x))
+      return bad("is unbounded (an infinite surface without trim)");
+  }
+  if (!(box.u1 > box.u0) || !(box.v1 > box.v0)) return bad("has an empty parameter box");
+  const bool reversed = face.Orientation() == TopAbs_REVERSED;
+  const UnitSquareMap map{box, reversed};
+  GProp_GProps props;
+  BRepGProp::SurfaceProperties(face, props);
+  const double area = std::abs(props.Mass());
+  const gp_Pnt c = props.CentreOfMass();
+  const Vec3 centroid{c.X(), c.Y(), c.Z()};
+  if (!std::isfinite(area) || !IsFinite(centroid))
+    return bad("has a non-finite area (NaN or infinite geometry)");
+  auto surface = std::make_shared<FaceSurface>(face, map);
+  for (double s : {0.0, 0.5, 1.0}) {
+    for (double t : {0.0, 0.5, 1.0}) {
+      if (!IsFinite(surface->Point(s, t)))
+        return bad("has non-finite points (NaN or infinite coordinates)");
+    }
+  }
+  const BRepAdaptor_Surface adaptor(face, true);
+  auto trim = std::make_shared<FaceTrim>(face, map, options.trim_tolerance);
+  const bool trimmed = trim->trimmed();  // before `trim` is moved from
+  return Face(index, TypeOf(adaptor.GetType()), area, box, reversed, centroid, trimmed,
+              std::move(surface), std::move(trim));
+}
+
+// All the kernel work of Load. REQUIRES: g_reader_mutex held; for IGES,
+// `iges_path` holds the bytes.
+absl::StatusOr<std::shared_ptr<const Model>> LoadUnguarded(ModelFormat format,
+                                                           absl::string_view bytes,
+                                                           const std::string& iges_path,
+                                                           absl::string_view name,
+                                                           const LoadOptions& options) {
+  TopoDS_Shape shape;
+  switch (format) {
+    case ModelFormat::kStep: {
+      ASSIGN_OR_RETURN(shape, ReadStep(bytes, name));
+      break;
+    }
+    case ModelFormat::kIges: {
+      ASSIGN_OR_RETURN(shape, ReadIges(iges_path, name));
+      break;
+    }
+    case ModelFormat::kNurbs: {
+      ASSIGN_OR_RETURN(shape, ReadNurbs(bytes, name));
+      break;
+    }
+  }
+  TopTools_IndexedMapOfShape map;
+  if (!shape.IsNull()) TopExp::MapShapes(shape, TopAbs_FACE, map);
+  if (map.Extent() == 0) return Invalid(format, name, "empty model: it has no faces");
+  std::vector<Face> faces;
+  faces.reserve(map.Extent());
+  for (int i = 1; i <= map.Extent(); ++i) {
+    ASSIGN_OR_RETURN(Face face, MakeFace(TopoDS::Face(map(i)), i - 1, format, name, options));
+    faces.push_back(std::move(face));
+  }
+  return std::make_shared<const Model>(std::string(name), std::move(faces));
+}
+
+// LoadUnguarded with the kernel's exceptions, and the faults it turns into
+// exceptions (cad/internal/kernel_setup.h), as statuses. A fault abandons
+// the frames below without their destructors: it leaks the kernel's objects
+// of this load, nothing else (no lock or file of ours lives below here).
+absl::StatusOr<std::shared_ptr<const Model>> GuardedLoad(ModelFormat format,
+                                                         absl::string_view bytes,
+                                                         const std::string& iges_path,
+                                                         absl::string_view name,
+                                                         const LoadOptions& options) {
+  try {
+    OCC_CATCH_SIGNALS
+    return LoadUnguarded(format, bytes, iges_path, name, options);
+  } catch (const Standard_Failure& e) {
+    return Invalid(format, name,
+                   absl::StrCat("the kernel failed on it: ", e.GetMessageString(), " (",
+                                e.DynamicType()->Name(), ")"));
+  } catch (const std::bad_alloc&) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat(ModelFormatName(format), " file ", name, ": out of memory while reading it"));
+  } catch (const std::exception& e) {
+    return absl::InternalError(
+        absl::StrCat(ModelFormatName(format), " file ", name, ": ", e.what()));
+  }
+}
+
+}  // namespace
+
+absl::StatusOr<ModelFormat> ParseModelFormat(absl::string_view text) {
+  const std::string lower = absl::AsciiStrToLower(text);
+  if (lower == "step" || lower == "stp") return ModelFormat::kStep;
+  if (lower == "iges" || lower == "igs") return ModelFormat::kIges;
+  if (lower == "nurbs") return ModelFormat::kNurbs;
+  return absl::InvalidArgumentError(
+      absl::StrCat("unknown model format '", text, "'; expected step, iges or nurbs"));
+}
+
+absl::string_view ModelFormatName(ModelFormat format) {
+  switch (format) {
+    case ModelFormat::kStep:
+      return "step";
+    case ModelFormat::kIges:
+      return "iges";
+    case ModelFormat::kNurbs:
+      return "nurbs";
+  }
+  return "unknown";
+}
+
+absl::StatusOr<std::shared_ptr<const Model>> Load(ModelFormat format, absl::string_view bytes,
+                                                  absl::string_view name,
+                                                  const LoadOptions& options) {
+  if (bytes.size() > options.max_bytes) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat(absl::AsciiStrToUpper(ModelFormatName(format)), " file ", name, " has ",
+                     bytes.size(), " bytes, above the limit of ", options.max_bytes, " bytes"));
+  }
+  // Checks without the kernel first; then our own resources (the temporary
+  // file, the lock) are taken outside GuardedLoad, whose signal guard skips
+  // destructors of the frames between the fault and itself.
+  std::string iges_path;
+  TempFile file;
+  if (format == ModelFormat::kStep) RETURN_IF_ERROR(CheckStepFraming(bytes, name));
+  if (format == ModelFormat::kIges) {
+    RETURN_IF_ERROR(CheckIgesFraming(bytes, name));
+    RETURN_IF_ERROR(file.Write(bytes));  // IGESControl_Reader reads only files
+    iges_path = file.path();
+  }
+  SilenceKernelMessages();
+  ConvertKernelSignals();
+  absl::MutexLock lock(&g_reader_mutex);
+  return GuardedLoad(format, bytes, iges_path, name, options);
+}
+
+}  // namespace sfc::cad

@@ -1,0 +1,60 @@
+// Loading a CAD model from bytes in memory: STEP, IGES, or our NURBS patch
+// text format (docs/NURBS_FORMAT.md).
+//
+// The bytes come from the caller (a client's upload, a file the CLI read);
+// Load never opens a path it is given. IGES, which OpenCASCADE reads only from
+// files, goes through a private temporary file that Load creates (mode 0600)
+// and deletes before returning.
+//
+// Thread-safety: Load may be called from many threads; the STEP and IGES
+// readers keep global state in the kernel, so those reads are serialised by
+// one process-wide mutex (NURBS patches too: they are quick).
+#ifndef SFCSAMPLER_CAD_LOAD_H_
+#define SFCSAMPLER_CAD_LOAD_H_
+
+#include <cstddef>
+#include <memory>
+
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "cad/model.h"
+
+namespace sfc::cad {
+
+enum class ModelFormat { kStep, kIges, kNurbs };
+
+// "step" (also "stp"), "iges" (also "igs"), "nurbs"; INVALID_ARGUMENT otherwise.
+absl::StatusOr<ModelFormat> ParseModelFormat(absl::string_view text);
+absl::string_view ModelFormatName(ModelFormat format);
+
+struct LoadOptions {
+  // Largest model accepted, in bytes; a larger one is RESOURCE_EXHAUSTED.
+  // Default 64 MiB.
+  size_t max_bytes = size_t{64} << 20;
+  // Tolerance of the trim classification, as a fraction of the parameter
+  // box's larger side (points this close to a trim curve count as inside).
+  // Default 1e-9.
+  double trim_tolerance = 1e-9;
+};
+
+// Reads a model from `bytes`. `name` names the input in every error message
+// (e.g. the file name the user gave). Errors:
+//   RESOURCE_EXHAUSTED  bytes.size() > options.max_bytes;
+//   INVALID_ARGUMENT    unreadable or truncated STEP/IGES, a model without
+//                       faces, an unbounded face, non-finite geometry, a
+//                       malformed NURBS patch (knots, multiplicities,
+//                       weights, counts, NaN);
+//   INTERNAL            the kernel failed in an unexpected way (its
+//                       exception's message is passed on).
+// Never throws: the kernel's Standard_Failure is caught here, and so is a
+// fault inside the kernel on malformed input (a null dereference in the IGES
+// reader), which the kernel's signal handlers turn into a Standard_Failure;
+// Load installs them for signals that have no handler yet
+// (cad/internal/kernel_setup.h). Such a fault leaks that load's kernel objects.
+absl::StatusOr<std::shared_ptr<const Model>> Load(ModelFormat format, absl::string_view bytes,
+                                                  absl::string_view name,
+                                                  const LoadOptions& options = {});
+
+}  // namespace sfc::cad
+
+#endif  // SFCSAMPLER_CAD_LOAD_H_

@@ -1,0 +1,86 @@
+#include "cad/model.h"
+
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "cad/face_order.h"
+#include "cad/internal/occ_face.h"
+
+namespace sfc::cad {
+
+absl::string_view FaceTypeName(FaceType type) {
+  switch (type) {
+    case FaceType::kPlane:
+      return "plane";
+    case FaceType::kCylinder:
+      return "cylinder";
+    case FaceType::kCone:
+      return "cone";
+    case FaceType::kSphere:
+      return "sphere";
+    case FaceType::kTorus:
+      return "torus";
+    case FaceType::kBSpline:
+      return "bspline";
+    case FaceType::kBezier:
+      return "bezier";
+    case FaceType::kRevolution:
+      return "revolution";
+    case FaceType::kExtrusion:
+      return "extrusion";
+    case FaceType::kOffset:
+      return "offset";
+    case FaceType::kOther:
+      return "other";
+  }
+  return "other";
+}
+
+Face::Face(int index, FaceType type, double area, ParameterBox box, bool reversed, Vec3 centroid,
+           bool trimmed, std::shared_ptr<const Surface> surface,
+           std::shared_ptr<const FaceTrim> trim)
+    : index_(index),
+      type_(type),
+      area_(area),
+      box_(box),
+      reversed_(reversed),
+      centroid_(centroid),
+      trimmed_(trimmed),
+      surface_(std::move(surface)),
+      trim_(std::move(trim)) {}
+
+bool Face::Contains(double s, double t) const { return trim_->Contains(s, t); }
+
+CellState Face::Classify(double s0, double s1, double t0, double t1) const {
+  return trim_->Classify(s0, s1, t0, t1);
+}
+
+Model::Model(std::string name, std::vector<Face> faces)
+    : name_(std::move(name)), faces_(std::move(faces)) {
+  std::vector<Vec3> centroids;
+  for (const Face& face : faces_) {
+    total_area_ += face.area();
+    centroids.push_back(face.centroid());
+  }
+  curve_order_ = HilbertOrder(centroids);
+}
+
+std::string DescribeModel(const Model& model) {
+  std::string out = absl::StrFormat("model %s: %d faces, total area %.10g\n", model.name(),
+                                    model.faces().size(), model.total_area());
+  absl::StrAppendFormat(&out, "%5s  %-10s  %16s  %-51s  %-8s  %s\n", "face", "type", "area",
+                        "parameter box [u0, u1] x [v0, v1]", "reversed", "trimmed");
+  for (const Face& face : model.faces()) {
+    const ParameterBox& b = face.parameter_box();
+    absl::StrAppendFormat(&out,
+                          "%5d  %-10s  %16.10g  [%11.6g, %11.6g] x [%11.6g, %11.6g]  %-8s  %s\n",
+                          face.index(), FaceTypeName(face.type()), face.area(), b.u0, b.u1, b.v0,
+                          b.v1, face.reversed() ? "yes" : "no", face.trimmed() ? "yes" : "no");
+  }
+  absl::StrAppend(&out, "curve order: ", absl::StrJoin(model.curve_order(), " "), "\n");
+  return out;
+}
+
+}  // namespace sfc::cad
