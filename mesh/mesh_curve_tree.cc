@@ -302,38 +302,105 @@ MeshCurveTree::Cell MeshCurveTree::LeafCell(size_t l) const {
   return cell;
 }
 
+namespace {
+
+// A cell's frame puts its entry, exit and apex at (0, 0), (1, 0), (0, 1).
+// Child 0 = (E, A, M) and child 1 = (A, X, M), M = (E + X) / 2, are the
+// affine maps of the child's frame into the parent's:
+//   T0(a, b) = (b / 2, a),   T1(a, b) = (a + b / 2, 1 - a - b).
+struct Affine {
+  double a11, a12, a21, a22, c1, c2;
+  void Apply(double* x, double* y) const {
+    const double nx = a11 * *x + a12 * *y + c1, ny = a21 * *x + a22 * *y + c2;
+    *x = nx, *y = ny;
+  }
+  Affine Then(const Affine& inner) const {  // this o inner
+    return {a11 * inner.a11 + a12 * inner.a21, a11 * inner.a12 + a12 * inner.a22,
+            a21 * inner.a11 + a22 * inner.a21, a21 * inner.a12 + a22 * inner.a22,
+            a11 * inner.c1 + a12 * inner.c2 + c1, a21 * inner.c1 + a22 * inner.c2 + c2};
+  }
+};
+constexpr Affine kChild[2] = {{0, 0.5, 1, 0, 0, 0}, {1, 0.5, -1, -1, 0, 1}};
+
+// The composition of 8 levels for each byte of child choices (highest bit =
+// outermost level). Coefficients are dyadic with small numerators: exact.
+const std::array<Affine, 256>& ByteMaps() {
+  static const std::array<Affine, 256> maps = [] {
+    std::array<Affine, 256> m{};
+    for (int v = 0; v < 256; ++v) {
+      Affine f{1, 0, 0, 1, 0, 0};
+      for (int bit = 7; bit >= 0; --bit) f = f.Then(kChild[(v >> bit) & 1]);
+      m[v] = f;
+    }
+    return m;
+  }();
+  return maps;
+}
+
+// The centroid of the cell reached by `levels` child choices (`bits`, first
+// level highest), in the starting cell's frame. Innermost levels first, a
+// byte at a time: no branches on the bits.
+void InnerPoint(uint64_t bits, int levels, double* x, double* y) {
+  const auto& maps = ByteMaps();
+  *x = 1.0 / 3, *y = 1.0 / 3;
+  for (; levels >= 8; levels -= 8, bits >>= 8) maps[bits & 255].Apply(x, y);
+  for (; levels > 0; --levels, bits >>= 1) kChild[bits & 1].Apply(x, y);
+}
+
+}  // namespace
+
 void MeshCurveTree::Descend(const Cell& cell, double t, std::array<double, 3>* bary,
                             double* area_position) {
-  Bary e = cell.corner[0], x = cell.corner[1], a = cell.corner[2];
-  double fe = cell.density[0], fx = cell.density[1], fa = cell.density[2];
-  double pos = cell.area_begin, size = cell.area_size;
   constexpr int kLevels = 52;  // all the bits of t
-  const bool uniform = cell.uniform;
-  for (int level = 0; level < kLevels; ++level) {
-    const Bary m = Mid(e, x);
-    double split = 0.5;
-    double fm = 0;
-    if (!uniform) {
-      fm = (fe + fx) * 0.5;
+  double ca, cb;               // the final centroid in the leaf's frame
+  if (cell.uniform) {
+    // Equal children: the child choices are the binary digits of t.
+    const uint64_t bits = static_cast<uint64_t>(std::ldexp(t, kLevels));
+    InnerPoint(bits, kLevels, &ca, &cb);
+    *area_position =
+        cell.area_begin + cell.area_size * std::ldexp(static_cast<double>(bits) + 0.5, -kLevels);
+  } else {
+    // Follow the linear model level by level while it still varies across
+    // the cell, then the remaining digits of t as for a uniform cell.
+    double ea = 0, eb = 0, xa = 1, xb = 0, aa = 0, ab = 1;
+    double fe = cell.density[0], fx = cell.density[1], fa = cell.density[2];
+    double pos = cell.area_begin, size = cell.area_size;
+    int level = 0;
+    for (; level < kLevels; ++level) {
+      // Once the model varies across the cell by less than 2^(level/2 - 26)
+      // of its value, it moves the sample by less than 2^-26 of the cell's
+      // size, the final resolution (cells halve in diameter every two
+      // levels): the remaining levels are pure curve bits.
+      const double lo = std::min({fe, fx, fa}), hi = std::max({fe, fx, fa});
+      if (hi - lo <= std::ldexp(hi, level / 2 - 26)) break;
+      const double ma = (ea + xa) * 0.5, mb = (eb + xb) * 0.5;
+      const double fm = (fe + fx) * 0.5;
+      // Exact integrals of the linear model over the two equal-area children.
       const double m0 = fe + fa + fm, m1 = fa + fx + fm;
-      if (m0 + m1 > 0) split = m0 / (m0 + m1);
+      const double split = m0 + m1 > 0 ? m0 / (m0 + m1) : 0.5;
+      size *= 0.5;
+      if (t < split) {
+        t = t / split;
+        xa = aa, xb = ab, fx = fa;
+      } else {
+        t = (t - split) / (1 - split);
+        ea = aa, eb = ab, fe = fa;
+        pos += size;
+      }
+      aa = ma, ab = mb, fa = fm;
+      if (!(t < 1)) t = std::nextafter(1.0, 0.0);
+      if (!(t >= 0)) t = 0;
     }
-    size *= 0.5;
-    if (t < split) {
-      t = t / split;
-      x = a, a = m;
-      if (!uniform) fx = fa, fa = fm;
-    } else {
-      t = (t - split) / (1 - split);
-      e = a, a = m;
-      if (!uniform) fe = fa, fa = fm;
-      pos += size;
-    }
-    if (!(t < 1)) t = std::nextafter(1.0, 0.0);
-    if (!(t >= 0)) t = 0;
+    const int rest = kLevels - level;
+    const uint64_t bits = static_cast<uint64_t>(std::ldexp(t, rest));
+    double ia, ib;
+    InnerPoint(bits, rest, &ia, &ib);
+    ca = ea + ia * (xa - ea) + ib * (aa - ea);
+    cb = eb + ia * (xb - eb) + ib * (ab - eb);
+    *area_position = pos + size * std::ldexp(static_cast<double>(bits) + 0.5, -rest);
   }
-  for (int i = 0; i < 3; ++i) (*bary)[i] = (e[i] + x[i] + a[i]) * (1.0 / 3);
-  *area_position = pos + size * 0.5;
+  const Bary &e = cell.corner[0], &x = cell.corner[1], &a = cell.corner[2];
+  for (int i = 0; i < 3; ++i) (*bary)[i] = e[i] + ca * (x[i] - e[i]) + cb * (a[i] - e[i]);
 }
 
 void MeshCurveTree::BuildBoxes() {

@@ -125,6 +125,31 @@ absl::StatusOr<size_t> MeshSampleCursor::Next(size_t max, SampleBatch* batch,
   const MeshCurveTree& tree = sampler.tree();
   const MeshSurface& surface = tree.surface();
   const auto& ends = tree.mass_ends();
+  {
+    // Reserve what this call can emit (at most the indices left), so large
+    // batches grow once instead of by doubling.
+    uint64_t left = use_order_ ? order_.size() - order_pos_ : 0;
+    if (!use_order_) {
+      for (size_t i = segment_; i < segments_.size(); ++i) {
+        left += segments_[i].end - (i == segment_ ? std::max(next_k_, segments_[i].begin)
+                                                  : segments_[i].begin);
+      }
+    }
+    const size_t want = batch->size() + static_cast<size_t>(std::min<uint64_t>(left, max));
+    for (auto* column : {&batch->u, &batch->v, &batch->x, &batch->y, &batch->z}) {
+      column->reserve(want);
+    }
+    batch->index.reserve(want);
+    if (fields_.normal) {
+      for (auto* column : {&batch->nx, &batch->ny, &batch->nz}) column->reserve(want);
+    }
+    if (fields_.density) batch->density.reserve(want);
+    if (fields_.curve_position) batch->curve_position.reserve(want);
+    if (mesh_columns != nullptr) {
+      mesh_columns->triangle.reserve(mesh_columns->size() + (want - batch->size()));
+      mesh_columns->w.reserve(mesh_columns->size() + (want - batch->size()));
+    }
+  }
   size_t emitted = 0;
   while (emitted < max) {
     uint64_t k;
