@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -68,11 +69,15 @@ size_t DrawAll(const std::shared_ptr<const MeshSampler>& sampler, SampleBatch* b
 
 struct Timing {
   double read_parse, tree, samples_cold, warm;
+  double cpu_cold, cpu_warm;  // process CPU seconds (std::clock): steadier on a shared machine
   size_t leaves;
 };
 
+double CpuSince(std::clock_t since) { return double(std::clock() - since) / CLOCKS_PER_SEC; }
+
 Timing Run(const std::string& path, bool curvature_density, uint64_t count) {
   Timing t{};
+  const std::clock_t cpu_start = std::clock();
   const auto start = std::chrono::steady_clock::now();
   auto mesh = LoadMesh(ReadAll(path), path);
   if (!mesh.ok()) {
@@ -97,9 +102,12 @@ Timing Run(const std::string& path, bool curvature_density, uint64_t count) {
   auto t2 = std::chrono::steady_clock::now();
   DrawAll(sampler, &batch);
   t.samples_cold = Seconds(t2);
+  t.cpu_cold = CpuSince(cpu_start);
+  const std::clock_t cpu_warm = std::clock();
   auto t3 = std::chrono::steady_clock::now();
   DrawAll(sampler, &batch);
   t.warm = Seconds(t3);
+  t.cpu_warm = CpuSince(cpu_warm);
   return t;
 }
 
@@ -157,19 +165,22 @@ int main(int argc, char** argv) {
   std::printf("# %llu samples on the icosphere (%zu triangles, binary PLY), median of %d runs\n",
               static_cast<unsigned long long>(count), sphere.triangles.size(), repeats);
   std::printf("| density | leaves | read+parse s | tree s | samples s | cold total s | warm s | "
-              "warm M samples/s |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
+              "cold cpu s | warm cpu s | warm M samples/s (cpu) |\n"
+              "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (bool curvature : {false, true}) {
-    std::vector<double> rp, tr, sc, cold, warm;
+    std::vector<double> rp, tr, sc, cold, warm, cpu_cold, cpu_warm;
     size_t leaves = 0;
     for (int r = 0; r < repeats; ++r) {
       const Timing t = Run(path, curvature, count);
       rp.push_back(t.read_parse), tr.push_back(t.tree), sc.push_back(t.samples_cold);
       cold.push_back(t.read_parse + t.tree + t.samples_cold), warm.push_back(t.warm);
+      cpu_cold.push_back(t.cpu_cold), cpu_warm.push_back(t.cpu_warm);
       leaves = t.leaves;
     }
-    std::printf("| %s | %zu | %.3f | %.3f | %.3f | %.3f | %.3f | %.1f |\n",
+    std::printf("| %s | %zu | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %.1f |\n",
                 curvature ? "mean:floor=0.1" : "uniform", leaves, Median(rp), Median(tr),
-                Median(sc), Median(cold), Median(warm), count / Median(warm) / 1e6);
+                Median(sc), Median(cold), Median(warm), Median(cpu_cold), Median(cpu_warm),
+                count / Median(cpu_warm) / 1e6);
   }
 
   std::printf("\n# spherical-triangle discrepancy, 128 triangles, mean of 4 seeds\n");

@@ -134,7 +134,7 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
   std::vector<Vec3> centroid(mesh.triangles.size());
   Vec3 lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-    if (IsDegenerateTriangle(mesh, t)) continue;
+    if (surface->degenerate(t)) continue;
     live.push_back(static_cast<uint32_t>(t));
     const auto& f = mesh.triangles[t];
     const Vec3 c = (mesh.positions[f[0]] + mesh.positions[f[1]] + mesh.positions[f[2]]) * (1.0 / 3);
@@ -347,18 +347,62 @@ void InnerPoint(uint64_t bits, int levels, double* x, double* y) {
   for (; levels > 0; --levels, bits >>= 1) kChild[bits & 1].Apply(x, y);
 }
 
+constexpr int kLevels = 52;  // all the bits of a sample's fraction t
+
+// The child choices of a uniform cell: the first 52 binary digits of t.
+uint64_t UniformBits(double t) { return static_cast<uint64_t>(t * 4503599627370496.0); }  // 2^52
+
+// Maps a point of a uniform cell's frame to barycentrics; the area position.
+void FinishUniform(const MeshCurveTree::Cell& cell, uint64_t bits, double ca, double cb,
+                   std::array<double, 3>* bary, double* area_position) {
+  *area_position = cell.area_begin +
+                   cell.area_size * ((static_cast<double>(bits) + 0.5) * (1.0 / 4503599627370496.0));
+  const Bary &e = cell.corner[0], &x = cell.corner[1], &a = cell.corner[2];
+  for (int i = 0; i < 3; ++i) (*bary)[i] = e[i] + ca * (x[i] - e[i]) + cb * (a[i] - e[i]);
+}
+
 }  // namespace
+
+void MeshCurveTree::DescendMany(size_t n, const Cell* const* cells, const double* t,
+                                std::array<double, 3>* bary, double* area_position) {
+  constexpr size_t kMax = 64;
+  size_t uniform[kMax];
+  uint64_t bits[kMax];
+  double x[kMax], y[kMax];
+  size_t u = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (cells[i]->uniform && u < kMax) {
+      uniform[u] = i;
+      bits[u] = UniformBits(t[i]);
+      x[u] = y[u] = 1.0 / 3;
+      ++u;
+    } else {
+      Descend(*cells[i], t[i], &bary[i], &area_position[i]);
+    }
+  }
+  // The steps of InnerPoint(bits, 52, ...), sample after sample at each step.
+  const auto& maps = ByteMaps();
+  for (int byte = 0; byte < kLevels / 8; ++byte) {
+    for (size_t j = 0; j < u; ++j) maps[(bits[j] >> (8 * byte)) & 255].Apply(&x[j], &y[j]);
+  }
+  for (int level = kLevels / 8 * 8; level < kLevels; ++level) {
+    for (size_t j = 0; j < u; ++j) kChild[(bits[j] >> level) & 1].Apply(&x[j], &y[j]);
+  }
+  for (size_t j = 0; j < u; ++j) {
+    const size_t i = uniform[j];
+    FinishUniform(*cells[i], bits[j], x[j], y[j], &bary[i], &area_position[i]);
+  }
+}
 
 void MeshCurveTree::Descend(const Cell& cell, double t, std::array<double, 3>* bary,
                             double* area_position) {
-  constexpr int kLevels = 52;  // all the bits of t
-  double ca, cb;               // the final centroid in the leaf's frame
+  double ca, cb;  // the final centroid in the leaf's frame
   if (cell.uniform) {
     // Equal children: the child choices are the binary digits of t.
-    const uint64_t bits = static_cast<uint64_t>(std::ldexp(t, kLevels));
+    const uint64_t bits = UniformBits(t);
     InnerPoint(bits, kLevels, &ca, &cb);
-    *area_position =
-        cell.area_begin + cell.area_size * std::ldexp(static_cast<double>(bits) + 0.5, -kLevels);
+    FinishUniform(cell, bits, ca, cb, bary, area_position);
+    return;
   } else {
     // Follow the linear model level by level while it still varies across
     // the cell, then the remaining digits of t as for a uniform cell.

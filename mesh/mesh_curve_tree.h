@@ -134,6 +134,11 @@ class MeshCurveTree {
   // and its position along the triangle's curve (area fraction).
   static void Descend(const Cell& cell, double t, std::array<double, 3>* bary,
                       double* area_position);
+  // Descend for n samples at once, bit for bit the same results: the 52
+  // levels of the uniform cells run interleaved across the samples, which
+  // overlaps their chains of dependent steps. cells[i] is sample i's cell.
+  static void DescendMany(size_t n, const Cell* const* cells, const double* t,
+                          std::array<double, 3>* bary, double* area_position);
 
  private:
   struct Box {

@@ -149,18 +149,32 @@ absl::StatusOr<TriangleMesh> LoadObj(absl::string_view bytes, absl::string_view 
 
 // ---------------------------------------------------------------- PLY
 
-// The value of a scalar property of any numeric PLY type, as a double.
-std::optional<double> NumberValue(const CgalPlyNumber* p) {
-  using CGAL::IO::internal::PLY_read_typed_number;
-  if (auto* q = dynamic_cast<const PLY_read_typed_number<double>*>(p)) return q->buffer();
-  if (auto* q = dynamic_cast<const PLY_read_typed_number<float>*>(p)) return q->buffer();
-  if (auto* q = dynamic_cast<const PLY_read_typed_number<int32_t>*>(p)) return q->buffer();
-  if (auto* q = dynamic_cast<const PLY_read_typed_number<uint32_t>*>(p)) return q->buffer();
-  if (auto* q = dynamic_cast<const PLY_read_typed_number<int16_t>*>(p)) return q->buffer();
-  if (auto* q = dynamic_cast<const PLY_read_typed_number<uint16_t>*>(p)) return q->buffer();
-  if (auto* q = dynamic_cast<const PLY_read_typed_number<int8_t>*>(p)) return q->buffer();
-  if (auto* q = dynamic_cast<const PLY_read_typed_number<uint8_t>*>(p)) return q->buffer();
-  return std::nullopt;
+// Reads the current value of a scalar property as a double. The property's
+// type is resolved once per element (Resolve), not once per value.
+using ScalarGetter = double (*)(const CgalPlyNumber*);
+
+template <typename T>
+double GetScalar(const CgalPlyNumber* p) {
+  return static_cast<double>(
+      static_cast<const CGAL::IO::internal::PLY_read_typed_number<T>*>(p)->buffer());
+}
+
+template <typename T>
+bool Is(const CgalPlyNumber* p) {
+  return dynamic_cast<const CGAL::IO::internal::PLY_read_typed_number<T>*>(p) != nullptr;
+}
+
+// The getter for a scalar property of any numeric PLY type; nullptr for lists.
+ScalarGetter Resolve(const CgalPlyNumber* p) {
+  if (Is<double>(p)) return &GetScalar<double>;
+  if (Is<float>(p)) return &GetScalar<float>;
+  if (Is<int32_t>(p)) return &GetScalar<int32_t>;
+  if (Is<uint32_t>(p)) return &GetScalar<uint32_t>;
+  if (Is<int16_t>(p)) return &GetScalar<int16_t>;
+  if (Is<uint16_t>(p)) return &GetScalar<uint16_t>;
+  if (Is<int8_t>(p)) return &GetScalar<int8_t>;
+  if (Is<uint8_t>(p)) return &GetScalar<uint8_t>;
+  return nullptr;
 }
 
 // A face's corner list of any integer type, copied into `out`; false when the
@@ -221,7 +235,7 @@ absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view 
     }
     for (size_t k = 0; k < props; ++k) {
       CgalPlyNumber* p = element.property(k);
-      if (!NumberValue(p).has_value() && !HasNarrowListCount(p)) {
+      if (Resolve(p) == nullptr && !HasNarrowListCount(p)) {
         return Malformed(name, absl::StrFormat("property '%s' of element '%s' is a list with a "
                                                "32-bit count; write 'property list uchar int %s'",
                                                p->name(), element.name(), p->name()));
@@ -232,7 +246,7 @@ absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view 
     int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, iw = -1, ifaces = -1;
     for (size_t k = 0; k < props; ++k) {
       const std::string& pn = element.property(k)->name();
-      const bool scalar = NumberValue(element.property(k)).has_value();
+      const bool scalar = Resolve(element.property(k)) != nullptr;
       if (is_vertex && scalar) {
         if (pn == "x") ix = k;
         if (pn == "y") iy = k;
@@ -263,6 +277,11 @@ absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view 
     }
     std::vector<int64_t> list;
     std::vector<uint32_t> corners;
+    auto getter = [&element](int k) {
+      return k < 0 ? ScalarGetter{nullptr} : Resolve(element.property(k));
+    };
+    const ScalarGetter gx = getter(ix), gy = getter(iy), gz = getter(iz), gnx = getter(inx),
+                       gny = getter(iny), gnz = getter(inz), gw = getter(iw);
     for (size_t j = 0; j < items; ++j) {
       for (size_t k = 0; k < props; ++k) element.property(k)->get(in);
       if (!in) {
@@ -271,15 +290,13 @@ absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view 
                                                element.name(), j, items));
       }
       if (is_vertex) {
-        mesh.positions.push_back({*NumberValue(element.property(ix)),
-                                  *NumberValue(element.property(iy)),
-                                  *NumberValue(element.property(iz))});
-        if (inx >= 0 && iny >= 0 && inz >= 0) {
-          mesh.normals.push_back({*NumberValue(element.property(inx)),
-                                  *NumberValue(element.property(iny)),
-                                  *NumberValue(element.property(inz))});
+        mesh.positions.push_back({gx(element.property(ix)), gy(element.property(iy)),
+                                  gz(element.property(iz))});
+        if (gnx && gny && gnz) {
+          mesh.normals.push_back({gnx(element.property(inx)), gny(element.property(iny)),
+                                  gnz(element.property(inz))});
         }
-        if (iw >= 0) mesh.weights.push_back(*NumberValue(element.property(iw)));
+        if (gw) mesh.weights.push_back(gw(element.property(iw)));
       } else if (is_face) {
         ListValue(element.property(ifaces), &list);
         if (list.size() < 3) {

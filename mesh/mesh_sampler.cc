@@ -37,13 +37,17 @@ uint64_t MeshSampler::FirstIndexAtOrAbove(double m) const {
   return lo;
 }
 
+double MeshSampler::FractionInLeaf(double m, size_t l) const {
+  const double begin = tree_->mass_begin(l);
+  const double t = (m - begin) / (tree_->mass_ends()[l] - begin);
+  if (!(t >= 0)) return 0;
+  if (!(t < 1)) return std::nextafter(1.0, 0.0);
+  return t;
+}
+
 MeshSample MeshSampler::AtMass(uint64_t k, double m, size_t l,
                                const MeshCurveTree::Cell& cell) const {
-  const double begin = tree_->mass_begin(l);
-  const double size = tree_->mass_ends()[l] - begin;
-  double t = (m - begin) / size;
-  if (!(t >= 0)) t = 0;
-  if (!(t < 1)) t = std::nextafter(1.0, 0.0);
+  const double t = FractionInLeaf(m, l);
   MeshSample s;
   s.index = k;
   s.leaf = l;
@@ -150,61 +154,93 @@ absl::StatusOr<size_t> MeshSampleCursor::Next(size_t max, SampleBatch* batch,
       mesh_columns->w.reserve(mesh_columns->size() + (want - batch->size()));
     }
   }
+  // Samples go in chunks: first their leaves and fractions, then their
+  // descents together (MeshCurveTree::DescendMany), then the columns.
+  constexpr size_t kChunk = 32;
+  uint64_t ks[kChunk];
+  double ts[kChunk], area_positions[kChunk];
+  const MeshCurveTree::Cell* cells[kChunk];
+  std::array<double, 3> barys[kChunk];
+  chunk_cells_.reserve(kChunk + 1);  // pointers into it stay valid for a chunk
+  const double triangles = static_cast<double>(tree.triangle_count());
   size_t emitted = 0;
-  while (emitted < max) {
-    uint64_t k;
-    if (use_order_) {
-      if (order_pos_ >= order_.size()) break;
-      k = order_[order_pos_++];
-    } else {
-      while (segment_ < segments_.size() && next_k_ >= segments_[segment_].end) {
-        if (++segment_ < segments_.size()) next_k_ = segments_[segment_].begin;
+  bool exhausted = false;
+  while (emitted < max && !exhausted) {
+    chunk_cells_.clear();
+    if (cached_leaf_ != SIZE_MAX) chunk_cells_.push_back(cached_cell_);
+    const size_t want = std::min(kChunk, max - emitted);
+    size_t n = 0;
+    while (n < want) {
+      uint64_t k;
+      if (use_order_) {
+        if (order_pos_ >= order_.size()) {
+          exhausted = true;
+          break;
+        }
+        k = order_[order_pos_++];
+      } else {
+        while (segment_ < segments_.size() && next_k_ >= segments_[segment_].end) {
+          if (++segment_ < segments_.size()) next_k_ = segments_[segment_].begin;
+        }
+        if (segment_ >= segments_.size()) {
+          exhausted = true;
+          break;
+        }
+        k = next_k_++;
       }
-      if (segment_ >= segments_.size()) break;
-      k = next_k_++;
-    }
-    const double m = sampler.MassCoordinate(k);
-    size_t l;
-    if (cached_leaf_ != SIZE_MAX && m >= tree.mass_begin(cached_leaf_) && m < ends[cached_leaf_]) {
-      l = cached_leaf_;
-    } else {
-      l = sampler.LeafForMass(m);
-      if (l != cached_leaf_) {
-        cached_leaf_ = l;
-        cached_cell_ = tree.LeafCell(l);
+      const double m = sampler.MassCoordinate(k);
+      if (cached_leaf_ == SIZE_MAX || !(m >= tree.mass_begin(cached_leaf_) && m < ends[cached_leaf_])) {
+        const size_t l = sampler.LeafForMass(m);
+        if (l != cached_leaf_) {
+          cached_leaf_ = l;
+          cached_cell_ = tree.LeafCell(l);
+          chunk_cells_.push_back(cached_cell_);
+        }
       }
+      ks[n] = k;
+      ts[n] = sampler.FractionInLeaf(m, cached_leaf_);
+      cells[n] = &chunk_cells_.back();
+      ++n;
     }
-    const MeshSample s = sampler.AtMass(k, m, l, cached_cell_);
-    if (!region_.Contains(0, 0, s.position)) continue;
-    batch->index.push_back(k);
-    batch->u.push_back(s.bary[1]);
-    batch->v.push_back(s.bary[2]);
-    batch->x.push_back(s.position.x);
-    batch->y.push_back(s.position.y);
-    batch->z.push_back(s.position.z);
-    if (fields_.normal) {
-      const Vec3 n = surface.Normal(s.triangle, s.bary);
-      batch->nx.push_back(n.x);
-      batch->ny.push_back(n.y);
-      batch->nz.push_back(n.z);
-    }
-    if (fields_.density) {
-      const double d = tree.density().uniform()
-                           ? 1.0
-                           : tree.density().Evaluate(surface.Attributes(s.triangle, s.bary));
-      if (!std::isfinite(d) || d < 0) {
-        return absl::InvalidArgumentError(absl::StrFormat(
-            "the density '%s' is %g at sample %d (%g, %g, %g); it must be finite and >= 0",
-            tree.density().spec(), d, k, s.position.x, s.position.y, s.position.z));
+    MeshCurveTree::DescendMany(n, cells, ts, barys, area_positions);
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t triangle = cells[i]->triangle;
+      const std::array<double, 3>& bary = barys[i];
+      const Vec3 position = surface.Point(triangle, bary);
+      if (!region_.Contains(0, 0, position)) continue;
+      const uint64_t k = ks[i];
+      batch->index.push_back(k);
+      batch->u.push_back(bary[1]);
+      batch->v.push_back(bary[2]);
+      batch->x.push_back(position.x);
+      batch->y.push_back(position.y);
+      batch->z.push_back(position.z);
+      if (fields_.normal) {
+        const Vec3 nrm = surface.Normal(triangle, bary);
+        batch->nx.push_back(nrm.x);
+        batch->ny.push_back(nrm.y);
+        batch->nz.push_back(nrm.z);
       }
-      batch->density.push_back(d);
+      if (fields_.density) {
+        const double d = tree.density().uniform()
+                             ? 1.0
+                             : tree.density().Evaluate(surface.Attributes(triangle, bary));
+        if (!std::isfinite(d) || d < 0) {
+          return absl::InvalidArgumentError(absl::StrFormat(
+              "the density '%s' is %g at sample %d (%g, %g, %g); it must be finite and >= 0",
+              tree.density().spec(), d, k, position.x, position.y, position.z));
+        }
+        batch->density.push_back(d);
+      }
+      if (fields_.curve_position) {
+        batch->curve_position.push_back((cells[i]->rank + area_positions[i]) / triangles);
+      }
+      if (mesh_columns != nullptr) {
+        mesh_columns->triangle.push_back(triangle);
+        mesh_columns->w.push_back(bary[0]);
+      }
+      ++emitted;
     }
-    if (fields_.curve_position) batch->curve_position.push_back(s.curve_position);
-    if (mesh_columns != nullptr) {
-      mesh_columns->triangle.push_back(s.triangle);
-      mesh_columns->w.push_back(s.bary[0]);
-    }
-    ++emitted;
   }
   return emitted;
 }

@@ -67,6 +67,8 @@ class MeshSampler {
   uint64_t FirstIndexAtOrAbove(double m) const;
   // Sample k. REQUIRES: k < sequence().count().
   MeshSample At(uint64_t k) const;
+  // Sample k's fraction of leaf l's mass, in [0, 1).
+  double FractionInLeaf(double m, size_t l) const;
   // Sample at mass coordinate m inside leaf l with cell `cell` (= LeafCell(l)).
   MeshSample AtMass(uint64_t k, double m, size_t l, const MeshCurveTree::Cell& cell) const;
 
@@ -115,6 +117,7 @@ class MeshSampleCursor {
   bool use_order_ = false;
   size_t cached_leaf_ = SIZE_MAX;  // the last leaf decoded
   MeshCurveTree::Cell cached_cell_;
+  std::vector<MeshCurveTree::Cell> chunk_cells_;  // the cells of one chunk of samples
 };
 
 }  // namespace sfc

@@ -39,6 +39,8 @@ class MeshSurface {
   // The density's inputs at a point (curvature only when computed).
   MeshPoint Attributes(size_t t, const std::array<double, 3>& b) const;
   const Vec3& FaceNormal(size_t t) const { return face_normals_[t]; }
+  // IsDegenerateTriangle(mesh(), t), computed once.
+  bool degenerate(size_t t) const { return face_normals_[t] == Vec3{}; }
 
  private:
   explicit MeshSurface(TriangleMesh mesh) : mesh_(std::move(mesh)) {}

@@ -62,7 +62,7 @@ absl::Status FinalizeMesh(TriangleMesh* mesh) {
       }
     }
   }
-  std::vector<std::pair<uint32_t, uint32_t>> edges;
+  std::vector<uint64_t> edges;  // (lower vertex << 32) | higher vertex
   edges.reserve(mesh->triangles.size() * 3);
   stats.degenerate_triangles = 0;
   stats.area = 0;
@@ -83,7 +83,7 @@ absl::Status FinalizeMesh(TriangleMesh* mesh) {
     stats.area += 0.5 * Norm(mesh->FaceCross(t));
     for (int c = 0; c < 3; ++c) {
       const uint32_t a = f[c], b = f[(c + 1) % 3];
-      edges.emplace_back(std::min(a, b), std::max(a, b));
+      edges.push_back(uint64_t{std::min(a, b)} << 32 | std::max(a, b));
     }
   }
   if (stats.degenerate_triangles == mesh->triangles.size()) {

@@ -238,6 +238,11 @@ TEST(MeshSampler, RangesJoinToTheFullSetAndHaveNoDuplicates) {
   EXPECT_EQ(joined.index, full.batch.index);
   EXPECT_EQ(joined.x, full.batch.x);
   EXPECT_EQ(joined.z, full.batch.z);
+  for (uint64_t k : {0ul, 12345ul, n - 1}) {  // the batched descent equals the single one
+    const MeshSample s = sampler->At(k);
+    EXPECT_EQ(s.position.x, full.batch.x[k]);
+    EXPECT_EQ(s.bary[1], full.batch.u[k]);
+  }
   std::set<std::tuple<double, double, double>> distinct;
   for (size_t i = 0; i < n; ++i) distinct.insert({full.batch.x[i], full.batch.y[i], full.batch.z[i]});
   EXPECT_EQ(distinct.size(), n);

@@ -18,7 +18,7 @@ packages=(
   libtinyobjloader-dev                           # OBJ meshes (mesh/): parses from a string, keeps vn
   libcgal-dev                                    # PLY meshes (mesh/): header-only reader from a stream, ASCII and
                                                  # binary, keeps every named vertex property (per-vertex weights);
-                                                 # assimp drops unknown PLY properties, PCL/VTK read files only
+                                                 # assimp keeps only PLY properties it knows; PCL/VTK are far heavier
   openssl                                        # a self-signed certificate for the TLS test
   nginx                                          # the consistent-hash gRPC proxy of the scale-out test
 )
