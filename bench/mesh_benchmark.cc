@@ -18,13 +18,13 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
-#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "core/discrepancy.h"
 #include "mesh/icosphere.h"
+#include "mesh/iid_points.h"
 #include "mesh/mesh_curve_tree.h"
 #include "mesh/mesh_loader.h"
 #include "mesh/mesh_sampler.h"
@@ -121,20 +121,8 @@ std::vector<Vec3> OnSphere(const SampleBatch& b) {
 }
 
 std::vector<Vec3> IidOnSphere(const TriangleMesh& mesh, size_t n, uint64_t seed) {
-  std::vector<double> areas;
-  for (size_t t = 0; t < mesh.triangles.size(); ++t) areas.push_back(Norm(mesh.FaceCross(t)));
-  std::discrete_distribution<size_t> pick(areas.begin(), areas.end());
-  std::uniform_real_distribution<double> u01(0, 1);
-  std::mt19937_64 rng(seed);
-  std::vector<Vec3> out;
-  for (size_t i = 0; i < n; ++i) {
-    const auto& f = mesh.triangles[pick(rng)];
-    double a = u01(rng), b = u01(rng);
-    if (a + b > 1) a = 1 - a, b = 1 - b;
-    const Vec3 p = mesh.positions[f[0]] * (1 - a - b) + mesh.positions[f[1]] * a +
-                   mesh.positions[f[2]] * b;
-    out.push_back(p * (1 / Norm(p)));
-  }
+  std::vector<Vec3> out = IidMeshPoints(mesh, n, seed);
+  for (Vec3& p : out) p = p * (1 / Norm(p));
   return out;
 }
 

@@ -130,6 +130,13 @@ TEST(MeshLoader, BrokenFilesGetClearErrorsNamingTheFile) {
   WriteFile(dir / "noface.ply",
             "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
             "property float z\nend_header\n0 0 0\n");
+  WriteFile(dir / "huge_count.ply",
+            "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\n"
+            "property float y\nproperty float z\nend_header\n");
+  WriteFile(dir / "wide_list.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+            "property float z\nelement face 1\nproperty list int int vertex_indices\nend_header\n"
+            "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
   TriangleMesh nan_mesh = sphere;
   nan_mesh.positions[7].y = std::numeric_limits<double>::quiet_NaN();
   WriteFile(dir / "nan.ply", MeshToPly(nan_mesh, true));
@@ -145,6 +152,8 @@ TEST(MeshLoader, BrokenFilesGetClearErrorsNamingTheFile) {
   ExpectError(load("index.obj"), StatusCode::kInvalidArgument, "index.obj", "vertex");
   ExpectError(load("noface.ply"), StatusCode::kInvalidArgument, "noface.ply", "no triangles");
   ExpectError(load("nan.ply"), StatusCode::kInvalidArgument, "nan.ply", "vertex 7");
+  ExpectError(load("huge_count.ply"), StatusCode::kInvalidArgument, "huge_count.ply", "truncated");
+  ExpectError(load("wide_list.ply"), StatusCode::kInvalidArgument, "wide_list.ply", "list uchar int");
   ExpectError(LoadMesh(binary, "big.ply", {.max_bytes = binary.size() - 1}),
               StatusCode::kResourceExhausted, "big.ply", "limit");
   ExpectError(LoadMeshFile((dir / "cut_bin.ply").string(), {.max_bytes = 100}),

@@ -15,6 +15,7 @@
 #include "gtest/gtest.h"
 #include "mesh/curvature.h"
 #include "mesh/icosphere.h"
+#include "mesh/iid_points.h"
 #include "mesh/internal/hilbert3d.h"
 #include "mesh/mesh_curve_tree.h"
 #include "mesh/mesh_sampler.h"
@@ -107,24 +108,6 @@ double CapDiscrepancy(const std::vector<Vec3>& points, int caps, uint64_t seed) 
   return worst;
 }
 
-// i.i.d. points on the mesh: triangle by area, then uniform barycentrics.
-std::vector<Vec3> IidPoints(const TriangleMesh& mesh, size_t n, uint64_t seed) {
-  std::vector<double> areas;
-  for (size_t t = 0; t < mesh.triangles.size(); ++t) areas.push_back(Norm(mesh.FaceCross(t)));
-  std::discrete_distribution<size_t> pick(areas.begin(), areas.end());
-  std::uniform_real_distribution<double> u01(0, 1);
-  std::mt19937_64 rng(seed);
-  std::vector<Vec3> out;
-  for (size_t i = 0; i < n; ++i) {
-    const auto& f = mesh.triangles[pick(rng)];
-    double a = u01(rng), b = u01(rng);
-    if (a + b > 1) a = 1 - a, b = 1 - b;
-    out.push_back(mesh.positions[f[0]] * (1 - a - b) + mesh.positions[f[1]] * a +
-                  mesh.positions[f[2]] * b);
-  }
-  return out;
-}
-
 TEST(MeshSampler, IcosphereCapDiscrepancyIsFarBelowIid) {
   const auto surface = Icosphere(6);
   for (uint64_t n : {1024u, 8192u}) {
@@ -135,7 +118,7 @@ TEST(MeshSampler, IcosphereCapDiscrepancyIsFarBelowIid) {
     const double ours_d = CapDiscrepancy(ours, 300, 11);
     // The typical i.i.d. figure: the median of three sets.
     std::vector<double> iid;
-    for (uint64_t s = 1; s <= 3; ++s) iid.push_back(CapDiscrepancy(IidPoints(surface->mesh(), n, s), 300, 11));
+    for (uint64_t s = 1; s <= 3; ++s) iid.push_back(CapDiscrepancy(IidMeshPoints(surface->mesh(), n, s), 300, 11));
     std::sort(iid.begin(), iid.end());
     const double iid_d = iid[1];
     SCOPED_TRACE(::testing::Message() << "N=" << n << " ours=" << ours_d << " iid=" << iid_d);
