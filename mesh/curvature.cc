@@ -15,8 +15,6 @@ VertexCurvature ComputeVertexCurvature(const TriangleMesh& mesh) {
   std::vector<double> angle_sum(nv, 0);
   std::vector<Vec3> laplace(nv);        // sum_j (cot a + cot b)(x_i - x_j)
   std::vector<Vec3> face_normals(nv);   // area-weighted, when the file has no normals
-  std::vector<std::pair<uint32_t, uint32_t>> edges;
-  edges.reserve(mesh.triangles.size() * 3);
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     if (IsDegenerateTriangle(mesh, t)) continue;
     const auto& f = mesh.triangles[t];
@@ -46,17 +44,12 @@ VertexCurvature ComputeVertexCurvature(const TriangleMesh& mesh) {
       } else {
         out.mixed_area[i] += angle[c] > M_PI / 2 ? area / 2 : area / 4;
       }
-      edges.emplace_back(std::min(i, j), std::max(i, j));
     }
   }
   std::vector<bool> boundary(nv, false);
-  std::sort(edges.begin(), edges.end());
-  for (size_t a = 0; a < edges.size();) {
-    size_t b = a;
-    while (b < edges.size() && edges[b] == edges[a]) ++b;
-    if (b - a == 1) boundary[edges[a].first] = boundary[edges[a].second] = true;
-    a = b;
-  }
+  ForEachEdge(mesh, [&boundary](uint32_t a, uint32_t b, uint32_t n) {
+    if (n == 1) boundary[a] = boundary[b] = true;
+  });
   for (size_t i = 0; i < nv; ++i) {
     const double area = out.mixed_area[i];
     if (!(area > 0)) continue;

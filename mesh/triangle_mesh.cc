@@ -18,6 +18,36 @@ bool IsDegenerateTriangle(const TriangleMesh& mesh, size_t t) {
   return !(Norm(Cross(b - a, c - a)) > 1e-12 * longest2);
 }
 
+void ForEachEdge(const TriangleMesh& mesh,
+                 const std::function<void(uint32_t a, uint32_t b, uint32_t n)>& f) {
+  const size_t nv = mesh.positions.size();
+  std::vector<uint32_t> start(nv + 1, 0);
+  auto for_each_half = [&](auto&& visit) {
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+      if (IsDegenerateTriangle(mesh, t)) continue;
+      const auto& tri = mesh.triangles[t];
+      for (int c = 0; c < 3; ++c) {
+        const uint32_t a = tri[c], b = tri[(c + 1) % 3];
+        visit(std::min(a, b), std::max(a, b));
+      }
+    }
+  };
+  for_each_half([&](uint32_t a, uint32_t) { ++start[a + 1]; });
+  for (size_t i = 0; i < nv; ++i) start[i + 1] += start[i];
+  std::vector<uint32_t> fill(start.begin(), start.end() - 1), other(start[nv]);
+  for_each_half([&](uint32_t a, uint32_t b) { other[fill[a]++] = b; });
+  for (size_t a = 0; a < nv; ++a) {
+    const auto begin = other.begin() + start[a], end = other.begin() + start[a + 1];
+    std::sort(begin, end);  // a handful of neighbours
+    for (auto i = begin; i != end;) {
+      auto j = i;
+      while (j != end && *j == *i) ++j;
+      f(static_cast<uint32_t>(a), *i, static_cast<uint32_t>(j - i));
+      i = j;
+    }
+  }
+}
+
 absl::Status FinalizeMesh(TriangleMesh* mesh) {
   const std::string& name = mesh->name;
   const size_t nv = mesh->positions.size();
@@ -62,8 +92,6 @@ absl::Status FinalizeMesh(TriangleMesh* mesh) {
       }
     }
   }
-  std::vector<uint64_t> edges;  // (lower vertex << 32) | higher vertex
-  edges.reserve(mesh->triangles.size() * 3);
   stats.degenerate_triangles = 0;
   stats.area = 0;
   for (size_t t = 0; t < mesh->triangles.size(); ++t) {
@@ -81,25 +109,17 @@ absl::Status FinalizeMesh(TriangleMesh* mesh) {
       continue;
     }
     stats.area += 0.5 * Norm(mesh->FaceCross(t));
-    for (int c = 0; c < 3; ++c) {
-      const uint32_t a = f[c], b = f[(c + 1) % 3];
-      edges.push_back(uint64_t{std::min(a, b)} << 32 | std::max(a, b));
-    }
   }
   if (stats.degenerate_triangles == mesh->triangles.size()) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "mesh '%s': all %d triangles are degenerate (no area): nothing to sample", name,
         mesh->triangles.size()));
   }
-  std::sort(edges.begin(), edges.end());
   stats.non_manifold_edges = stats.boundary_edges = 0;
-  for (size_t i = 0; i < edges.size();) {
-    size_t j = i;
-    while (j < edges.size() && edges[j] == edges[i]) ++j;
-    if (j - i == 1) ++stats.boundary_edges;
-    if (j - i > 2) ++stats.non_manifold_edges;
-    i = j;
-  }
+  ForEachEdge(*mesh, [&stats](uint32_t, uint32_t, uint32_t n) {
+    if (n == 1) ++stats.boundary_edges;
+    if (n > 2) ++stats.non_manifold_edges;
+  });
   return absl::OkStatus();
 }
 

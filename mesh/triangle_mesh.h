@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,12 @@ struct TriangleMesh {
 // True when triangle t has (numerically) no area: a repeated corner, or
 // |e1 x e2| <= 1e-12 * (longest edge)^2. Such triangles are never sampled.
 bool IsDegenerateTriangle(const TriangleMesh& mesh, size_t t);
+
+// Calls f(a, b, n) once per distinct edge {a, b} (a < b) of the
+// non-degenerate triangles, n = how many of them have it, in order of a.
+// O(triangles): edges are bucketed by their lower vertex.
+void ForEachEdge(const TriangleMesh& mesh,
+                 const std::function<void(uint32_t a, uint32_t b, uint32_t n)>& f);
 
 // Checks a freshly built mesh and fills `stats`. Errors (INVALID_ARGUMENT,
 // naming mesh->name): no triangles or only degenerate ones, a corner index
