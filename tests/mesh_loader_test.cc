@@ -130,6 +130,11 @@ TEST(MeshLoader, BrokenFilesGetClearErrorsNamingTheFile) {
   WriteFile(dir / "noface.ply",
             "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
             "property float z\nend_header\n0 0 0\n");
+  WriteFile(dir / "inf.obj", "v 0 0 0\nv 1 1e999 0\nv 0 1 0\nf 1 2 3\n");
+  WriteFile(dir / "nan_ascii.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+            "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+            "0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n");
   WriteFile(dir / "huge_count.ply",
             "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\n"
             "property float y\nproperty float z\nend_header\n");
@@ -152,6 +157,8 @@ TEST(MeshLoader, BrokenFilesGetClearErrorsNamingTheFile) {
   ExpectError(load("index.obj"), StatusCode::kInvalidArgument, "index.obj", "vertex");
   ExpectError(load("noface.ply"), StatusCode::kInvalidArgument, "noface.ply", "no triangles");
   ExpectError(load("nan.ply"), StatusCode::kInvalidArgument, "nan.ply", "vertex 7");
+  ExpectError(load("inf.obj"), StatusCode::kInvalidArgument, "inf.obj", "finite");
+  ExpectError(load("nan_ascii.ply"), StatusCode::kInvalidArgument, "nan_ascii.ply", "vertex");
   ExpectError(load("huge_count.ply"), StatusCode::kInvalidArgument, "huge_count.ply", "truncated");
   ExpectError(load("wide_list.ply"), StatusCode::kInvalidArgument, "wide_list.ply", "list uchar int");
   ExpectError(LoadMesh(binary, "big.ply", {.max_bytes = binary.size() - 1}),
