@@ -15,6 +15,10 @@ packages=(
   prometheus-cpp-dev                             # server metrics
   libcairo2-dev libpng-dev                       # pictures and plots
   libssl-dev                                     # constant-time token comparison (CRYPTO_memcmp)
+  libtinyobjloader-dev                           # OBJ meshes (mesh/): parses from a string, keeps vn
+  libcgal-dev                                    # PLY meshes (mesh/): header-only reader from a stream, ASCII and
+                                                 # binary, keeps every named vertex property (per-vertex weights);
+                                                 # assimp keeps only PLY properties it knows; PCL/VTK are far heavier
   openssl                                        # a self-signed certificate for the TLS test
   nginx                                          # the consistent-hash gRPC proxy of the scale-out test
   python3-dev pybind11-dev                       # the Python extension sfcsampler._core (embedded engine)

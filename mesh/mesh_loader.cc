@@ -1,0 +1,383 @@
+#include "mesh/mesh_loader.h"
+
+#include <CGAL/IO/PLY/PLY_reader.h>
+#include <tiny_obj_loader.h>
+
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
+#include "core/status_macros.h"
+
+namespace sfc {
+namespace {
+
+using CgalPlyReader = CGAL::IO::internal::PLY_reader;
+using CgalPlyElement = CGAL::IO::internal::PLY_element;
+using CgalPlyNumber = CGAL::IO::internal::PLY_read_number;
+
+absl::Status Malformed(absl::string_view name, absl::string_view what) {
+  return absl::InvalidArgumentError(absl::StrFormat("mesh '%s': %s", name, what));
+}
+
+// Appends a polygon as a fan of triangles (0, i, i+1).
+void AddPolygon(const std::vector<uint32_t>& corners, TriangleMesh* mesh) {
+  ++mesh->stats.faces;
+  if (corners.size() > 3) ++mesh->stats.triangulated_polygons;
+  for (size_t i = 1; i + 1 < corners.size(); ++i) {
+    mesh->triangles.push_back({corners[0], corners[i], corners[i + 1]});
+  }
+}
+
+// ---------------------------------------------------------------- OBJ
+
+// tinyobjloader reads a coordinate it cannot parse ("nan", a cut-off line) as
+// 0 without a word, so the vertex lines are checked here first: at least three
+// numbers, each finite.
+absl::Status CheckObjVertexLines(absl::string_view text, absl::string_view name) {
+  size_t line_number = 0;
+  for (absl::string_view line : absl::StrSplit(text, '\n')) {
+    ++line_number;
+    line = absl::StripAsciiWhitespace(line);
+    if (!absl::StartsWith(line, "v ") && !absl::StartsWith(line, "v\t")) continue;
+    std::vector<absl::string_view> tokens =
+        absl::StrSplit(line.substr(2), absl::ByAnyChar(" \t"), absl::SkipEmpty());
+    if (tokens.size() < 3) {
+      return Malformed(name, absl::StrFormat("line %d: a vertex needs three coordinates, found %d "
+                                             "(a truncated file?)",
+                                             line_number, tokens.size()));
+    }
+    for (int c = 0; c < 3; ++c) {
+      double value;
+      if (!absl::SimpleAtod(tokens[c], &value) || !std::isfinite(value)) {
+        return Malformed(name, absl::StrFormat("line %d: vertex coordinate '%s' is not a finite "
+                                               "number",
+                                               line_number, tokens[c]));
+      }
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<TriangleMesh> LoadObj(absl::string_view bytes, absl::string_view name,
+                                     const MeshLoadOptions& options) {
+  if (!options.weight_property.empty()) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "mesh '%s': OBJ files have no named vertex properties, so weight property '%s' cannot "
+        "be read; give the mesh as PLY with a vertex property of that name",
+        name, options.weight_property));
+  }
+  RETURN_IF_ERROR(CheckObjVertexLines(bytes, name));
+  tinyobj::ObjReader reader;
+  tinyobj::ObjReaderConfig config;
+  config.triangulate = false;  // we fan-triangulate and count the polygons
+  config.vertex_color = false;
+  if (!reader.ParseFromString(std::string(bytes), "", config)) {
+    return Malformed(name, absl::StrFormat("not a valid OBJ file: %s",
+                                           absl::StripAsciiWhitespace(reader.Error())));
+  }
+  const std::string& warning = reader.Warning();
+  if (absl::StrContains(warning, "out of bounds")) {
+    return Malformed(name, "a face uses a vertex index past the vertices (a truncated file?)");
+  }
+  if (absl::StrContains(warning, "Degenerated face")) {
+    return Malformed(name, "a face has fewer than three corners (a truncated file?)");
+  }
+  const tinyobj::attrib_t& attrib = reader.GetAttrib();
+  TriangleMesh mesh;
+  mesh.name = std::string(name);
+  const size_t nv = attrib.vertices.size() / 3;
+  mesh.positions.resize(nv);
+  for (size_t i = 0; i < nv; ++i) {
+    mesh.positions[i] = {attrib.vertices[3 * i], attrib.vertices[3 * i + 1],
+                         attrib.vertices[3 * i + 2]};
+  }
+  // OBJ normals belong to face corners; they are vertex normals only when
+  // every corner of a vertex names the same one.
+  std::vector<int> normal_of(nv, -1);
+  bool vertex_normals = !attrib.normals.empty();
+  std::vector<uint32_t> corners;
+  for (const tinyobj::shape_t& shape : reader.GetShapes()) {
+    size_t offset = 0;
+    for (const unsigned int count : shape.mesh.num_face_vertices) {
+      corners.clear();
+      for (size_t c = 0; c < count; ++c) {
+        const tinyobj::index_t& index = shape.mesh.indices[offset + c];
+        if (index.vertex_index < 0 || static_cast<size_t>(index.vertex_index) >= nv) {
+          return Malformed(name, absl::StrFormat("a face uses vertex %d but the file has %d "
+                                                 "vertices (a truncated file?)",
+                                                 index.vertex_index + 1, nv));
+        }
+        corners.push_back(static_cast<uint32_t>(index.vertex_index));
+        if (vertex_normals) {
+          int& n = normal_of[index.vertex_index];
+          if (index.normal_index < 0 ||
+              static_cast<size_t>(index.normal_index) * 3 + 2 >= attrib.normals.size() ||
+              (n >= 0 && n != index.normal_index)) {
+            vertex_normals = false;
+          } else {
+            n = index.normal_index;
+          }
+        }
+      }
+      offset += count;
+      AddPolygon(corners, &mesh);
+    }
+  }
+  if (vertex_normals) {
+    mesh.normals.resize(nv);
+    for (size_t i = 0; i < nv; ++i) {
+      if (normal_of[i] < 0) continue;  // unused vertex: any unit vector
+      const size_t n = static_cast<size_t>(normal_of[i]) * 3;
+      mesh.normals[i] = {attrib.normals[n], attrib.normals[n + 1], attrib.normals[n + 2]};
+    }
+    for (Vec3& n : mesh.normals) {
+      if (n == Vec3{}) n = {0, 0, 1};
+    }
+  }
+  return mesh;
+}
+
+// ---------------------------------------------------------------- PLY
+
+// Reads the current value of a scalar property as a double. The property's
+// type is resolved once per element (Resolve), not once per value.
+using ScalarGetter = double (*)(const CgalPlyNumber*);
+
+template <typename T>
+double GetScalar(const CgalPlyNumber* p) {
+  return static_cast<double>(
+      static_cast<const CGAL::IO::internal::PLY_read_typed_number<T>*>(p)->buffer());
+}
+
+template <typename T>
+bool Is(const CgalPlyNumber* p) {
+  return dynamic_cast<const CGAL::IO::internal::PLY_read_typed_number<T>*>(p) != nullptr;
+}
+
+// The getter for a scalar property of any numeric PLY type; nullptr for lists.
+ScalarGetter Resolve(const CgalPlyNumber* p) {
+  if (Is<double>(p)) return &GetScalar<double>;
+  if (Is<float>(p)) return &GetScalar<float>;
+  if (Is<int32_t>(p)) return &GetScalar<int32_t>;
+  if (Is<uint32_t>(p)) return &GetScalar<uint32_t>;
+  if (Is<int16_t>(p)) return &GetScalar<int16_t>;
+  if (Is<uint16_t>(p)) return &GetScalar<uint16_t>;
+  if (Is<int8_t>(p)) return &GetScalar<int8_t>;
+  if (Is<uint8_t>(p)) return &GetScalar<uint8_t>;
+  return nullptr;
+}
+
+// A face's corner list of any integer type, copied into `out`; false when the
+// property is not an integer list.
+bool ListValue(const CgalPlyNumber* p, std::vector<int64_t>* out) {
+  using CGAL::IO::internal::PLY_read_typed_list;
+  out->clear();
+  auto copy = [out](const auto& buffer) {
+    out->assign(buffer.begin(), buffer.end());
+    return true;
+  };
+  if (auto* q = dynamic_cast<const PLY_read_typed_list<int32_t>*>(p)) return copy(q->buffer());
+  if (auto* q = dynamic_cast<const PLY_read_typed_list<uint32_t>*>(p)) return copy(q->buffer());
+  if (auto* q = dynamic_cast<const PLY_read_typed_list<int16_t>*>(p)) return copy(q->buffer());
+  if (auto* q = dynamic_cast<const PLY_read_typed_list<uint16_t>*>(p)) return copy(q->buffer());
+  if (auto* q = dynamic_cast<const PLY_read_typed_list<int8_t>*>(p)) return copy(q->buffer());
+  if (auto* q = dynamic_cast<const PLY_read_typed_list<uint8_t>*>(p)) return copy(q->buffer());
+  return false;
+}
+
+// CGAL's list reader resizes to the stored count before reading it: a 32-bit
+// count in a broken file would allocate gigabytes. Only 8- and 16-bit counts
+// (what writers use: "property list uchar int vertex_indices") are read.
+bool HasNarrowListCount(const CgalPlyNumber* p) {
+  using CGAL::IO::internal::PLY_read_typed_list_with_typed_size;
+  auto narrow = [p](auto index_tag) {
+    using Index = decltype(index_tag);
+    return dynamic_cast<const PLY_read_typed_list_with_typed_size<uint8_t, Index>*>(p) ||
+           dynamic_cast<const PLY_read_typed_list_with_typed_size<int8_t, Index>*>(p) ||
+           dynamic_cast<const PLY_read_typed_list_with_typed_size<uint16_t, Index>*>(p) ||
+           dynamic_cast<const PLY_read_typed_list_with_typed_size<int16_t, Index>*>(p);
+  };
+  return narrow(int32_t{}) || narrow(uint32_t{}) || narrow(int16_t{}) || narrow(uint16_t{}) ||
+         narrow(int8_t{}) || narrow(uint8_t{}) || narrow(float{}) || narrow(double{});
+}
+
+absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view name,
+                                     const MeshLoadOptions& options) {
+  std::istringstream in(std::string(bytes), std::ios::in | std::ios::binary);
+  CgalPlyReader reader(/*verbose=*/false);
+  if (!reader.init(in)) {
+    return Malformed(name, "not a valid PLY header (it must start with 'ply', give a 'format' "
+                           "line and end with 'end_header')");
+  }
+  TriangleMesh mesh;
+  mesh.name = std::string(name);
+  bool have_vertices = false;
+  for (size_t e = 0; e < reader.number_of_elements(); ++e) {
+    CgalPlyElement& element = reader.element(e);
+    const size_t items = element.number_of_items();
+    const size_t props = element.number_of_properties();
+    if (props == 0 || items == 0) continue;
+    // Every item of an element with properties takes at least one byte.
+    if (items > bytes.size()) {
+      return Malformed(name, absl::StrFormat("element '%s' declares %d items, more than the %d "
+                                             "bytes of the file can hold (a truncated file?)",
+                                             element.name(), items, bytes.size()));
+    }
+    for (size_t k = 0; k < props; ++k) {
+      CgalPlyNumber* p = element.property(k);
+      if (Resolve(p) == nullptr && !HasNarrowListCount(p)) {
+        return Malformed(name, absl::StrFormat("property '%s' of element '%s' is a list with a "
+                                               "32-bit count; write 'property list uchar int %s'",
+                                               p->name(), element.name(), p->name()));
+      }
+    }
+    const bool is_vertex = element.name() == "vertex";
+    const bool is_face = element.name() == "face";
+    int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, iw = -1, ifaces = -1;
+    for (size_t k = 0; k < props; ++k) {
+      const std::string& pn = element.property(k)->name();
+      const bool scalar = Resolve(element.property(k)) != nullptr;
+      if (is_vertex && scalar) {
+        if (pn == "x") ix = k;
+        if (pn == "y") iy = k;
+        if (pn == "z") iz = k;
+        if (pn == "nx") inx = k;
+        if (pn == "ny") iny = k;
+        if (pn == "nz") inz = k;
+        if (!options.weight_property.empty() && pn == options.weight_property) iw = k;
+      }
+      if (is_face && !scalar && (pn == "vertex_indices" || pn == "vertex_index")) ifaces = k;
+    }
+    if (is_vertex) {
+      if (ix < 0 || iy < 0 || iz < 0) {
+        return Malformed(name, "the vertex element needs scalar properties x, y and z");
+      }
+      if (!options.weight_property.empty() && iw < 0) {
+        return Malformed(name, absl::StrFormat("the vertex element has no scalar property '%s' "
+                                               "to read weights from",
+                                               options.weight_property));
+      }
+      have_vertices = true;
+      mesh.positions.reserve(items);
+      const bool normals = inx >= 0 && iny >= 0 && inz >= 0;
+      if (normals) mesh.normals.reserve(items);
+      if (iw >= 0) mesh.weights.reserve(items);
+    } else if (is_face && ifaces < 0) {
+      return Malformed(name, "the face element needs a list property 'vertex_indices'");
+    }
+    std::vector<int64_t> list;
+    std::vector<uint32_t> corners;
+    auto getter = [&element](int k) {
+      return k < 0 ? ScalarGetter{nullptr} : Resolve(element.property(k));
+    };
+    const ScalarGetter gx = getter(ix), gy = getter(iy), gz = getter(iz), gnx = getter(inx),
+                       gny = getter(iny), gnz = getter(inz), gw = getter(iw);
+    for (size_t j = 0; j < items; ++j) {
+      for (size_t k = 0; k < props; ++k) element.property(k)->get(in);
+      if (!in) {
+        return Malformed(name, absl::StrFormat("the file ends or breaks inside %s %d of %d (a "
+                                               "truncated or malformed file?)",
+                                               element.name(), j, items));
+      }
+      if (is_vertex) {
+        mesh.positions.push_back({gx(element.property(ix)), gy(element.property(iy)),
+                                  gz(element.property(iz))});
+        if (gnx && gny && gnz) {
+          mesh.normals.push_back({gnx(element.property(inx)), gny(element.property(iny)),
+                                  gnz(element.property(inz))});
+        }
+        if (gw) mesh.weights.push_back(gw(element.property(iw)));
+      } else if (is_face) {
+        ListValue(element.property(ifaces), &list);
+        if (list.size() < 3) {
+          return Malformed(name, absl::StrFormat("face %d has %d corners; a face needs at least "
+                                                 "three",
+                                                 j, list.size()));
+        }
+        corners.clear();
+        for (int64_t c : list) {
+          if (c < 0 || c > UINT32_MAX) {
+            return Malformed(name, absl::StrFormat("face %d uses vertex index %d", j, c));
+          }
+          corners.push_back(static_cast<uint32_t>(c));
+        }
+        AddPolygon(corners, &mesh);
+      }
+    }
+  }
+  if (!have_vertices) return Malformed(name, "the file has no vertex element");
+  return mesh;
+}
+
+}  // namespace
+
+std::optional<MeshFormat> MeshFormatFromFileName(absl::string_view file_name) {
+  const size_t dot = file_name.rfind('.');
+  if (dot == absl::string_view::npos) return std::nullopt;
+  const std::string ext = absl::AsciiStrToLower(std::string(file_name.substr(dot + 1)));
+  if (ext == "obj") return MeshFormat::kObj;
+  if (ext == "ply") return MeshFormat::kPly;
+  return std::nullopt;
+}
+
+absl::StatusOr<TriangleMesh> LoadMesh(absl::string_view bytes, absl::string_view name,
+                                      const MeshLoadOptions& options) {
+  if (bytes.size() > options.max_bytes) {
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "mesh '%s' is %d bytes, past the limit of %d bytes", name, bytes.size(),
+        options.max_bytes));
+  }
+  if (bytes.empty()) {
+    return absl::InvalidArgumentError(absl::StrFormat("mesh '%s' is empty (0 bytes)", name));
+  }
+  MeshFormat format = options.format;
+  if (format == MeshFormat::kAuto) {
+    format = absl::StartsWith(bytes, "ply") ? MeshFormat::kPly : MeshFormat::kObj;
+  }
+  absl::StatusOr<TriangleMesh> mesh;
+  try {
+    mesh = format == MeshFormat::kPly ? LoadPly(bytes, name, options)
+                                      : LoadObj(bytes, name, options);
+  } catch (const std::bad_alloc&) {
+    return absl::ResourceExhaustedError(
+        absl::StrFormat("mesh '%s' needs more memory than is available", name));
+  } catch (const std::exception& e) {
+    return Malformed(name, absl::StrFormat("the reader failed: %s", e.what()));
+  }
+  if (!mesh.ok()) return mesh.status();
+  RETURN_IF_ERROR(FinalizeMesh(&*mesh));
+  return mesh;
+}
+
+absl::StatusOr<TriangleMesh> LoadMeshFile(const std::string& path, const MeshLoadOptions& options) {
+  std::ifstream file(path, std::ios::binary | std::ios::ate);
+  if (!file) return absl::NotFoundError(absl::StrFormat("cannot open mesh file '%s'", path));
+  const std::streamoff size = file.tellg();
+  if (size < 0) return absl::NotFoundError(absl::StrFormat("cannot read mesh file '%s'", path));
+  if (static_cast<uint64_t>(size) > options.max_bytes) {
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "mesh '%s' is %d bytes, past the limit of %d bytes", path, size, options.max_bytes));
+  }
+  std::string bytes(static_cast<size_t>(size), '\0');
+  file.seekg(0);
+  if (!file.read(bytes.data(), size)) {
+    return absl::NotFoundError(absl::StrFormat("cannot read mesh file '%s'", path));
+  }
+  MeshLoadOptions resolved = options;
+  if (resolved.format == MeshFormat::kAuto && !absl::StartsWith(bytes, "ply")) {
+    resolved.format = MeshFormatFromFileName(path).value_or(MeshFormat::kAuto);
+  }
+  return LoadMesh(bytes, path, resolved);
+}
+
+}  // namespace sfc

@@ -1,0 +1,59 @@
+// Loads OBJ and PLY triangle meshes from bytes in memory (the server never
+// opens a client's path), through Debian-packaged readers: tinyobjloader for
+// OBJ and CGAL's PLY reader for PLY (ASCII and binary, both byte orders,
+// named vertex properties kept, so a user can name one as per-vertex weights).
+//
+// Polygons are split into triangle fans (counted in MeshStats). Errors name
+// the mesh: INVALID_ARGUMENT for an empty mesh, a truncated or malformed file,
+// a non-finite coordinate, an index past the vertices, a missing weight
+// property; RESOURCE_EXHAUSTED for input past MeshLoadOptions::max_bytes.
+//
+// Thread-safety: the functions are thread-safe (no shared state).
+#ifndef SFCSAMPLER_MESH_MESH_LOADER_H_
+#define SFCSAMPLER_MESH_MESH_LOADER_H_
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include "absl/strings/string_view.h"
+
+#include "absl/status/statusor.h"
+#include "mesh/triangle_mesh.h"
+
+namespace sfc {
+
+enum class MeshFormat {
+  kAuto,  // PLY when the bytes start with "ply", otherwise OBJ
+  kObj,
+  kPly,
+};
+
+// "obj", "ply" (case-insensitive) from a file name's extension; nullopt otherwise.
+std::optional<MeshFormat> MeshFormatFromFileName(absl::string_view file_name);
+
+struct MeshLoadOptions {
+  // Input larger than this is refused with RESOURCE_EXHAUSTED before parsing.
+  // Default 512 MiB. The parsed mesh takes at most a few times the input size.
+  uint64_t max_bytes = uint64_t{512} << 20;
+  MeshFormat format = MeshFormat::kAuto;
+  // Name of a PLY vertex property (any numeric type) read as per-vertex
+  // weights (MeshDensityKind::kVertexWeight); empty = none. OBJ has no named
+  // vertex properties: naming one for an OBJ file is INVALID_ARGUMENT.
+  std::string weight_property;
+};
+
+// Parses `bytes` as a mesh called `name` (used in messages only), then
+// FinalizeMesh(). Vertex normals are kept when the file gives one per vertex
+// (PLY nx, ny, nz; OBJ vn when every corner of a vertex uses the same vn).
+absl::StatusOr<TriangleMesh> LoadMesh(absl::string_view bytes, absl::string_view name,
+                                      const MeshLoadOptions& options = {});
+
+// Reads a local file (for the CLI and tools; the size is checked against
+// max_bytes before reading) and calls LoadMesh with the file's extension as
+// the format when options.format is kAuto. NOT_FOUND when it cannot be read.
+absl::StatusOr<TriangleMesh> LoadMeshFile(const std::string& path,
+                                          const MeshLoadOptions& options = {});
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_MESH_MESH_LOADER_H_

@@ -1,0 +1,248 @@
+#include "mesh/mesh_sampler.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "absl/strings/str_format.h"
+#include "core/status_macros.h"
+
+namespace sfc {
+
+MeshSampler::MeshSampler(std::shared_ptr<const MeshCurveTree> tree, Sequence sequence)
+    : tree_(std::move(tree)), sequence_(sequence) {
+  last_positive_leaf_ = tree_->leaf_count() - 1;
+  while (last_positive_leaf_ > 0 &&
+         !(tree_->mass_ends()[last_positive_leaf_] > tree_->mass_begin(last_positive_leaf_))) {
+    --last_positive_leaf_;
+  }
+}
+
+size_t MeshSampler::LeafForMass(double m) const {
+  const auto& ends = tree_->mass_ends();
+  const size_t l = static_cast<size_t>(std::upper_bound(ends.begin(), ends.end(), m) - ends.begin());
+  // q_k S_M can round up to S_M itself: it then belongs to the last leaf with mass.
+  return l >= ends.size() ? last_positive_leaf_ : l;
+}
+
+uint64_t MeshSampler::FirstIndexAtOrAbove(double m) const {
+  uint64_t lo = 0, hi = sequence_.count();
+  while (lo < hi) {
+    const uint64_t mid = lo + (hi - lo) / 2;
+    if (MassCoordinate(mid) >= m) {
+      hi = mid;
+    } else {
+      lo = mid + 1;
+    }
+  }
+  return lo;
+}
+
+double MeshSampler::FractionInLeaf(double m, size_t l) const {
+  const double begin = tree_->mass_begin(l);
+  const double t = (m - begin) / (tree_->mass_ends()[l] - begin);
+  if (!(t >= 0)) return 0;
+  if (!(t < 1)) return std::nextafter(1.0, 0.0);
+  return t;
+}
+
+MeshSample MeshSampler::AtMass(uint64_t k, double m, size_t l,
+                               const MeshCurveTree::Cell& cell) const {
+  const double t = FractionInLeaf(m, l);
+  MeshSample s;
+  s.index = k;
+  s.leaf = l;
+  s.triangle = cell.triangle;
+  double area_position;
+  MeshCurveTree::Descend(cell, t, &s.bary, &area_position);
+  s.position = tree_->surface().Point(cell.triangle, s.bary);
+  s.curve_position = (cell.rank + area_position) / static_cast<double>(tree_->triangle_count());
+  return s;
+}
+
+MeshSample MeshSampler::At(uint64_t k) const {
+  const double m = MassCoordinate(k);
+  const size_t l = LeafForMass(m);
+  return AtMass(k, m, l, tree_->LeafCell(l));
+}
+
+absl::StatusOr<std::unique_ptr<MeshSampleCursor>> MeshSampleCursor::Create(
+    std::shared_ptr<const MeshSampler> sampler, uint64_t begin, uint64_t end,
+    const Region& region, const SampleFields& fields) {
+  const uint64_t count = sampler->sequence().count();
+  if (begin > end || end > count) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the index range [%d, %d) is not inside the set of %d samples; it needs begin <= end <= "
+        "count",
+        begin, end, count));
+  }
+  if (region.kind == Region::Kind::kParameterRect) {
+    return absl::InvalidArgumentError(
+        "a mesh has no parameter square, so a parameter rectangle (uv:) selects nothing; give a "
+        "3D box (box:x0,y0,z0,x1,y1,z1)");
+  }
+  RETURN_IF_ERROR(region.Validate());
+  auto cursor =
+      std::unique_ptr<MeshSampleCursor>(new MeshSampleCursor(std::move(sampler), region, fields));
+  RETURN_IF_ERROR(cursor->Plan(begin, end));
+  return cursor;
+}
+
+absl::Status MeshSampleCursor::Plan(uint64_t begin, uint64_t end) {
+  const MeshSampler& sampler = *sampler_;
+  const MeshCurveTree& tree = sampler.tree();
+  if (!sampler.sequence().monotone()) {
+    // Index order is not curve order: sort by mass coordinate (ties by index).
+    std::vector<std::pair<double, uint64_t>> keyed;
+    keyed.reserve(end - begin);
+    for (uint64_t k = begin; k < end; ++k) keyed.emplace_back(sampler.MassCoordinate(k), k);
+    std::sort(keyed.begin(), keyed.end());
+    order_.reserve(keyed.size());
+    for (const auto& [m, k] : keyed) order_.push_back(k);
+    use_order_ = true;
+    return absl::OkStatus();
+  }
+  if (region_.kind == Region::Kind::kAll) {
+    segments_.push_back({begin, end});
+  } else {
+    // Only the runs of triangles whose boxes meet the region: their samples
+    // are the indices whose mass coordinates fall in the runs' mass intervals.
+    std::vector<std::pair<size_t, size_t>> runs;
+    tree.RanksMeetingBox(region_.lo, region_.hi, &runs);
+    const uint64_t count = sampler.sequence().count();
+    for (const auto& [a, b] : runs) {
+      const uint64_t k0 = sampler.FirstIndexAtOrAbove(tree.mass_begin(tree.first_leaf(a)));
+      // The run that ends the curve also takes q_k S_M rounded up to S_M.
+      const uint64_t k1 = b == tree.triangle_count()
+                              ? count
+                              : sampler.FirstIndexAtOrAbove(tree.mass_begin(tree.first_leaf(b)));
+      const uint64_t lo = std::max(k0, begin), hi = std::min(k1, end);
+      if (lo < hi) segments_.push_back({lo, hi});
+    }
+  }
+  if (!segments_.empty()) next_k_ = segments_[0].begin;
+  return absl::OkStatus();
+}
+
+absl::StatusOr<size_t> MeshSampleCursor::Next(size_t max, SampleBatch* batch,
+                                              MeshSampleColumns* mesh_columns) {
+  const MeshSampler& sampler = *sampler_;
+  const MeshCurveTree& tree = sampler.tree();
+  const MeshSurface& surface = tree.surface();
+  const auto& ends = tree.mass_ends();
+  {
+    // Reserve what this call can emit (at most the indices left), so large
+    // batches grow once instead of by doubling.
+    uint64_t left = use_order_ ? order_.size() - order_pos_ : 0;
+    if (!use_order_) {
+      for (size_t i = segment_; i < segments_.size(); ++i) {
+        left += segments_[i].end - (i == segment_ ? std::max(next_k_, segments_[i].begin)
+                                                  : segments_[i].begin);
+      }
+    }
+    const size_t want = batch->size() + static_cast<size_t>(std::min<uint64_t>(left, max));
+    for (auto* column : {&batch->u, &batch->v, &batch->x, &batch->y, &batch->z}) {
+      column->reserve(want);
+    }
+    batch->index.reserve(want);
+    if (fields_.normal) {
+      for (auto* column : {&batch->nx, &batch->ny, &batch->nz}) column->reserve(want);
+    }
+    if (fields_.density) batch->density.reserve(want);
+    if (fields_.curve_position) batch->curve_position.reserve(want);
+    if (mesh_columns != nullptr) {
+      mesh_columns->triangle.reserve(mesh_columns->size() + (want - batch->size()));
+      mesh_columns->w.reserve(mesh_columns->size() + (want - batch->size()));
+    }
+  }
+  // Samples go in chunks: first their leaves and fractions, then their
+  // descents together (MeshCurveTree::DescendMany), then the columns.
+  constexpr size_t kChunk = 32;
+  uint64_t ks[kChunk];
+  double ts[kChunk], area_positions[kChunk];
+  const MeshCurveTree::Cell* cells[kChunk];
+  std::array<double, 3> barys[kChunk];
+  chunk_cells_.reserve(kChunk + 1);  // pointers into it stay valid for a chunk
+  const double triangles = static_cast<double>(tree.triangle_count());
+  size_t emitted = 0;
+  bool exhausted = false;
+  while (emitted < max && !exhausted) {
+    chunk_cells_.clear();
+    if (cached_leaf_ != SIZE_MAX) chunk_cells_.push_back(cached_cell_);
+    const size_t want = std::min(kChunk, max - emitted);
+    size_t n = 0;
+    while (n < want) {
+      uint64_t k;
+      if (use_order_) {
+        if (order_pos_ >= order_.size()) {
+          exhausted = true;
+          break;
+        }
+        k = order_[order_pos_++];
+      } else {
+        while (segment_ < segments_.size() && next_k_ >= segments_[segment_].end) {
+          if (++segment_ < segments_.size()) next_k_ = segments_[segment_].begin;
+        }
+        if (segment_ >= segments_.size()) {
+          exhausted = true;
+          break;
+        }
+        k = next_k_++;
+      }
+      const double m = sampler.MassCoordinate(k);
+      if (cached_leaf_ == SIZE_MAX || !(m >= tree.mass_begin(cached_leaf_) && m < ends[cached_leaf_])) {
+        const size_t l = sampler.LeafForMass(m);
+        if (l != cached_leaf_) {
+          cached_leaf_ = l;
+          cached_cell_ = tree.LeafCell(l);
+          chunk_cells_.push_back(cached_cell_);
+        }
+      }
+      ks[n] = k;
+      ts[n] = sampler.FractionInLeaf(m, cached_leaf_);
+      cells[n] = &chunk_cells_.back();
+      ++n;
+    }
+    MeshCurveTree::DescendMany(n, cells, ts, barys, area_positions);
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t triangle = cells[i]->triangle;
+      const std::array<double, 3>& bary = barys[i];
+      const Vec3 position = surface.Point(triangle, bary);
+      if (!region_.Contains(0, 0, position)) continue;
+      const uint64_t k = ks[i];
+      batch->index.push_back(k);
+      batch->u.push_back(bary[1]);
+      batch->v.push_back(bary[2]);
+      batch->x.push_back(position.x);
+      batch->y.push_back(position.y);
+      batch->z.push_back(position.z);
+      if (fields_.normal) {
+        const Vec3 nrm = surface.Normal(triangle, bary);
+        batch->nx.push_back(nrm.x);
+        batch->ny.push_back(nrm.y);
+        batch->nz.push_back(nrm.z);
+      }
+      if (fields_.density) {
+        const double d = tree.density().uniform()
+                             ? 1.0
+                             : tree.density().Evaluate(surface.Attributes(triangle, bary));
+        if (!std::isfinite(d) || d < 0) {
+          return absl::InvalidArgumentError(absl::StrFormat(
+              "the density '%s' is %g at sample %d (%g, %g, %g); it must be finite and >= 0",
+              tree.density().spec(), d, k, position.x, position.y, position.z));
+        }
+        batch->density.push_back(d);
+      }
+      if (fields_.curve_position) {
+        batch->curve_position.push_back((cells[i]->rank + area_positions[i]) / triangles);
+      }
+      if (mesh_columns != nullptr) {
+        mesh_columns->triangle.push_back(triangle);
+        mesh_columns->w.push_back(bary[0]);
+      }
+      ++emitted;
+    }
+  }
+  return emitted;
+}
+
+}  // namespace sfc

@@ -1,0 +1,174 @@
+// Loading OBJ and PLY meshes from bytes: round trips of the icosphere fixture
+// through every format, named weight properties, polygons, degenerate and
+// non-manifold input, and the errors for broken files.
+#include <unistd.h>
+
+#include <cmath>
+#include <limits>
+
+#include "gtest/gtest.h"
+#include "mesh/icosphere.h"
+#include "mesh/mesh_loader.h"
+#include "mesh/mesh_writer.h"
+#include "tests/mesh_test_util.h"
+
+namespace sfc {
+namespace {
+
+using testing::ReadFile;
+using testing::ScratchDir;
+using testing::WriteFile;
+
+// PLY keeps doubles bit for bit; tinyobjloader's own number parser can be
+// off by an ulp or two from the 17 digits written, hence `tolerance` for OBJ.
+void ExpectSameMesh(const TriangleMesh& a, const TriangleMesh& b, double tolerance = 0) {
+  ASSERT_EQ(a.positions.size(), b.positions.size());
+  ASSERT_EQ(a.triangles.size(), b.triangles.size());
+  for (size_t i = 0; i < a.positions.size(); ++i) {
+    if (tolerance == 0) {
+      ASSERT_EQ(a.positions[i], b.positions[i]) << i;
+    } else {
+      ASSERT_LE(Norm(a.positions[i] - b.positions[i]), tolerance) << i;
+    }
+  }
+  for (size_t t = 0; t < a.triangles.size(); ++t) ASSERT_EQ(a.triangles[t], b.triangles[t]) << t;
+}
+
+TEST(MeshLoader, IcosphereRoundTripsThroughObjAndBothPlyEncodings) {
+  const TriangleMesh sphere = MakeIcosphere(6);
+  ASSERT_EQ(sphere.triangles.size(), 81920u);
+  const auto dir = ScratchDir("roundtrip");
+  WriteFile(dir / "ico.obj", MeshToObj(sphere));
+  WriteFile(dir / "ico_bin.ply", MeshToPly(sphere, /*binary=*/true));
+  WriteFile(dir / "ico_ascii.ply", MeshToPly(sphere, /*binary=*/false));
+  for (const char* file : {"ico.obj", "ico_bin.ply", "ico_ascii.ply"}) {
+    SCOPED_TRACE(file);
+    auto loaded = LoadMesh(ReadFile(dir / file), file);
+    ASSERT_TRUE(loaded.ok()) << loaded.status();
+    ExpectSameMesh(sphere, *loaded, std::string(file) == "ico.obj" ? 1e-15 : 0);
+    EXPECT_EQ(loaded->stats.degenerate_triangles, 0u);
+    EXPECT_EQ(loaded->stats.non_manifold_edges, 0u);
+    EXPECT_EQ(loaded->stats.boundary_edges, 0u);  // closed surface
+    EXPECT_NEAR(loaded->stats.area, 4 * M_PI, 0.01);
+  }
+  auto from_file = LoadMeshFile((dir / "ico.obj").string());
+  ASSERT_TRUE(from_file.ok()) << from_file.status();
+  ExpectSameMesh(sphere, *from_file, 1e-15);
+}
+
+TEST(MeshLoader, KeepsVertexNormalsAndNamedWeights) {
+  TriangleMesh sphere = MakeIcosphere(2, /*with_normals=*/true);
+  sphere.weights.resize(sphere.positions.size());
+  for (size_t i = 0; i < sphere.weights.size(); ++i) sphere.weights[i] = 1 + sphere.positions[i].z;
+  for (bool binary : {true, false}) {
+    const std::string bytes = MeshToPly(sphere, binary, "importance");
+    MeshLoadOptions options;
+    options.weight_property = "importance";
+    auto loaded = LoadMesh(bytes, "w.ply", options);
+    ASSERT_TRUE(loaded.ok()) << loaded.status();
+    ASSERT_EQ(loaded->weights.size(), sphere.weights.size());
+    for (size_t i = 0; i < sphere.weights.size(); ++i) EXPECT_EQ(loaded->weights[i], sphere.weights[i]);
+    ASSERT_EQ(loaded->normals.size(), sphere.positions.size());
+    EXPECT_NEAR(loaded->normals[5].x, sphere.positions[5].x, 1e-12);
+    options.weight_property = "missing";
+    auto missing = LoadMesh(bytes, "w.ply", options);
+    EXPECT_EQ(missing.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(missing.status().message().find("missing"), std::string::npos);
+  }
+  auto obj = LoadMesh(MeshToObj(sphere), "w.obj", {.weight_property = "importance"});
+  EXPECT_EQ(obj.status().code(), absl::StatusCode::kInvalidArgument);
+  auto obj_normals = LoadMesh(MeshToObj(sphere), "n.obj");
+  ASSERT_TRUE(obj_normals.ok()) << obj_normals.status();
+  EXPECT_EQ(obj_normals->normals.size(), sphere.positions.size());
+}
+
+TEST(MeshLoader, TriangulatesPolygonsAndCountsDegenerateAndNonManifold) {
+  // A quad, a degenerate triangle (repeated corner), and three triangles on one edge.
+  const std::string obj =
+      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 0 -1 0\n"
+      "f 1 2 3 4\nf 1 2 2\nf 1 2 5\nf 1 6 2\n";
+  auto mesh = LoadMesh(obj, "poly.obj");
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(mesh->stats.faces, 4u);
+  EXPECT_EQ(mesh->stats.triangulated_polygons, 1u);
+  EXPECT_EQ(mesh->triangles.size(), 5u);
+  EXPECT_EQ(mesh->stats.degenerate_triangles, 1u);
+  EXPECT_EQ(mesh->stats.non_manifold_edges, 1u);  // edge (1, 2): quad, the tent, the fin
+  EXPECT_NEAR(mesh->stats.area, 1 + 0.5 + 0.5, 1e-15);
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
+  auto quad = LoadMesh(ply, "quad.ply");
+  ASSERT_TRUE(quad.ok()) << quad.status();
+  EXPECT_EQ(quad->triangles.size(), 2u);
+  EXPECT_EQ(quad->stats.triangulated_polygons, 1u);
+}
+
+void ExpectError(const absl::StatusOr<TriangleMesh>& result, absl::StatusCode code,
+                 const std::string& name, const std::string& words) {
+  ASSERT_FALSE(result.ok()) << name;
+  EXPECT_EQ(result.status().code(), code) << result.status();
+  EXPECT_NE(result.status().message().find(name), std::string::npos) << result.status();
+  EXPECT_NE(result.status().message().find(words), std::string::npos) << result.status();
+}
+
+TEST(MeshLoader, BrokenFilesGetClearErrorsNamingTheFile) {
+  const TriangleMesh sphere = MakeIcosphere(3);
+  const auto dir = ScratchDir("broken");
+  const std::string binary = MeshToPly(sphere, true);
+  const std::string ascii = MeshToPly(sphere, false);
+  const std::string obj = MeshToObj(sphere);
+  WriteFile(dir / "cut_bin.ply", binary.substr(0, binary.size() * 2 / 3));
+  WriteFile(dir / "cut_ascii.ply", ascii.substr(0, ascii.size() / 2));
+  WriteFile(dir / "cut.obj", obj.substr(0, obj.size() / 3));  // only vertex lines remain
+  WriteFile(dir / "cut_face.obj", obj.substr(0, obj.find("\nf ") + 6));  // "f a b" cut mid-line
+  WriteFile(dir / "empty.ply", "");
+  WriteFile(dir / "nan.obj", "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n");
+  WriteFile(dir / "short.obj", "v 0 0 0\nv 1 0 0\nv 0 1\nf 1 2 3\n");
+  WriteFile(dir / "index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+  WriteFile(dir / "noface.ply",
+            "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+            "property float z\nend_header\n0 0 0\n");
+  WriteFile(dir / "inf.obj", "v 0 0 0\nv 1 1e999 0\nv 0 1 0\nf 1 2 3\n");
+  WriteFile(dir / "nan_ascii.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+            "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+            "0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n");
+  WriteFile(dir / "huge_count.ply",
+            "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\n"
+            "property float y\nproperty float z\nend_header\n");
+  WriteFile(dir / "wide_list.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+            "property float z\nelement face 1\nproperty list int int vertex_indices\nend_header\n"
+            "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  TriangleMesh nan_mesh = sphere;
+  nan_mesh.positions[7].y = std::numeric_limits<double>::quiet_NaN();
+  WriteFile(dir / "nan.ply", MeshToPly(nan_mesh, true));
+  auto load = [&](const std::string& file) { return LoadMeshFile((dir / file).string()); };
+  using absl::StatusCode;
+  ExpectError(load("cut_bin.ply"), StatusCode::kInvalidArgument, "cut_bin.ply", "truncated");
+  ExpectError(load("cut_ascii.ply"), StatusCode::kInvalidArgument, "cut_ascii.ply", "truncated");
+  ExpectError(load("cut.obj"), StatusCode::kInvalidArgument, "cut.obj", "");
+  ExpectError(load("cut_face.obj"), StatusCode::kInvalidArgument, "cut_face.obj", "truncated");
+  ExpectError(load("empty.ply"), StatusCode::kInvalidArgument, "empty.ply", "empty");
+  ExpectError(load("nan.obj"), StatusCode::kInvalidArgument, "nan.obj", "finite");
+  ExpectError(load("short.obj"), StatusCode::kInvalidArgument, "short.obj", "three coordinates");
+  ExpectError(load("index.obj"), StatusCode::kInvalidArgument, "index.obj", "vertex");
+  ExpectError(load("noface.ply"), StatusCode::kInvalidArgument, "noface.ply", "no triangles");
+  ExpectError(load("nan.ply"), StatusCode::kInvalidArgument, "nan.ply", "vertex 7");
+  ExpectError(load("inf.obj"), StatusCode::kInvalidArgument, "inf.obj", "finite");
+  ExpectError(load("nan_ascii.ply"), StatusCode::kInvalidArgument, "nan_ascii.ply", "vertex");
+  ExpectError(load("huge_count.ply"), StatusCode::kInvalidArgument, "huge_count.ply", "truncated");
+  ExpectError(load("wide_list.ply"), StatusCode::kInvalidArgument, "wide_list.ply", "list uchar int");
+  ExpectError(LoadMesh(binary, "big.ply", {.max_bytes = binary.size() - 1}),
+              StatusCode::kResourceExhausted, "big.ply", "limit");
+  ExpectError(LoadMeshFile((dir / "cut_bin.ply").string(), {.max_bytes = 100}),
+              StatusCode::kResourceExhausted, "cut_bin.ply", "limit");
+  ExpectError(load("absent.obj"), StatusCode::kNotFound, "absent.obj", "");
+  ExpectError(LoadMesh("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n", "flat.obj"),
+              StatusCode::kInvalidArgument, "flat.obj", "degenerate");
+}
+
+}  // namespace
+}  // namespace sfc
