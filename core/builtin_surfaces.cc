@@ -157,26 +157,108 @@ class WhitneyUmbrella final : public Surface {
 // Signed power sign(c)|c|^e.
 double SignedPow(double c, double e) { return std::copysign(std::pow(std::fabs(c), e), c); }
 
+// g(x) = sign(c(x)) |c(x)|^e for c = cos or sin, with its first two
+// derivatives. With e < 1 the derivatives are infinite where c = 0 (the
+// superellipsoid's singular lines, paper Sect. 5.3); callers of the jet see
+// the infinity, the tree never evaluates its mass estimates there.
+struct PowTrig {
+  double g = 0, d1 = 0, d2 = 0;
+};
+// c = cos x or sin x, dc its derivative (-sin x or cos x); c'' = -c.
+PowTrig SignedPowOf(double c, double dc, double e, int order) {
+  PowTrig r;
+  const double a = std::fabs(c);
+  r.g = std::copysign(std::pow(a, e), c);
+  // d/dx sign(c)|c|^e = e |c|^(e-1) c'
+  r.d1 = e == 1 ? dc : e * std::pow(a, e - 1) * dc;
+  if (order >= 2) {
+    // d2 = e (e-1) |c|^(e-2) sign(c) c'^2 + e |c|^(e-1) c''
+    const double curv = e == 1 ? 0 : e * (e - 1) * std::copysign(std::pow(a, e - 2), c) * dc * dc;
+    r.d2 = curv + (e == 1 ? -c : -e * std::pow(a, e - 1) * c);
+  }
+  return r;
+}
+
 class Superellipsoid final : public Surface {
  public:
   Superellipsoid(double e, bool reparam) : e_(e), reparam_(reparam) {}
   Vec3 Point(double u, double v) const override {
-    const double a = Angle(u, -kPi / 2, 2), b = Angle(v, -kPi, 4);
+    const double a = Angle(u, -kPi / 2, 2).x, b = Angle(v, -kPi, 4).x;
     const double ca = SignedPow(std::cos(a), e_), sa = SignedPow(std::sin(a), e_);
     const double cb = SignedPow(std::cos(b), e_), sb = SignedPow(std::sin(b), e_);
     return {ca * cb, ca * sb, sa};
   }
 
+  // Closed-form derivatives (chain rule through the angle maps).
+  SurfaceJet Jet(double u, double v, int order) const override {
+    SurfaceJet j;
+    Combine(FactorsU(u, order), FactorsV(v, order), order, &j);
+    return j;
+  }
+  void JetGrid(const double* us, int nu, const double* vs, int nv, int order,
+               SurfaceJet* out) const override {
+    if (nu > 9 || nv > 9) return Surface::JetGrid(us, nu, vs, nv, order, out);
+    Factors fv[9];
+    for (int j = 0; j < nv; ++j) fv[j] = FactorsV(vs[j], order);
+    for (int i = 0; i < nu; ++i) {
+      const Factors fu = FactorsU(us[i], order);
+      for (int j = 0; j < nv; ++j) Combine(fu, fv[j], order, &out[i * nv + j]);
+    }
+  }
+
  private:
+  // An angle and its first two derivatives with respect to the parameter.
+  struct AngleJet {
+    double x, d1, d2;
+  };
+  // cos- and sin-type factors of one parameter, differentiated by it.
+  struct Factors {
+    PowTrig c, s;
+  };
+
   // Maps x in [0,1] onto [start, start + pieces * pi/2], piecewise by quarter
-  // turns, with the double-ended power law when reparameterising.
-  double Angle(double x, double start, int pieces) const {
-    if (!reparam_) return start + x * pieces * (kPi / 2);
+  // turns, with the double-ended power law q(s) = s^3 / (s^3 + (1-s)^3) when
+  // reparameterising.
+  AngleJet Angle(double x, double start, int pieces) const {
+    const double quarter = kPi / 2;
+    if (!reparam_) return {start + x * pieces * quarter, pieces * quarter, 0};
     const double y = x * pieces;
     const int piece = std::min(static_cast<int>(y), pieces - 1);
-    const double s = y - piece;
-    const double s3 = s * s * s, r3 = (1 - s) * (1 - s) * (1 - s);
-    return start + (piece + s3 / (s3 + r3)) * (kPi / 2);
+    const double s = y - piece, r = 1 - s;
+    const double s3 = s * s * s, r3 = r * r * r, d = s3 + r3;
+    // q' = 3 s^2 r^2 / d^2, q'' = (n' d - 2 n d') / d^3 with n = 3 s^2 r^2.
+    const double n = 3 * s * s * r * r, dn = 6 * s * r * (r - s), dd = 3 * s * s - 3 * r * r;
+    const double q1 = n / (d * d), q2 = (dn * d - 2 * n * dd) / (d * d * d);
+    return {start + (piece + s3 / d) * quarter, q1 * pieces * quarter,
+            q2 * pieces * pieces * quarter};
+  }
+
+  Factors FactorsOf(const AngleJet& a, int order) const {
+    const double c = std::cos(a.x), s = std::sin(a.x);
+    Factors f;
+    f.c = SignedPowOf(c, -s, e_, order);
+    f.s = SignedPowOf(s, c, e_, order);
+    // Chain rule: d/dx g(a(x)) = g' a', d2 = g'' a'^2 + g' a''.
+    for (PowTrig* p : {&f.c, &f.s}) {
+      p->d2 = p->d2 * a.d1 * a.d1 + (a.d2 != 0 ? p->d1 * a.d2 : 0);
+      p->d1 *= a.d1;
+    }
+    return f;
+  }
+  Factors FactorsU(double u, int order) const { return FactorsOf(Angle(u, -kPi / 2, 2), order); }
+  Factors FactorsV(double v, int order) const { return FactorsOf(Angle(v, -kPi, 4), order); }
+
+  // f = (ca cb, ca sb, sa) from the u factors (ca, sa) and v factors (cb, sb).
+  static void Combine(const Factors& fu, const Factors& fv, int order, SurfaceJet* j) {
+    const PowTrig &ca = fu.c, &sa = fu.s, &cb = fv.c, &sb = fv.s;
+    j->p = {ca.g * cb.g, ca.g * sb.g, sa.g};
+    j->fu = {ca.d1 * cb.g, ca.d1 * sb.g, sa.d1};
+    j->fv = {ca.g * cb.d1, ca.g * sb.d1, 0};
+    if (order >= 2) {
+      j->fuu = {ca.d2 * cb.g, ca.d2 * sb.g, sa.d2};
+      j->fuv = {ca.d1 * cb.d1, ca.d1 * sb.d1, 0};
+      j->fvv = {ca.g * cb.d2, ca.g * sb.d2, 0};
+    }
   }
 
   const double e_;

@@ -152,8 +152,9 @@ TEST(Sampler, NoTwoSamplesCoincide) {
 // plus the error of the area x density estimate.
 void ExpectCellCountsWithinJitterBound(const char* surface, const char* density, uint64_t n,
                                        const std::function<double(double, double, double, double)>& true_mass,
-                                       double total, int depth, double slack) {
-  const auto s = MakeSetup(surface, density, n);
+                                       double total, int depth, double slack,
+                                       const CurveTreeOptions& options = {}) {
+  const auto s = MakeSetup(surface, density, n, options);
   const SampleBatch b = Collect(MakeSampler(s, SequenceKind::kJittered, n, 9), 0, n);
   const int side = 1 << depth;
   std::vector<int> counts(side * side, 0);
@@ -180,6 +181,24 @@ TEST(Sampler, CountsPerCellMatchTheAreaOnTheSphere) {
     return (std::cos(pi * a) - std::cos(pi * b)) * 2 * pi * (d - c);
   };
   ExpectCellCountsWithinJitterBound("sphere", "uniform", 30000, area, 4 * pi, 3, 0.1);
+}
+
+TEST(Sampler, PlacementInsideOneLeafFollowsASteepDensity) {
+  // A tolerance no cell fails and a density the quadratic model holds
+  // exactly: the whole square is one leaf, and its 10^6 samples must still
+  // fill the 16 x 16 sub-cells in proportion to a density that varies
+  // 10^4-fold in u and 11-fold in v.
+  CurveTreeOptions one_leaf;
+  one_leaf.tolerance = 10;
+  const auto check = MakeSetup("plane", "expr:(u+0.01)*(u+0.01)*(v+0.1)", 1000000, one_leaf);
+  ASSERT_EQ(check.tree->leaf_count(), 1u);
+  auto mass = [](double a, double b, double c, double d) {
+    auto pu = [](double u) { return (u + 0.01) * (u + 0.01) * (u + 0.01) / 3; };
+    auto pv = [](double v) { return (v + 0.1) * (v + 0.1) / 2; };
+    return (pu(b) - pu(a)) * (pv(d) - pv(c));
+  };
+  ExpectCellCountsWithinJitterBound("plane", "expr:(u+0.01)*(u+0.01)*(v+0.1)", 1000000, mass,
+                                    mass(0, 1, 0, 1), 4, 0.5, one_leaf);
 }
 
 TEST(Sampler, CountsPerCellFollowDensityUPlusVOnTheSquare) {
