@@ -183,9 +183,10 @@ class Superellipsoid final : public Surface {
  public:
   Superellipsoid(double e, bool reparam) : e_(e), reparam_(reparam) {}
   Vec3 Point(double u, double v) const override {
-    const double a = Angle(u, -kPi / 2, 2).x, b = Angle(v, -kPi, 4).x;
-    const double ca = SignedPow(std::cos(a), e_), sa = SignedPow(std::sin(a), e_);
-    const double cb = SignedPow(std::cos(b), e_), sb = SignedPow(std::sin(b), e_);
+    double ca, sa, cb, sb;
+    Angle(u, -1, 2).CosSin(&ca, &sa);
+    Angle(v, -2, 4).CosSin(&cb, &sb);
+    ca = SignedPow(ca, e_), sa = SignedPow(sa, e_), cb = SignedPow(cb, e_), sb = SignedPow(sb, e_);
     return {ca * cb, ca * sb, sa};
   }
 
@@ -197,8 +198,8 @@ class Superellipsoid final : public Surface {
   }
   void JetGrid(const double* us, int nu, const double* vs, int nv, int order,
                SurfaceJet* out) const override {
-    if (nu > 9 || nv > 9) return Surface::JetGrid(us, nu, vs, nv, order, out);
-    Factors fv[9];
+    if (nu > 16 || nv > 16) return Surface::JetGrid(us, nu, vs, nv, order, out);
+    Factors fv[16];
     for (int j = 0; j < nv; ++j) fv[j] = FactorsV(vs[j], order);
     for (int i = 0; i < nu; ++i) {
       const Factors fu = FactorsU(us[i], order);
@@ -207,34 +208,53 @@ class Superellipsoid final : public Surface {
   }
 
  private:
-  // An angle and its first two derivatives with respect to the parameter.
+  // An angle quarter * pi/2 + offset (|offset| <= pi/4), kept apart so that
+  // cos and sin near their zeros keep full relative precision (the angle
+  // itself would round -pi + pi - 1e-20 to 0), and its first two derivatives
+  // with respect to the parameter.
   struct AngleJet {
-    double x, d1, d2;
+    int quarter;
+    double offset, d1, d2;
+    void CosSin(double* c, double* s) const {
+      const double co = std::cos(offset), so = std::sin(offset);
+      switch (((quarter % 4) + 4) % 4) {
+        case 0: *c = co, *s = so; break;
+        case 1: *c = -so, *s = co; break;
+        case 2: *c = -co, *s = -so; break;
+        default: *c = so, *s = -co; break;
+      }
+    }
   };
   // cos- and sin-type factors of one parameter, differentiated by it.
   struct Factors {
     PowTrig c, s;
   };
 
-  // Maps x in [0,1] onto [start, start + pieces * pi/2], piecewise by quarter
-  // turns, with the double-ended power law q(s) = s^3 / (s^3 + (1-s)^3) when
-  // reparameterising.
-  AngleJet Angle(double x, double start, int pieces) const {
+  // Maps x in [0,1] onto [start, start + pieces] quarter turns, piecewise by
+  // quarter turns, with the double-ended power law q(s) = s^3 / (s^3 + (1-s)^3)
+  // when reparameterising.
+  AngleJet Angle(double x, int start, int pieces) const {
     const double quarter = kPi / 2;
-    if (!reparam_) return {start + x * pieces * quarter, pieces * quarter, 0};
-    const double y = x * pieces;
+    const double y = x * pieces;  // exact: pieces is a power of two
+    if (!reparam_) {
+      const double k = std::round(y);
+      return {start + static_cast<int>(k), (y - k) * quarter, pieces * quarter, 0};
+    }
     const int piece = std::min(static_cast<int>(y), pieces - 1);
     const double s = y - piece, r = 1 - s;
     const double s3 = s * s * s, r3 = r * r * r, d = s3 + r3;
     // q' = 3 s^2 r^2 / d^2, q'' = (n' d - 2 n d') / d^3 with n = 3 s^2 r^2.
     const double n = 3 * s * s * r * r, dn = 6 * s * r * (r - s), dd = 3 * s * s - 3 * r * r;
     const double q1 = n / (d * d), q2 = (dn * d - 2 * n * dd) / (d * d * d);
-    return {start + (piece + s3 / d) * quarter, q1 * pieces * quarter,
-            q2 * pieces * pieces * quarter};
+    const double d1 = q1 * pieces * quarter, d2 = q2 * pieces * pieces * quarter;
+    // Near the piece's end measure from it: 1 - q = r^3 / d without cancellation.
+    if (s <= 0.5) return {start + piece, s3 / d * quarter, d1, d2};
+    return {start + piece + 1, -r3 / d * quarter, d1, d2};
   }
 
   Factors FactorsOf(const AngleJet& a, int order) const {
-    const double c = std::cos(a.x), s = std::sin(a.x);
+    double c, s;
+    a.CosSin(&c, &s);
     Factors f;
     f.c = SignedPowOf(c, -s, e_, order);
     f.s = SignedPowOf(s, c, e_, order);
@@ -245,8 +265,8 @@ class Superellipsoid final : public Surface {
     }
     return f;
   }
-  Factors FactorsU(double u, int order) const { return FactorsOf(Angle(u, -kPi / 2, 2), order); }
-  Factors FactorsV(double v, int order) const { return FactorsOf(Angle(v, -kPi, 4), order); }
+  Factors FactorsU(double u, int order) const { return FactorsOf(Angle(u, -1, 2), order); }
+  Factors FactorsV(double v, int order) const { return FactorsOf(Angle(v, -2, 4), order); }
 
   // f = (ca cb, ca sb, sa) from the u factors (ca, sa) and v factors (cb, sb).
   static void Combine(const Factors& fu, const Factors& fv, int order, SurfaceJet* j) {

@@ -148,7 +148,7 @@ class CurveTree {
   // max(kMinSamples, kErrorFloor N^(1/4)) samples, by the flatness test only
   // while it carries max(kMinSamples, kFlatnessFloor N^(1/2)).
   static constexpr double kMinSamples = 0.125;
-  static constexpr double kErrorFloor = 1.0 / 16;
+  static constexpr double kErrorFloor = 1.0 / 64;
   static constexpr double kErrorFloorPower = 0.5;
   static constexpr double kFlatnessFloor = 1.0 / 16;
   static constexpr double kSingularExcess = 1.02;
