@@ -49,6 +49,12 @@ struct LeafModel {
 double ModelIntegral(const LeafModel& model, LeafModel::Kind kind, int grid, double x0, double x1,
                      double y0, double y1);
 
+// The integrals over the grid x grid sub-squares of the square
+// [x0, x0 + side] x [y0, y0 + side]: out[i * grid + j] for the sub-square i
+// along x, j along y. Shares the 1D integrals between sub-squares.
+void SubSquareIntegrals(const LeafModel& model, LeafModel::Kind kind, int grid, double x0,
+                        double y0, double side, double out[9]);
+
 // The same for unnormalised quadratic node values (double precision), used by
 // the tree's error test.
 double QuadraticIntegral(const double values[9], double x0, double x1, double y0, double y1);

@@ -263,7 +263,7 @@ absl::Status SampleCursor::Emit(uint64_t k, LeafCache& cache, SampleBatch* batch
     // progressive set extended on the same tree keeps its prefix.
     cache.samples = leaf_mass / tree.total_mass() * std::ldexp(1.0, tree.grade());
     cache.stack.clear();
-    cache.stack.push_back({0.0, 1.0, 0.0, 0.0, 1.0, 0.0, cache.cell.state});
+    cache.stack.push_back({0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 1.0, cache.cell.state});
   }
   const double t = std::clamp((m - begin_mass) / leaf_mass, 0.0, 1.0);
 
@@ -276,26 +276,34 @@ absl::Status SampleCursor::Emit(uint64_t k, LeafCache& cache, SampleBatch* batch
   const int g = curve.grid(), w = curve.arity();
   while (static_cast<int>(stack.size()) <= kMaxModelLevels &&
          (stack.back().t1 - stack.back().t0) * cache.samples >= kNegligibleSamples) {
-    const Level top = stack.back();
-    const double side = top.side / g;
-    double share[9], sum = 0;
-    for (int c = 0; c < w; ++c) {
-      const Curve::Child& ch = curve.ChildOf(top.state, c);
-      const double x0 = top.x0 + ch.dx * side, y0 = top.y0 + ch.dy * side;
-      share[c] = std::max(0.0, ModelIntegral(model, kind, g, x0, x0 + side, y0, y0 + side));
-      sum += share[c];
+    Level& top = stack.back();
+    if (top.children == 0) {
+      // The children's t bounds from the model's exact integrals, once per level.
+      double by_grid[9], share[9], sum = 0;
+      SubSquareIntegrals(model, kind, g, top.x0, top.y0, top.side, by_grid);
+      for (int c = 0; c < w; ++c) {
+        const Curve::Child& ch = curve.ChildOf(top.state, c);
+        share[c] = std::max(0.0, by_grid[ch.dx * g + ch.dy]);
+        sum += share[c];
+      }
+      if (!(sum > 0)) break;  // the model vanishes here: pure curve bits
+      double acc = 0;
+      for (int c = 0; c < w; ++c) {
+        acc += share[c];
+        top.bounds[c] = c + 1 == w ? top.t1 : top.t0 + (top.t1 - top.t0) * (acc / sum);
+      }
+      top.children = w;
     }
-    if (!(sum > 0)) break;  // the model vanishes here: pure curve bits
-    double t0 = top.t0, acc = 0;
+    double t0 = top.t0;
     int c = 0;
     for (; c < w; ++c) {
-      acc += share[c];
-      const double t1 = c + 1 == w ? top.t1 : top.t0 + (top.t1 - top.t0) * (acc / sum);
-      if (t < t1 && share[c] > 0) {
+      const double t1 = top.bounds[c];
+      if (t < t1 && t1 > t0) {
         const Curve::Child& ch = curve.ChildOf(top.state, c);
-        stack.push_back({t0, t1, top.x0 + ch.dx * side, top.y0 + ch.dy * side, side,
-                         top.pos + c * std::pow(static_cast<double>(w), -static_cast<double>(stack.size())),
-                         ch.state});
+        const double side = top.side / g, span = top.span / w;
+        const Level child{t0, t1, top.x0 + ch.dx * side, top.y0 + ch.dy * side, side,
+                          top.pos + c * span, span, ch.state};
+        stack.push_back(child);
         break;
       }
       t0 = t1;
@@ -355,8 +363,7 @@ absl::Status SampleCursor::Emit(uint64_t k, LeafCache& cache, SampleBatch* batch
   }
   if (fields_.curve_position) {
     const double span = static_cast<double>(tree.leaf_end(l) - tree.leaf_start(l));
-    const double level_span = std::pow(static_cast<double>(w), -static_cast<double>(stack.size() - 1));
-    const double pos = at.pos + tr * level_span;
+    const double pos = at.pos + tr * at.span;
     batch->curve_position.push_back((static_cast<double>(tree.leaf_start(l)) + pos * span) /
                                     static_cast<double>(curve.Span(0)));
   }

@@ -86,8 +86,10 @@ class SampleCursor {
   // square [x0, x0 + side) x [y0, y0 + side) in leaf units, its orientation
   // and its start along the leaf's curve (a fraction of the leaf's span).
   struct Level {
-    double t0, t1, x0, y0, side, pos;
+    double t0, t1, x0, y0, side, pos, span;  // span: the level's share of the leaf's curve
     int state;
+    int children = 0;  // 0 until bounds[] is filled: then the curve's arity
+    double bounds[9];  // upper t of each child, in curve order
   };
   // The last leaf decoded and its descent, reused by consecutive samples; one
   // per thread.
@@ -100,7 +102,7 @@ class SampleCursor {
 
  public:
   // Below this many samples' worth a sub-cell's placement is pure curve bits.
-  static constexpr double kNegligibleSamples = 1.0 / 1024;
+  static constexpr double kNegligibleSamples = 1.0 / 8;
   // The model descent stops after this many levels in any case.
   static constexpr int kMaxModelLevels = 40;
 
