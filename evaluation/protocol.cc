@@ -12,8 +12,8 @@
 #include "core/builtin_surfaces.h"
 #include "evaluation/reference_measure.h"
 #include "core/counter_hash.h"
-#include "core/discrepancy.h"
-#include "core/reference_sets.h"
+#include "evaluation/discrepancy.h"
+#include "evaluation/reference_sets.h"
 #include "core/sampler.h"
 #include "core/status_macros.h"
 
