@@ -236,20 +236,8 @@ class CurveTree::Builder {
         const int k = 3 * i + j;
         const SurfaceJet& jet = jets[k];
         if (!IsFinite(jet.p)) return SurfaceNotFiniteError(us[i], vs[j]);
-        SurfacePoint point;
-        point.u = us[i];
-        point.v = vs[j];
-        point.p = jet.p;
         double area;
-        if (order_ == 2) {
-          const SurfaceGeometry geo = GeometryOf(jet);
-          point.normal = geo.normal;
-          point.gaussian_curvature = geo.gaussian_curvature;
-          point.mean_curvature = geo.mean_curvature;
-          area = geo.area_element;
-        } else {
-          area = Norm(Cross(jet.fu, jet.fv));
-        }
+        const SurfacePoint point = PointFromJet(jet, us[i], vs[j], order_ == 2, &area);
         if (!std::isfinite(area)) {
           // A singular line through the node: the curvatures are unusable,
           // delta is taken from the neighbouring nodes below.
@@ -259,11 +247,7 @@ class CurveTree::Builder {
           continue;
         }
         delta[k] = density_.Value(point);
-        if (!std::isfinite(delta[k]) || delta[k] < 0) {
-          return absl::InvalidArgumentError(absl::StrFormat(
-              "the density is %g at (u,v) = (%.17g, %.17g); densities must be finite and >= 0",
-              delta[k], us[i], vs[j]));
-        }
+        RETURN_IF_ERROR(CheckDensityValue(delta[k], us[i], vs[j]));
         amin = std::min(amin, area);
         amax = std::max(amax, area);
         eval.area += kGaussWeight[i] * kGaussWeight[j] * area * h * h;

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "absl/strings/str_format.h"
+#include "core/area_estimator.h"
 
 namespace sfc {
 namespace {
@@ -63,16 +64,10 @@ absl::StatusOr<std::vector<double>> GradedCellMasses(const Surface& surface, con
       for (int a = 0; a < nodes; ++a) {
         for (int b = 0; b < nodes; ++b) {
           const SurfaceJet& jet = jets[a * nodes + b];
-          const SurfaceGeometry geo = GeometryOf(jet);
-          SurfacePoint point;
-          point.u = us[a];
-          point.v = vs[b];
-          point.p = jet.p;
-          point.normal = geo.normal;
-          point.gaussian_curvature = geo.gaussian_curvature;
-          point.mean_curvature = geo.mean_curvature;
+          double area;
+          const SurfacePoint point = PointFromJet(jet, us[a], vs[b], curvature, &area);
           const double delta = density.Value(point);
-          const double m = delta * Norm(Cross(jet.fu, jet.fv));
+          const double m = delta * area;
           if (!std::isfinite(m) || delta < 0) {
             return absl::InvalidArgumentError(absl::StrFormat(
                 "the reference measure is not finite at (u,v) = (%.17g, %.17g)", us[a], vs[b]));

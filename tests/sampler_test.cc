@@ -201,6 +201,30 @@ TEST(Sampler, PlacementInsideOneLeafFollowsASteepDensity) {
                                     mass(0, 1, 0, 1), 4, 0.5, one_leaf);
 }
 
+TEST(Sampler, NoSampleLandsWhereTheLeafModelIsNegative) {
+  // One leaf (no cell fails flatness, the error allowance is huge) whose
+  // quadratic model of max(u - 0.6, 0) dips below zero for u in (0.11, 0.5):
+  // the descent must clamp those sub-cells to no mass, not walk backwards.
+  CurveTreeOptions one_leaf;
+  one_leaf.tolerance = 10;
+  one_leaf.rho = 1e12;
+  const uint64_t n = 100000;
+  const auto s = MakeSetup("plane", "expr:max(u-0.6,0)", n, one_leaf);
+  ASSERT_EQ(s.tree->leaf_count(), 1u);
+  const LeafModel& model = s.tree->leaf_model(0);
+  const LeafModel::Kind kind = s.tree->leaf_model_kind(0);
+  ASSERT_LT(ModelIntegral(model, kind, 2, 0.25, 0.375, 0, 1), 0) << "the model should dip";
+  const SampleBatch b = Collect(MakeSampler(s, SequenceKind::kJittered, n, 3), 0, n);
+  ASSERT_EQ(b.size(), n);
+  const int side = 8;
+  for (size_t i = 0; i < n; ++i) {
+    ASSERT_TRUE(b.u[i] >= 0 && b.u[i] <= 1 && b.v[i] >= 0 && b.v[i] <= 1);
+    const double cx = std::floor(b.u[i] * side) / side, cy = std::floor(b.v[i] * side) / side;
+    ASSERT_GT(ModelIntegral(model, kind, 2, cx, cx + 1.0 / side, cy, cy + 1.0 / side), 0)
+        << "sample " << i << " at u = " << b.u[i];
+  }
+}
+
 TEST(Sampler, CountsPerCellFollowDensityUPlusVOnTheSquare) {
   auto mass = [](double a, double b, double c, double d) {
     return (b - a) * (d - c) * ((a + b) / 2 + (c + d) / 2);
