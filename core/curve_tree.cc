@@ -419,8 +419,8 @@ class CurveTree::Builder {
   }
 
   // Room for one more leaf, within the budget. Capacity grows by half (not
-  // doubling) and never past the budget, so the arrays' peak is at most
-  // 1.5 x max_leaves x kBytesPerLeaf during a reallocation.
+  // doubling), one array at a time, and never past the budget: the peak is
+  // while the model array moves, about 80 bytes x max_leaves (README).
   absl::Status Grow() {
     if (starts_.size() >= options_.max_leaves) return BudgetError();
     if (starts_.size() == starts_.capacity()) {
