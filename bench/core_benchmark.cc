@@ -47,8 +47,8 @@ void BM_BuildTreeAndSampleSphere(benchmark::State& state) {
   state.counters["leaves"] = static_cast<double>(leaves);
   state.SetItemsProcessed(state.iterations() * n);
 }
-// Second argument: rho (1 is the default; larger trades sub-leaf density
-// accuracy for a coarser tree).
+// Second argument: rho (1 is the default; it scales the tree's model-error
+// allowance, larger trades accuracy for a coarser tree).
 BENCHMARK(BM_BuildTreeAndSampleSphere)
     ->Args({kMillion, 1})
     ->Args({kMillion, 4})

@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "core/discrepancy.h"
+#include "evaluation/discrepancy.h"
 #include "mesh/icosphere.h"
 #include "mesh/iid_points.h"
 #include "mesh/mesh_curve_tree.h"

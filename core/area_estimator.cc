@@ -26,29 +26,13 @@ namespace {
 absl::StatusOr<DensityAt> DensityFromJet(const SurfaceJet& jet, const Density& density, double u,
                                          double v) {
   if (!IsFinite(jet.p)) return SurfaceNotFiniteError(u, v);
-  SurfacePoint point;
-  point.u = u;
-  point.v = v;
-  point.p = jet.p;
   double area_element;
-  if (density.NeedsCurvature()) {
-    const SurfaceGeometry geo = GeometryOf(jet);
-    point.normal = geo.normal;
-    point.gaussian_curvature = geo.gaussian_curvature;
-    point.mean_curvature = geo.mean_curvature;
-    area_element = geo.area_element;
-  } else {
-    area_element = Norm(Cross(jet.fu, jet.fv));
-  }
+  const SurfacePoint point = PointFromJet(jet, u, v, density.NeedsCurvature(), &area_element);
   DensityAt out;
   out.p = jet.p;
   out.delta = density.Value(point);
   out.area_element = area_element;
-  if (!std::isfinite(out.delta) || out.delta < 0) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "the density is %g at (u,v) = (%.17g, %.17g); densities must be finite and >= 0", out.delta,
-        u, v));
-  }
+  RETURN_IF_ERROR(CheckDensityValue(out.delta, u, v));
   // A derivative that overflows (a singular parameterisation) gives an infinite
   // area element; the point itself is finite, so treat the element as unusable.
   if (!std::isfinite(out.area_element)) {
@@ -61,6 +45,30 @@ absl::StatusOr<DensityAt> DensityFromJet(const SurfaceJet& jet, const Density& d
 }
 
 }  // namespace
+
+SurfacePoint PointFromJet(const SurfaceJet& jet, double u, double v, bool curvature,
+                          double* area_element) {
+  SurfacePoint point;
+  point.u = u;
+  point.v = v;
+  point.p = jet.p;
+  if (curvature) {
+    const SurfaceGeometry geo = GeometryOf(jet);
+    point.normal = geo.normal;
+    point.gaussian_curvature = geo.gaussian_curvature;
+    point.mean_curvature = geo.mean_curvature;
+    *area_element = geo.area_element;
+  } else {
+    *area_element = Norm(Cross(jet.fu, jet.fv));
+  }
+  return point;
+}
+
+absl::Status CheckDensityValue(double delta, double u, double v) {
+  if (std::isfinite(delta) && delta >= 0) return absl::OkStatus();
+  return absl::InvalidArgumentError(absl::StrFormat(
+      "the density is %g at (u,v) = (%.17g, %.17g); densities must be finite and >= 0", delta, u, v));
+}
 
 absl::Status SurfaceNotFiniteError(double u, double v) {
   return absl::InvalidArgumentError(absl::StrFormat(

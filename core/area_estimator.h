@@ -29,6 +29,15 @@ std::optional<AreaEstimator> AreaEstimatorFromName(std::string_view name);
 // INVALID_ARGUMENT saying the surface is not finite at (u, v) and what to fix.
 absl::Status SurfaceNotFiniteError(double u, double v);
 
+// The density's view of the point (u, v) whose jet is `jet`, with the area
+// element there in *area_element (|f_u x f_v|; infinite on a singular line).
+// The normal and curvatures are filled only when `curvature` is set.
+SurfacePoint PointFromJet(const SurfaceJet& jet, double u, double v, bool curvature,
+                          double* area_element);
+
+// INVALID_ARGUMENT unless delta (the density at (u, v)) is finite and >= 0.
+absl::Status CheckDensityValue(double delta, double u, double v);
+
 // delta and the area element at one parameter point.
 struct DensityAt {
   Vec3 p;

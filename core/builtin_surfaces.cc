@@ -190,13 +190,36 @@ class WhitneyUmbrella final : public Surface {
 // Signed power sign(c)|c|^e.
 double SignedPow(double c, double e) { return std::copysign(std::pow(std::fabs(c), e), c); }
 
+// g(x) = sign(c(x)) |c(x)|^e for c = cos or sin, with its first two
+// derivatives. With e < 1 the derivatives are infinite where c = 0 (the
+// superellipsoid's singular lines, paper Sect. 5.3); callers of the jet see
+// the infinity, the tree never evaluates its mass estimates there.
+struct PowTrig {
+  double g = 0, d1 = 0, d2 = 0;
+};
+// c = cos x or sin x, dc its derivative (-sin x or cos x); c'' = -c.
+PowTrig SignedPowOf(double c, double dc, double e, int order) {
+  PowTrig r;
+  const double a = std::fabs(c);
+  r.g = std::copysign(std::pow(a, e), c);
+  // d/dx sign(c)|c|^e = e |c|^(e-1) c'
+  r.d1 = e == 1 ? dc : e * std::pow(a, e - 1) * dc;
+  if (order >= 2) {
+    // d2 = e (e-1) |c|^(e-2) sign(c) c'^2 + e |c|^(e-1) c''
+    const double curv = e == 1 ? 0 : e * (e - 1) * std::copysign(std::pow(a, e - 2), c) * dc * dc;
+    r.d2 = curv + (e == 1 ? -c : -e * std::pow(a, e - 1) * c);
+  }
+  return r;
+}
+
 class Superellipsoid final : public Surface {
  public:
   Superellipsoid(double e, bool reparam) : e_(e), reparam_(reparam) {}
   Vec3 Point(double u, double v) const override {
-    const double a = Angle(u, -kPi / 2, 2), b = Angle(v, -kPi, 4);
-    const double ca = SignedPow(std::cos(a), e_), sa = SignedPow(std::sin(a), e_);
-    const double cb = SignedPow(std::cos(b), e_), sb = SignedPow(std::sin(b), e_);
+    double ca, sa, cb, sb;
+    Angle(u, -1, 2).CosSin(&ca, &sa);
+    Angle(v, -2, 4).CosSin(&cb, &sb);
+    ca = SignedPow(ca, e_), sa = SignedPow(sa, e_), cb = SignedPow(cb, e_), sb = SignedPow(sb, e_);
     return {ca * cb, ca * sb, sa};
   }
   std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override {
@@ -206,16 +229,95 @@ class Superellipsoid final : public Surface {
     return BoxOf(ca * cb, ca * sb, sa);
   }
 
+  // Closed-form derivatives (chain rule through the angle maps).
+  SurfaceJet Jet(double u, double v, int order) const override {
+    SurfaceJet j;
+    Combine(FactorsU(u, order), FactorsV(v, order), order, &j);
+    return j;
+  }
+  void JetGrid(const double* us, int nu, const double* vs, int nv, int order,
+               SurfaceJet* out) const override {
+    if (nu > 16 || nv > 16) return Surface::JetGrid(us, nu, vs, nv, order, out);
+    Factors fv[16];
+    for (int j = 0; j < nv; ++j) fv[j] = FactorsV(vs[j], order);
+    for (int i = 0; i < nu; ++i) {
+      const Factors fu = FactorsU(us[i], order);
+      for (int j = 0; j < nv; ++j) Combine(fu, fv[j], order, &out[i * nv + j]);
+    }
+  }
+
  private:
-  // Maps x in [0,1] onto [start, start + pieces * pi/2], piecewise by quarter
-  // turns, with the double-ended power law when reparameterising.
-  double Angle(double x, double start, int pieces) const {
-    if (!reparam_) return start + x * pieces * (kPi / 2);
-    const double y = x * pieces;
+  // An angle quarter * pi/2 + offset (|offset| <= pi/4), kept apart so that
+  // cos and sin near their zeros keep full relative precision (the angle
+  // itself would round -pi + pi - 1e-20 to 0), and its first two derivatives
+  // with respect to the parameter.
+  struct AngleJet {
+    int quarter;
+    double offset, d1, d2;
+    void CosSin(double* c, double* s) const {
+      const double co = std::cos(offset), so = std::sin(offset);
+      switch (((quarter % 4) + 4) % 4) {
+        case 0: *c = co, *s = so; break;
+        case 1: *c = -so, *s = co; break;
+        case 2: *c = -co, *s = -so; break;
+        default: *c = so, *s = -co; break;
+      }
+    }
+  };
+  // cos- and sin-type factors of one parameter, differentiated by it.
+  struct Factors {
+    PowTrig c, s;
+  };
+
+  // Maps x in [0,1] onto [start, start + pieces] quarter turns, piecewise by
+  // quarter turns, with the double-ended power law q(s) = s^3 / (s^3 + (1-s)^3)
+  // when reparameterising.
+  AngleJet Angle(double x, int start, int pieces) const {
+    const double quarter = kPi / 2;
+    const double y = x * pieces;  // exact: pieces is a power of two
+    if (!reparam_) {
+      const double k = std::round(y);
+      return {start + static_cast<int>(k), (y - k) * quarter, pieces * quarter, 0};
+    }
     const int piece = std::min(static_cast<int>(y), pieces - 1);
-    const double s = y - piece;
-    const double s3 = s * s * s, r3 = (1 - s) * (1 - s) * (1 - s);
-    return start + (piece + s3 / (s3 + r3)) * (kPi / 2);
+    const double s = y - piece, r = 1 - s;
+    const double s3 = s * s * s, r3 = r * r * r, d = s3 + r3;
+    // q' = 3 s^2 r^2 / d^2, q'' = (n' d - 2 n d') / d^3 with n = 3 s^2 r^2.
+    const double n = 3 * s * s * r * r, dn = 6 * s * r * (r - s), dd = 3 * s * s - 3 * r * r;
+    const double q1 = n / (d * d), q2 = (dn * d - 2 * n * dd) / (d * d * d);
+    const double d1 = q1 * pieces * quarter, d2 = q2 * pieces * pieces * quarter;
+    // Near the piece's end measure from it: 1 - q = r^3 / d without cancellation.
+    if (s <= 0.5) return {start + piece, s3 / d * quarter, d1, d2};
+    return {start + piece + 1, -r3 / d * quarter, d1, d2};
+  }
+
+  Factors FactorsOf(const AngleJet& a, int order) const {
+    double c, s;
+    a.CosSin(&c, &s);
+    Factors f;
+    f.c = SignedPowOf(c, -s, e_, order);
+    f.s = SignedPowOf(s, c, e_, order);
+    // Chain rule: d/dx g(a(x)) = g' a', d2 = g'' a'^2 + g' a''.
+    for (PowTrig* p : {&f.c, &f.s}) {
+      p->d2 = p->d2 * a.d1 * a.d1 + (a.d2 != 0 ? p->d1 * a.d2 : 0);
+      p->d1 *= a.d1;
+    }
+    return f;
+  }
+  Factors FactorsU(double u, int order) const { return FactorsOf(Angle(u, -1, 2), order); }
+  Factors FactorsV(double v, int order) const { return FactorsOf(Angle(v, -2, 4), order); }
+
+  // f = (ca cb, ca sb, sa) from the u factors (ca, sa) and v factors (cb, sb).
+  static void Combine(const Factors& fu, const Factors& fv, int order, SurfaceJet* j) {
+    const PowTrig &ca = fu.c, &sa = fu.s, &cb = fv.c, &sb = fv.s;
+    j->p = {ca.g * cb.g, ca.g * sb.g, sa.g};
+    j->fu = {ca.d1 * cb.g, ca.d1 * sb.g, sa.d1};
+    j->fv = {ca.g * cb.d1, ca.g * sb.d1, 0};
+    if (order >= 2) {
+      j->fuu = {ca.d2 * cb.g, ca.d2 * sb.g, sa.d2};
+      j->fuv = {ca.d1 * cb.d1, ca.d1 * sb.d1, 0};
+      j->fvv = {ca.g * cb.d2, ca.g * sb.d2, 0};
+    }
   }
 
   // Encloses Angle(x, start, pieces) for x in [x0, x1]: Angle's operations on

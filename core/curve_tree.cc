@@ -10,15 +10,18 @@
 namespace sfc {
 namespace {
 
-void RecordHit(const DepthCapHit& hit, PrecisionReport* report) {
-  auto& worst = report->worst;
+constexpr int kNeverFails = 63;
+// Fixed-point scale of the running masses: S_base is 2^56 units.
+constexpr int kMassBits = 56;
+
+void RecordHit(const DepthCapHit& hit, std::vector<DepthCapHit>* worst) {
   auto ratio = [](const DepthCapHit& h) { return h.limit > 0 ? h.measured / h.limit : INFINITY; };
-  if (worst.size() == PrecisionReport::kMaxReported && ratio(hit) <= ratio(worst.back())) return;
-  auto pos = std::upper_bound(worst.begin(), worst.end(), hit, [&](const auto& a, const auto& b) {
+  if (worst->size() == PrecisionReport::kMaxReported && ratio(hit) <= ratio(worst->back())) return;
+  auto pos = std::upper_bound(worst->begin(), worst->end(), hit, [&](const auto& a, const auto& b) {
     return ratio(a) > ratio(b);
   });
-  worst.insert(pos, hit);
-  if (worst.size() > PrecisionReport::kMaxReported) worst.pop_back();
+  worst->insert(pos, hit);
+  if (worst->size() > PrecisionReport::kMaxReported) worst->pop_back();
 }
 
 absl::Status LeafBudgetError(uint64_t max_leaves) {
@@ -29,9 +32,50 @@ absl::Status LeafBudgetError(uint64_t max_leaves) {
       max_leaves, max_leaves * CurveTree::kBytesPerLeaf, CurveTree::kBytesPerLeaf));
 }
 
+double TriangleArea(const Vec3& a, const Vec3& b, const Vec3& c) {
+  return 0.5 * Norm(Cross(b - a, c - a));
+}
+
+// The leaf's error allowance in samples at grade g (file comment of
+// curve_tree.h), and whether the leaf carries enough samples to be split.
+bool FailsAt(int g, double error, double mass, double base, double rho) {
+  const double n = std::ldexp(1.0, g);
+  const double mu = mass / base;
+  return mu * n >= std::max(CurveTree::kMinSamples,
+                           CurveTree::kErrorFloor * std::pow(n, CurveTree::kErrorFloorPower)) &&
+         error / base * n > rho * CurveTree::kErrorShare * std::pow(n, 0.25) * mu;
+}
+
+// The smallest grade g at which the leaf carries scale * N^power samples
+// (N = 2^g, power < 1, so the condition only tightens as g grows).
+int SamplesGrade(double mass, double base, double scale, double power) {
+  for (int g = 0; g <= 62; ++g) {
+    const double n = std::ldexp(1.0, g);
+    if (mass / base * n >= std::max(CurveTree::kMinSamples, scale * std::pow(n, power))) return g;
+  }
+  return kNeverFails;
+}
+
+// The smallest grade in [0, 62] at which the leaf fails, kNeverFails if none.
+// Both conditions are monotone in g, so a binary search finds it.
+int FailGrade(double error, double mass, double base, double rho) {
+  if (!(error > 0) || !(mass > 0)) return kNeverFails;
+  if (!FailsAt(62, error, mass, base, rho)) return kNeverFails;
+  int lo = 0, hi = 62;
+  while (lo < hi) {
+    const int mid = (lo + hi) / 2;
+    if (FailsAt(mid, error, mass, base, rho)) {
+      hi = mid;
+    } else {
+      lo = mid + 1;
+    }
+  }
+  return lo;
+}
+
 }  // namespace
 
-// Holds what one build or refinement pass needs; not thread-safe, one per call.
+// Holds what one build or refinement needs; not thread-safe, one per call.
 class CurveTree::Builder {
  public:
   Builder(const Surface& surface, const Density& density, const CurveTreeOptions& options,
@@ -41,115 +85,87 @@ class CurveTree::Builder {
         options_(options),
         control_(control),
         curve_(Curve::Get(options.curve)),
-        // Trees with the triangle estimator decide splits with (c): (a) needs
-        // neighbours that do not exist yet while a cell is being split.
-        decision_estimator_(options.estimator == AreaEstimator::kTriangle
-                                ? AreaEstimator::kFirstFundamentalForm
-                                : options.estimator) {}
+        order_(density.NeedsCurvature() ? 2 : 1) {}
 
-  // Stage 1: the paper's PopulateCurveTree from the root.
-  absl::Status BuildGeometric() {
-    return Geometric(0, 0, 0, 0, Curve::kRootState);
+  // One cell's mass estimate and model (file comment of curve_tree.h).
+  struct CellEval {
+    double mass = 0;
+    double area = 0;  // the same for delta = 1 (quadrature of the area element)
+    double values[9];  // quadratic: m at the Gauss nodes; piecewise: sub-square masses
+    bool piecewise = false;
+  };
+
+  // Stage 1: the paper's PopulateCurveTree from the root; fills starts_ and
+  // masses_ with the stage-1 leaves.
+  absl::Status BuildGeometric() { return Geometric(0, 0, 0, 0, Curve::kRootState); }
+
+  // Stage 2 from the cell (depth, x, y) whose curve range starts at `start`:
+  // appends its leaves at `grade`.
+  absl::Status RefineCell(int depth, uint64_t start, uint64_t x, uint64_t y, int state) {
+    ASSIGN_OR_RETURN(const CellEval eval, Evaluate(depth, x, y));
+    return Refine(depth, start, x, y, state, eval);
   }
 
-  // Per-leaf masses (not running sums) for the leaves in starts_, for the
-  // triangle estimator; the others fill masses_ as leaves are made.
-  absl::Status ComputeTriangleMasses() {
-    const size_t n = starts_.size();
-    std::vector<double> cu(n), cv(n);
-    for (size_t l = 0; l < n; ++l) {
-      const CurveTree::Cell cell = CellOf(l);
-      cu[l] = cell.u0 + cell.size / 2;
-      cv[l] = cell.v0 + cell.size / 2;
-    }
-    masses_.resize(n);
-    if (n < 3) {
-      for (size_t l = 0; l < n; ++l) {
-        const CurveTree::Cell cell = CellOf(l);
-        ASSIGN_OR_RETURN(masses_[l], CellMass(surface_, density_, AreaEstimator::kFirstFundamentalForm,
-                                              cell.u0, cell.v0, cell.size));
-      }
-      return absl::OkStatus();
-    }
-    for (size_t l = 0; l < n; ++l) {
-      // The end vertices use the nearest full triangle.
-      const size_t mid = std::clamp<size_t>(l, 1, n - 2);
-      ASSIGN_OR_RETURN(masses_[l], TriangleMass(surface_, density_, cu[mid - 1], cv[mid - 1],
-                                                cu[mid], cv[mid], cu[mid + 1], cv[mid + 1]));
-    }
-    return absl::OkStatus();
-  }
-
-  // One refinement pass to `grade` over `prev`, filling starts_ and masses_.
-  absl::Status RefinePass(const CurveTree& prev, int grade) {
-    StartMassPass(prev, grade);
-    const size_t n = prev.leaf_count();
+  void StartStage2(double base, int grade, size_t expected_leaves) {
+    base_ = base;
+    grade_ = grade;
     starts_.clear();
     masses_.clear();
-    // Most passes that split grow the tree by less than half.
-    starts_.reserve(n + n / 2);
-    masses_.reserve(n + n / 2);
-    for (size_t l = 0; l < n; ++l) {
-      const double s = prev.mass_end(l) - prev.mass_begin(l);
-      if (s <= limit_) {
-        RETURN_IF_ERROR(Keep(prev.starts_[l], s));
-        continue;
-      }
-      const CurveTree::Cell cell = prev.LeafCell(l);
-      if (cell.depth >= options_.depth_cap) {
-        RecordMassHit(cell.u0, cell.v0, cell.size, s);
-        RETURN_IF_ERROR(Keep(prev.starts_[l], s));
-        continue;
-      }
-      RETURN_IF_ERROR(SplitForMass(cell.depth, prev.starts_[l], cell.x, cell.y, cell.state));
-    }
+    models_.clear();
+    errors_.clear();
+    info_.clear();
+    Reserve(expected_leaves);
+  }
+
+  // Copies leaf l of `prev` unchanged.
+  absl::Status CopyLeaf(const CurveTree& prev, size_t l) {
+    RETURN_IF_ERROR(Grow());
+    starts_.push_back(prev.starts_[l]);
+    masses_.push_back(prev.mass_end_[l] - (l == 0 ? 0 : prev.mass_end_[l - 1]));
+    models_.push_back(prev.models_[l]);
+    errors_.push_back(prev.errors_[l]);
+    info_.push_back(prev.info_[l]);
     return absl::OkStatus();
   }
 
-  // For a pass that splits nothing: reports the leaves the cap keeps above
-  // this grade's mass limit.
-  void ReportMassCaps(const CurveTree& prev, int grade) {
-    StartMassPass(prev, grade);
-    for (size_t l = 0; l < prev.leaf_count(); ++l) {
-      const double s = prev.mass_end(l) - prev.mass_begin(l);
-      if (s <= limit_) continue;
-      const CurveTree::Cell cell = prev.LeafCell(l);
-      RecordMassHit(cell.u0, cell.v0, cell.size, s);
-    }
-  }
+  // Stage-1 leaves, as (start, mass) pairs.
+  const std::vector<uint64_t>& stage1_starts() const { return stage1_starts_; }
+  double stage1_mass() const { return stage1_mass_; }
+  double stage1_area() const { return stage1_area_; }
 
-  // True when RefinePass(prev, grade) would split some leaf.
-  bool PassSplits(const CurveTree& prev, int grade) const {
-    const double limit = options_.rho * prev.base_mass_ / std::ldexp(1.0, grade);
-    for (size_t l = 0; l < prev.leaf_count(); ++l) {
-      if (prev.mass_end(l) - prev.mass_begin(l) > limit &&
-          prev.leaf_depth(l) < options_.depth_cap) {
-        return true;
-      }
-    }
-    return false;
-  }
-
-  // Installs starts_ and running sums of masses_ into `tree`.
+  // Installs the leaves into `tree`.
   absl::Status Finish(CurveTree* tree) {
     if (options_.estimator == AreaEstimator::kTriangle) RETURN_IF_ERROR(ComputeTriangleMasses());
     tree->starts_ = std::move(starts_);
-    tree->mass_end_.resize(masses_.size());
-    double sum = 0;
-    for (size_t l = 0; l < masses_.size(); ++l) tree->mass_end_[l] = sum += masses_[l];
-    if (!(sum > 0) || !std::isfinite(sum)) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "the density integrates to %g over the surface; it must be positive somewhere (check "
-          "the density, or add a floor)",
-          sum));
+    tree->models_ = std::move(models_);
+    tree->errors_ = std::move(errors_);
+    tree->info_ = std::move(info_);
+    tree->mass_end_ = std::move(masses_);
+    uint64_t sum = 0;
+    for (uint64_t& m : tree->mass_end_) {
+      if (m > UINT64_MAX - sum) {
+        return absl::InvalidArgumentError(
+            "the surface's mass estimates grew more than 256-fold under refinement; the "
+            "parameterisation is too singular for the estimates to converge (reparameterise it)");
+      }
+      m = sum += m;
     }
-    tree->precision_ = report_;
+    if (sum == 0) {
+      return absl::InvalidArgumentError(
+          "the density integrates to 0 over the surface; it must be positive somewhere (check "
+          "the density, or add a floor)");
+    }
     tree->ComputeDepthRange();
+    tree->ComputeReport();
     return absl::OkStatus();
   }
 
-  void set_report(const PrecisionReport& r) { report_ = r; }
   const PrecisionReport& report() const { return report_; }
+  void set_report(const PrecisionReport& report) { report_ = report; }
+
+  // Stage 1 splits for flatness down to this depth only (4096 cells for
+  // Hilbert, 6561 for the 3x3 curves).
+  int BaseDepth() const { return curve_.grid() == 2 ? 6 : 4; }
 
  private:
   absl::Status Geometric(int depth, uint64_t start, uint64_t x, uint64_t y, int state) {
@@ -159,7 +175,9 @@ class CurveTree::Builder {
     NoteDepth(depth, u0 + h / 2, v0 + h / 2);
     ASSIGN_OR_RETURN(const double spread, CellSpread(u0, v0, h));
     const bool wants_split = spread > options_.tolerance;
-    if (wants_split && depth < options_.depth_cap) {
+    // Deeper than the base depth the flatness test runs in stage 2, where a
+    // leaf too light to matter stops it.
+    if (wants_split && depth < BaseDepth() && depth < options_.depth_cap) {
       const uint64_t span = curve_.Span(depth + 1);
       const int g = curve_.grid();
       for (int c = 0; c < curve_.arity(); ++c) {
@@ -168,15 +186,17 @@ class CurveTree::Builder {
       }
       return absl::OkStatus();
     }
-    if (wants_split) {
+    if (wants_split && depth >= options_.depth_cap) {
       ++report_.geometry_capped_leaves;
-      RecordHit({DepthCapHit::Test::kGeometry, u0, v0, h, spread, options_.tolerance}, &report_);
+      RecordHit({DepthCapHit::Test::kGeometry, u0, v0, h, spread, options_.tolerance}, &report_.worst);
     }
-    double mass = 0;
-    if (options_.estimator != AreaEstimator::kTriangle) {
-      ASSIGN_OR_RETURN(mass, CellMass(surface_, density_, options_.estimator, u0, v0, h));
-    }
-    return Keep(start, mass);
+    if (stage1_starts_.size() >= options_.max_leaves) return BudgetError();
+    ASSIGN_OR_RETURN(const CellEval eval, Evaluate(depth, x, y));
+    const bool singular = eval.piecewise;
+    stage1_starts_.push_back(start);
+    stage1_mass_ += eval.mass;
+    stage1_area_ += singular ? INFINITY : eval.area;
+    return absl::OkStatus();
   }
 
   // AssessSubdivision: the largest distance from f(centre) to f at the 4
@@ -197,58 +217,225 @@ class CurveTree::Builder {
     return spread;
   }
 
-  absl::Status SplitForMass(int depth, uint64_t start, uint64_t x, uint64_t y, int state) {
+  // The cell's model: m at the 3 x 3 Gauss nodes; where the area element
+  // blows up, the masses of the mapped g x g sub-squares instead.
+  absl::StatusOr<CellEval> Evaluate(int depth, uint64_t x, uint64_t y) {
     RETURN_IF_ERROR(Checkpoint());
-    const int g = curve_.grid();
-    const uint64_t span = curve_.Span(depth + 1);
-    const double h = 1.0 / curve_.PowG(depth + 1);
-    NoteDepth(depth + 1, (x * g + 0.5) * h, (y * g + 0.5) * h);
-    double masses[9];  // by grid position, [dx * g + dy]
-    RETURN_IF_ERROR(CellMassesOnGrid(surface_, density_, decision_estimator_, x * g * h, y * g * h, h,
-                                     g, masses));
-    for (int c = 0; c < curve_.arity(); ++c) {
-      const Curve::Child& ch = curve_.ChildOf(state, c);
-      const uint64_t cx = x * g + ch.dx, cy = y * g + ch.dy;
-      const uint64_t child_start = start + c * span;
-      const double mass = masses[ch.dx * g + ch.dy];
-      if (mass > limit_ && depth + 1 < options_.depth_cap) {
-        RETURN_IF_ERROR(SplitForMass(depth + 1, child_start, cx, cy, ch.state));
-        continue;
+    const double h = 1.0 / curve_.PowG(depth);
+    const double u0 = x * h, v0 = y * h;
+    double us[3], vs[3];
+    for (int i = 0; i < 3; ++i) us[i] = u0 + kGaussNode[i] * h, vs[i] = v0 + kGaussNode[i] * h;
+    SurfaceJet jets[9];
+    surface_.JetGrid(us, 3, vs, 3, order_, jets);
+    CellEval eval;
+    double delta[9];
+    bool singular = false;
+    double amin = INFINITY, amax = 0, gauss = 0;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        const int k = 3 * i + j;
+        const SurfaceJet& jet = jets[k];
+        if (!IsFinite(jet.p)) return SurfaceNotFiniteError(us[i], vs[j]);
+        double area;
+        const SurfacePoint point = PointFromJet(jet, us[i], vs[j], order_ == 2, &area);
+        if (!std::isfinite(area)) {
+          // A singular line through the node: the curvatures are unusable,
+          // delta is taken from the neighbouring nodes below.
+          singular = true;
+          delta[k] = NAN;
+          eval.values[k] = 0;
+          continue;
+        }
+        delta[k] = density_.Value(point);
+        RETURN_IF_ERROR(CheckDensityValue(delta[k], us[i], vs[j]));
+        amin = std::min(amin, area);
+        amax = std::max(amax, area);
+        eval.area += kGaussWeight[i] * kGaussWeight[j] * area * h * h;
+        eval.values[k] = delta[k] * area;
+        gauss += kGaussWeight[i] * kGaussWeight[j] * eval.values[k];
       }
-      if (mass > limit_) RecordMassHit(cx * h, cy * h, h, mass);
-      RETURN_IF_ERROR(Keep(child_start, mass));
     }
-    return absl::OkStatus();
+    eval.mass = gauss * h * h;
+    // A smooth patch has nearly constant area element on a small cell; only
+    // where it varies by 2x can the quadrature be far off.
+    if (!singular && !(amax <= 2 * amin)) {
+      double sub[9];
+      ASSIGN_OR_RETURN(const double triangles, SubSquareMasses(u0, v0, h, delta, sub));
+      if (triangles > kSingularExcess * eval.mass) {
+        singular = true;
+        std::copy(sub, sub + 9, eval.values);
+        eval.mass = triangles;
+        eval.piecewise = true;
+        return eval;
+      }
+      return eval;
+    }
+    if (singular) {
+      double sub[9];
+      ASSIGN_OR_RETURN(eval.mass, SubSquareMasses(u0, v0, h, delta, sub));
+      std::copy(sub, sub + 9, eval.values);
+      eval.piecewise = true;
+    }
+    return eval;
   }
 
-  // Sets the grade's mass limit and forgets the previous grade's mass hits.
-  void StartMassPass(const CurveTree& prev, int grade) {
-    limit_ = options_.rho * prev.base_mass_ / std::ldexp(1.0, grade);
-    report_.mass_capped_leaves = 0;
-    report_.worst.erase(std::remove_if(report_.worst.begin(), report_.worst.end(),
-                                       [](const DepthCapHit& h) {
-                                         return h.test == DepthCapHit::Test::kMass;
-                                       }),
-                        report_.worst.end());
+  // The masses of the g x g sub-squares of the cell, each the area of its
+  // mapped quadrilateral (the mean of its two triangulations) times delta at
+  // the Gauss node nearest its centre. Returns their sum.
+  absl::StatusOr<double> SubSquareMasses(double u0, double v0, double h, const double delta[9],
+                                         double sub[9]) const {
+    const int g = curve_.grid();
+    Vec3 p[16];
+    for (int i = 0; i <= g; ++i) {
+      for (int j = 0; j <= g; ++j) {
+        const double u = i == g ? u0 + h : u0 + i * (h / g);
+        const double v = j == g ? v0 + h : v0 + j * (h / g);
+        p[i * (g + 1) + j] = surface_.Point(u, v);
+        if (!IsFinite(p[i * (g + 1) + j])) return SurfaceNotFiniteError(u, v);
+      }
+    }
+    double known = 0;
+    int n_known = 0;
+    for (int k = 0; k < 9; ++k) {
+      if (std::isfinite(delta[k])) known += delta[k], ++n_known;
+    }
+    const double fallback = n_known > 0 ? known / n_known : 0;
+    double total = 0;
+    for (int i = 0; i < g; ++i) {
+      for (int j = 0; j < g; ++j) {
+        const Vec3& a = p[i * (g + 1) + j];
+        const Vec3& b = p[(i + 1) * (g + 1) + j];
+        const Vec3& c = p[(i + 1) * (g + 1) + j + 1];
+        const Vec3& d = p[i * (g + 1) + j + 1];
+        const double area = 0.5 * (TriangleArea(a, b, c) + TriangleArea(a, c, d) +
+                                   TriangleArea(a, b, d) + TriangleArea(b, c, d));
+        // Node index nearest the sub-square's centre along each axis.
+        const int ni = g == 3 ? i : 2 * i, nj = g == 3 ? j : 2 * j;
+        const double dk = delta[3 * ni + nj];
+        sub[i * g + j] = area * (std::isfinite(dk) ? dk : fallback);
+        total += sub[i * g + j];
+      }
+    }
+    return total;
   }
 
-  void RecordMassHit(double u0, double v0, double size, double mass) {
-    ++report_.mass_capped_leaves;
-    RecordHit({DepthCapHit::Test::kMass, u0, v0, size, mass, limit_}, &report_);
+  // The parent model's integral over child (cx, cy) of its g x g grid.
+  double ModelOverChild(const CellEval& eval, int cx, int cy, double h) const {
+    const int g = curve_.grid();
+    if (eval.piecewise) return eval.values[cx * g + cy];
+    return h * h * QuadraticIntegral(eval.values, static_cast<double>(cx) / g,
+                                     static_cast<double>(cx + 1) / g, static_cast<double>(cy) / g,
+                                     static_cast<double>(cy + 1) / g);
   }
 
-  absl::Status Keep(uint64_t start, double mass) {
-    if (starts_.size() >= options_.max_leaves) {
-      // Say where the tree was growing deepest: usually a singularity.
-      return absl::ResourceExhaustedError(absl::StrCat(
-          LeafBudgetError(options_.max_leaves).message(),
-          absl::StrFormat(". The deepest split so far is at depth %d near (u,v) = (%.9g, %.9g)%s",
-                          deepest_, deepest_u_, deepest_v_,
-                          deepest_ >= 20 ? "; the surface may be singular there" : "")));
+  absl::Status Refine(int depth, uint64_t start, uint64_t x, uint64_t y, int state,
+                      const CellEval& eval) {
+    const int g = curve_.grid();
+    const double h = 1.0 / curve_.PowG(depth);
+    // A leaf too light to fail at this grade is not examined: it keeps the
+    // grade at which it must be (a pure function of the cell), and a later
+    // refinement examines it then, as a fresh build would.
+    int fail = SamplesGrade(eval.mass, base_, kErrorFloor, kErrorFloorPower);
+    double error = 0;
+    CellEval children[9];
+    if (fail <= grade_ && depth < curve_.max_depth()) {
+      for (int c = 0; c < curve_.arity(); ++c) {
+        const Curve::Child& ch = curve_.ChildOf(state, c);
+        ASSIGN_OR_RETURN(children[c], Evaluate(depth + 1, x * g + ch.dx, y * g + ch.dy));
+        error += std::fabs(ModelOverChild(eval, ch.dx, ch.dy, h) - children[c].mass);
+      }
+      fail = FailGrade(error, eval.mass, base_, options_.rho);
+      // The paper's flatness test, for leaves that carry a whole sample.
+      int flat = SamplesGrade(eval.mass, base_, kFlatnessFloor, 0.5);
+      if (flat <= grade_) {
+        ASSIGN_OR_RETURN(const double spread, CellSpread(x * h, y * h, h));
+        if (!(spread > options_.tolerance)) {
+          flat = kNeverFails;
+        } else if (depth >= options_.depth_cap) {
+          ++report_.geometry_capped_leaves;
+          RecordHit({DepthCapHit::Test::kGeometry, x * h, y * h, h, spread, options_.tolerance},
+                    &report_.worst);
+        }
+      }
+      fail = std::min(fail, flat);
+    }
+    if (fail <= grade_ && depth < options_.depth_cap) {
+      NoteDepth(depth + 1, (x + 0.5) * h, (y + 0.5) * h);
+      const uint64_t span = curve_.Span(depth + 1);
+      for (int c = 0; c < curve_.arity(); ++c) {
+        const Curve::Child& ch = curve_.ChildOf(state, c);
+        RETURN_IF_ERROR(Refine(depth + 1, start + c * span, x * g + ch.dx, y * g + ch.dy, ch.state,
+                               children[c]));
+      }
+      return absl::OkStatus();
+    }
+    RETURN_IF_ERROR(Grow());
+    double mass = eval.mass;
+    if (options_.estimator == AreaEstimator::kSquare) {
+      ASSIGN_OR_RETURN(mass, CellMass(surface_, density_, AreaEstimator::kSquare, x * h, y * h, h));
     }
     starts_.push_back(start);
-    masses_.push_back(mass);
+    masses_.push_back(ToFixed(mass));
+    models_.push_back(eval.piecewise ? LeafModel::FromPiecewise(eval.values, g)
+                                     : LeafModel::FromQuadratic(eval.values));
+    errors_.push_back(static_cast<float>(error));
+    info_.push_back(static_cast<uint8_t>(fail | (eval.piecewise ? kPiecewiseBit : 0)));
     return absl::OkStatus();
+  }
+
+  uint64_t ToFixed(double mass) const {
+    const double q = std::ldexp(mass / base_, kMassBits);
+    return q >= 0x1p63 ? (uint64_t{1} << 63) : static_cast<uint64_t>(std::llround(q));
+  }
+
+  // Per-leaf masses for the triangle estimator (a), from the final leaves.
+  absl::Status ComputeTriangleMasses() {
+    const size_t n = starts_.size();
+    auto centre = [&](size_t l) {
+      const CurveTree::Cell cell = CellOfRange(curve_, starts_[l],
+                                               l + 1 < n ? starts_[l + 1] : curve_.Span(0));
+      return std::pair<double, double>{cell.u0 + cell.size / 2, cell.v0 + cell.size / 2};
+    };
+    if (n < 3) return absl::OkStatus();  // too few vertices for (a): keep the model's masses
+    for (size_t l = 0; l < n; ++l) {
+      // The end vertices use the nearest full triangle.
+      const size_t mid = std::clamp<size_t>(l, 1, n - 2);
+      const auto [u0, v0] = centre(mid - 1);
+      const auto [u1, v1] = centre(mid);
+      const auto [u2, v2] = centre(mid + 1);
+      ASSIGN_OR_RETURN(const double mass, TriangleMass(surface_, density_, u0, v0, u1, v1, u2, v2));
+      masses_[l] = ToFixed(mass);
+    }
+    return absl::OkStatus();
+  }
+
+  absl::Status BudgetError() const {
+    // Say where the tree was growing deepest: usually a singularity.
+    return absl::ResourceExhaustedError(absl::StrCat(
+        LeafBudgetError(options_.max_leaves).message(),
+        absl::StrFormat(". The deepest split so far is at depth %d near (u,v) = (%.9g, %.9g)%s",
+                        deepest_, deepest_u_, deepest_v_,
+                        deepest_ >= 20 ? "; the surface may be singular there" : "")));
+  }
+
+  // Room for one more leaf, within the budget. Capacity grows by half (not
+  // doubling), one array at a time, and never past the budget: the peak is
+  // while the model array moves, about 80 bytes x max_leaves (README).
+  absl::Status Grow() {
+    if (starts_.size() >= options_.max_leaves) return BudgetError();
+    if (starts_.size() == starts_.capacity()) {
+      Reserve(std::min<uint64_t>(options_.max_leaves, starts_.capacity() + starts_.capacity() / 2 + 1024));
+    }
+    return absl::OkStatus();
+  }
+
+  void Reserve(size_t n) {
+    n = std::min<uint64_t>(n, options_.max_leaves);
+    starts_.reserve(n);
+    masses_.reserve(n);
+    models_.reserve(n);
+    errors_.reserve(n);
+    info_.reserve(n);
   }
 
   // Asks the caller whether to go on, every BuildControl::kCheckInterval cells.
@@ -267,24 +454,25 @@ class CurveTree::Builder {
     deepest_v_ = v;
   }
 
-  // The cell of leaf l of starts_.
-  CurveTree::Cell CellOf(size_t l) const {
-    return CurveTree::CellOfRange(curve_, starts_[l],
-                                  l + 1 < starts_.size() ? starts_[l + 1] : curve_.Span(0));
-  }
-
   const Surface& surface_;
   const Density& density_;
   const CurveTreeOptions& options_;
   const BuildControl& control_;
   uint64_t cells_since_check_ = 0;
   const Curve& curve_;
-  const AreaEstimator decision_estimator_;
-  double limit_ = 0;
+  const int order_;
+  double base_ = 1;
+  int grade_ = 0;
   int deepest_ = 0;
   double deepest_u_ = 0.5, deepest_v_ = 0.5;
+  std::vector<uint64_t> stage1_starts_;
+  double stage1_mass_ = 0;
+  double stage1_area_ = 0;
   std::vector<uint64_t> starts_;
-  std::vector<double> masses_;
+  std::vector<uint64_t> masses_;  // per leaf, fixed point
+  std::vector<LeafModel> models_;
+  std::vector<float> errors_;
+  std::vector<uint8_t> info_;
   PrecisionReport report_;
 };
 
@@ -350,13 +538,36 @@ absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Build(const Surface&
   auto tree = std::shared_ptr<CurveTree>(new CurveTree());
   tree->curve_ = &Curve::Get(resolved.curve);
   tree->options_ = resolved;
+  tree->grade_ = grade;
   Builder builder(surface, density, tree->options_, control);
   RETURN_IF_ERROR(builder.BuildGeometric());
+  const double base = builder.stage1_mass();
+  if (!(builder.stage1_area() > 0)) {
+    return absl::InvalidArgumentError(
+        "the surface has zero area (its area element vanishes on the whole parameter box, e.g. "
+        "it is a curve or a point); there is nothing to sample");
+  }
+  if (!(base > 0) || !std::isfinite(base)) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the density integrates to %g over the surface; it must be positive somewhere (check "
+        "the density, or add a floor)",
+        base));
+  }
+  tree->base_mass_ = base;
+  tree->mass_unit_ = std::ldexp(base, -kMassBits);
+  const std::vector<uint64_t>& starts = builder.stage1_starts();
+  builder.StartStage2(base, grade, starts.size() * 2);
+  const Curve& curve = *tree->curve_;
+  for (size_t l = 0; l < starts.size(); ++l) {
+    const uint64_t end = l + 1 < starts.size() ? starts[l + 1] : curve.Span(0);
+    const Cell cell = CellOfRange(curve, starts[l], end);
+    RETURN_IF_ERROR(builder.RefineCell(cell.depth, starts[l], cell.x, cell.y, cell.state));
+  }
+  tree->precision_ = builder.report();
   RETURN_IF_ERROR(builder.Finish(tree.get()));
-  tree->base_mass_ = tree->total_mass();
-  if (grade == 0) return std::shared_ptr<const CurveTree>(std::move(tree));
-  return tree->Refined(surface, density, grade, control);
+  return std::shared_ptr<const CurveTree>(std::move(tree));
 }
+
 
 absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Refined(const Surface& surface,
                                                                     const Density& density,
@@ -366,22 +577,25 @@ absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Refined(const Surfac
     return absl::InvalidArgumentError(absl::StrFormat(
         "cannot refine a grade-%d tree to grade %d; grades only grow, up to 62", grade_, grade));
   }
-  // The copy is private until returned, so the passes may update it in place.
-  auto tree = std::shared_ptr<CurveTree>(new CurveTree(*this));
-  for (int g = grade_ + 1; g <= grade; ++g) {
-    Builder builder(surface, density, tree->options_, control);
-    builder.set_report(tree->precision_);
-    if (builder.PassSplits(*tree, g)) {
-      RETURN_IF_ERROR(builder.RefinePass(*tree, g));
-      RETURN_IF_ERROR(builder.Finish(tree.get()));
+  auto tree = std::shared_ptr<CurveTree>(new CurveTree());
+  tree->curve_ = curve_;
+  tree->options_ = options_;
+  tree->grade_ = grade;
+  tree->base_mass_ = base_mass_;
+  tree->mass_unit_ = mass_unit_;
+  Builder builder(surface, density, tree->options_, control);
+  builder.set_report(precision_);  // keeps the flatness hits of leaves at the cap
+  builder.StartStage2(base_mass_, grade, leaf_count() + leaf_count() / 4);
+  for (size_t l = 0; l < leaf_count(); ++l) {
+    const Cell cell = LeafCell(l);
+    if (leaf_fail_grade(l) <= grade && cell.depth < options_.depth_cap) {
+      RETURN_IF_ERROR(builder.RefineCell(cell.depth, starts_[l], cell.x, cell.y, cell.state));
     } else {
-      builder.ReportMassCaps(*tree, g);
-      tree->precision_ = builder.report();
+      RETURN_IF_ERROR(builder.CopyLeaf(*this, l));
     }
-    tree->grade_ = g;
   }
-  tree->starts_.shrink_to_fit();
-  tree->mass_end_.shrink_to_fit();
+  tree->precision_ = builder.report();
+  RETURN_IF_ERROR(builder.Finish(tree.get()));
   return std::shared_ptr<const CurveTree>(std::move(tree));
 }
 
@@ -404,6 +618,14 @@ size_t CurveTree::LeafAt(uint64_t index) const {
          1;
 }
 
+size_t CurveTree::FirstLeafEndingAbove(double m, size_t lo) const {
+  const double unit = mass_unit_;
+  return static_cast<size_t>(
+      std::upper_bound(mass_end_.begin() + lo, mass_end_.end(), m,
+                       [unit](double x, uint64_t end) { return x < static_cast<double>(end) * unit; }) -
+      mass_end_.begin());
+}
+
 void CurveTree::ComputeDepthRange() {
   min_depth_ = curve_->max_depth();
   max_depth_ = 0;
@@ -411,6 +633,44 @@ void CurveTree::ComputeDepthRange() {
     const int d = leaf_depth(l);
     min_depth_ = std::min(min_depth_, d);
     max_depth_ = std::max(max_depth_, d);
+  }
+}
+
+void CurveTree::ComputeReport() {
+  PrecisionReport& r = precision_;
+  r.mass_capped_leaves = r.small_failing_leaves = r.singular_leaves = 0;
+  r.error_samples = r.unresolved_error_samples = 0;
+  r.singular.clear();
+  r.worst.erase(std::remove_if(r.worst.begin(), r.worst.end(),
+                               [](const DepthCapHit& h) { return h.test == DepthCapHit::Test::kMass; }),
+                r.worst.end());
+  const double n = std::ldexp(1.0, grade_);
+  for (size_t l = 0; l < starts_.size(); ++l) {
+    const double error = errors_[l] / base_mass_ * n;
+    r.error_samples += error;
+    const bool piecewise = leaf_model_kind(l) == LeafModel::Kind::kPiecewise;
+    if (piecewise) ++r.singular_leaves;
+    const int fail = leaf_fail_grade(l);
+    const double mass = mass_end(l) - mass_begin(l);
+    const double allowance = options_.rho * kErrorShare * std::pow(n, 0.25) * mass / base_mass_;
+    const bool error_fails = error > allowance;
+    if (fail <= grade_) {
+      ++r.mass_capped_leaves;
+      r.unresolved_error_samples += error;
+      const Cell c = LeafCell(l);
+      RecordHit({DepthCapHit::Test::kMass, c.u0, c.v0, c.size, error, allowance}, &r.worst);
+    } else if (error_fails) {
+      ++r.small_failing_leaves;
+      r.unresolved_error_samples += error;
+    }
+    if (piecewise) {
+      const Cell c = LeafCell(l);
+      DepthCapHit hit{DepthCapHit::Test::kSingular, c.u0, c.v0, c.size, 0, 0};
+      auto pos = std::upper_bound(r.singular.begin(), r.singular.end(), hit,
+                                  [](const DepthCapHit& a, const DepthCapHit& b) { return a.size < b.size; });
+      r.singular.insert(pos, hit);
+      if (r.singular.size() > PrecisionReport::kMaxReported) r.singular.pop_back();
+    }
   }
 }
 

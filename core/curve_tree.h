@@ -1,23 +1,51 @@
 // The adaptive curve tree (paper Fig. 2, PopulateCurveTree) with the masses
-// along the curve (Fig. 1 lines 4-6), stored as its leaves in curve order.
+// along the curve (Fig. 1 lines 4-6), stored as its leaves in curve order,
+// each with a local model of the mass density (core/leaf_model.h).
 //
 // A tree is built in two stages, both deterministic:
-//  1. The paper's geometric test: a cell is split while the largest distance
-//     from f(centre) to f at its 4 corners and 4 edge midpoints exceeds the
-//     tolerance a, and its depth is below the cap r (AssessSubdivision).
-//  2. The sample-mass test of ALGORITHM.md, graded: a tree of grade g is fine
-//     enough for up to 2^g samples, i.e. no leaf below the cap carries more
-//     than rho * S_base / 2^g of mass, where S_base is the total mass of the
-//     stage-1 tree (fixed, so decisions never depend on later refinement).
-//     Children made by this test inherit their parent's geometric pass: a cell
-//     flat to a is re-split only for mass.
-// The tree of grade g is by definition stage 1 followed by the refinement
-// passes for grades 1..g; Refined() runs the missing passes on a coarser tree,
-// so a cached tree refined from g to g' is bit-identical to one built for g'.
+//  1. The paper's geometric test down to a base depth (6 for Hilbert, 4 for
+//     the 3x3 curves): a cell is split while the largest distance from
+//     f(centre) to f at its 4 corners and 4 edge midpoints exceeds the
+//     tolerance a (AssessSubdivision). S_base is the total mass of these
+//     leaves (fixed, so decisions never depend on later refinement).
+//  2. Graded refinement: a tree of grade g serves up to N = 2^g samples. With
+//     mu = mass / S_base a leaf's share, a leaf splits (below the cap r) when
+//      - its model error e, the sum over its children of |its model's
+//        integral over the child - the child's own mass estimate|, is too
+//        large:  e / S_base * N > rho * kErrorShare * N^(1/4) * mu, while it
+//        carries at least max(kMinSamples, kErrorFloor * N^(1/2)) samples; or
+//      - it fails the paper's flatness test while it carries at least
+//        max(kMinSamples, kFlatnessFloor * N^(1/2)) samples.
+//     The error allowance is proportional to the leaf's share of the mass, so
+//     the error summed over any run of examined leaves stays below rho *
+//     kErrorShare * N^(1/4) samples: a fraction of the jittered set's own
+//     discrepancy. The floors bound the tree: at most ~N / floor leaves are
+//     examined, so leaves grow like N^(1/2) at worst (smooth surfaces: much
+//     slower), and a singular line (where a smooth model's relative error
+//     never shrinks) ends at leaves of a few samples, reported in precision().
+//     Every condition only tightens as N grows, so each leaf stores the
+//     smallest grade at which it must be examined again ("fail grade"), and a
+//     coarser tree refines exactly those leaves.
+// The tree of grade g is by definition stage 1 followed by stage 2 at grade
+// g; Refined() re-runs stage 2 from the leaves whose fail grade is <= the new
+// grade, so a cached tree refined from g to g' is bit-identical to one built
+// for g'.
 //
-// Leaf layout: 16 bytes per leaf, the 64-bit curve index where the leaf starts
-// (its cell, depth and orientation follow from it and the next leaf's start)
-// and the running mass S_l at its end.
+// Mass estimates: the leaf's mass is its model's integral. The quadratic model
+// (3 x 3 Gauss nodes) never evaluates on a cell edge. Where the area element
+// blows up (it is not finite at a node, or the area of the mapped
+// sub-squares' triangles exceeds the quadrature by kSingularExcess, which a
+// smooth patch never does: inscribed triangles have less area), the leaf uses
+// the piecewise model of the mapped triangles, which converges on singular
+// lines (paper Sect. 5.3). Such leaves are counted and located in
+// precision().
+//
+// Leaf layout: 57 bytes per leaf: the 64-bit curve index where the leaf
+// starts (its cell, depth and orientation follow from it and the next leaf's
+// start), the running mass S_l at its end in fixed point (units of
+// S_base / 2^56, so a leaf's mass is an exact difference and refinement
+// reproduces a fresh build bit for bit), the model (9 floats), its error
+// estimate (a float) and one byte holding the model kind and the fail grade.
 //
 // Thread-safety: a built CurveTree is immutable and shared as
 // std::shared_ptr<const CurveTree>; all const methods are thread-safe.
@@ -33,6 +61,7 @@
 #include "core/area_estimator.h"
 #include "core/curve.h"
 #include "core/density.h"
+#include "core/leaf_model.h"
 #include "core/surface.h"
 
 namespace sfc {
@@ -45,19 +74,23 @@ struct CurveTreeOptions {
   double tolerance = 0;
   // The paper's r; 0 means the curve's deepest level (31 Hilbert, 20 3x3).
   int depth_cap = 0;
-  // Largest mass a leaf may carry, in samples' worth (ALGORITHM.md); > 0.
+  // Scales the model-error allowance (see the file comment); > 0. Larger
+  // values trade accuracy for a smaller tree.
   double rho = 1.0;
   // Budget: building or refining past this many leaves is RESOURCE_EXHAUSTED.
-  uint64_t max_leaves = uint64_t{1} << 24;
+  // The default, 2^22 leaves at 57 bytes, is 239 MB (228 MiB).
+  uint64_t max_leaves = uint64_t{1} << 22;
 };
 
 // Where the depth cap stopped a split that a test still wanted (paper Sect. 5.3).
 struct DepthCapHit {
-  enum class Test { kGeometry, kMass };
+  // kGeometry / kMass: the depth cap stopped the flatness / error test.
+  // kSingular: a leaf where the area element blows up (measured = limit = 0).
+  enum class Test { kGeometry, kMass, kSingular };
   Test test = Test::kGeometry;
   double u0 = 0, v0 = 0, size = 0;  // the leaf's parameter cell
-  double measured = 0;              // distance (geometry) or mass (mass test)
-  double limit = 0;                 // the tolerance a, or the grade's mass limit
+  double measured = 0;              // distance (geometry) or model error in samples (kMass)
+  double limit = 0;                 // the tolerance a, or the leaf's error allowance in samples
 };
 
 // Lets the caller stop a build or refinement that is no longer wanted (its
@@ -71,8 +104,19 @@ struct BuildControl {
 
 struct PrecisionReport {
   uint64_t geometry_capped_leaves = 0;
-  uint64_t mass_capped_leaves = 0;
-  std::vector<DepthCapHit> worst;  // at most kMaxReported, largest measured/limit first
+  uint64_t mass_capped_leaves = 0;  // the depth cap stopped the error test
+  // Leaves whose error test failed but that carry fewer than kMinSamples
+  // samples, so they were kept (a singular line ends this way).
+  uint64_t small_failing_leaves = 0;
+  // Leaves with the piecewise model: the area element blows up there.
+  uint64_t singular_leaves = 0;
+  // Precision reached: the estimated model error summed over all leaves, in
+  // samples of the grade's N (each leaf's e / S_base * 2^grade).
+  double error_samples = 0;
+  // ... and summed over the leaves the tests still wanted to split.
+  double unresolved_error_samples = 0;
+  std::vector<DepthCapHit> worst;     // at most kMaxReported, largest measured/limit first
+  std::vector<DepthCapHit> singular;  // at most kMaxReported singular leaves, the smallest first
   static constexpr int kMaxReported = 8;
 };
 
@@ -98,6 +142,17 @@ class CurveTree {
   // The smallest grade fine enough for `count` samples: ceil(log2(count)).
   static int GradeFor(uint64_t count);
 
+  // The error test's constants (file comment).
+  static constexpr double kErrorShare = 0.25;
+  // A leaf is examined by the error test only while it carries at least
+  // max(kMinSamples, kErrorFloor N^(1/4)) samples, by the flatness test only
+  // while it carries max(kMinSamples, kFlatnessFloor N^(1/2)).
+  static constexpr double kMinSamples = 0.125;
+  static constexpr double kErrorFloor = 1.0 / 64;
+  static constexpr double kErrorFloorPower = 0.5;
+  static constexpr double kFlatnessFloor = 1.0 / 16;
+  static constexpr double kSingularExcess = 1.02;
+
   const Curve& curve() const { return *curve_; }
   // The options with tolerance and depth cap resolved to the values used.
   const CurveTreeOptions& options() const { return options_; }
@@ -109,12 +164,17 @@ class CurveTree {
     return l + 1 < starts_.size() ? starts_[l + 1] : curve_->Span(0);
   }
   int leaf_depth(size_t l) const { return curve_->DepthOfSpan(leaf_end(l) - leaf_start(l)); }
-  // Running masses: mass_begin(l) = S_{l-1}, mass_end(l) = S_l.
-  double mass_begin(size_t l) const { return l == 0 ? 0.0 : mass_end_[l - 1]; }
-  double mass_end(size_t l) const { return mass_end_[l]; }
-  const std::vector<double>& mass_ends() const { return mass_end_; }
-  double total_mass() const { return mass_end_.back(); }
+  // Running masses: mass_begin(l) = S_{l-1}, mass_end(l) = S_l, both
+  // non-decreasing in l.
+  double mass_begin(size_t l) const { return l == 0 ? 0.0 : mass_end(l - 1); }
+  double mass_end(size_t l) const { return static_cast<double>(mass_end_[l]) * mass_unit_; }
+  double total_mass() const { return mass_end(mass_end_.size() - 1); }
   double base_mass() const { return base_mass_; }
+  // The first leaf l with mass_end(l) > m (leaf_count() if none), searching
+  // [lo, leaf_count()).
+  size_t FirstLeafEndingAbove(double m, size_t lo = 0) const;
+  // Its leaf's estimated model error (mass units).
+  double leaf_error(size_t l) const { return errors_[l]; }
 
   // The leaf's parameter cell [u0, u0+size) x [v0, v0+size), its position
   // (x, y) among the g^depth x g^depth cells of its depth, and orientation.
@@ -128,12 +188,25 @@ class CurveTree {
   // Index of the leaf containing curve index `index`.
   size_t LeafAt(uint64_t index) const;
 
+  // The leaf's density model and its kind, in the leaf's unit coordinates.
+  const LeafModel& leaf_model(size_t l) const { return models_[l]; }
+  LeafModel::Kind leaf_model_kind(size_t l) const {
+    return (info_[l] & kPiecewiseBit) ? LeafModel::Kind::kPiecewise : LeafModel::Kind::kQuadratic;
+  }
+  // The smallest grade at which the leaf fails the error test (63: never).
+  int leaf_fail_grade(size_t l) const { return info_[l] & kFailGradeMask; }
+
   const PrecisionReport& precision() const { return precision_; }
   int min_depth() const { return min_depth_; }
   int max_depth() const { return max_depth_; }
   // Bytes held by the leaf arrays.
-  size_t bytes() const { return starts_.capacity() * sizeof(uint64_t) + mass_end_.capacity() * sizeof(double); }
-  static constexpr size_t kBytesPerLeaf = sizeof(uint64_t) + sizeof(double);
+  size_t bytes() const {
+    return starts_.capacity() * sizeof(uint64_t) + mass_end_.capacity() * sizeof(uint64_t) +
+           models_.capacity() * sizeof(LeafModel) + errors_.capacity() * sizeof(float) +
+           info_.capacity();
+  }
+  static constexpr size_t kBytesPerLeaf = sizeof(uint64_t) + sizeof(uint64_t) + sizeof(LeafModel) +
+                                          sizeof(float) + sizeof(uint8_t);
 
  private:
   class Builder;
@@ -141,13 +214,21 @@ class CurveTree {
   // The cell covering curve indices [start, end). REQUIRES: a cell's range.
   static Cell CellOfRange(const Curve& curve, uint64_t start, uint64_t end);
   void ComputeDepthRange();
+  void ComputeReport();
 
   const Curve* curve_ = nullptr;
   CurveTreeOptions options_;
   int grade_ = 0;
   double base_mass_ = 0;
+  static constexpr uint8_t kFailGradeMask = 63;
+  static constexpr uint8_t kPiecewiseBit = 64;
+
   std::vector<uint64_t> starts_;
-  std::vector<double> mass_end_;
+  std::vector<uint64_t> mass_end_;  // fixed point, units of mass_unit_
+  double mass_unit_ = 0;            // base_mass_ / 2^56
+  std::vector<LeafModel> models_;
+  std::vector<float> errors_;
+  std::vector<uint8_t> info_;  // fail grade | kPiecewiseBit
   PrecisionReport precision_;
   int min_depth_ = 0, max_depth_ = 0;
 };

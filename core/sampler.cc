@@ -24,10 +24,9 @@ Sampler::Sampler(std::shared_ptr<const CurveTree> tree, std::shared_ptr<const Su
 }
 
 size_t Sampler::LeafForMass(double m) const {
-  const auto& ends = tree_->mass_ends();
-  const size_t l = static_cast<size_t>(std::upper_bound(ends.begin(), ends.end(), m) - ends.begin());
+  const size_t l = tree_->FirstLeafEndingAbove(m);
   // q_k S_M can round up to S_M itself: it then belongs to the last leaf with mass.
-  return l >= ends.size() ? last_positive_leaf_ : l;
+  return l >= tree_->leaf_count() ? last_positive_leaf_ : l;
 }
 
 uint64_t Sampler::FirstIndexAtOrAbove(double m) const {
@@ -235,37 +234,89 @@ absl::Status SampleCursor::Emit(uint64_t k, LeafCache& cache, SampleBatch* batch
 
   // Consecutive samples fall in the same or a nearby later leaf: gallop
   // forward from the last one before falling back to a full binary search.
+  const size_t leaves = tree.leaf_count();
   size_t l = SIZE_MAX;
-  const auto& ends = tree.mass_ends();
   if (cache.leaf != SIZE_MAX && m >= tree.mass_begin(cache.leaf)) {
     size_t lo = cache.leaf, step = 1, hi = lo;
-    while (hi < ends.size() && ends[hi] <= m) {
+    while (hi < leaves && tree.mass_end(hi) <= m) {
       lo = hi + 1;
       hi = lo + step;
       step *= 2;
     }
-    hi = std::min(hi, ends.size());
-    l = static_cast<size_t>(std::upper_bound(ends.begin() + lo, ends.begin() + hi, m) - ends.begin());
-    if (l >= ends.size()) l = SIZE_MAX;
+    hi = std::min(hi, leaves);
+    l = tree.FirstLeafEndingAbove(m, lo);
+    if (l > hi || l >= leaves) l = SIZE_MAX;
   }
   if (l == SIZE_MAX) l = sampler.LeafForMass(m);
+  const double begin_mass = tree.mass_begin(l);
+  const double leaf_mass = tree.mass_end(l) - begin_mass;
   if (l != cache.leaf) {
     cache.cell = tree.LeafCell(l);
     cache.leaf = l;
+    // Samples' worth at the tree's grade, not the sequence's count: a
+    // progressive set extended on the same tree keeps its prefix.
+    cache.samples = leaf_mass / tree.total_mass() * std::ldexp(1.0, tree.grade());
+    cache.stack.clear();
+    cache.stack.push_back({0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 1.0, cache.cell.state});
   }
-  const double begin_mass = tree.mass_begin(l);
-  const double t = std::clamp((m - begin_mass) / (tree.mass_end(l) - begin_mass), 0.0, 1.0);
+  const double t = std::clamp((m - begin_mass) / leaf_mass, 0.0, 1.0);
 
-  // Analytic continuation: follow t down the leaf's own curve.
+  // Model descent: pop to the deepest level holding t, then descend while the
+  // sub-cell carries a noticeable part of a sample.
+  auto& stack = cache.stack;
+  while (stack.size() > 1 && !(t >= stack.back().t0 && t < stack.back().t1)) stack.pop_back();
+  const LeafModel& model = tree.leaf_model(l);
+  const LeafModel::Kind kind = tree.leaf_model_kind(l);
+  const int g = curve.grid(), w = curve.arity();
+  while (static_cast<int>(stack.size()) <= kMaxModelLevels &&
+         (stack.back().t1 - stack.back().t0) * cache.samples >= kNegligibleSamples) {
+    Level& top = stack.back();
+    if (top.children == 0) {
+      // The children's t bounds from the model's exact integrals, once per level.
+      double by_grid[9], share[9], sum = 0;
+      SubSquareIntegrals(model, kind, g, top.x0, top.y0, top.side, by_grid);
+      for (int c = 0; c < w; ++c) {
+        const Curve::Child& ch = curve.ChildOf(top.state, c);
+        share[c] = std::max(0.0, by_grid[ch.dx * g + ch.dy]);
+        sum += share[c];
+      }
+      if (!(sum > 0)) break;  // the model vanishes here: pure curve bits
+      double acc = 0;
+      for (int c = 0; c < w; ++c) {
+        acc += share[c];
+        top.bounds[c] = c + 1 == w ? top.t1 : top.t0 + (top.t1 - top.t0) * (acc / sum);
+      }
+      top.children = w;
+    }
+    double t0 = top.t0;
+    int c = 0;
+    for (; c < w; ++c) {
+      const double t1 = top.bounds[c];
+      if (t < t1 && t1 > t0) {
+        const Curve::Child& ch = curve.ChildOf(top.state, c);
+        const double side = top.side / g, span = top.span / w;
+        const Level child{t0, t1, top.x0 + ch.dx * side, top.y0 + ch.dy * side, side,
+                          top.pos + c * span, span, ch.state};
+        stack.push_back(child);
+        break;
+      }
+      t0 = t1;
+    }
+    if (c == w) break;  // rounding left t past the last child: stay here
+  }
+  const Level& at = stack.back();
+  const double tr = at.t1 > at.t0 ? std::clamp((t - at.t0) / (at.t1 - at.t0), 0.0, 1.0) : 0.0;
+
+  // Analytic continuation: follow the rest of t down the sub-cell's own curve.
   const int levels = curve.continuation_levels();
   const uint64_t scale = curve.PowW(levels);
-  const uint64_t digits = std::min(static_cast<uint64_t>(t * static_cast<double>(scale)), scale - 1);
+  const uint64_t digits = std::min(static_cast<uint64_t>(tr * static_cast<double>(scale)), scale - 1);
   uint64_t cx, cy;
-  int state = cache.cell.state;
+  int state = at.state;
   curve.Descend(digits, levels, &cx, &cy, &state);
-  const double cell = cache.cell.size / curve.PowG(levels);
-  const double u = cache.cell.u0 + (static_cast<double>(cx) + 0.5) * cell;
-  const double v = cache.cell.v0 + (static_cast<double>(cy) + 0.5) * cell;
+  const double cell = at.side / curve.PowG(levels);
+  const double u = cache.cell.u0 + (at.x0 + (static_cast<double>(cx) + 0.5) * cell) * cache.cell.size;
+  const double v = cache.cell.v0 + (at.y0 + (static_cast<double>(cy) + 0.5) * cell) * cache.cell.size;
 
   const bool need_jet = fields_.normal || fields_.density;
   SurfaceJet jet;
@@ -306,7 +357,8 @@ absl::Status SampleCursor::Emit(uint64_t k, LeafCache& cache, SampleBatch* batch
   }
   if (fields_.curve_position) {
     const double span = static_cast<double>(tree.leaf_end(l) - tree.leaf_start(l));
-    batch->curve_position.push_back((static_cast<double>(tree.leaf_start(l)) + t * span) /
+    const double pos = at.pos + tr * at.span;
+    batch->curve_position.push_back((static_cast<double>(tree.leaf_start(l)) + pos * span) /
                                     static_cast<double>(curve.Span(0)));
   }
   return absl::OkStatus();

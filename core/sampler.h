@@ -2,11 +2,17 @@
 // yields, by index range or region, in curve order.
 //
 // Sample k lands in the leaf l with S_{l-1} <= q_k S_M < S_l. Inside the leaf
-// the curve continues analytically (ALGORITHM.md, "Position inside a leaf"):
-// the fraction t = (q_k S_M - S_{l-1}) / s_l is followed down the leaf's own
-// curve for continuation_levels() more levels (all 52 bits of t for Hilbert),
-// and the sample sits at the centre of the cell reached. Nothing is snapped to
-// leaf centres, and the result is a pure function of (tree, sequence, k).
+// it follows the leaf's model (ALGORITHM.md, "Inside a leaf, follow the
+// model"): the fraction t = (q_k S_M - S_{l-1}) / s_l descends the leaf's own
+// curve, at each level entering the child whose share of the model's exact
+// integral holds t. Once the sub-cell reached carries less than
+// kNegligibleSamples of one sample (counted at the tree's grade, so every
+// sequence on one tree places a given t alike), the rest of t is followed as pure curve
+// bits for continuation_levels() more levels (all 52 bits of t for Hilbert),
+// and the sample sits at the centre of the cell reached. The descent is kept
+// on a per-level stack that consecutive samples of one leaf share. Nothing is
+// snapped to leaf centres, and the result is a pure function of
+// (tree, sequence, k): the stack only caches values computed the same way.
 //
 // Thread-safety: Sampler is immutable and thread-safe. A SampleCursor is used
 // by one thread at a time.
@@ -76,11 +82,31 @@ class SampleCursor {
   absl::StatusOr<size_t> Next(size_t max, SampleBatch* batch);
 
  private:
-  // The last leaf decoded, reused by consecutive samples; one per thread.
+  // A sub-cell of the model descent: leaf-fraction interval [t0, t1), its
+  // square [x0, x0 + side) x [y0, y0 + side) in leaf units, its orientation
+  // and its start along the leaf's curve (a fraction of the leaf's span).
+  struct Level {
+    double t0, t1, x0, y0, side, pos, span;  // span: the level's share of the leaf's curve
+    int state;
+    int children = 0;  // 0 until bounds[] is filled: then the curve's arity
+    double bounds[9];  // upper t of each child, in curve order
+  };
+  // The last leaf decoded and its descent, reused by consecutive samples; one
+  // per thread.
   struct LeafCache {
     size_t leaf = SIZE_MAX;
     CurveTree::Cell cell{};
+    double samples = 0;  // the leaf's mass in samples
+    std::vector<Level> stack;
   };
+
+ public:
+  // Below this many samples' worth a sub-cell's placement is pure curve bits.
+  static constexpr double kNegligibleSamples = 1.0 / 8;
+  // The model descent stops after this many levels in any case.
+  static constexpr int kMaxModelLevels = 40;
+
+ private:
 
   SampleCursor(std::shared_ptr<const Sampler> sampler, Region region, SampleFields fields);
   absl::Status PlanRegion(uint64_t begin, uint64_t end);

@@ -16,7 +16,7 @@
 namespace sfc {
 
 // Bumped whenever the same request could yield different samples.
-inline constexpr char kAlgorithmVersion[] = "sfcsampler-1";
+inline constexpr char kAlgorithmVersion[] = "sfcsampler-2";  // 2: error-controlled tree, in-leaf model descent
 
 // Everything that shapes a curve tree (the cache key) except its grade.
 struct TreeSpec {
@@ -43,7 +43,7 @@ struct SampleRequest {
 // Limits that every request is checked against (server flags).
 struct EngineLimits {
   uint64_t max_count = 100'000'000;              // largest N
-  uint64_t max_tree_leaves = uint64_t{1} << 24;  // per tree: 16 B a leaf, 256 MiB
+  uint64_t max_tree_leaves = uint64_t{1} << 22;  // per tree: 57 B a leaf (CurveTree::kBytesPerLeaf), 228 MiB
   size_t max_spec_length = 4096;                 // surface/density spec, in characters
   int generation_threads = 1;                    // threads filling one stream's large batches
   // Sequences that are not monotone in k are sorted into curve order per

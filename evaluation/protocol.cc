@@ -10,9 +10,10 @@
 #include "catalog/catalog.h"
 #include "core/area_estimator.h"
 #include "core/builtin_surfaces.h"
+#include "evaluation/reference_measure.h"
 #include "core/counter_hash.h"
-#include "core/discrepancy.h"
-#include "core/reference_sets.h"
+#include "evaluation/discrepancy.h"
+#include "evaluation/reference_sets.h"
 #include "core/sampler.h"
 #include "core/status_macros.h"
 
@@ -104,12 +105,17 @@ CurveTreeOptions CurveOptions(CurveType curve, AreaEstimator estimator) {
 struct SurfaceCase {
   const char* surface;
   const char* density;
+  int l_min = 0, l_max = 0;  // own sizes 2^l, 2^l + 2^(l-1); 0: the protocol's
+  bool random = true;        // also the i.i.d. baseline (needs a bounded area element)
 };
 constexpr SurfaceCase kSurfaceCases[] = {
     {"torus", "uniform"},
     {"eight", "gaussian:floor=0.05"},
     {"monkey_saddle", "gaussian:floor=0.01"},
     {"plane", "expr:u+v"},
+    // The paper's Sect. 5.3 surface, not reparameterised: the area element is
+    // infinite on u = 1/2 and v = 0, 1/4, 1/2, 3/4, 1. N = 64 .. 24576.
+    {"superellipsoid", "uniform", 6, 14, false},
 };
 
 // i.i.d. points with density proportional to delta dA, by rejection: the
@@ -250,25 +256,26 @@ absl::StatusOr<std::vector<ProtocolRow>> RunProtocol(const ProtocolOptions& opti
     for (const SurfaceCase& c : kSurfaceCases) {
       ASSIGN_OR_RETURN(const SurfaceFromSpec surface, MakeSurface(c.surface));
       ASSIGN_OR_RETURN(const DensityFromSpec density, MakeDensity(c.density));
-      const std::string domain = absl::StrCat("surface ", c.surface, " with ", c.density);
-      // Cell integrals of delta dA by 3x3 Gauss-Legendre on a 256 x 256 grid,
-      // computed once per surface.
+      const std::string domain =
+          absl::StrCat("surface ", c.surface, " with ", c.density,
+                       c.l_min ? absl::StrFormat(" (N = %d..%d)", (1 << c.l_min),
+                                                 (1 << c.l_max) + (1 << (c.l_max - 1)))
+                               : std::string());
+      // Cell integrals of delta dA by a graded 8 x 8 Gauss-Legendre rule on a
+      // 256 x 256 grid (evaluation/reference_measure.h), computed once per
+      // surface; nothing here is shared with the tree.
       constexpr int kGrid = 256;
-      std::vector<double> cells(kGrid * kGrid);
-      for (int i = 0; i < kGrid; ++i) {
-        for (int j = 0; j < kGrid; ++j) {
-          ASSIGN_OR_RETURN(cells[i * kGrid + j],
-                           CellMass(*surface.surface, *density.density, AreaEstimator::kQuadrature,
-                                    static_cast<double>(i) / kGrid, static_cast<double>(j) / kGrid, 1.0 / kGrid));
-        }
-      }
+      ASSIGN_OR_RETURN(const std::vector<double> cells,
+                       GradedCellMasses(*surface.surface, *density.density, kGrid, 8));
       auto cell_mass = [&](double u0, double v0, double) {
         return cells[std::lround(u0 * kGrid) * kGrid + std::lround(v0 * kGrid)];
       };
       OurSampler ours(surface.surface, CurveOptions(CurveType::kHilbert, AreaEstimator::kFirstFundamentalForm),
                       density.density, c.surface, c.density, options.our_sets);
+      const std::vector<uint64_t> case_sizes = c.l_min ? Sizes(c.l_min, c.l_max) : sizes;
       for (const char* method : {"random", "hilbert-jittered"}) {
-        for (uint64_t n : sizes) {
+        if (!c.random && std::string(method) == "random") continue;
+        for (uint64_t n : case_sizes) {
           const auto start = std::chrono::steady_clock::now();
           std::vector<Point2> pts;
           if (std::string(method) == "random") {

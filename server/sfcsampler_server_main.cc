@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
   app.add_option("--metrics-address", o.metrics_address, "host:port of Prometheus /metrics (\"\" = none)")
       ->capture_default_str();
   app.add_option("--max-count", o.limits.max_count, "largest N per request")->capture_default_str();
-  app.add_option("--max-tree-leaves", o.limits.max_tree_leaves, "largest tree, in leaves (16 bytes each)")
+  app.add_option("--max-tree-leaves", o.limits.max_tree_leaves, "largest tree, in leaves (57 bytes each)")
       ->capture_default_str();
   app.add_option("--max-spec-length", o.limits.max_spec_length, "longest surface or density spec, characters")
       ->capture_default_str();

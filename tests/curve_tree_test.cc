@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "catalog/catalog.h"
 #include "core/builtin_surfaces.h"
 #include "gtest/gtest.h"
 #include "tests/test_util.h"
@@ -43,42 +44,72 @@ TEST(CurveTree, LeavesTileTheSquareForEveryCurve) {
     CurveTreeOptions options;
     options.curve = type;
     options.tolerance = 0.05;
-    const auto s = MakeSetup("monkey_saddle", "gaussian:floor=0.1", 2000, options);
+    const auto s = MakeSetup("monkey_saddle", "gaussian:floor=0.1", 1000000, options);
     ExpectLeavesTileTheSquare(*s.tree);
     EXPECT_GT(s.tree->max_depth(), s.tree->min_depth()) << "the tree should be adaptive";
   }
 }
 
-TEST(CurveTree, EveryLeafPassesTheFlatnessTestOrSitsAtTheCap) {
+TEST(CurveTree, EveryLeafThatCarriesEnoughSamplesPassesTheFlatnessTestOrSitsAtTheCap) {
+  // On the plane a cell of side h has spread h / sqrt(2): the tolerance
+  // splits the base cells (depth 6), not those of depth 7.
   CurveTreeOptions options;
-  options.tolerance = 0.02;
-  options.depth_cap = 9;
-  const auto s = MakeSetup("eight", "uniform", 1, options);
-  for (size_t l = 0; l < s.tree->leaf_count(); ++l) {
-    const CurveTree::Cell c = s.tree->LeafCell(l);
-    const Vec3 centre = s.surface->Point(c.u0 + c.size / 2, c.v0 + c.size / 2);
-    double spread = 0;
-    for (int i = 0; i <= 2; ++i) {
-      for (int j = 0; j <= 2; ++j) {
-        spread = std::max(spread, Norm(s.surface->Point(c.u0 + i * c.size / 2, c.v0 + j * c.size / 2) - centre));
+  options.tolerance = 0.006;
+  for (const char* surface : {"plane", "eight"}) {
+    const uint64_t n = uint64_t{1} << 22;
+    const auto s = MakeSetup(surface, "uniform", n, options);
+    const double floor =
+        std::max(CurveTree::kMinSamples, CurveTree::kFlatnessFloor * std::sqrt(double(n)));
+    int checked = 0;
+    for (size_t l = 0; l < s.tree->leaf_count(); ++l) {
+      const CurveTree::Cell c = s.tree->LeafCell(l);
+      const Vec3 centre = s.surface->Point(c.u0 + c.size / 2, c.v0 + c.size / 2);
+      double spread = 0;
+      for (int i = 0; i <= 2; ++i) {
+        for (int j = 0; j <= 2; ++j) {
+          spread = std::max(spread, Norm(s.surface->Point(c.u0 + i * c.size / 2, c.v0 + j * c.size / 2) - centre));
+        }
+      }
+      const double samples = (s.tree->mass_end(l) - s.tree->mass_begin(l)) / s.tree->base_mass() * n;
+      // 1% margin: the test reads the leaf's running-sum mass, the build its own estimate.
+      if (samples > floor * 1.01) {
+        ASSERT_LE(spread, options.tolerance) << surface << " leaf " << l;
+        ++checked;
       }
     }
-    if (c.depth < options.depth_cap) ASSERT_LE(spread, options.tolerance) << "leaf " << l;
+    if (std::string(surface) == "plane") EXPECT_GT(checked, 1000);
   }
 }
 
-TEST(CurveTree, NoLeafBelowTheCapCarriesMoreThanRhoSamplesOfMass) {
-  for (double rho : {1.0, 4.0}) {
-    CurveTreeOptions options;
-    options.rho = rho;
-    const uint64_t n = 5000;
-    const auto s = MakeSetup("sphere", "expr:1+10*u", n, options);
-    const double limit = rho * s.tree->base_mass() / std::ldexp(1.0, s.tree->grade());
+// Exact mass of [u0,u0+h] x [v0,v0+h] on the unit sphere for delta = 1 + 10 u
+// (u = theta / pi): 2 pi^2 h int (1 + 10 u) sin(pi u) du.
+double SphereCellMass(double u0, double h) {
+  const double pi = 3.14159265358979323846;
+  auto prim = [&](double u) {
+    return -std::cos(pi * u) / pi + 10 * (std::sin(pi * u) - pi * u * std::cos(pi * u)) / (pi * pi);
+  };
+  return 2 * pi * pi * h * (prim(u0 + h) - prim(u0));
+}
+
+TEST(CurveTree, LeafMassErrorsSumToWellBelowTheJitteredDiscrepancy) {
+  // ALGORITHM.md: the error summed over any run of leaves stays well below
+  // N^(1/4) samples; the sum over all leaves of |error| bounds every run.
+  for (uint64_t n : {uint64_t{1} << 12, uint64_t{1} << 20, uint64_t{1} << 26}) {
+    const auto s = MakeSetup("sphere", "expr:1+10*u", n);
+    double exact_total = 0;
     for (size_t l = 0; l < s.tree->leaf_count(); ++l) {
-      ASSERT_LE(s.tree->mass_end(l) - s.tree->mass_begin(l), limit * (1 + 1e-12));
+      const CurveTree::Cell c = s.tree->LeafCell(l);
+      exact_total += SphereCellMass(c.u0, c.size);
     }
-    // ... which is at most rho samples' worth for this N (S_base ~ S_M).
-    EXPECT_LE(limit / s.tree->total_mass() * n, rho * 1.01);
+    double error_samples = 0;
+    for (size_t l = 0; l < s.tree->leaf_count(); ++l) {
+      const CurveTree::Cell c = s.tree->LeafCell(l);
+      const double share = (s.tree->mass_end(l) - s.tree->mass_begin(l)) / s.tree->total_mass();
+      error_samples += std::fabs(share - SphereCellMass(c.u0, c.size) / exact_total) * n;
+    }
+    EXPECT_LT(error_samples, 0.25 * std::pow(double(n), 0.25)) << "N = " << n;
+    // ... and the tree does not grow like N.
+    EXPECT_LT(s.tree->leaf_count(), 65536u) << "N = " << n;
   }
 }
 
@@ -88,7 +119,7 @@ TEST(CurveTree, RefiningACachedTreeEqualsBuildingAFreshOne) {
     CurveTreeOptions options;
     options.estimator = e;
     const auto coarse = MakeSetup("torus", "gaussian:floor=0.2", 100, options);
-    const auto fresh = MakeSetup("torus", "gaussian:floor=0.2", 20000, options);
+    const auto fresh = MakeSetup("torus", "gaussian:floor=0.2", 1 << 22, options);
     auto refined = coarse.tree->Refined(*coarse.surface, *coarse.density, fresh.tree->grade());
     ASSERT_TRUE(refined.ok()) << refined.status();
     ASSERT_EQ((*refined)->leaf_count(), fresh.tree->leaf_count());
@@ -96,6 +127,8 @@ TEST(CurveTree, RefiningACachedTreeEqualsBuildingAFreshOne) {
     for (size_t l = 0; l < fresh.tree->leaf_count(); ++l) {
       ASSERT_EQ((*refined)->leaf_start(l), fresh.tree->leaf_start(l));
       ASSERT_EQ((*refined)->mass_end(l), fresh.tree->mass_end(l));  // bit-identical
+      ASSERT_EQ((*refined)->leaf_fail_grade(l), fresh.tree->leaf_fail_grade(l));
+      for (int k = 0; k < 9; ++k) ASSERT_EQ((*refined)->leaf_model(l).c[k], fresh.tree->leaf_model(l).c[k]);
     }
   }
 }
@@ -151,6 +184,42 @@ TEST(CurveTree, BadInputIsInvalidArgument) {
   bad.tolerance = -1;
   EXPECT_EQ(CurveTree::Build(*plane, *uniform, bad, 3).status().code(),
             absl::StatusCode::kInvalidArgument);
+}
+
+TEST(CurveTree, ASurfaceWithZeroAreaIsReportedAsSuch) {
+  // A segment: the bounding box has a diagonal, the area element is 0.
+  const auto segment = MakeSurface("expr:x=u;y=0;z=0");
+  ASSERT_TRUE(segment.ok()) << segment.status();
+  auto uniform = MakeUniformDensity();
+  const auto tree = CurveTree::Build(*segment->surface, *uniform, {}, 3);
+  ASSERT_EQ(tree.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(tree.status().message().find("zero area"), std::string::npos) << tree.status();
+  // A plane with a zero density is a different error.
+  auto plane = MakePlane();
+  const auto zero = MakeDensity("expr:0");
+  ASSERT_TRUE(zero.ok());
+  const auto t2 = CurveTree::Build(*plane, *zero->density, {}, 3);
+  EXPECT_NE(t2.status().message().find("density integrates"), std::string::npos) << t2.status();
+}
+
+TEST(CurveTree, SingularLinesAreLocatedAndTheTreeStaysSmall) {
+  // The paper's Sect. 5.3 surface without reparameterisation: the area
+  // element is infinite on u = 1/2 and v in {0, 1/4, 1/2, 3/4, 1}.
+  const auto s = MakeSetup("superellipsoid", "uniform", 24576);
+  const PrecisionReport& r = s.tree->precision();
+  EXPECT_GT(r.singular_leaves, 0u);
+  ASSERT_FALSE(r.singular.empty());
+  for (const DepthCapHit& h : r.singular) {
+    auto near_line = [&](double lo, double size, std::initializer_list<double> lines) {
+      for (double x : lines) {
+        if (x >= lo - 1e-12 && x <= lo + size + 1e-12) return true;
+      }
+      return false;
+    };
+    EXPECT_TRUE(near_line(h.u0, h.size, {0, 0.5, 1}) || near_line(h.v0, h.size, {0, 0.25, 0.5, 0.75, 1}))
+        << h.u0 << " " << h.v0 << " " << h.size;
+  }
+  EXPECT_LE(s.tree->leaf_count(), uint64_t{1} << 20);
 }
 
 TEST(CurveTree, GradeIsTheCeilingOfLog2) {

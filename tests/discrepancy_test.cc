@@ -1,13 +1,13 @@
 // The discrepancy estimators against brute force on small exact cases, their
 // area formulas against numeric integration, and the defining properties of
 // the reference sets.
-#include "core/discrepancy.h"
+#include "evaluation/discrepancy.h"
 
 #include <cmath>
 #include <set>
 
 #include "core/counter_hash.h"
-#include "core/reference_sets.h"
+#include "evaluation/reference_sets.h"
 #include "gtest/gtest.h"
 
 namespace sfc {

@@ -152,8 +152,9 @@ TEST(Sampler, NoTwoSamplesCoincide) {
 // plus the error of the area x density estimate.
 void ExpectCellCountsWithinJitterBound(const char* surface, const char* density, uint64_t n,
                                        const std::function<double(double, double, double, double)>& true_mass,
-                                       double total, int depth, double slack) {
-  const auto s = MakeSetup(surface, density, n);
+                                       double total, int depth, double slack,
+                                       const CurveTreeOptions& options = {}) {
+  const auto s = MakeSetup(surface, density, n, options);
   const SampleBatch b = Collect(MakeSampler(s, SequenceKind::kJittered, n, 9), 0, n);
   const int side = 1 << depth;
   std::vector<int> counts(side * side, 0);
@@ -180,6 +181,48 @@ TEST(Sampler, CountsPerCellMatchTheAreaOnTheSphere) {
     return (std::cos(pi * a) - std::cos(pi * b)) * 2 * pi * (d - c);
   };
   ExpectCellCountsWithinJitterBound("sphere", "uniform", 30000, area, 4 * pi, 3, 0.1);
+}
+
+TEST(Sampler, PlacementInsideOneLeafFollowsASteepDensity) {
+  // A tolerance no cell fails and a density the quadratic model holds
+  // exactly: the whole square is one leaf, and its 10^6 samples must still
+  // fill the 16 x 16 sub-cells in proportion to a density that varies
+  // 10^4-fold in u and 11-fold in v.
+  CurveTreeOptions one_leaf;
+  one_leaf.tolerance = 10;
+  const auto check = MakeSetup("plane", "expr:(u+0.01)*(u+0.01)*(v+0.1)", 1000000, one_leaf);
+  ASSERT_EQ(check.tree->leaf_count(), 1u);
+  auto mass = [](double a, double b, double c, double d) {
+    auto pu = [](double u) { return (u + 0.01) * (u + 0.01) * (u + 0.01) / 3; };
+    auto pv = [](double v) { return (v + 0.1) * (v + 0.1) / 2; };
+    return (pu(b) - pu(a)) * (pv(d) - pv(c));
+  };
+  ExpectCellCountsWithinJitterBound("plane", "expr:(u+0.01)*(u+0.01)*(v+0.1)", 1000000, mass,
+                                    mass(0, 1, 0, 1), 4, 0.5, one_leaf);
+}
+
+TEST(Sampler, NoSampleLandsWhereTheLeafModelIsNegative) {
+  // One leaf (no cell fails flatness, the error allowance is huge) whose
+  // quadratic model of max(u - 0.6, 0) dips below zero for u in (0.11, 0.5):
+  // the descent must clamp those sub-cells to no mass, not walk backwards.
+  CurveTreeOptions one_leaf;
+  one_leaf.tolerance = 10;
+  one_leaf.rho = 1e12;
+  const uint64_t n = 100000;
+  const auto s = MakeSetup("plane", "expr:max(u-0.6,0)", n, one_leaf);
+  ASSERT_EQ(s.tree->leaf_count(), 1u);
+  const LeafModel& model = s.tree->leaf_model(0);
+  const LeafModel::Kind kind = s.tree->leaf_model_kind(0);
+  ASSERT_LT(ModelIntegral(model, kind, 2, 0.25, 0.375, 0, 1), 0) << "the model should dip";
+  const SampleBatch b = Collect(MakeSampler(s, SequenceKind::kJittered, n, 3), 0, n);
+  ASSERT_EQ(b.size(), n);
+  const int side = 8;
+  for (size_t i = 0; i < n; ++i) {
+    ASSERT_TRUE(b.u[i] >= 0 && b.u[i] <= 1 && b.v[i] >= 0 && b.v[i] <= 1);
+    const double cx = std::floor(b.u[i] * side) / side, cy = std::floor(b.v[i] * side) / side;
+    ASSERT_GT(ModelIntegral(model, kind, 2, cx, cx + 1.0 / side, cy, cy + 1.0 / side), 0)
+        << "sample " << i << " at u = " << b.u[i];
+  }
 }
 
 TEST(Sampler, CountsPerCellFollowDensityUPlusVOnTheSquare) {

@@ -304,12 +304,15 @@ TEST(Server, ACancelledStreamIsFreedAtOnce) {
 }
 
 
-// A request whose tree takes many seconds to build (a flatness tolerance far
-// below the surface's size splits to the leaf budget) unless stopped.
-SampleRequest HeavyBuild(const std::string& surface = "torus") {
-  SampleRequest r = Request(surface, 1000);
-  r.tree.options.tolerance = 1e-9;
-  return r;
+// A request whose tree takes a minute to build unless stopped: a pole the
+// tree refines towards until the leaf budget of HeavyOptions().
+SampleRequest HeavyBuild(const std::string& pole_at = "0.3") {
+  return Request("expr:x=u;y=v;z=1/(u-" + pole_at + ")", 100'000'000);
+}
+ServerOptions HeavyOptions() {
+  ServerOptions o = LoopbackOptions();
+  o.limits.max_tree_leaves = uint64_t{1} << 25;
+  return o;
 }
 
 // Waits up to `seconds` for `done`; true if it came.
@@ -323,7 +326,7 @@ bool Within(double seconds, const std::function<bool()>& done) {
 }
 
 TEST(Server, ABuildNobodyWaitsForAnyMoreStopsAndFreesItsSlot) {
-  Running r = StartServer(LoopbackOptions());
+  Running r = StartServer(HeavyOptions());
   ClientOptions co;
   co.target = "127.0.0.1:" + std::to_string(r.server->port());
   co.deadline_seconds = 0.5;
@@ -343,7 +346,7 @@ TEST(Server, ABuildNobodyWaitsForAnyMoreStopsAndFreesItsSlot) {
 }
 
 TEST(Server, AWaiterLeavesAtItsOwnDeadlineWhileTheBuildGoesOnForOthers) {
-  Running r = StartServer(LoopbackOptions());
+  Running r = StartServer(HeavyOptions());
   absl::Status patient_status;
   std::atomic<bool> stop_patient{false};
   // The patient client cancels from its callback... which never runs during
@@ -368,7 +371,7 @@ TEST(Server, AWaiterLeavesAtItsOwnDeadlineWhileTheBuildGoesOnForOthers) {
 }
 
 TEST(Server, BuildsBeyondTheQueueAreTurnedAwayAndNamedTheLimit) {
-  ServerOptions options = LoopbackOptions();
+  ServerOptions options = HeavyOptions();
   options.max_concurrent_builds = 1;
   options.max_queued_builds = 0;
   Running r = StartServer(options);
@@ -376,9 +379,9 @@ TEST(Server, BuildsBeyondTheQueueAreTurnedAwayAndNamedTheLimit) {
   co.target = "127.0.0.1:" + std::to_string(r.server->port());
   co.deadline_seconds = 2;
   auto client = *SamplerClient::Connect(co);
-  std::thread first([&] { (void)Fetch(*client, HeavyBuild("torus")); });
+  std::thread first([&] { (void)Fetch(*client, HeavyBuild("0.3")); });
   ASSERT_TRUE(Within(5, [&] { return r.server->cache().stats().builds_running == 1; }));
-  ExpectStatus(Fetch(*r.client, HeavyBuild("sphere")).status(), absl::StatusCode::kResourceExhausted,
+  ExpectStatus(Fetch(*r.client, HeavyBuild("0.4")).status(), absl::StatusCode::kResourceExhausted,
                "max_queued_builds");
   // A cached tree needs no builder: it is still served.
   first.join();
@@ -408,7 +411,7 @@ TEST(Server, AFailedBuildIsRememberedAndNotRepeated) {
 TEST(Server, ShutdownStopsARunningBuild) {
   ClientOptions co;
   co.max_resumes = 0;  // see the server's answer, not a retry
-  Running r = StartServer(LoopbackOptions(), co);
+  Running r = StartServer(HeavyOptions(), co);
   absl::Status status;
   std::thread waiting([&] { status = Fetch(*r.client, HeavyBuild()).status(); });
   ASSERT_TRUE(Within(5, [&] { return r.server->cache().stats().builds_running == 1; }));
@@ -460,7 +463,7 @@ TEST(Server, AStockClientReceivesEveryColumnWithinItsDefaultMessageLimit) {
 TEST(Server, EveryBadInputGetsItsStatusCode) {
   ServerOptions options = LoopbackOptions();
   options.limits.max_count = 1'000'000;
-  options.limits.max_tree_leaves = 100'000;
+  options.limits.max_tree_leaves = 20'000;
   options.limits.max_spec_length = 200;
   options.max_batch_size = 10000;
   ClientOptions co;
@@ -482,7 +485,7 @@ TEST(Server, EveryBadInputGetsItsStatusCode) {
   ExpectStatus(fetch(Request("sphere", 0)), kInvalid, "count");
   ExpectStatus(fetch(Request("sphere", 2'000'000)), kInvalid, "max_count");
   ExpectStatus(fetch(Request("expr:x=u;y=v;z=" + std::string(300, '1'), 10)), kInvalid, "max_spec_length");
-  ExpectStatus(fetch(Request("sphere", 1'000'000)), absl::StatusCode::kResourceExhausted, "max_leaves");
+  ExpectStatus(fetch(Request("expr:x=u;y=v;z=1/(u-0.3)", 1'000'000)), absl::StatusCode::kResourceExhausted, "max_leaves");
   ExpectStatus(fetch(Request("expr:x=u;y=v;z=u**v", 10)), kInvalid, "position");
 
   ClientOptions big_batches;

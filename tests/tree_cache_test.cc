@@ -65,13 +65,14 @@ TEST(TreeCache, AnExceptionInABuildBecomesItsStatusAndLeavesNothingPending) {
 
 TEST(TreeCache, AWaiterWhoseCheckFailsLeavesAtOnce) {
   TreeCache cache(TreeCacheOptions{});
-  auto slow = *MakeSurface("torus");
+  // A pole the tree refines towards for a minute, unless stopped.
+  auto slow = *MakeSurface("expr:x=u;y=v;z=1/(u-0.3)");
   auto d = *MakeDensity("uniform");
   TreeFactory heavy;
-  CurveTreeOptions fine;
-  fine.tolerance = 1e-9;
-  heavy.build = [slow, d, fine](int grade, const BuildControl& control) {
-    return CurveTree::Build(*slow.surface, *d.density, fine, grade, control);
+  CurveTreeOptions big;
+  big.max_leaves = uint64_t{1} << 25;
+  heavy.build = [slow, d, big](int grade, const BuildControl& control) {
+    return CurveTree::Build(*slow.surface, *d.density, big, grade, control);
   };
   heavy.refine = nullptr;
   std::atomic<bool> give_up{false};
@@ -83,7 +84,7 @@ TEST(TreeCache, AWaiterWhoseCheckFailsLeavesAtOnce) {
     give_up = true;
   });
   const auto start = std::chrono::steady_clock::now();
-  auto result = cache.Get(Key("heavy"), 0, heavy, caller);
+  auto result = cache.Get(Key("heavy"), CurveTree::GradeFor(100'000'000), heavy, caller);
   quit.join();
   EXPECT_EQ(result.status().code(), absl::StatusCode::kDeadlineExceeded);
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));

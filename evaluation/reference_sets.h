@@ -1,12 +1,12 @@
 // Reference point sets for the evaluation protocol (paper Sects. 2, 4, 5.1),
 // written from their definitions. Thread-safety: pure functions.
-#ifndef SFCSAMPLER_CORE_REFERENCE_SETS_H_
-#define SFCSAMPLER_CORE_REFERENCE_SETS_H_
+#ifndef SFCSAMPLER_EVALUATION_REFERENCE_SETS_H_
+#define SFCSAMPLER_EVALUATION_REFERENCE_SETS_H_
 
 #include <cstdint>
 #include <vector>
 
-#include "core/discrepancy.h"
+#include "evaluation/discrepancy.h"
 #include "core/vec3.h"
 
 namespace sfc {
@@ -37,4 +37,4 @@ double RadicalInverse2(uint64_t k);
 
 }  // namespace sfc
 
-#endif  // SFCSAMPLER_CORE_REFERENCE_SETS_H_
+#endif  // SFCSAMPLER_EVALUATION_REFERENCE_SETS_H_

@@ -1,4 +1,4 @@
-#include "core/reference_sets.h"
+#include "evaluation/reference_sets.h"
 
 #include <algorithm>
 #include <cmath>

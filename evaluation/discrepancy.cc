@@ -1,4 +1,4 @@
-#include "core/discrepancy.h"
+#include "evaluation/discrepancy.h"
 
 #include <algorithm>
 #include <cmath>

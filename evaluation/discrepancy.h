@@ -5,8 +5,8 @@
 // Each estimator takes the sup over a finite family, so it is a lower bound of
 // the true sup over the whole family; each says which shapes it tries, its
 // cost, and where it is exact. Thread-safety: pure functions.
-#ifndef SFCSAMPLER_CORE_DISCREPANCY_H_
-#define SFCSAMPLER_CORE_DISCREPANCY_H_
+#ifndef SFCSAMPLER_EVALUATION_DISCREPANCY_H_
+#define SFCSAMPLER_EVALUATION_DISCREPANCY_H_
 
 #include <cstdint>
 #include <functional>
@@ -62,4 +62,4 @@ double ParameterRectDiscrepancy(const std::vector<Point2>& uv,
 
 }  // namespace sfc
 
-#endif  // SFCSAMPLER_CORE_DISCREPANCY_H_
+#endif  // SFCSAMPLER_EVALUATION_DISCREPANCY_H_

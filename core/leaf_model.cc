@@ -1,0 +1,156 @@
+#include "core/leaf_model.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sfc {
+namespace {
+
+// Lagrange basis polynomial i on the Gauss nodes at x.
+double Basis(int i, double x) {
+  double p = 1;
+  for (int k = 0; k < 3; ++k) {
+    if (k != i) p *= (x - kGaussNode[k]) / (kGaussNode[i] - kGaussNode[k]);
+  }
+  return p;
+}
+
+// Its leading (x^2) coefficient.
+double BasisLead(int i) {
+  double p = 1;
+  for (int k = 0; k < 3; ++k) {
+    if (k != i) p /= kGaussNode[i] - kGaussNode[k];
+  }
+  return p;
+}
+
+// The basis polynomials' coefficients: L_i(x) = k0 + k1 x + k2 x^2.
+struct BasisTable {
+  double k[3][3];
+  BasisTable() {
+    for (int i = 0; i < 3; ++i) {
+      const double l0 = Basis(i, 0), l1 = Basis(i, 1), lead = BasisLead(i);
+      k[i][0] = l0;
+      k[i][2] = lead;
+      k[i][1] = l1 - l0 - lead;
+    }
+  }
+};
+
+// int_a^b L_i = d L_i(mid) + lead d^3 / 12, exact for a quadratic and free of
+// the cancellation of b^3 - a^3 on tiny intervals.
+void BasisIntegrals(double a, double b, double out[3]) {
+  static const BasisTable table;
+  const double d = b - a, mid = (a + b) / 2, d3 = d * d * d / 12;
+  for (int i = 0; i < 3; ++i) {
+    const double* k = table.k[i];
+    out[i] = d * (k[0] + mid * (k[1] + mid * k[2])) + k[2] * d3;
+  }
+}
+
+template <typename T>
+double Quadratic(const T* c, double x0, double x1, double y0, double y1) {
+  double ix[3], iy[3];
+  BasisIntegrals(x0, x1, ix);
+  BasisIntegrals(y0, y1, iy);
+  double sum = 0;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) sum += static_cast<double>(c[3 * i + j]) * ix[i] * iy[j];
+  }
+  return sum;
+}
+
+double Overlap(double a0, double a1, double b0, double b1) {
+  return std::max(0.0, std::min(a1, b1) - std::max(a0, b0));
+}
+
+}  // namespace
+
+LeafModel LeafModel::Uniform() {
+  LeafModel m;
+  std::fill(m.c, m.c + 9, 1.0f);
+  return m;
+}
+
+LeafModel LeafModel::FromQuadratic(const double values[9]) {
+  double total = 0;
+  bool ok = true;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      total += kGaussWeight[i] * kGaussWeight[j] * values[3 * i + j];
+      ok = ok && std::isfinite(values[3 * i + j]) && values[3 * i + j] >= 0;
+    }
+  }
+  if (!ok || !(total > 0) || !std::isfinite(total)) return Uniform();
+  LeafModel m;
+  for (int k = 0; k < 9; ++k) m.c[k] = static_cast<float>(values[k] / total);
+  return m;
+}
+
+LeafModel LeafModel::FromPiecewise(const double masses[9], int grid) {
+  const int n = grid * grid;
+  double total = 0;
+  bool ok = true;
+  for (int k = 0; k < n; ++k) {
+    total += masses[k];
+    ok = ok && std::isfinite(masses[k]) && masses[k] >= 0;
+  }
+  LeafModel m;
+  std::fill(m.c, m.c + 9, 1.0f);
+  if (!ok || !(total > 0) || !std::isfinite(total)) return m;
+  // Density on a sub-square of area 1 / n: its share of the mass times n.
+  for (int k = 0; k < n; ++k) m.c[k] = static_cast<float>(masses[k] / total * n);
+  return m;
+}
+
+double ModelIntegral(const LeafModel& model, LeafModel::Kind kind, int grid, double x0, double x1,
+                     double y0, double y1) {
+  if (kind == LeafModel::Kind::kQuadratic) return Quadratic(model.c, x0, x1, y0, y1);
+  const double side = 1.0 / grid;
+  double sum = 0;
+  for (int i = 0; i < grid; ++i) {
+    const double ox = Overlap(x0, x1, i * side, (i + 1) * side);
+    if (ox == 0) continue;
+    for (int j = 0; j < grid; ++j) {
+      const double oy = Overlap(y0, y1, j * side, (j + 1) * side);
+      if (oy > 0) sum += static_cast<double>(model.c[i * grid + j]) * ox * oy;
+    }
+  }
+  return sum;
+}
+
+void SubSquareIntegrals(const LeafModel& model, LeafModel::Kind kind, int grid, double x0,
+                        double y0, double side, double out[9]) {
+  const double step = side / grid;
+  if (kind == LeafModel::Kind::kPiecewise) {
+    for (int i = 0; i < grid; ++i) {
+      for (int j = 0; j < grid; ++j) {
+        out[i * grid + j] = ModelIntegral(model, kind, grid, x0 + i * step, x0 + (i + 1) * step,
+                                          y0 + j * step, y0 + (j + 1) * step);
+      }
+    }
+    return;
+  }
+  double ix[3][3], iy[3][3];
+  for (int i = 0; i < grid; ++i) {
+    BasisIntegrals(x0 + i * step, x0 + (i + 1) * step, ix[i]);
+    BasisIntegrals(y0 + i * step, y0 + (i + 1) * step, iy[i]);
+  }
+  for (int i = 0; i < grid; ++i) {
+    for (int j = 0; j < grid; ++j) {
+      double sum = 0;
+      for (int a = 0; a < 3; ++a) {
+        const double row = model.c[3 * a] * iy[j][0] + model.c[3 * a + 1] * iy[j][1] +
+                           model.c[3 * a + 2] * iy[j][2];
+        sum += ix[i][a] * row;
+      }
+      out[i * grid + j] = sum;
+    }
+  }
+}
+
+double QuadraticIntegral(const double values[9], double x0, double x1, double y0, double y1) {
+  return Quadratic(values, x0, x1, y0, y1);
+}
+
+}  // namespace sfc

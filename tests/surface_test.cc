@@ -1,0 +1,78 @@
+// Closed-form jets of the built-in surfaces agree with high-order finite
+// differences of their positions (away from singular lines), and the
+// superellipsoid's jet reports its singular lines as infinite.
+#include <cmath>
+#include <memory>
+
+#include "core/builtin_surfaces.h"
+#include "gtest/gtest.h"
+
+namespace sfc {
+namespace {
+
+// 4th-order central differences of Point.
+Vec3 Du(const Surface& s, double u, double v, double h) {
+  return (s.Point(u - 2 * h, v) - s.Point(u + 2 * h, v) + (s.Point(u + h, v) - s.Point(u - h, v)) * 8) *
+         (1 / (12 * h));
+}
+Vec3 Dv(const Surface& s, double u, double v, double h) {
+  return (s.Point(u, v - 2 * h) - s.Point(u, v + 2 * h) + (s.Point(u, v + h) - s.Point(u, v - h)) * 8) *
+         (1 / (12 * h));
+}
+
+void ExpectNear(const Vec3& a, const Vec3& b, double tol, const char* what, double u, double v) {
+  const double scale = 1 + Norm(b);
+  EXPECT_LT(Norm(a - b), tol * scale) << what << " at (" << u << ", " << v << ")";
+}
+
+void ExpectJetMatchesDifferences(const Surface& s) {
+  // Points a tenth away from the superellipsoid's singular lines, where
+  // finite differences of a |c|^(1/3) profile are still accurate.
+  for (double u : {0.2, 0.33, 0.61, 0.8}) {
+    for (double v : {0.1, 0.15, 0.4, 0.6, 0.9}) {
+      const SurfaceJet j = s.Jet(u, v, 2);
+      const double h = 1e-4;
+      ExpectNear(j.p, s.Point(u, v), 1e-14, "p", u, v);
+      ExpectNear(j.fu, Du(s, u, v, h), 1e-7, "fu", u, v);
+      ExpectNear(j.fv, Dv(s, u, v, h), 1e-7, "fv", u, v);
+      const double k = 1e-3;
+      ExpectNear(j.fuu, (Du(s, u + k, v, h) - Du(s, u - k, v, h)) * (1 / (2 * k)), 1e-3, "fuu", u, v);
+      ExpectNear(j.fvv, (Dv(s, u, v + k, h) - Dv(s, u, v - k, h)) * (1 / (2 * k)), 1e-3, "fvv", u, v);
+      ExpectNear(j.fuv, (Du(s, u, v + k, h) - Du(s, u, v - k, h)) * (1 / (2 * k)), 1e-3, "fuv", u, v);
+      // The grid version is the same jet.
+      double us[1] = {u}, vs[1] = {v};
+      SurfaceJet g;
+      s.JetGrid(us, 1, vs, 1, 2, &g);
+      EXPECT_EQ(g.fu.x, j.fu.x);
+      EXPECT_EQ(g.fvv.y, j.fvv.y);
+    }
+  }
+}
+
+TEST(BuiltinSurfaces, SuperellipsoidJetIsExact) {
+  for (double e : {1.0 / 3, 1.0, 2.5}) {
+    for (bool reparam : {false, true}) {
+      SCOPED_TRACE(testing::Message() << "e = " << e << " reparam = " << reparam);
+      ExpectJetMatchesDifferences(*MakeSuperellipsoid(e, reparam));
+    }
+  }
+}
+
+TEST(BuiltinSurfaces, OtherJetsAreExact) {
+  ExpectJetMatchesDifferences(*MakeSphere(1));
+  ExpectJetMatchesDifferences(*MakeTorus(1, 0.3));
+  ExpectJetMatchesDifferences(*MakeEightSurface());
+  ExpectJetMatchesDifferences(*MakeMonkeySaddle());
+  ExpectJetMatchesDifferences(*MakeWhitneyUmbrella());
+}
+
+TEST(BuiltinSurfaces, SuperellipsoidSingularLinesAreInfiniteNotNaNPositions) {
+  auto s = MakeSuperellipsoid(1.0 / 3, false);
+  // u = 1/2 is the equator, where sin(angle) = 0: the area element is infinite.
+  const SurfaceJet j = s->Jet(0.5, 0.3, 1);
+  EXPECT_TRUE(std::isfinite(j.p.x) && std::isfinite(j.p.z));
+  EXPECT_TRUE(std::isinf(Norm(Cross(j.fu, j.fv))));
+}
+
+}  // namespace
+}  // namespace sfc
