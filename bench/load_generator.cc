@@ -15,7 +15,8 @@
 //   bad         a request outside a limit or malformed: INVALID_ARGUMENT or
 //               RESOURCE_EXHAUSTED as the request deserves.
 // In every scenario a RESOURCE_EXHAUSTED naming the build queue
-// (max_queued_builds) is the server shedding load: expected, and counted.
+// (max_queued_builds) is the server shedding load: expected, and counted;
+// the worker then backs off for 0.25-1 s, as a client told to retry later.
 // Every outcome is classified expected or unexpected. A sampler thread reads
 // the server's VmRSS and VmHWM from /proc/PID/status. At the end it prints a
 // table and exits 1 if anything unexpected happened.
@@ -94,14 +95,16 @@ class Tally {
   void Samples(uint64_t n) { samples_.fetch_add(n, std::memory_order_relaxed); }
   // A request the server turned away because its build queue was full is
   // load shedding, which a client retries later: expected in every scenario.
-  void Outcome(const std::string& scenario, grpc::StatusCode code, bool expected,
+  // Returns true for such a request, after which the worker backs off.
+  bool Outcome(const std::string& scenario, grpc::StatusCode code, bool expected,
                const std::string& detail) {
     absl::MutexLock lock(&mu_);
     ++by_code_[code];
     ++by_scenario_[scenario];
     if (code == grpc::StatusCode::OK) ++completed_;
-    if (code == grpc::StatusCode::RESOURCE_EXHAUSTED &&
-        detail.find("max_queued_builds") != std::string::npos) {
+    const bool shed = code == grpc::StatusCode::RESOURCE_EXHAUSTED &&
+                      detail.find("max_queued_builds") != std::string::npos;
+    if (shed) {
       ++shed_;
       expected = true;
     }
@@ -111,6 +114,7 @@ class Tally {
         examples_.push_back(absl::StrFormat("%s: code %d: %s", scenario, static_cast<int>(code), detail));
       }
     }
+    return shed;
   }
   void Checked(bool same) {
     absl::MutexLock lock(&mu_);
@@ -298,10 +302,20 @@ class Worker {
       } else {
         Bad();
       }
+      if (shed_) {
+        // "Retry later": a well-behaved client backs off for 0.25-1 s.
+        shed_ = false;
+        std::this_thread::sleep_for(std::chrono::milliseconds(250 + rng_() % 750));
+      }
     }
   }
 
  private:
+  void Report(const std::string& scenario, grpc::StatusCode code, bool expected,
+              const std::string& detail) {
+    shed_ = tally_->Outcome(scenario, code, expected, detail);
+  }
+
   void Complete() {
     const SampleRequest request = ValidRequest(rng_);
     SampleBatch received;
@@ -312,7 +326,7 @@ class Worker {
       return absl::OkStatus();
     });
     if (!summary.ok()) {
-      tally_->Outcome("complete", ToGrpcCode(summary.status().code()), false,
+      Report("complete", ToGrpcCode(summary.status().code()), false,
                       std::string(summary.status().message()));
       return;
     }
@@ -321,12 +335,12 @@ class Worker {
     const auto range = SamplingEngine::ResolveRange(request);
     if (request.region.kind == Region::Kind::kAll &&
         summary->received != range->second - range->first) {
-      tally_->Outcome("complete", grpc::StatusCode::DATA_LOSS, false,
+      Report("complete", grpc::StatusCode::DATA_LOSS, false,
                       absl::StrFormat("received %d of %d samples", summary->received,
                                       range->second - range->first));
       return;
     }
-    tally_->Outcome("complete", grpc::StatusCode::OK, true, "");
+    Report("complete", grpc::StatusCode::OK, true, "");
     if (check) tally_->Checked(SameAsInProcess(request, received));
   }
 
@@ -378,7 +392,7 @@ class Worker {
     const grpc::Status status = reader->Finish();
     // A stream that ended before the cancel (OK) would mean a 2 M request
     // finished within a few reads: unexpected.
-    tally_->Outcome("cancel", status.error_code(), status.error_code() == grpc::StatusCode::CANCELLED,
+    Report("cancel", status.error_code(), status.error_code() == grpc::StatusCode::CANCELLED,
                     status.error_message());
   }
 
@@ -400,7 +414,7 @@ class Worker {
     }
     const grpc::Status status = reader->Finish();
     const auto code = status.error_code();
-    tally_->Outcome("slow", code,
+    Report("slow", code,
                     code == grpc::StatusCode::OK || code == grpc::StatusCode::CANCELLED ||
                         code == grpc::StatusCode::DEADLINE_EXCEEDED,
                     status.error_message());
@@ -414,7 +428,7 @@ class Worker {
     while (reader->Read(&response)) Count(response);
     const grpc::Status status = reader->Finish();
     const auto code = status.error_code();
-    tally_->Outcome("deadline", code,
+    Report("deadline", code,
                     code == grpc::StatusCode::DEADLINE_EXCEEDED || code == grpc::StatusCode::OK,
                     status.error_message());
   }
@@ -427,7 +441,7 @@ class Worker {
     uint64_t got = 0;
     while (reader->Read(&response)) got += Count(response);
     const grpc::Status status = reader->Finish();
-    tally_->Outcome(absl::StrFormat("bad (%s)", bad.what), status.error_code(),
+    Report(absl::StrFormat("bad (%s)", bad.what), status.error_code(),
                     status.error_code() == bad.expected && got == 0 && !status.error_message().empty(),
                     status.error_message());
   }
@@ -440,6 +454,7 @@ class Worker {
   const SamplingEngine* const engine_;
   std::mt19937_64 rng_;
   uint64_t completes_ = 0;
+  bool shed_ = false;  // the last stream was turned away by a full build queue
 };
 
 // kB value of `field` ("VmRSS:") in /proc/PID/status, in bytes; 0 if absent.
