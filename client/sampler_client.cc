@@ -9,6 +9,7 @@
 #include "catalog/catalog.h"
 #include "engine/model_source.h"
 #include "engine/tree_key.h"
+#include "grpc/grpc.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "grpcpp/client_context.h"
 #include "grpcpp/create_channel.h"
@@ -82,6 +83,12 @@ absl::StatusOr<std::unique_ptr<SamplerClient>> SamplerClient::Connect(const Clie
   }
   grpc::ChannelArguments args;
   args.SetMaxReceiveMessageSize(-1);
+  // gRPC's reconnect backoff starts at 1 s and grows to 120 s; a resume after
+  // a server restart would meet a channel still waiting it out (and failing
+  // calls at once) long after the server is back. Retry the connection every
+  // 100 ms at first and never less often than once a second.
+  args.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, 100);
+  args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 1000);
   auto channel = grpc::CreateCustomChannel(options.target, credentials, args);
   return std::unique_ptr<SamplerClient>(new SamplerClient(options, std::move(channel)));
 }
@@ -221,7 +228,11 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
     }
     // Resume.
     ++summary.resumes;
-    std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int64_t>(backoff * 1000)));
+    const auto pause = std::chrono::milliseconds(static_cast<int64_t>(backoff * 1000));
+    std::this_thread::sleep_for(pause);
+    // A server that is restarting: wait up to as long again for the channel
+    // to connect, so this attempt is not spent on a refused connection.
+    channel_->WaitForConnected(std::chrono::system_clock::now() + pause);
     backoff *= 2;
     if (monotone && summary.received > 0) {
       const auto range = SamplingEngine::ResolveRange(request);

@@ -34,7 +34,9 @@ struct ClientOptions {
   std::string tls_root_certs_file;         // ... trusting these roots ("" = system roots)
   std::string tls_cert_file, tls_key_file; // client certificate and key for mutual TLS ("" = none)
   int max_resumes = 5;                     // resumes per Sample() call
-  double resume_backoff_seconds = 0.2;     // first wait; doubles each time
+  // First wait before a resume; doubles each time. After each wait the
+  // client waits up to as long again for the connection to come back.
+  double resume_backoff_seconds = 0.2;
   double deadline_seconds = 0;             // per RPC; 0 = none
   ::sfcsampler::v1::Precision precision = ::sfcsampler::v1::PRECISION_FLOAT64;
   uint32_t batch_size = 0;                 // samples per message; 0 = the server chooses

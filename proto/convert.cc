@@ -208,13 +208,20 @@ absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fiel
   if (in.index_size() != 0 && static_cast<size_t>(in.index_size()) != n) {
     return absl::DataLossError(absl::StrFormat("a batch has %d indices for %d samples", in.index_size(), n));
   }
-  if (n > 0 && !in.has_f64() && !in.has_f32()) return absl::DataLossError("a batch has no columns");
+  if (n == 0) return absl::OkStatus();
+  if (!in.has_f64() && !in.has_f32()) return absl::DataLossError("a batch has no columns");
+  // `size` is just a number on the wire; only the columns bound what it may
+  // make us allocate, so check them before appending any index.
+  const size_t u_values = in.has_f64() ? in.f64().u_size() : in.f32().u_size();
+  if (u_values != n) {
+    return absl::DataLossError(
+        absl::StrFormat("a batch's column u has %d values for %d samples", u_values, n));
+  }
   if (in.index_size() == 0) {
     for (size_t i = 0; i < n; ++i) out->index.push_back(in.first_index() + i);
   } else {
     out->index.insert(out->index.end(), in.index().begin(), in.index().end());
   }
-  if (n == 0) return absl::OkStatus();
   return in.has_f64() ? TakeColumns(in.f64(), fields, n, out) : TakeColumns(in.f32(), fields, n, out);
 }
 

@@ -1,0 +1,51 @@
+// libFuzzer target: the client side of the wire, SampleResponse bytes ->
+// ParseFromString -> AppendFromProto (proto/convert.h), for each combination
+// of optional columns. A batch is either appended with every requested column
+// as long as the index column, or refused with DATA_LOSS; a hostile or broken
+// server must not make the client allocate more than its message holds.
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+
+#include "proto/convert.h"
+
+namespace {
+
+[[noreturn]] void Fail(const char* what) {
+  std::fprintf(stderr, "fuzz: %s\n", what);
+  __builtin_trap();
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  sfc::v1::SampleResponse response;
+  if (!response.ParseFromArray(data, static_cast<int>(size))) return 0;
+  for (int mask = 0; mask < 8; ++mask) {
+    sfc::SampleFields fields;
+    fields.normal = mask & 1;
+    fields.density = mask & 2;
+    fields.curve_position = mask & 4;
+    sfc::SampleBatch batch;
+    const absl::Status status = sfc::AppendFromProto(response.batch(), fields, &batch);
+    if (!status.ok()) {
+      if (status.code() != absl::StatusCode::kDataLoss || status.message().empty()) {
+        Fail("a malformed batch is not DATA_LOSS with a message");
+      }
+      continue;
+    }
+    const size_t n = batch.size();
+    if (batch.u.size() != n || batch.v.size() != n || batch.x.size() != n || batch.y.size() != n ||
+        batch.z.size() != n) {
+      Fail("an accepted batch has a column of another length than its indices");
+    }
+    if (fields.normal && (batch.nx.size() != n || batch.ny.size() != n || batch.nz.size() != n)) {
+      Fail("an accepted batch lacks a requested normal column");
+    }
+    if (fields.density && batch.density.size() != n) Fail("an accepted batch lacks densities");
+    if (fields.curve_position && batch.curve_position.size() != n) {
+      Fail("an accepted batch lacks curve positions");
+    }
+  }
+  return 0;
+}

@@ -1,0 +1,95 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets of fuzz/ with clang, ASan and UBSan into
+# ./build-fuzz (the normal ./build is untouched), runs each for SECONDS
+# (default 60) on a corpus seeded from fuzz/corpus, and prints a table:
+# target, executions, exec/s, findings. Exits 1 when anything was found; the
+# reproducers are in build-fuzz/findings/RUN/TARGET/ (replay one with
+# `build-fuzz/fuzz/TARGET FILE`). Not part of ctest: it takes minutes.
+#   bash tools/fuzz.sh [SECONDS] [TARGET...]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds="${1:-60}"
+shift || true
+targets=("$@")
+[ ${#targets[@]} -gt 0 ] || targets=(spec_fuzzer expression_fuzzer request_fuzzer proto_request_fuzzer proto_batch_fuzzer)
+
+bash tools/setup-debian.sh
+# The fuzz build alone needs clang and its runtimes (libFuzzer, ASan, UBSan);
+# Debian ships libFuzzer for clang 14 in libclang-rt-14-dev.
+need=()
+for p in clang libclang-rt-14-dev; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || need+=("$p")
+done
+if [ ${#need[@]} -gt 0 ]; then
+  sudo=""; [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  echo "fuzz: installing ${need[*]}" >&2
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${need[@]}" >&2
+fi
+
+out=build-fuzz
+mkdir -p "$out"
+if [ ! -f "$out/build.ninja" ]; then
+  CC=clang CXX=clang++ cmake -S . -B "$out" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DSFC_BUILD_FUZZERS=ON -DSFC_BUILD_TESTS=OFF -DSFC_BUILD_BENCHMARKS=OFF > "$out/build.log" 2>&1 \
+    || { cat "$out/build.log"; exit 1; }
+fi
+cmake --build "$out" -j2 --target fuzzers >> "$out/build.log" 2>&1 || { tail -50 "$out/build.log"; exit 1; }
+
+# Seeds: text files as they are; protobuf text format (.txtpb) encoded to wire bytes.
+declare -A message=([proto_request_fuzzer]=sfcsampler.v1.SampleRequest [proto_batch_fuzzer]=sfcsampler.v1.SampleResponse)
+seed_dir() { local t="${1%_fuzzer}"; echo "fuzz/corpus/$t"; }
+findings_dir="$out/findings/$(date -u +%Y%m%dT%H%M%S)"
+for t in "${targets[@]}"; do
+  corpus="$out/corpus/$t"
+  mkdir -p "$corpus" "$findings_dir/$t"
+  src=$(seed_dir "$t")
+  [ -d "$src" ] || continue
+  for f in "$src"/*; do
+    case "$f" in
+      *.txtpb)
+        protoc --proto_path=proto --encode="${message[$t]}" proto/sfcsampler/v1/sampler.proto \
+          < "$f" > "$corpus/seed-$(basename "$f" .txtpb)" ;;
+      *) cp "$f" "$corpus/" ;;
+    esac
+  done
+done
+
+# One target for `seconds`: libFuzzer stops at its first finding, so it is
+# restarted (keeping the corpus) until the time is used up.
+printf '%-22s %8s %12s %10s %9s\n' target seconds executions exec/s findings
+total_findings=0
+for t in "${targets[@]}"; do
+  dict=()
+  case "$t" in spec_fuzzer|expression_fuzzer) dict=(-dict=fuzz/spec.dict) ;; esac
+  log="$findings_dir/$t/fuzz.log"
+  : > "$log"
+  start=$(date +%s)
+  execs=0
+  while :; do
+    left=$((seconds - ($(date +%s) - start)))
+    [ "$left" -gt 0 ] || break
+    run_log=$(mktemp)
+    "$out/fuzz/$t" -max_total_time="$left" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=1024 \
+      -print_final_stats=1 "${dict[@]}" -artifact_prefix="$findings_dir/$t/" \
+      "$out/corpus/$t" > "$run_log" 2>&1 || true
+    n=$(sed -n 's/^stat::number_of_executed_units: *//p' "$run_log" | tail -1)
+    [ -n "$n" ] || n=$(grep -o '^#[0-9]*' "$run_log" | tr -d '#' | sort -n | tail -1)
+    execs=$((execs + ${n:-0}))
+    cat "$run_log" >> "$log"
+    rm -f "$run_log"
+    # Stop early when a target cannot even start.
+    grep -q "INFO: Seed:" "$log" || { echo "fuzz: $t did not start; see $log" >&2; break; }
+  done
+  elapsed=$(( $(date +%s) - start ))
+  findings=$(find "$findings_dir/$t" -maxdepth 1 -type f \( -name 'crash-*' -o -name 'leak-*' \
+    -o -name 'timeout-*' -o -name 'oom-*' -o -name 'slow-unit-*' \) | wc -l)
+  total_findings=$((total_findings + findings))
+  rate=$(awk -v e="$execs" -v s="$elapsed" 'BEGIN {printf "%d", (s > 0 ? e / s : 0)}')
+  printf '%-22s %8d %12d %10d %9d\n' "$t" "$elapsed" "$execs" "$rate" "$findings"
+done
+if [ "$total_findings" -gt 0 ]; then
+  echo "fuzz: $total_findings finding(s); reproducers and logs in $findings_dir/" >&2
+  find "$findings_dir" -maxdepth 2 -type f ! -name fuzz.log >&2
+  exit 1
+fi

@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# Load and soak run (not in ctest): starts a real sfcsampler-server on
+# loopback with modest limits, runs bench/load_generator against it (STREAMS
+# concurrent streams for SECONDS: complete streams of mixed surfaces,
+# densities, counts, ranges, shards and regions spot-checked against an
+# in-process run; cancels; slow readers; client deadlines; bad requests), and
+# prints its table: outcomes by status code, unexpected outcomes (target 0),
+# samples/s, and the server's peak RSS against its cache budget (target:
+# within budget + 20%). Exits 1 on any unexpected outcome.
+#   bash tools/soak.sh [SECONDS] [STREAMS]      (defaults 60 and 64)
+# SFC_SOAK_CACHE_BYTES (default 256 MiB) sets the server's cache budget;
+# SFC_SOAK_SERVER_FLAGS adds server flags.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds="${1:-60}"
+streams="${2:-64}"
+cache_bytes="${SFC_SOAK_CACHE_BYTES:-268435456}"
+bash tools/build.sh
+server=build/server/sfcsampler-server
+dir=$(mktemp -d)
+pid=""
+cleanup() { [ -n "$pid" ] && kill "$pid" 2>/dev/null; wait 2>/dev/null || true; rm -rf "$dir"; }
+trap cleanup EXIT
+
+# Stream slots: one per client stream plus an eighth, for the moment between
+# a client's cancel (which it sees at once) and the server noticing it. A
+# server that keeps slots for departed clients still runs out.
+slots=$((streams + (streams + 7) / 8))
+flags=(--address 127.0.0.1:0 --health-address "" --metrics-address ""
+       --cache-bytes "$cache_bytes" --max-tree-leaves 4194304 --max-count 2000000
+       --max-concurrent-streams "$slots" --request-deadline 120 --shutdown-grace 5)
+# A write timeout for stalled readers, where this server has one.
+if "$server" --help 2>&1 | grep -q -- --write-timeout; then flags+=(--write-timeout 5); fi
+# shellcheck disable=SC2206
+flags+=(${SFC_SOAK_SERVER_FLAGS:-})
+"$server" "${flags[@]}" > "$dir/server.log" 2>&1 &
+pid=$!
+for _ in $(seq 200); do grep -q listening "$dir/server.log" && break; sleep 0.05; done
+port=$(sed -n 's/.* port=\([0-9]*\) .*/\1/p' "$dir/server.log")
+[ -n "$port" ] || { cat "$dir/server.log"; echo "soak: the server did not start" >&2; exit 1; }
+echo "soak: server pid $pid on 127.0.0.1:$port: ${flags[*]}"
+echo "soak: $streams streams for $seconds s"
+
+status=0
+build/bench/load_generator --server "127.0.0.1:$port" --server-pid "$pid" --streams "$streams" \
+  --seconds "$seconds" || status=$?
+# Every client has gone: a second later no stream should hold a slot.
+sleep 1
+build/client/sfcsampler cache --server "127.0.0.1:$port" > "$dir/cache.txt" || status=1
+sed 's/^/soak: cache: /' "$dir/cache.txt"
+active=$(awk '$1 == "active_streams:" {print $2}' "$dir/cache.txt")
+echo "soak: streams still active 1 s after every client left: ${active:-0} (target 0)"
+[ "${active:-0}" -eq 0 ] || status=1
+stop_start=$(date +%s.%N)
+kill -TERM "$pid"
+wait "$pid" || { echo "soak: the server did not exit cleanly" >&2; status=1; }
+pid=""
+echo "soak: SIGTERM to exit: $(awk -v a="$stop_start" -v b="$(date +%s.%N)" 'BEGIN {printf "%.1f", b - a}') s (grace 5 s)"
+errors=$(grep -c '\[error\]\|\[critical\]' "$dir/server.log" || true)
+echo "soak: server log lines at error level: $errors"
+exit "$status"
