@@ -95,16 +95,18 @@ grep -q 'grpc_status=-/3 ' "$dir/access.log" || fail "the proxy did not log the 
 grep -q 'grpc_status=0/- ' "$dir/access.log" || fail "the proxy did not log OK statuses from trailers"
 echo "proxy log: gRPC status from trailers and from Trailers-Only responses"
 
-# 4. A replica killed mid-build: a new surface whose tree takes about a second
-# (an expression torus, finite-difference derivatives). Its owner is the
-# replica whose miss count rises; it dies before a single sample is sent, the
-# proxy answers the broken call, the client asks again, and the proxy sends
-# the retry to the surviving replica, which builds the same tree.
-slow_surface="expr:x=(1+0.4*cos(v))*cos(u);y=(1+0.4*cos(v))*sin(u);z=0.4*sin(v);u1=2*_pi;v1=2*_pi"
+# 4. A replica killed mid-build: a tree that takes a second or two to build
+# (the eight surface by |K|, sized for 10^8 samples, of which we ask 10^5).
+# Its owner is the replica whose miss count rises; it dies before a single
+# sample is sent, the proxy answers the broken call, the client asks again,
+# and the proxy sends the retry to the surviving replica, which builds the
+# same tree.
+slow_surface="eight"
+slow_tree=(--density gaussian:floor=0.05 --tree-count 100000000)
 alive=(); for j in 0 1 2; do [ "$j" -ne "$victim" ] && alive+=("$j"); done
 misses=(); for j in "${alive[@]}"; do misses+=("$(cache_stat "${ports[$j]}" misses)"); done
-"$cli" sample -q --surface "$slow_surface" --count 100000 --seed 3 -o "$dir/slow-embedded.csv"
-timeout 120 "$cli" sample --server "$proxy" --surface "$slow_surface" --count 100000 --seed 3 \
+"$cli" sample -q --surface "$slow_surface" "${slow_tree[@]}" --count 100000 --seed 3 -o "$dir/slow-embedded.csv"
+timeout 120 "$cli" sample --server "$proxy" --surface "$slow_surface" "${slow_tree[@]}" --count 100000 --seed 3 \
   -o "$dir/slow-proxy.csv" 2> "$dir/slow-client.log" &
 client=$!
 builder=""
@@ -117,7 +119,8 @@ for _ in $(seq 200); do
   sleep 0.02
 done
 [ -n "$builder" ] || fail "no replica started building $slow_surface"
-[ -s "$dir/slow-proxy.csv" ] && [ "$(wc -l < "$dir/slow-proxy.csv")" -gt 1 ] && fail "samples arrived before the kill: the build was too quick"
+running=$(cache_stat "${ports[$builder]}" builds_running)
+[ "$running" = 1 ] || fail "the replica was not building when it was to be killed (builds_running=$running): the build was too quick"
 kill -9 "${rpids[$builder]}"
 wait "$client" || fail "the request did not complete after the replica building its tree died: $(cat "$dir/slow-client.log")"
 grep -q "[1-9][0-9]* resumes" "$dir/slow-client.log" || fail "the client should have retried: $(cat "$dir/slow-client.log")"
