@@ -141,6 +141,12 @@ class CurveTree::Builder {
     tree->errors_ = std::move(errors_);
     tree->info_ = std::move(info_);
     tree->mass_end_ = std::move(masses_);
+    // In place for large arrays (core/pod_array.h): bytes() counts what is kept.
+    tree->starts_.shrink_to_fit();
+    tree->models_.shrink_to_fit();
+    tree->errors_.shrink_to_fit();
+    tree->info_.shrink_to_fit();
+    tree->mass_end_.shrink_to_fit();
     uint64_t sum = 0;
     for (uint64_t& m : tree->mass_end_) {
       if (m > UINT64_MAX - sum) {
@@ -418,9 +424,9 @@ class CurveTree::Builder {
                         deepest_ >= 20 ? "; the surface may be singular there" : "")));
   }
 
-  // Room for one more leaf, within the budget. Capacity grows by half (not
-  // doubling), one array at a time, and never past the budget: the peak is
-  // while the model array moves, about 80 bytes x max_leaves (README).
+  // Room for one more leaf, within the budget. Capacity grows by half and
+  // never past the budget; PodArray grows without copying and its unwritten
+  // tail takes no memory, so the peak is about the leaves' own bytes (README).
   absl::Status Grow() {
     if (starts_.size() >= options_.max_leaves) return BudgetError();
     if (starts_.size() == starts_.capacity()) {
@@ -468,11 +474,11 @@ class CurveTree::Builder {
   std::vector<uint64_t> stage1_starts_;
   double stage1_mass_ = 0;
   double stage1_area_ = 0;
-  std::vector<uint64_t> starts_;
-  std::vector<uint64_t> masses_;  // per leaf, fixed point
-  std::vector<LeafModel> models_;
-  std::vector<float> errors_;
-  std::vector<uint8_t> info_;
+  PodArray<uint64_t> starts_;
+  PodArray<uint64_t> masses_;  // per leaf, fixed point
+  PodArray<LeafModel> models_;
+  PodArray<float> errors_;
+  PodArray<uint8_t> info_;
   PrecisionReport report_;
 };
 

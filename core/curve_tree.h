@@ -62,6 +62,7 @@
 #include "core/curve.h"
 #include "core/density.h"
 #include "core/leaf_model.h"
+#include "core/pod_array.h"
 #include "core/surface.h"
 
 namespace sfc {
@@ -223,12 +224,13 @@ class CurveTree {
   static constexpr uint8_t kFailGradeMask = 63;
   static constexpr uint8_t kPiecewiseBit = 64;
 
-  std::vector<uint64_t> starts_;
-  std::vector<uint64_t> mass_end_;  // fixed point, units of mass_unit_
+  // PodArray, not std::vector: growing them moves no bytes (core/pod_array.h).
+  PodArray<uint64_t> starts_;
+  PodArray<uint64_t> mass_end_;  // fixed point, units of mass_unit_
   double mass_unit_ = 0;            // base_mass_ / 2^56
-  std::vector<LeafModel> models_;
-  std::vector<float> errors_;
-  std::vector<uint8_t> info_;  // fail grade | kPiecewiseBit
+  PodArray<LeafModel> models_;
+  PodArray<float> errors_;
+  PodArray<uint8_t> info_;  // fail grade | kPiecewiseBit
   PrecisionReport precision_;
   int min_depth_ = 0, max_depth_ = 0;
 };
