@@ -240,12 +240,20 @@ void ToProto(const PreparedTree& t, v1::TreeInfo* out) {
   out->set_tolerance(tree.options().tolerance);
   out->set_flatness_capped_leaves(tree.precision().geometry_capped_leaves);
   out->set_mass_capped_leaves(tree.precision().mass_capped_leaves);
-  for (const DepthCapHit& h : tree.precision().worst) {
-    auto* w = out->add_warnings();
-    w->set_test(h.test == DepthCapHit::Test::kGeometry ? "flatness" : "mass");
+  auto add = [](const DepthCapHit& h, v1::DepthCapWarning* w) {
+    w->set_test(h.test == DepthCapHit::Test::kGeometry ? "flatness"
+                : h.test == DepthCapHit::Test::kMass   ? "mass"
+                                                       : "singular");
     w->set_u0(h.u0), w->set_v0(h.v0), w->set_size(h.size);
     w->set_measured(h.measured), w->set_limit(h.limit);
-  }
+  };
+  const PrecisionReport& precision = tree.precision();
+  for (const DepthCapHit& h : precision.worst) add(h, out->add_warnings());
+  for (const DepthCapHit& h : precision.singular) add(h, out->add_singular());
+  out->set_error_samples(precision.error_samples);
+  out->set_unresolved_error_samples(precision.unresolved_error_samples);
+  out->set_singular_leaves(precision.singular_leaves);
+  out->set_small_failing_leaves(precision.small_failing_leaves);
 }
 
 void ToProto(const CatalogEntry& e, v1::CatalogEntry* out) {

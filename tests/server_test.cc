@@ -588,6 +588,34 @@ TEST(Server, AModelIsUploadedOnceAndNamedByItsHash) {
   EXPECT_EQ(r.server->models().stats().rejected, 1u);
 }
 
+TEST(Server, TheStreamHeaderSaysWhereTheParameterisationIsSingularAndThePrecisionReached) {
+  Running r = StartServer(LoopbackOptions());
+  StreamSummary hard, smooth;
+  ASSERT_TRUE(Fetch(*r.client, Request("superellipsoid", 24576), &hard).ok());
+  ASSERT_TRUE(Fetch(*r.client, Request("torus", 24576), &smooth).ok());
+  const v1::TreeInfo& t = hard.header.tree();
+  EXPECT_GT(t.singular_leaves(), 0u);
+  ASSERT_GT(t.singular_size(), 0);
+  for (const v1::DepthCapWarning& w : t.singular()) {
+    EXPECT_EQ(w.test(), "singular");
+    // The superellipsoid's area element blows up where cos or sin of an
+    // angle vanishes: on the parameter lines u, v in {0, 1/4, 1/2, 3/4, 1}.
+    auto on_quarter_line = [](double lo, double hi) {
+      for (double q : {0.0, 0.25, 0.5, 0.75, 1.0}) {
+        if (lo <= q && q <= hi) return true;
+      }
+      return false;
+    };
+    EXPECT_TRUE(on_quarter_line(w.u0(), w.u0() + w.size()) || on_quarter_line(w.v0(), w.v0() + w.size()))
+        << w.u0() << " " << w.v0() << " " << w.size();
+  }
+  // The precision reached stays below the jittered set's own discrepancy
+  // (about N^(1/4) = 12.5 samples here), on the hard surface as on a smooth one.
+  EXPECT_LT(t.error_samples(), 12.5);
+  EXPECT_EQ(smooth.header.tree().singular_leaves(), 0u);
+  EXPECT_LT(smooth.header.tree().error_samples(), 12.5);
+}
+
 TEST(Server, ATokenIsRequiredWhenSetButHealthStaysOpen) {
   ServerOptions options = LoopbackOptions();
   options.token = "s3cret";

@@ -87,8 +87,20 @@ void PrintTreeInfo(const ::sfcsampler::v1::TreeInfo& t, const Verbosity& verbosi
                  t.cache_hit() ? "cache hit" : t.refined() ? "refined from cache" : "built",
                  static_cast<unsigned long long>(t.leaves()), t.min_depth(), t.max_depth(),
                  static_cast<unsigned long long>(t.bytes()), t.tolerance());
+    std::fprintf(stderr, "precision: model error %.3g samples in all (%.3g where the tests wanted more) at N = 2^%d\n",
+                 t.error_samples(), t.unresolved_error_samples(), t.grade());
   }
   if (verbosity.no_warnings) return;
+  if (t.singular_leaves() > 0) {
+    std::fprintf(stderr,
+                 "warning: the parameterisation is singular (the area element blows up, paper Sect. "
+                 "5.3) in %llu leaves; their masses come from mapped sub-triangles. Finest:\n",
+                 static_cast<unsigned long long>(t.singular_leaves()));
+    for (const auto& w : t.singular()) {
+      std::fprintf(stderr, "  cell u in [%.9g, %.9g], v in [%.9g, %.9g]\n", w.u0(), w.u0() + w.size(),
+                   w.v0(), w.v0() + w.size());
+    }
+  }
   if (t.flatness_capped_leaves() || t.mass_capped_leaves()) {
     std::fprintf(stderr,
                  "warning: the depth cap stopped splits the tests still wanted (paper Sect. 5.3): "
