@@ -271,11 +271,10 @@ BadCase BadRequest(std::mt19937_64& rng, const ServerLimits& limits) {
       r.tree.surface = "expr:x=u;y=v;z=" + std::string(limits.max_spec_length, '1');
       return invalid("spec too long");
     default:
-      // A tree that needs more leaves than the server allows: about 2.7
-      // leaves a sample at rho = 1 (README), so max_count samples at rho 0.01.
+      // A tree that needs more leaves than the server allows: a pole the tree
+      // refines towards until its budget, asked for max_count samples.
       r.count = limits.max_count;
-      r.tree.options.rho = 0.01;
-      r.tree.surface = "torus:R=1;r=0.3";
+      r.tree.surface = "expr:x=u;y=v;z=1/(u-0.3)";
       return BadCase{r, grpc::StatusCode::RESOURCE_EXHAUSTED, "tree above max_tree_leaves"};
   }
 }

@@ -446,11 +446,12 @@ class CurveTree::Builder {
 
   // Asks the caller whether to go on, every BuildControl::kCheckInterval cells.
   absl::Status Checkpoint() {
-    if (!control_.check || ++cells_since_check_ < BuildControl::kCheckInterval) {
+    if ((!control_.check && !control_.charge) || ++cells_since_check_ < BuildControl::kCheckInterval) {
       return absl::OkStatus();
     }
     cells_since_check_ = 0;
-    return control_.check();
+    if (control_.charge) RETURN_IF_ERROR(control_.charge(starts_.size() * CurveTree::kBytesPerLeaf));
+    return control_.check ? control_.check() : absl::OkStatus();
   }
 
   void NoteDepth(int depth, double u, double v) {

@@ -100,6 +100,10 @@ struct DepthCapHit {
 // status it returns aborts the build, which then returns that status.
 struct BuildControl {
   std::function<absl::Status()> check;  // empty: never stop
+  // Told, at the same moments, the bytes of leaves the build holds so far
+  // (leaves x kBytesPerLeaf), so a shared memory budget can count builds in
+  // progress; a non-OK status aborts the build likewise. Empty: not told.
+  std::function<absl::Status(uint64_t bytes)> charge;
   static constexpr uint64_t kCheckInterval = 4096;
 };
 

@@ -52,6 +52,8 @@ class CacheStatsCollector final : public prometheus::Collectable {
     add("sfcsampler_cache_budget_bytes", "The cache's memory budget", T::Gauge,
         cache_->budget_bytes());
     add("sfcsampler_builds_running", "Tree builds running now", T::Gauge, s.builds_running);
+    add("sfcsampler_building_bytes", "Bytes of trees being built (counted against the cache budget)",
+        T::Gauge, s.building_bytes);
     add("sfcsampler_builds_queued", "Tree builds waiting for a builder thread", T::Gauge,
         s.builds_queued);
     add("sfcsampler_builds_stopped_total",

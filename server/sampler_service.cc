@@ -272,6 +272,7 @@ grpc::Status SamplerService::GetCacheStats(grpc::ServerContext* context,
     response->set_max_concurrent_builds(options_.max_concurrent_builds);
     response->set_max_queued_builds(options_.max_queued_builds);
     response->set_builds_running(s.builds_running);
+    response->set_building_bytes(s.building_bytes);
     response->set_builds_queued(s.builds_queued);
     response->set_builds_stopped(s.builds_stopped);
     response->set_builds_failed(s.builds_failed);

@@ -144,8 +144,23 @@ absl::Status TreeCache::BuildCheck(const Job& job) const {
   return absl::OkStatus();
 }
 
+absl::Status TreeCache::Charge(Job& job, uint64_t bytes) {
+  absl::MutexLock lock(&mu_);
+  stats_.building_bytes = stats_.building_bytes - job.charged + bytes;
+  job.charged = bytes;
+  EvictOverBudget();
+  if (stats_.building_bytes > options_.budget_bytes) {
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "the trees being built need more than the server's tree memory of %d bytes (cache_bytes): "
+        "retry later, or ask for fewer samples",
+        options_.budget_bytes));
+  }
+  return absl::OkStatus();
+}
+
 void TreeCache::Run(Job& job) {
-  BuildControl control{[this, &job] { return BuildCheck(job); }};
+  BuildControl control{[this, &job] { return BuildCheck(job); },
+                       [this, &job](uint64_t bytes) { return Charge(job, bytes); }};
   const auto start = Clock::now();
   Result result = absl::InternalError("the tree build did not run");
   try {
@@ -168,6 +183,8 @@ void TreeCache::Run(Job& job) {
 
 void TreeCache::Finish(Job& job, Result result, double seconds) {
   --stats_.builds_running;
+  stats_.building_bytes -= job.charged;
+  job.charged = 0;
   pending_.erase(job.id);
   stats_.build_seconds += seconds;
   if (result.ok()) {
@@ -217,7 +234,7 @@ void TreeCache::Stop() {
 }
 
 void TreeCache::EvictOverBudget() {
-  while (stats_.bytes > options_.budget_bytes && !lru_.empty()) {
+  while (stats_.bytes + stats_.building_bytes > options_.budget_bytes && !lru_.empty()) {
     auto it = entries_.find(lru_.back());
     stats_.bytes -= it->second.bytes;
     auto grades = grades_.find(it->second.canonical);

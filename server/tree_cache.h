@@ -16,6 +16,10 @@
 //  - every request waits with its own check (client gone, deadline), and a
 //    build that no request wants any more stops at its next BuildControl
 //    check; Stop() (shutdown) stops them all;
+//  - trees being built count against budget_bytes as they grow: cached trees
+//    are evicted to make room, and a build that would push the builds in
+//    progress past the budget on their own fails with RESOURCE_EXHAUSTED, so
+//    cached plus growing trees stay within the budget;
 //  - a build that failed (budget, bad surface) is remembered for
 //    failure_ttl_seconds, so identical requests get its error at once instead
 //    of repeating it;
@@ -58,7 +62,8 @@ struct TreeCacheStats {
   uint64_t evictions = 0;
   uint64_t waits = 0;  // requests that joined another request's build
   uint64_t entries = 0;
-  uint64_t bytes = 0;
+  uint64_t bytes = 0;           // of cached trees
+  uint64_t building_bytes = 0;  // of trees being built, now
   double build_seconds = 0;
   uint64_t builds_running = 0;    // now
   uint64_t builds_queued = 0;     // now, waiting for a builder thread
@@ -107,6 +112,7 @@ class TreeCache final : public TreeSource {
     std::shared_ptr<const CurveTree> coarser;  // refine this one, if set
     // Guarded by the cache's mu_.
     int waiters = 0;
+    uint64_t charged = 0;  // bytes the build holds, as it last said
     bool started = false, done = false;
     Result result;
   };
@@ -120,6 +126,8 @@ class TreeCache final : public TreeSource {
   void Finish(Job& job, Result result, double seconds) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   // Why a build should stop now, or OK.
   absl::Status BuildCheck(const Job& job) const ABSL_LOCKS_EXCLUDED(mu_);
+  // Counts `bytes` for a growing build; evicts for room or refuses.
+  absl::Status Charge(Job& job, uint64_t bytes) ABSL_LOCKS_EXCLUDED(mu_);
   void EvictOverBudget() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   void Forget(const std::shared_ptr<Job>& job) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
 

@@ -93,6 +93,30 @@ TEST(TreeCache, AWaiterWhoseCheckFailsLeavesAtOnce) {
   EXPECT_EQ(cache.stats().builds_stopped, 1u);
 }
 
+TEST(TreeCache, GrowingTreesCountAgainstTheBudgetAndEvictCachedOnes) {
+  TreeCacheOptions options;
+  options.budget_bytes = 8 << 20;
+  TreeCache cache(options);
+  std::atomic<int> calls{0};
+  ASSERT_TRUE(cache.Get(Key("s"), 20, Real("sphere", &calls), {}).ok());
+  ASSERT_EQ(cache.stats().entries, 1u);
+  // A pole the tree refines towards: it grows past 8 MiB long before its
+  // own leaf budget, so the cache evicts the sphere for room, then refuses.
+  auto pole = *MakeSurface("expr:x=u;y=v;z=1/(u-0.3)");
+  auto d = *MakeDensity("uniform");
+  TreeFactory heavy;
+  heavy.build = [pole, d](int grade, const BuildControl& control) {
+    return CurveTree::Build(*pole.surface, *d.density, {}, grade, control);
+  };
+  auto result = cache.Get(Key("pole"), CurveTree::GradeFor(100'000'000), heavy, {});
+  EXPECT_EQ(result.status().code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_NE(result.status().message().find("cache_bytes"), std::string::npos) << result.status();
+  const TreeCacheStats s = cache.stats();
+  EXPECT_EQ(s.evictions, 1u);
+  EXPECT_EQ(s.entries, 0u);
+  EXPECT_EQ(s.building_bytes, 0u);
+}
+
 TEST(TreeCache, AfterStopMissesAreUnavailableButHitsAreServed) {
   TreeCache cache(TreeCacheOptions{});
   std::atomic<int> calls{0};
