@@ -51,6 +51,28 @@ SampleRequest Request(const std::string& surface, uint64_t count, uint64_t seed 
   return r;
 }
 
+// A stream far larger than flow-control buffers, so the server is still
+// writing it when something happens, on a tree that builds at once (the
+// plane needs few leaves when each may carry many samples).
+SampleRequest LongStream(uint64_t count, uint64_t seed = 1) {
+  SampleRequest r = Request("plane", count, seed);
+  r.tree.options.rho = 1e6;
+  return r;
+}
+
+// Stops `server` under its streams and starts a server with `next` on the
+// same port (from another thread, as a restart would).
+std::unique_ptr<SamplerServer> ReplaceOnSamePort(SamplerServer& server, ServerOptions next) {
+  std::unique_ptr<SamplerServer> replacement;
+  std::thread([&] {
+    const int port = server.port();
+    server.Shutdown(0, 0);
+    next.address = "127.0.0.1:" + std::to_string(port);
+    replacement = *SamplerServer::Start(next);
+  }).join();
+  return replacement;
+}
+
 // All samples of a request, as one batch.
 absl::StatusOr<SampleBatch> Fetch(SamplerClient& client, const SampleRequest& request,
                                   StreamSummary* summary = nullptr) {
@@ -121,9 +143,7 @@ TEST(Server, TheClientResumesAcrossAServerRestart) {
   co.batch_size = 1000;
   co.resume_backoff_seconds = 0.3;
   auto client = *SamplerClient::Connect(co);
-  // Larger than flow control buffers: the server is still writing when it dies.
-  SampleRequest request = Request("plane", 2'000'000, 8);
-  request.tree.options.rho = 1e6;  // a coarse tree that builds at once
+  const SampleRequest request = LongStream(2'000'000, 8);  // still streaming when the server dies
   auto reference = Fetch(*client, request);
   ASSERT_TRUE(reference.ok());
 
@@ -135,13 +155,8 @@ TEST(Server, TheClientResumesAcrossAServerRestart) {
     got.index.insert(got.index.end(), b.index.begin(), b.index.end());
     got.u.insert(got.u.end(), b.u.begin(), b.u.end());
     if (!restarted && got.size() >= 50000) {
-      // Kill the server under the stream and bring a new one up on the same port.
       restarted = true;
-      std::thread([&] {
-        server->Shutdown(0, 0);
-        options.address = "127.0.0.1:" + std::to_string(port);
-        second = *SamplerServer::Start(options);
-      }).join();
+      second = ReplaceOnSamePort(*server, options);
     }
     return absl::OkStatus();
   });
@@ -164,19 +179,12 @@ TEST(Server, AResumeOnAServerOfAnotherReleaseFailsInsteadOfMixingSets) {
   std::unique_ptr<SamplerServer> upgraded;
   uint64_t received = 0;
   bool restarted = false;
-  SampleRequest request = Request("plane", 2'000'000, 8);  // outlasts flow control buffers
-  request.tree.options.rho = 1e6;
-  auto result = client->Sample(request, [&](const v1::StreamHeader&, const SampleBatch& b) {
+  auto result = client->Sample(LongStream(2'000'000, 8), [&](const v1::StreamHeader&, const SampleBatch& b) {
     received += b.size();
     if (!restarted && received >= 50000) {
       // The replica is replaced by one of the current release mid-stream.
       restarted = true;
-      std::thread([&] {
-        server->Shutdown(0, 0);
-        ServerOptions current = LoopbackOptions();
-        current.address = "127.0.0.1:" + std::to_string(port);
-        upgraded = *SamplerServer::Start(current);
-      }).join();
+      upgraded = ReplaceOnSamePort(*server, LoopbackOptions());
     }
     return absl::OkStatus();
   });
@@ -502,11 +510,8 @@ TEST(Server, StreamsBeyondTheConcurrencyLimitAreResourceExhausted) {
   co.batch_size = 1000;
   Running r = StartServer(options, co);
   absl::Status second;
-  // A stream far larger than flow control buffers, so the server is still
-  // writing it while the second request comes.
-  SampleRequest long_stream = Request("plane", 4'000'000);
-  long_stream.tree.options.rho = 1e6;  // a coarse tree that builds at once
-  auto first = r.client->Sample(long_stream, [&](const v1::StreamHeader&, const SampleBatch&) {
+  // The server is still writing the first stream when the second request comes.
+  auto first = r.client->Sample(LongStream(4'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
     second = Fetch(*r.client, Request("torus", 10)).status();
     return absl::CancelledError("checked");
   });
@@ -520,11 +525,8 @@ TEST(Server, TheServerDeadlineEndsLongStreams) {
   ClientOptions co;
   co.batch_size = 100;
   Running r = StartServer(options, co);
-  // A tree that builds at once (the plane needs few leaves when each may
-  // carry many samples), and a stream that runs past the deadline.
-  SampleRequest long_stream = Request("plane", 4'000'000);
-  long_stream.tree.options.rho = 1e6;
-  auto result = r.client->Sample(long_stream, [&](const v1::StreamHeader&, const SampleBatch&) {
+  // A tree that builds at once, and a stream that runs past the deadline.
+  auto result = r.client->Sample(LongStream(4'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
     std::this_thread::sleep_for(milliseconds(2));
     return absl::OkStatus();
   });
