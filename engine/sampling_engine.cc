@@ -3,6 +3,7 @@
 #include "absl/strings/str_format.h"
 #include "catalog/catalog.h"
 #include "core/status_macros.h"
+#include "engine/model_source.h"
 
 namespace sfc {
 
@@ -25,6 +26,14 @@ absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint6
           "(max_spec_length)",
           text->size(), limits_.max_spec_length));
     }
+  }
+  ASSIGN_OR_RETURN(const std::optional<ModelSpec> model, ParseModelSpec(spec.surface));
+  if (model) {
+    return absl::UnimplementedError(absl::StrFormat(
+        "sampling %s models is not available in this release: servers store uploaded models "
+        "(sfcsampler upload) and the model libraries read them, but surfaces made from them come "
+        "in the next one; use a catalogue surface or an expr: surface",
+        ModelFormatName(model->format)));
   }
   ASSIGN_OR_RETURN(SurfaceFromSpec surface, MakeSurface(spec.surface));
   ASSIGN_OR_RETURN(DensityFromSpec density, MakeDensity(spec.density));

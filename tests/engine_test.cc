@@ -128,6 +128,19 @@ TEST(Engine, BadRangeShardOrRegionIsInvalidArgument) {
   ExpectError(engine.Start(r).status(), absl::StatusCode::kInvalidArgument, "empty");
 }
 
+TEST(Engine, AModelSpecSaysModelsCannotBeSampledYetRatherThanUnknownSurface) {
+  DirectTreeSource source;
+  SamplingEngine engine({}, &source);
+  SampleRequest r;
+  r.count = 10;
+  r.tree.surface = "step:part.step";
+  ExpectError(engine.Start(r).status(), absl::StatusCode::kUnimplemented, "step models");
+  r.tree.surface = "obj:sha256=" + std::string(64, 'a');
+  ExpectError(engine.Start(r).status(), absl::StatusCode::kUnimplemented, "obj models");
+  r.tree.surface = "ply:sha256=12";
+  ExpectError(engine.Start(r).status(), absl::StatusCode::kInvalidArgument, "SHA-256");
+}
+
 TEST(Engine, ATreeSizedForFewerSamplesThanTheSetIsRefused) {
   DirectTreeSource source;
   SamplingEngine engine({}, &source);
