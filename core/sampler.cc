@@ -66,14 +66,8 @@ absl::StatusOr<std::unique_ptr<SampleCursor>> SampleCursor::Create(
 absl::Status SampleCursor::PlanRegion(uint64_t begin, uint64_t end) {
   const Sampler& sampler = *sampler_;
   if (!sampler.sequence().monotone()) {
-    // Index order is not curve order: sort the range by mass coordinate (ties
-    // by index), which is the order of the curve.
-    std::vector<std::pair<double, uint64_t>> keyed;
-    keyed.reserve(end - begin);
-    for (uint64_t k = begin; k < end; ++k) keyed.emplace_back(sampler.MassCoordinate(k), k);
-    std::sort(keyed.begin(), keyed.end());
-    order_.reserve(keyed.size());
-    for (const auto& [m, k] : keyed) order_.push_back(k);
+    // Index order is not curve order.
+    order_ = IndicesInCurveOrder(begin, end, [&](uint64_t k) { return sampler.MassCoordinate(k); });
     use_order_ = true;
     return absl::OkStatus();
   }

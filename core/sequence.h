@@ -6,9 +6,12 @@
 #ifndef SFCSAMPLER_CORE_SEQUENCE_H_
 #define SFCSAMPLER_CORE_SEQUENCE_H_
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 namespace sfc {
 
@@ -47,6 +50,22 @@ class Sequence {
   uint64_t count_;
   uint64_t seed_;
 };
+
+// The indices [begin, end) in curve order, for sequences that are not
+// monotone in k: sorted by `mass_coordinate(k)` (q_k S_M), ties by index.
+// Holds 16 bytes an index while it sorts.
+template <typename MassCoordinate>
+std::vector<uint64_t> IndicesInCurveOrder(uint64_t begin, uint64_t end,
+                                          const MassCoordinate& mass_coordinate) {
+  std::vector<std::pair<double, uint64_t>> keyed;
+  keyed.reserve(end - begin);
+  for (uint64_t k = begin; k < end; ++k) keyed.emplace_back(mass_coordinate(k), k);
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<uint64_t> order;
+  order.reserve(keyed.size());
+  for (const auto& [m, k] : keyed) order.push_back(k);
+  return order;
+}
 
 }  // namespace sfc
 

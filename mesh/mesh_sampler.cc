@@ -91,13 +91,8 @@ absl::Status MeshSampleCursor::Plan(uint64_t begin, uint64_t end) {
   const MeshSampler& sampler = *sampler_;
   const MeshCurveTree& tree = sampler.tree();
   if (!sampler.sequence().monotone()) {
-    // Index order is not curve order: sort by mass coordinate (ties by index).
-    std::vector<std::pair<double, uint64_t>> keyed;
-    keyed.reserve(end - begin);
-    for (uint64_t k = begin; k < end; ++k) keyed.emplace_back(sampler.MassCoordinate(k), k);
-    std::sort(keyed.begin(), keyed.end());
-    order_.reserve(keyed.size());
-    for (const auto& [m, k] : keyed) order_.push_back(k);
+    // Index order is not curve order.
+    order_ = IndicesInCurveOrder(begin, end, [&](uint64_t k) { return sampler.MassCoordinate(k); });
     use_order_ = true;
     return absl::OkStatus();
   }

@@ -23,7 +23,8 @@ double SecondsSince(Clock::time_point start) {
 // is gone, or the server's request deadline has passed.
 BuildControl RequestControl(const grpc::ServerContext* context, Clock::time_point deadline,
                             double deadline_seconds) {
-  return BuildControl{[context, deadline, deadline_seconds]() -> absl::Status {
+  BuildControl control;
+  control.check = [context, deadline, deadline_seconds]() -> absl::Status {
     if (context->IsCancelled()) {
       return absl::CancelledError("the client cancelled the request or its deadline passed");
     }
@@ -35,7 +36,8 @@ BuildControl RequestControl(const grpc::ServerContext* context, Clock::time_poin
           deadline_seconds));
     }
     return absl::OkStatus();
-  }};
+  };
+  return control;
 }
 
 }  // namespace

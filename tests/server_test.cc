@@ -356,9 +356,7 @@ TEST(Server, ABuildNobodyWaitsForAnyMoreStopsAndFreesItsSlot) {
 TEST(Server, AWaiterLeavesAtItsOwnDeadlineWhileTheBuildGoesOnForOthers) {
   Running r = StartServer(HeavyOptions());
   absl::Status patient_status;
-  std::atomic<bool> stop_patient{false};
-  // The patient client cancels from its callback... which never runs during
-  // the build, so it gets a deadline long enough to outlive the impatient one.
+  // The patient client's deadline outlives the impatient one's by seconds.
   ClientOptions pc;
   pc.target = "127.0.0.1:" + std::to_string(r.server->port());
   pc.deadline_seconds = 3;

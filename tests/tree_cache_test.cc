@@ -76,9 +76,10 @@ TEST(TreeCache, AWaiterWhoseCheckFailsLeavesAtOnce) {
   };
   heavy.refine = nullptr;
   std::atomic<bool> give_up{false};
-  BuildControl caller{[&]() -> absl::Status {
+  BuildControl caller;
+  caller.check = [&]() -> absl::Status {
     return give_up ? absl::DeadlineExceededError("mine") : absl::OkStatus();
-  }};
+  };
   std::thread quit([&] {
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
     give_up = true;
