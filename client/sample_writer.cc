@@ -71,6 +71,8 @@ std::string SampleWriter::NpyHeader(uint64_t count) const {
   if (fields_.density) names.push_back("density");
   if (fields_.curve_position) names.push_back("curve_position");
   for (const char* name : names) descr += absl::StrFormat(", ('%s', %s)", name, f);
+  if (fields_.face) descr += ", ('face', '<u4')";
+  if (fields_.triangle) descr += ", ('triangle', '<u4')";
   descr += "]";
   std::string dict =
       absl::StrFormat("{'descr': %s, 'fortran_order': False, 'shape': (%d,), }", descr, count);
@@ -119,6 +121,8 @@ absl::Status SampleWriter::WriteHeader(uint64_t count) {
     if (fields_.normal) h += ",nx,ny,nz";
     if (fields_.density) h += ",density";
     if (fields_.curve_position) h += ",curve_position";
+    if (fields_.face) h += ",face";
+    if (fields_.triangle) h += ",triangle";
     h += "\n";
     return WriteAll(out_, h);
   }
@@ -141,6 +145,8 @@ absl::Status SampleWriter::WriteHeader(uint64_t count) {
   h += "property uint index\n";
   if (fields_.density) property("density");
   if (fields_.curve_position) property("curve_position");
+  if (fields_.face) h += "property uint face\n";
+  if (fields_.triangle) h += "property uint triangle\n";
   h += "end_header\n";
   return WriteAll(out_, h);
 }
@@ -156,6 +162,8 @@ absl::Status SampleWriter::WriteRows(std::FILE* to, const SampleBatch& b) {
       }
       if (fields_.density) buffer_ += ',', AppendNumber(&buffer_, b.density[i]);
       if (fields_.curve_position) buffer_ += ',', AppendNumber(&buffer_, b.curve_position[i]);
+      if (fields_.face) buffer_ += ',', AppendUint(&buffer_, b.face[i]);
+      if (fields_.triangle) buffer_ += ',', AppendUint(&buffer_, b.triangle[i]);
       buffer_ += '\n';
     } else if (format_ == OutputFormat::kNpy) {
       // One packed record per sample, fields in the header's order.
@@ -166,6 +174,8 @@ absl::Status SampleWriter::WriteRows(std::FILE* to, const SampleBatch& b) {
       }
       if (fields_.density) AppendValue(&buffer_, b.density[i]);
       if (fields_.curve_position) AppendValue(&buffer_, b.curve_position[i]);
+      if (fields_.face) AppendBinary(&buffer_, b.face[i]);
+      if (fields_.triangle) AppendBinary(&buffer_, b.triangle[i]);
     } else if (format_ == OutputFormat::kPlyAscii) {
       std::string row;
       for (double d : {b.x[i], b.y[i], b.z[i]}) AppendNumber(&row, d), row += ' ';
@@ -177,6 +187,8 @@ absl::Status SampleWriter::WriteRows(std::FILE* to, const SampleBatch& b) {
       AppendUint(&row, b.index[i]);
       if (fields_.density) row += ' ', AppendNumber(&row, b.density[i]);
       if (fields_.curve_position) row += ' ', AppendNumber(&row, b.curve_position[i]);
+      if (fields_.face) row += ' ', AppendUint(&row, b.face[i]);
+      if (fields_.triangle) row += ' ', AppendUint(&row, b.triangle[i]);
       buffer_ += row + '\n';
     } else {
       for (double d : {b.x[i], b.y[i], b.z[i]}) AppendValue(&buffer_, d);
@@ -188,6 +200,8 @@ absl::Status SampleWriter::WriteRows(std::FILE* to, const SampleBatch& b) {
       AppendBinary(&buffer_, static_cast<uint32_t>(b.index[i]));
       if (fields_.density) AppendValue(&buffer_, b.density[i]);
       if (fields_.curve_position) AppendValue(&buffer_, b.curve_position[i]);
+      if (fields_.face) AppendBinary(&buffer_, b.face[i]);
+      if (fields_.triangle) AppendBinary(&buffer_, b.triangle[i]);
     }
   }
   return WriteAll(to, buffer_);

@@ -2,7 +2,8 @@
 // .npy format.
 //
 // CSV starts with the header index,u,v,x,y,z, then the optional columns
-// nx,ny,nz, density, curve_position. Numbers are written in the shortest form
+// nx,ny,nz, density, curve_position, face, triangle (the last two unsigned
+// integers in every format). Numbers are written in the shortest form
 // that reads back to the same double (or float, in float32 precision), so
 // output is byte-identical for the same samples. PLY has one vertex element
 // with x y z (double or float), the optional normals, u v and index (uint32);

@@ -13,6 +13,8 @@ struct SampleFields {
   bool normal = false;          // unit normal (nx, ny, nz)
   bool density = false;         // delta at the sample
   bool curve_position = false;  // position along the parameter-space curve, in [0,1)
+  bool face = false;            // CAD models: the sample's face, 0-based in the file's order
+  bool triangle = false;        // meshes: the sample's triangle, 0-based in the file's order
 };
 
 struct SampleBatch {
@@ -22,6 +24,8 @@ struct SampleBatch {
   std::vector<double> nx, ny, nz;
   std::vector<double> density;
   std::vector<double> curve_position;
+  std::vector<uint32_t> face;
+  std::vector<uint32_t> triangle;
 
   size_t size() const { return index.size(); }
 
@@ -39,11 +43,17 @@ struct SampleBatch {
       std::vector<double>& to = this->*column;
       to.insert(to.end(), from.begin() + begin, from.begin() + end);
     }
+    for (auto column : {&SampleBatch::face, &SampleBatch::triangle}) {
+      const std::vector<uint32_t>& from = other.*column;
+      if (from.empty()) continue;
+      std::vector<uint32_t>& to = this->*column;
+      to.insert(to.end(), from.begin() + begin, from.begin() + end);
+    }
   }
   void Append(const SampleBatch& other) { AppendFrom(other, 0, other.size()); }
   void Clear() {
     for (auto* c : {&u, &v, &x, &y, &z, &nx, &ny, &nz, &density, &curve_position}) c->clear();
-    index.clear();
+    index.clear(), face.clear(), triangle.clear();
   }
 };
 

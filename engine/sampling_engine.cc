@@ -110,6 +110,17 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
         SequenceName(request.sequence), limits_.max_sorted_range));
   }
   RETURN_IF_ERROR(request.region.Validate());
+  if (request.fields.face || request.fields.triangle) {
+    ASSIGN_OR_RETURN(const std::optional<ModelSpec> model, ParseModelSpec(request.tree.surface));
+    const bool mesh = model && (model->format == ModelFormat::kObj || model->format == ModelFormat::kPly);
+    if (request.fields.face && (!model || mesh)) {
+      return absl::InvalidArgumentError(
+          "the face column needs a CAD model surface (step:, iges: or nurbs:)");
+    }
+    if (request.fields.triangle && !mesh) {
+      return absl::InvalidArgumentError("the triangle column needs a mesh surface (obj: or ply:)");
+    }
+  }
   if (request.tree_count != 0 && request.tree_count < request.count) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "tree_count %d is below count %d: the tree must be sized for at least the whole set "

@@ -32,6 +32,23 @@ void PutColumns(const SampleBatch& b, const SampleFields& fields, Columns* c) {
 }
 
 template <typename Column>
+void PutIndexColumn(const std::vector<uint32_t>& from, Column* to) {
+  to->Reserve(static_cast<int>(from.size()));
+  for (uint32_t i : from) to->AddAlreadyReserved(i);
+}
+
+template <typename Column>
+absl::Status TakeIndexColumn(const char* name, const Column& from, size_t n,
+                             std::vector<uint32_t>* to) {
+  if (static_cast<size_t>(from.size()) != n) {
+    return absl::DataLossError(absl::StrFormat(
+        "a batch's column %s has %d values for %d samples", name, from.size(), n));
+  }
+  to->insert(to->end(), from.begin(), from.end());
+  return absl::OkStatus();
+}
+
+template <typename Column>
 absl::Status Take(const char* name, const Column& from, size_t n, std::vector<double>* to) {
   if (static_cast<size_t>(from.size()) != n) {
     return absl::DataLossError(absl::StrFormat(
@@ -138,6 +155,8 @@ absl::StatusOr<SampleRequest> FromProto(const v1::SampleRequest& p) {
   r.fields.normal = p.normals();
   r.fields.density = p.density();
   r.fields.curve_position = p.curve_position();
+  r.fields.face = p.face();
+  r.fields.triangle = p.triangle();
   return r;
 }
 
@@ -169,6 +188,8 @@ v1::SampleRequest ToProto(const SampleRequest& r) {
   p.set_normals(r.fields.normal);
   p.set_density(r.fields.density);
   p.set_curve_position(r.fields.curve_position);
+  p.set_face(r.fields.face);
+  p.set_triangle(r.fields.triangle);
   return p;
 }
 
@@ -188,6 +209,8 @@ void ToProto(const SampleBatch& b, const SampleFields& fields, v1::Precision pre
   } else {
     PutColumns(b, fields, out->mutable_f64());
   }
+  if (fields.face) PutIndexColumn(b.face, out->mutable_face());
+  if (fields.triangle) PutIndexColumn(b.triangle, out->mutable_triangle());
 }
 
 uint32_t MaxSamplesPerMessage(const SampleFields& fields, v1::Precision precision,
@@ -195,10 +218,12 @@ uint32_t MaxSamplesPerMessage(const SampleFields& fields, v1::Precision precisio
   const size_t columns = 5 + (fields.normal ? 3 : 0) + (fields.density ? 1 : 0) +
                          (fields.curve_position ? 1 : 0);
   const size_t width = precision == v1::PRECISION_FLOAT32 ? sizeof(float) : sizeof(double);
-  const size_t per_sample = columns * width + (indices_listed ? sizeof(uint64_t) : 0);
+  const size_t index_columns = (fields.face ? 1 : 0) + (fields.triangle ? 1 : 0);
+  const size_t per_sample = columns * width + index_columns * sizeof(uint32_t) +
+                            (indices_listed ? sizeof(uint64_t) : 0);
   // Each packed column costs a tag and a length (at most 1 + 5 bytes); the
   // batch's own fields and the two message wrappers at most 64 more.
-  const size_t fixed = reserved_bytes + 6 * (columns + 1) + 64;
+  const size_t fixed = reserved_bytes + 6 * (columns + index_columns + 1) + 64;
   if (max_message_bytes <= fixed) return 0;
   return static_cast<uint32_t>(std::min<size_t>((max_message_bytes - fixed) / per_sample, UINT32_MAX));
 }
@@ -222,7 +247,11 @@ absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fiel
   } else {
     out->index.insert(out->index.end(), in.index().begin(), in.index().end());
   }
-  return in.has_f64() ? TakeColumns(in.f64(), fields, n, out) : TakeColumns(in.f32(), fields, n, out);
+  RETURN_IF_ERROR(in.has_f64() ? TakeColumns(in.f64(), fields, n, out)
+                                : TakeColumns(in.f32(), fields, n, out));
+  if (fields.face) RETURN_IF_ERROR(TakeIndexColumn("face", in.face(), n, &out->face));
+  if (fields.triangle) RETURN_IF_ERROR(TakeIndexColumn("triangle", in.triangle(), n, &out->triangle));
+  return absl::OkStatus();
 }
 
 void ToProto(const PreparedTree& t, v1::TreeInfo* out) {

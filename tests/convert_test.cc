@@ -58,5 +58,41 @@ TEST(AppendFromProto, RefusesAMissingRequestedColumn) {
   EXPECT_EQ(AppendFromProto(wire, with_normals, &got).code(), absl::StatusCode::kDataLoss);
 }
 
+TEST(AppendFromProto, CarriesTheFaceAndTriangleColumnsAndRefusesAShortOne) {
+  SampleBatch sent = ThreeSamples();
+  sent.face = {0, 4, 4294967295u};
+  sent.triangle = {2, 1, 0};
+  SampleFields fields;
+  fields.face = fields.triangle = true;
+  v1::SampleBatch wire;
+  ToProto(sent, fields, v1::PRECISION_FLOAT32, &wire);
+  SampleBatch got;
+  ASSERT_TRUE(AppendFromProto(wire, fields, &got).ok());
+  EXPECT_EQ(got.face, sent.face);
+  EXPECT_EQ(got.triangle, sent.triangle);
+
+  wire.mutable_triangle()->RemoveLast();
+  SampleBatch short_one;
+  EXPECT_EQ(AppendFromProto(wire, fields, &short_one).code(), absl::StatusCode::kDataLoss);
+}
+
+TEST(MaxSamplesPerMessage, AMessageOfThatManySamplesWithModelColumnsFitsTheCap) {
+  SampleFields fields;
+  fields.normal = fields.face = fields.triangle = true;
+  const size_t cap = 1 << 16;
+  const uint32_t n = MaxSamplesPerMessage(fields, v1::PRECISION_FLOAT64, true, 0, cap);
+  ASSERT_GT(n, 0u);
+  SampleBatch b;
+  for (uint32_t i = 0; i < n; ++i) {
+    b.index.push_back(uint64_t{1} << 40 | (i * 7919u));  // not consecutive: indices listed
+    for (auto* c : {&b.u, &b.v, &b.x, &b.y, &b.z, &b.nx, &b.ny, &b.nz}) c->push_back(i);
+    b.face.push_back(UINT32_MAX);
+    b.triangle.push_back(UINT32_MAX);
+  }
+  v1::SampleResponse response;
+  ToProto(b, fields, v1::PRECISION_FLOAT64, response.mutable_batch());
+  EXPECT_LE(response.ByteSizeLong(), cap);
+}
+
 }  // namespace
 }  // namespace sfc

@@ -63,6 +63,9 @@ void AddSampleFlags(CLI::App* cmd, RequestFlags* f) {
   cmd->add_flag("--normals", f->normals, "add unit normals nx,ny,nz");
   cmd->add_flag("--density-column", f->density_column, "add the density value at each sample");
   cmd->add_flag("--curve-position", f->curve_position, "add the position along the curve in [0,1)");
+  cmd->add_flag("--face", f->face, "CAD models: add each sample's face index (file order)");
+  cmd->add_flag("--triangle", f->triangle,
+                "meshes: add each sample's triangle index (file order); u,v are then barycentric");
 }
 
 absl::StatusOr<TreeSpec> ToTreeSpec(const RequestFlags& f) {
@@ -119,6 +122,8 @@ absl::StatusOr<SampleRequest> ToSampleRequest(const RequestFlags& f) {
   r.fields.normal = f.normals;
   r.fields.density = f.density_column;
   r.fields.curve_position = f.curve_position;
+  r.fields.face = f.face;
+  r.fields.triangle = f.triangle;
   return r;
 }
 

@@ -27,6 +27,7 @@ struct RequestFlags {
   std::string shard;   // "i/K"
   std::string region;  // "uv:U0,U1,V0,V1" or "box:X0,Y0,Z0,X1,Y1,Z1"
   bool normals = false, density_column = false, curve_position = false;
+  bool face = false, triangle = false;
 };
 
 // Adds the tree-shaping flags (surface, density, curve, ...) to `cmd`.
