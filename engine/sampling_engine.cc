@@ -4,11 +4,50 @@
 #include "catalog/catalog.h"
 #include "core/status_macros.h"
 #include "engine/model_source.h"
+#ifdef SFC_HAVE_MESH
+#include "engine/mesh_jobs.h"
+#endif
 
 namespace sfc {
 
-SamplingEngine::SamplingEngine(EngineLimits limits, TreeSource* source)
-    : limits_(limits), source_(source) {}
+SamplingEngine::SamplingEngine(EngineLimits limits, TreeSource* source, const ModelSource* models)
+    : limits_(limits), source_(source), models_(models) {}
+
+absl::StatusOr<PreparedTree> SamplingEngine::PrepareModel(const ModelSpec& model,
+                                                          const TreeSpec& spec, uint64_t count,
+                                                          const BuildControl& caller) const {
+  const bool mesh = model.format == ModelFormat::kObj || model.format == ModelFormat::kPly;
+  if (!mesh) {
+    return absl::UnimplementedError(absl::StrFormat(
+        "sampling %s models is not available in this release: servers store uploaded models "
+        "(sfcsampler upload) and the model libraries read them, but surfaces made from them come "
+        "in the next one; use a mesh, a catalogue surface or an expr: surface",
+        ModelFormatName(model.format)));
+  }
+#ifndef SFC_HAVE_MESH
+  return absl::UnimplementedError(
+      "this build of sfcsampler has no mesh support (configured with SFC_BUILD_MESH=OFF)");
+#else
+  if (!models_) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "\"%s\" names a model, and this engine has no model source to read it from",
+        spec.surface));
+  }
+  ASSIGN_OR_RETURN(const StoredModel stored, models_->Resolve(model));
+  ASSIGN_OR_RETURN(MeshTreeRecipe recipe,
+                   MeshTreeFor(stored, spec.density, spec.options.tolerance,
+                               limits_.max_tree_leaves, loaded_.get()));
+  CurveTreeOptions options;  // a mesh's curve has no options but the tolerance
+  options.tolerance = spec.options.tolerance;
+  PreparedTree prepared;
+  prepared.kind = TreeKind::kMesh;
+  prepared.key = MakeTreeKey(stored.Spec(), recipe.canonical_density, options);
+  prepared.grade = CurveTree::GradeFor(count);
+  ASSIGN_OR_RETURN(prepared.lookup,
+                   source_->Get(prepared.key, prepared.grade, recipe.factory, caller));
+  return prepared;
+#endif
+}
 
 absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint64_t count,
                                                      const BuildControl& caller) const {
@@ -28,13 +67,7 @@ absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint6
     }
   }
   ASSIGN_OR_RETURN(const std::optional<ModelSpec> model, ParseModelSpec(spec.surface));
-  if (model) {
-    return absl::UnimplementedError(absl::StrFormat(
-        "sampling %s models is not available in this release: servers store uploaded models "
-        "(sfcsampler upload) and the model libraries read them, but surfaces made from them come "
-        "in the next one; use a catalogue surface or an expr: surface",
-        ModelFormatName(model->format)));
-  }
+  if (model) return PrepareModel(*model, spec, count, caller);
   ASSIGN_OR_RETURN(SurfaceFromSpec surface, MakeSurface(spec.surface));
   ASSIGN_OR_RETURN(DensityFromSpec density, MakeDensity(spec.density));
   CurveTreeOptions options = spec.options;
@@ -47,12 +80,15 @@ absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint6
   prepared.density = density.density;
   TreeFactory factory;
   factory.build = [surface = prepared.surface, density = prepared.density, options](
-                      int grade, const BuildControl& control) {
-    return CurveTree::Build(*surface, *density, options, grade, control);
+                      int grade, const BuildControl& control) -> TreeFactory::Result {
+    return AsAnyTree(CurveTree::Build(*surface, *density, options, grade, control));
   };
   factory.refine = [surface = prepared.surface, density = prepared.density](
-                       const CurveTree& coarser, int grade, const BuildControl& control) {
-    return coarser.Refined(*surface, *density, grade, control);
+                       const AnyTree& coarser, int grade,
+                       const BuildControl& control) -> TreeFactory::Result {
+    const auto tree = TreeAs<CurveTree>(&coarser);
+    if (!tree) return absl::InternalError("refining a tree of another kind");
+    return AsAnyTree(tree->Refined(*surface, *density, grade, control));
   };
   ASSIGN_OR_RETURN(prepared.lookup, source_->Get(prepared.key, prepared.grade, factory, caller));
   return prepared;
@@ -131,14 +167,22 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
   const uint64_t tree_count = request.tree_count == 0 ? request.count : request.tree_count;
   SamplingJob job;
   ASSIGN_OR_RETURN(job.tree, Prepare(request.tree, tree_count, caller));
-  job.sampler = std::make_shared<const Sampler>(job.tree.lookup.tree, job.tree.surface,
-                                                job.tree.density,
-                                                Sequence(request.sequence, request.count, request.seed));
   job.begin = range.first;
   job.end = range.second;
-  ASSIGN_OR_RETURN(job.cursor,
-                   SampleCursor::Create(job.sampler, job.begin, job.end, request.region, request.fields,
-                                        limits_.generation_threads));
+  Sequence sequence(request.sequence, request.count, request.seed);
+#ifdef SFC_HAVE_MESH
+  if (job.tree.kind == TreeKind::kMesh) {
+    ASSIGN_OR_RETURN(job.cursor, MeshCursor(*job.tree.lookup.any, std::move(sequence), job.begin,
+                                            job.end, request.region, request.fields));
+    return job;
+  }
+#endif
+  job.sampler = std::make_shared<const Sampler>(job.tree.lookup.tree, job.tree.surface,
+                                                job.tree.density, std::move(sequence));
+  ASSIGN_OR_RETURN(std::unique_ptr<SampleCursor> cursor,
+                   SampleCursor::Create(job.sampler, job.begin, job.end, request.region,
+                                        request.fields, limits_.generation_threads));
+  job.cursor = std::make_unique<SurfaceBatchCursor>(std::move(cursor));
   return job;
 }
 

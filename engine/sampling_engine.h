@@ -12,31 +12,42 @@
 
 #include "absl/status/statusor.h"
 #include "core/sampler.h"
+#include "engine/batch_cursor.h"
+#include "engine/loaded_models.h"
+#include "engine/model_source.h"
 #include "engine/sample_request.h"
 #include "engine/tree_key.h"
 #include "engine/tree_source.h"
 
 namespace sfc {
 
+// What a tree is over: a parametric surface (catalogue, expression; its
+// CurveTree is lookup.tree) or a triangle mesh (lookup.any holds its tree).
+enum class TreeKind { kSurface, kMesh };
+
 struct PreparedTree {
   TreeKey key;
   int grade = 0;
+  TreeKind kind = TreeKind::kSurface;
   TreeLookup lookup;
+  // kSurface only.
   std::shared_ptr<const Surface> surface;
   std::shared_ptr<const Density> density;
 };
 
 struct SamplingJob {
   PreparedTree tree;
-  std::shared_ptr<const Sampler> sampler;
+  std::shared_ptr<const Sampler> sampler;  // kSurface only
   uint64_t begin = 0, end = 0;  // the resolved index range
-  std::unique_ptr<SampleCursor> cursor;
+  std::unique_ptr<BatchCursor> cursor;
 };
 
 class SamplingEngine {
  public:
-  // `source` is not owned and must outlive the engine.
-  SamplingEngine(EngineLimits limits, TreeSource* source);
+  // `source` and `models` are not owned and must outlive the engine. `models`
+  // resolves model specs (step:, obj:, ...): files for the embedded CLI, the
+  // upload store for the server; null refuses model specs.
+  SamplingEngine(EngineLimits limits, TreeSource* source, const ModelSource* models = nullptr);
 
   const EngineLimits& limits() const { return limits_; }
 
@@ -57,8 +68,13 @@ class SamplingEngine {
   static absl::StatusOr<std::pair<uint64_t, uint64_t>> ResolveRange(const SampleRequest& request);
 
  private:
+  absl::StatusOr<PreparedTree> PrepareModel(const ModelSpec& model, const TreeSpec& spec,
+                                            uint64_t count, const BuildControl& caller) const;
+
   const EngineLimits limits_;
   TreeSource* const source_;
+  const ModelSource* const models_;
+  const std::unique_ptr<LoadedModels> loaded_ = std::make_unique<LoadedModels>();
 };
 
 }  // namespace sfc

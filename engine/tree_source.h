@@ -13,20 +13,59 @@
 
 namespace sfc {
 
-// How to make the tree of a key: from scratch, or by refining a coarser one
-// (which gives the same tree, see core/curve_tree.h). The functions own what
-// they use: a shared build may run on another thread after the request that
-// started it has gone.
-struct TreeFactory {
-  std::function<absl::StatusOr<std::shared_ptr<const CurveTree>>(int grade,
-                                                                 const BuildControl& control)>
-      build;
-  std::function<absl::StatusOr<std::shared_ptr<const CurveTree>>(
-      const CurveTree& coarser, int grade, const BuildControl& control)>
-      refine;
+// A built tree of any kind, as caches hold it: a CurveTree (catalogue and
+// expression surfaces, CAD models) or a mesh's tree. Only its size matters to
+// a cache; the engine, which made it, knows its type (TypedTree<T>).
+class AnyTree {
+ public:
+  virtual ~AnyTree() = default;
+  virtual uint64_t bytes() const = 0;
+  virtual uint64_t leaves() const = 0;
 };
 
+template <typename Tree>
+class TypedTree final : public AnyTree {
+ public:
+  TypedTree(std::shared_ptr<const Tree> tree, uint64_t bytes, uint64_t leaves)
+      : tree_(std::move(tree)), bytes_(bytes), leaves_(leaves) {}
+  uint64_t bytes() const override { return bytes_; }
+  uint64_t leaves() const override { return leaves_; }
+  const std::shared_ptr<const Tree>& tree() const { return tree_; }
+
+ private:
+  std::shared_ptr<const Tree> tree_;
+  uint64_t bytes_, leaves_;
+};
+
+// The Tree inside `any`, or null if it holds another kind.
+template <typename Tree>
+std::shared_ptr<const Tree> TreeAs(const AnyTree* any) {
+  const auto* typed = dynamic_cast<const TypedTree<Tree>*>(any);
+  return typed ? typed->tree() : nullptr;
+}
+
+// How to make the tree of a key: from scratch, or by refining a coarser one
+// (which gives the same tree, see core/curve_tree.h; kinds of tree that
+// cannot be refined leave `refine` empty and are built afresh). The functions
+// own what they use: a shared build may run on another thread after the
+// request that started it has gone.
+struct TreeFactory {
+  using Result = absl::StatusOr<std::shared_ptr<const AnyTree>>;
+  std::function<Result(int grade, const BuildControl& control)> build;
+  std::function<Result(const AnyTree& coarser, int grade, const BuildControl& control)> refine;
+};
+
+// Wraps a build's result as an AnyTree (for trees with bytes() and leaf_count()).
+template <typename Tree>
+TreeFactory::Result AsAnyTree(absl::StatusOr<std::shared_ptr<const Tree>> tree) {
+  if (!tree.ok()) return tree.status();
+  const uint64_t bytes = (*tree)->bytes(), leaves = (*tree)->leaf_count();
+  return std::make_shared<const TypedTree<Tree>>(*std::move(tree), bytes, leaves);
+}
+
 struct TreeLookup {
+  std::shared_ptr<const AnyTree> any;
+  // `any` as a CurveTree, or null for a mesh's tree.
   std::shared_ptr<const CurveTree> tree;
   bool cache_hit = false;    // the exact tree was cached
   bool refined = false;      // made by refining a cached coarser tree
@@ -49,7 +88,10 @@ class DirectTreeSource final : public TreeSource {
                                  const BuildControl& caller) override {
     auto tree = factory.build(grade, caller);
     if (!tree.ok()) return tree.status();
-    return TreeLookup{*std::move(tree), false, false};
+    TreeLookup lookup;
+    lookup.any = *std::move(tree);
+    lookup.tree = TreeAs<CurveTree>(lookup.any.get());
+    return lookup;
   }
 };
 

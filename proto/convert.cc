@@ -255,13 +255,19 @@ absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fiel
 }
 
 void ToProto(const PreparedTree& t, v1::TreeInfo* out) {
-  const CurveTree& tree = *t.lookup.tree;
   out->set_key(t.key.Hex());
   out->set_key_with_grade(t.key.HexWithGrade(t.grade));
   out->set_canonical(t.key.canonical);
   out->set_grade(t.grade);
   out->set_cache_hit(t.lookup.cache_hit);
   out->set_refined(t.lookup.refined);
+  out->set_kind(t.lookup.tree ? "surface" : "mesh");
+  if (!t.lookup.tree) {  // a mesh's tree: its size only
+    out->set_leaves(t.lookup.any->leaves());
+    out->set_bytes(t.lookup.any->bytes());
+    return;
+  }
+  const CurveTree& tree = *t.lookup.tree;
   out->set_leaves(tree.leaf_count());
   out->set_bytes(tree.bytes());
   out->set_min_depth(tree.min_depth());

@@ -48,7 +48,7 @@ SamplerService::SamplerService(const ServerOptions& options, TreeCache* cache, M
       cache_(cache),
       models_(models),
       metrics_(metrics),
-      engine_(options.limits, cache),
+      engine_(options.limits, cache, models),
       authenticator_(options.token.empty() || token_checked_by_transport
                          ? nullptr
                          : std::make_unique<const TokenAuthenticator>(options.token)),

@@ -36,7 +36,7 @@ absl::StatusOr<TreeLookup> TreeCache::Get(const TreeKey& key, int grade, const T
     if (auto it = entries_.find(id); it != entries_.end()) {
       lru_.splice(lru_.begin(), lru_, it->second.lru);
       ++stats_.hits;
-      return TreeLookup{it->second.tree, true, false};
+      return TreeLookup{it->second.tree, TreeAs<CurveTree>(it->second.tree.get()), true, false};
     }
     if (stopping_) {
       return absl::UnavailableError("the server is shutting down; retry on another replica or later");
@@ -72,7 +72,7 @@ absl::StatusOr<TreeLookup> TreeCache::Get(const TreeKey& key, int grade, const T
       job->canonical = key.canonical;
       job->grade = grade;
       job->factory = factory;
-      if (auto g = grades_.find(key.canonical); g != grades_.end()) {
+      if (auto g = grades_.find(key.canonical); g != grades_.end() && factory.refine) {
         auto below = g->second.lower_bound(grade);
         if (below != g->second.begin()) {
           job->coarser = entries_.at(absl::StrCat(key.canonical, "#g", *std::prev(below))).tree;
@@ -101,7 +101,8 @@ absl::StatusOr<TreeLookup> TreeCache::Get(const TreeKey& key, int grade, const T
     // Joined a build just as every earlier waiter gave up on it: start over.
     if (absl::IsCancelled(job->result.status())) continue;
     if (!job->result.ok()) return job->result.status();
-    return TreeLookup{*job->result, false, job->coarser != nullptr};
+    return TreeLookup{*job->result, TreeAs<CurveTree>(job->result->get()), false,
+                      job->coarser != nullptr};
   }
 }
 

@@ -6,7 +6,7 @@
 // (one build). A miss for grade g refines the finest cached coarser grade of
 // the same tree instead of building anew (the result is the same tree, see
 // core/curve_tree.h). The cache holds at most budget_bytes of trees and evicts
-// the least recently used; trees are shared as shared_ptr<const CurveTree>, so
+// the least recently used; trees (of any kind: engine/tree_source.h AnyTree) are shared as shared_ptrs, so
 // a stream keeps its tree alive through eviction.
 //
 // Builds are bounded:
@@ -96,9 +96,9 @@ class TreeCache final : public TreeSource {
 
  private:
   using Clock = std::chrono::steady_clock;
-  using Result = absl::StatusOr<std::shared_ptr<const CurveTree>>;
+  using Result = TreeFactory::Result;
   struct Entry {
-    std::shared_ptr<const CurveTree> tree;
+    std::shared_ptr<const AnyTree> tree;
     uint64_t bytes;
     std::string canonical;
     int grade;
@@ -109,7 +109,7 @@ class TreeCache final : public TreeSource {
     std::string id, canonical;
     int grade = 0;
     TreeFactory factory;                       // the first requester's; owns its data
-    std::shared_ptr<const CurveTree> coarser;  // refine this one, if set
+    std::shared_ptr<const AnyTree> coarser;    // refine this one, if set
     // Guarded by the cache's mu_.
     int waiters = 0;
     uint64_t charged = 0;  // bytes the build holds, as it last said

@@ -31,7 +31,12 @@ set +e
 "$probe" --address "127.0.0.1:1" --timeout 0.5 > /dev/null 2>&1; [ $? -eq 2 ] || fail "an unreachable server should exit 2"
 set -e
 
+# A mesh (an octahedron) travels once, by content hash, and gives the same
+# bytes over the wire as in process.
+printf 'v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\nf 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n' > "$tmp/octahedron.obj"
+
 for args in "--surface torus --density gaussian:floor=0.1 --count 20000 --seed 4" \
+            "--surface obj:$tmp/octahedron.obj --density expr:1+x*x --count 5000 --triangle --normals" \
             "--surface sphere --count 20000 --region box:0,0,0,1,1,1 --normals --curve-position" \
             "--surface plane --density expr:u+v --count 5000 --sequence progressive --shard 1/3"; do
   # shellcheck disable=SC2086

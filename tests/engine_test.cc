@@ -128,15 +128,14 @@ TEST(Engine, BadRangeShardOrRegionIsInvalidArgument) {
   ExpectError(engine.Start(r).status(), absl::StatusCode::kInvalidArgument, "empty");
 }
 
-TEST(Engine, AModelSpecSaysModelsCannotBeSampledYetRatherThanUnknownSurface) {
+TEST(Engine, AModelSpecIsAModelNotAnUnknownSurface) {
   DirectTreeSource source;
-  SamplingEngine engine({}, &source);
+  FileModelSource files;
+  SamplingEngine engine({}, &source, &files);
   SampleRequest r;
   r.count = 10;
-  r.tree.surface = "step:part.step";
-  ExpectError(engine.Start(r).status(), absl::StatusCode::kUnimplemented, "step models");
-  r.tree.surface = "obj:sha256=" + std::string(64, 'a');
-  ExpectError(engine.Start(r).status(), absl::StatusCode::kUnimplemented, "obj models");
+  r.tree.surface = "obj:/nonexistent/part.obj";
+  ExpectError(engine.Start(r).status(), absl::StatusCode::kInvalidArgument, "part.obj");
   r.tree.surface = "ply:sha256=12";
   ExpectError(engine.Start(r).status(), absl::StatusCode::kInvalidArgument, "SHA-256");
 }

@@ -18,12 +18,11 @@ TreeKey Key(const std::string& name) { return MakeTreeKey(name, "uniform", {}); 
 
 TreeFactory Throwing(std::function<void()> thrower) {
   TreeFactory f;
-  f.build = [thrower](int, const BuildControl&) -> absl::StatusOr<std::shared_ptr<const CurveTree>> {
+  f.build = [thrower](int, const BuildControl&) -> TreeFactory::Result {
     thrower();
     return absl::InternalError("unreachable");
   };
-  f.refine = [thrower](const CurveTree&, int, const BuildControl&)
-      -> absl::StatusOr<std::shared_ptr<const CurveTree>> {
+  f.refine = [thrower](const AnyTree&, int, const BuildControl&) -> TreeFactory::Result {
     thrower();
     return absl::InternalError("unreachable");
   };
@@ -37,11 +36,11 @@ TreeFactory Real(const std::string& surface, std::atomic<int>* calls) {
   TreeFactory f;
   f.build = [s, d, calls](int grade, const BuildControl& control) {
     ++*calls;
-    return CurveTree::Build(*s.surface, *d.density, {}, grade, control);
+    return AsAnyTree(CurveTree::Build(*s.surface, *d.density, {}, grade, control));
   };
-  f.refine = [s, d, calls](const CurveTree& coarser, int grade, const BuildControl& control) {
+  f.refine = [s, d, calls](const AnyTree& coarser, int grade, const BuildControl& control) {
     ++*calls;
-    return coarser.Refined(*s.surface, *d.density, grade, control);
+    return AsAnyTree(TreeAs<CurveTree>(&coarser)->Refined(*s.surface, *d.density, grade, control));
   };
   return f;
 }
@@ -72,7 +71,7 @@ TEST(TreeCache, AWaiterWhoseCheckFailsLeavesAtOnce) {
   CurveTreeOptions big;
   big.max_leaves = uint64_t{1} << 25;
   heavy.build = [slow, d, big](int grade, const BuildControl& control) {
-    return CurveTree::Build(*slow.surface, *d.density, big, grade, control);
+    return AsAnyTree(CurveTree::Build(*slow.surface, *d.density, big, grade, control));
   };
   heavy.refine = nullptr;
   std::atomic<bool> give_up{false};
@@ -107,7 +106,7 @@ TEST(TreeCache, GrowingTreesCountAgainstTheBudgetAndEvictCachedOnes) {
   auto d = *MakeDensity("uniform");
   TreeFactory heavy;
   heavy.build = [pole, d](int grade, const BuildControl& control) {
-    return CurveTree::Build(*pole.surface, *d.density, {}, grade, control);
+    return AsAnyTree(CurveTree::Build(*pole.surface, *d.density, {}, grade, control));
   };
   auto result = cache.Get(Key("pole"), CurveTree::GradeFor(100'000'000), heavy, {});
   EXPECT_EQ(result.status().code(), absl::StatusCode::kResourceExhausted);

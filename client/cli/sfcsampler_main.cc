@@ -81,6 +81,12 @@ struct Verbosity {
 // The tree summary and the depth-cap warnings, on stderr; the same for the
 // embedded mode (converted with ToProto) and the wire.
 void PrintTreeInfo(const ::sfcsampler::v1::TreeInfo& t, const Verbosity& verbosity = {}) {
+  if (!verbosity.quiet && t.kind() == "mesh") {
+    std::fprintf(stderr, "mesh tree %s (%s): %llu leaves, %llu bytes\n", t.key_with_grade().c_str(),
+                 t.cache_hit() ? "cache hit" : "built", static_cast<unsigned long long>(t.leaves()),
+                 static_cast<unsigned long long>(t.bytes()));
+    return;
+  }
   if (!verbosity.quiet) {
     std::fprintf(stderr, "tree %s (%s): %llu leaves, depth %d..%d, %llu bytes, tolerance %.6g\n",
                  t.key_with_grade().c_str(),
@@ -114,6 +120,12 @@ void PrintTreeInfo(const ::sfcsampler::v1::TreeInfo& t, const Verbosity& verbosi
                    w.measured(), w.limit(), w.measured() / w.limit());
     }
   }
+}
+
+// Model specs in process name local files.
+const FileModelSource& LocalModels() {
+  static const FileModelSource* const files = new FileModelSource();
+  return *files;
 }
 
 void PrintTree(const PreparedTree& tree, double seconds, const Verbosity& verbosity = {}) {
@@ -165,7 +177,7 @@ absl::Status StreamSamples(const SampleRequest& request, const Connection& conn,
   DirectTreeSource source;
   EngineLimits limits;
   limits.generation_threads = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
-  SamplingEngine engine(limits, &source);
+  SamplingEngine engine(limits, &source, &LocalModels());
   progress->StartPhase("building the curve tree");
   auto job = engine.Start(request);
   progress->EndPhase();
@@ -262,7 +274,7 @@ int RunPrepare(const RequestFlags& flags, const Connection& conn) {
     return 0;
   }
   DirectTreeSource source;
-  SamplingEngine engine(EngineLimits{}, &source);
+  SamplingEngine engine(EngineLimits{}, &source, &LocalModels());
   const auto start = std::chrono::steady_clock::now();
   Progress progress(true);
   progress.StartPhase("building the curve tree");
@@ -452,9 +464,14 @@ int RunRender(const RequestFlags& flags, const RenderFlags& r, const Connection&
           "without --server (the tree is the same), or draw samples"));
     }
     DirectTreeSource source;
-    SamplingEngine engine(EngineLimits{}, &source);
+    SamplingEngine engine(EngineLimits{}, &source, &LocalModels());
     auto job = engine.Start(*request);
     if (!job.ok()) return Fail(job.status());
+    if (!job->tree.lookup.tree) {
+      return Fail(absl::InvalidArgumentError(
+          "--what curve and param-curve draw a parameter-square curve tree; a mesh has none: "
+          "draw its samples (--what samples)"));
+    }
     const CurveTree& tree = *job->tree.lookup.tree;
     status = r.what == "curve" ? RenderCurve(tree, *job->tree.surface, view, r.output)
                                : RenderParameterCurve(tree, view, r.output);

@@ -33,7 +33,7 @@ class RecentTreeSource final : public TreeSource {
       for (auto it = recent_.begin(); it != recent_.end(); ++it) {
         if (it->first == id) {
           recent_.splice(recent_.begin(), recent_, it);
-          return TreeLookup{it->second, true, false};
+          return TreeLookup{it->second, TreeAs<CurveTree>(it->second.get()), true, false};
         }
       }
     }
@@ -44,13 +44,13 @@ class RecentTreeSource final : public TreeSource {
       recent_.emplace_front(id, *tree);
       while (recent_.size() > capacity_) recent_.pop_back();
     }
-    return TreeLookup{*std::move(tree), false, false};
+    return TreeLookup{*tree, TreeAs<CurveTree>(tree->get()), false, false};
   }
 
  private:
   const size_t capacity_;
   absl::Mutex mu_;
-  std::list<std::pair<std::string, std::shared_ptr<const CurveTree>>> recent_ ABSL_GUARDED_BY(mu_);
+  std::list<std::pair<std::string, std::shared_ptr<const AnyTree>>> recent_ ABSL_GUARDED_BY(mu_);
 };
 
 }  // namespace sfc::python

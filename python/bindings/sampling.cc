@@ -28,7 +28,6 @@ namespace {
 
 // The tree summary with the same names as the wire's TreeInfo message.
 py::dict TreeInfoDict(const PreparedTree& t) {
-  const CurveTree& tree = *t.lookup.tree;
   py::dict d;
   d["key"] = t.key.Hex();
   d["key_with_grade"] = t.key.HexWithGrade(t.grade);
@@ -36,6 +35,12 @@ py::dict TreeInfoDict(const PreparedTree& t) {
   d["grade"] = t.grade;
   d["cache_hit"] = t.lookup.cache_hit;
   d["refined"] = t.lookup.refined;
+  if (!t.lookup.tree) {  // a mesh's tree: its size only
+    d["leaves"] = t.lookup.any->leaves();
+    d["bytes"] = t.lookup.any->bytes();
+    return d;
+  }
+  const CurveTree& tree = *t.lookup.tree;
   d["leaves"] = static_cast<uint64_t>(tree.leaf_count());
   d["bytes"] = static_cast<uint64_t>(tree.bytes());
   d["min_depth"] = tree.min_depth();
@@ -148,7 +153,7 @@ class PyJob {
 class PyEngine {
  public:
   PyEngine(size_t max_trees, int threads)
-      : source_(max_trees), engine_(Limits(threads), &source_) {}
+      : source_(max_trees), engine_(Limits(threads), &source_, &files_) {}
 
   std::unique_ptr<PyJob> Start(const PyRequest& r, const std::string& precision) {
     if (precision != "float64" && precision != "float32") {
@@ -187,6 +192,7 @@ class PyEngine {
   }
 
   RecentTreeSource source_;
+  FileModelSource files_;  // model specs name local files in process
   SamplingEngine engine_;
 };
 

@@ -1,0 +1,140 @@
+#include "engine/mesh_jobs.h"
+
+#include <utility>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "catalog/catalog.h"
+#include "catalog/expression.h"
+#include "core/status_macros.h"
+#include "mesh/mesh_curve_tree.h"
+#include "mesh/mesh_loader.h"
+#include "mesh/mesh_sampler.h"
+
+namespace sfc {
+namespace {
+
+struct MeshDensityChoice {
+  std::shared_ptr<const MeshDensity> density;
+  std::string canonical;
+  std::string weight_property;  // vertex:NAME
+};
+
+absl::StatusOr<MeshDensityChoice> ParseMeshDensity(const std::string& text) {
+  const std::string spec(absl::StripAsciiWhitespace(text));
+  MeshDensityChoice out;
+  if (absl::StartsWith(spec, "vertex:")) {
+    out.weight_property = std::string(absl::StripAsciiWhitespace(spec.substr(7)));
+    if (out.weight_property.empty()) {
+      return absl::InvalidArgumentError(
+          "density vertex: needs the name of a PLY vertex property, e.g. vertex:quality");
+    }
+    out.density = VertexWeightMeshDensity();
+    out.canonical = "vertex:" + out.weight_property;
+    return out;
+  }
+  if (absl::StartsWith(spec, "expr:")) {
+    const std::string body(absl::StripAsciiWhitespace(spec.substr(5)));
+    ASSIGN_OR_RETURN(std::shared_ptr<const Expression> f,
+                     Expression::Compile("mesh density expression (in x, y, z)", body, {"x", "y", "z"}));
+    out.density = std::make_shared<FunctionMeshDensity>(
+        [f](const MeshPoint& p) {
+          const double xyz[3] = {p.position.x, p.position.y, p.position.z};
+          return f->Evaluate(xyz);
+        },
+        "expr:" + body);
+    out.canonical = "expr:" + body;
+    return out;
+  }
+  // Catalogue densities: validated and made canonical by the catalogue.
+  ASSIGN_OR_RETURN(const DensityFromSpec catalog, MakeDensity(spec));
+  out.canonical = catalog.canonical;
+  if (catalog.canonical == "uniform") {
+    out.density = UniformMeshDensity();
+    return out;
+  }
+  const bool gaussian = absl::StartsWith(catalog.canonical, "gaussian");
+  const bool mean = absl::StartsWith(catalog.canonical, "mean");
+  const size_t at = catalog.canonical.find("floor=");
+  double floor = 0;
+  if ((gaussian || mean) && at != std::string::npos &&
+      absl::SimpleAtod(catalog.canonical.substr(at + 6), &floor)) {
+    out.density = gaussian ? GaussianCurvatureMeshDensity(floor) : MeanCurvatureMeshDensity(floor);
+    return out;
+  }
+  return absl::InvalidArgumentError(absl::StrFormat(
+      "density \"%s\" is not available on meshes; use uniform, gaussian:floor=F, mean:floor=F, "
+      "expr:EXPRESSION in x, y, z, or vertex:PROPERTY",
+      spec));
+}
+
+// The mesh cursor as a BatchCursor: moves the triangle column into the batch.
+class MeshBatchCursor final : public BatchCursor {
+ public:
+  MeshBatchCursor(std::unique_ptr<MeshSampleCursor> cursor, bool triangle)
+      : cursor_(std::move(cursor)), triangle_(triangle) {}
+
+  absl::StatusOr<size_t> Next(size_t max, SampleBatch* batch) override {
+    columns_.Clear();
+    ASSIGN_OR_RETURN(const size_t n, cursor_->Next(max, batch, triangle_ ? &columns_ : nullptr));
+    if (triangle_) batch->triangle.insert(batch->triangle.end(), columns_.triangle.begin(), columns_.triangle.end());
+    return n;
+  }
+
+ private:
+  std::unique_ptr<MeshSampleCursor> cursor_;
+  const bool triangle_;
+  MeshSampleColumns columns_;
+};
+
+}  // namespace
+
+absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::string& density,
+                                           double tolerance, uint64_t max_leaves,
+                                           LoadedModels* loaded) {
+  ASSIGN_OR_RETURN(MeshDensityChoice choice, ParseMeshDensity(density));
+  const bool curvature = choice.density->needs_curvature();
+  const std::string key = absl::StrCat(model.Spec(), "|curvature=", curvature,
+                                       "|weights=", choice.weight_property);
+  MeshLoadOptions options;
+  options.format = model.format == ModelFormat::kPly ? MeshFormat::kPly : MeshFormat::kObj;
+  options.weight_property = choice.weight_property;
+  options.max_bytes = model.bytes->size();
+  ASSIGN_OR_RETURN(std::shared_ptr<const MeshSurface> surface,
+                   loaded->Get<MeshSurface>(key, [&]() -> absl::StatusOr<std::shared_ptr<const MeshSurface>> {
+                     const std::string name = model.name.empty() ? model.Spec() : model.name;
+                     ASSIGN_OR_RETURN(TriangleMesh mesh, LoadMesh(*model.bytes, name, options));
+                     return MeshSurface::Create(std::move(mesh), curvature);
+                   }));
+  MeshTreeRecipe recipe;
+  recipe.canonical_density = choice.canonical;
+  recipe.factory.build = [surface, density = choice.density, tolerance, max_leaves](
+                             int grade, const BuildControl& control) -> TreeFactory::Result {
+    RETURN_IF_ERROR(control.check ? control.check() : absl::OkStatus());
+    MeshTreeOptions options;
+    options.count = uint64_t{1} << grade;
+    if (tolerance > 0) options.tolerance = tolerance;
+    options.max_leaves = max_leaves;
+    ASSIGN_OR_RETURN(std::shared_ptr<const MeshCurveTree> tree,
+                     MeshCurveTree::Build(surface, density, options));
+    const uint64_t bytes = tree->stats().bytes, leaves = tree->leaf_count();
+    return std::make_shared<const TypedTree<MeshCurveTree>>(std::move(tree), bytes, leaves);
+  };
+  return recipe;
+}
+
+absl::StatusOr<std::unique_ptr<BatchCursor>> MeshCursor(const AnyTree& tree, Sequence sequence,
+                                                        uint64_t begin, uint64_t end,
+                                                        const Region& region,
+                                                        const SampleFields& fields) {
+  auto mesh_tree = TreeAs<MeshCurveTree>(&tree);
+  if (!mesh_tree) return absl::InternalError("a mesh request found a tree of another kind");
+  auto sampler = std::make_shared<const MeshSampler>(std::move(mesh_tree), std::move(sequence));
+  ASSIGN_OR_RETURN(auto cursor, MeshSampleCursor::Create(sampler, begin, end, region, fields));
+  return std::make_unique<MeshBatchCursor>(std::move(cursor), fields.triangle);
+}
+
+}  // namespace sfc
