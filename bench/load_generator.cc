@@ -70,7 +70,8 @@ struct Flags {
 // What the server will hold requests to (from GetCacheStats).
 struct ServerLimits {
   uint64_t max_count = 0, max_tree_leaves = 0, max_spec_length = 0, max_sorted_range = 0;
-  uint64_t budget_bytes = 0;
+  uint64_t budget_bytes = 0;         // trees (cache_bytes)
+  uint64_t stream_memory_bytes = 0;  // streams' working memory
   uint32_t max_concurrent_streams = 0;
 };
 
@@ -144,11 +145,13 @@ class Tally {
     std::printf("| samples received | %" PRIu64 " | |\n", samples_.load());
     std::printf("| samples/s (all streams, %.0f s) | %.3g | |\n", seconds, samples_.load() / seconds);
     const double mib = 1024.0 * 1024.0;
-    std::printf("| server cache budget | %.1f MiB | |\n", limits.budget_bytes / mib);
+    // The server's memory budgets: trees plus streams' working memory.
+    const double budget = limits.budget_bytes + limits.stream_memory_bytes;
+    std::printf("| server memory budget: cache + stream memory | %.1f + %.1f MiB | |\n",
+                limits.budget_bytes / mib, limits.stream_memory_bytes / mib);
     std::printf("| server peak VmRSS (sampled every 100 ms) | %.1f MiB | <= %.1f MiB |\n", peak_rss / mib,
-                1.2 * limits.budget_bytes / mib);
-    std::printf("| server VmHWM at the end | %.1f MiB | <= %.1f MiB |\n", hwm / mib,
-                1.2 * limits.budget_bytes / mib);
+                1.2 * budget / mib);
+    std::printf("| server VmHWM at the end | %.1f MiB | <= %.1f MiB |\n", hwm / mib, 1.2 * budget / mib);
     for (const std::string& e : examples_) std::printf("unexpected: %s\n", e.c_str());
   }
   uint64_t unexpected() const {
@@ -508,6 +511,7 @@ int Main(int argc, char** argv) {
   limits.max_spec_length = stats->max_spec_length();
   limits.max_sorted_range = stats->max_sorted_range();
   limits.budget_bytes = stats->budget_bytes();
+  limits.stream_memory_bytes = stats->stream_memory_bytes();
   limits.max_concurrent_streams = stats->max_concurrent_streams();
 
   // The in-process reference uses the server's limits, so both accept the

@@ -40,6 +40,25 @@ BuildControl RequestControl(const grpc::ServerContext* context, Clock::time_poin
   return control;
 }
 
+// What a stream holds while it runs: the sort of a non-monotone sequence's
+// range (16 bytes a sample), and one batch with its message: per sample the
+// index and the columns in the batch (float64, the model columns uint32),
+// and the same on the wire (float32 if asked; indices listed, at most). The
+// batch is the requested size, or the largest the server would choose. An
+// invalid range counts nothing here: Start refuses it.
+uint64_t StreamWorkingBytes(const SampleRequest& request, const v1::SampleRequest& wire) {
+  const auto range = SamplingEngine::ResolveRange(request);
+  const uint64_t n = range.ok() ? range->second - range->first : 0;
+  const uint64_t sort = Sequence(request.sequence, 1, 0).monotone() ? 0 : 16 * n;
+  const SampleFields& f = request.fields;
+  const uint64_t columns = 5 + (f.normal ? 3 : 0) + (f.density ? 1 : 0) + (f.curve_position ? 1 : 0);
+  const uint64_t index_columns = (f.face ? 1 : 0) + (f.triangle ? 1 : 0);
+  const uint64_t width = wire.precision() == v1::PRECISION_FLOAT32 ? 4 : 8;
+  const uint64_t per_sample = (8 + 8 * columns + 4 * index_columns) + (8 + width * columns + 4 * index_columns);
+  const uint64_t batch = wire.batch_size() != 0 ? wire.batch_size() : kDefaultBatchSize;
+  return sort + per_sample * std::min(n, batch);
+}
+
 }  // namespace
 
 SamplerService::SamplerService(const ServerOptions& options, TreeCache* cache, ModelStore* models,
@@ -52,7 +71,8 @@ SamplerService::SamplerService(const ServerOptions& options, TreeCache* cache, M
       authenticator_(options.token.empty() || token_checked_by_transport
                          ? nullptr
                          : std::make_unique<const TokenAuthenticator>(options.token)),
-      watchdog_(options.write_timeout_seconds) {}
+      watchdog_(options.write_timeout_seconds),
+      stream_memory_(options.stream_memory_bytes) {}
 
 grpc::Status SamplerService::Admit(const grpc::ServerContext& context) const {
   if (draining_.load()) {
@@ -110,7 +130,12 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
                                         "(max_batch_size)",
                                         request.batch_size(), options_.max_batch_size));
   }
-  auto job = engine_.Start(*parsed, RequestControl(context, deadline, options_.request_deadline_seconds));
+  const BuildControl control = RequestControl(context, deadline, options_.request_deadline_seconds);
+  // The stream's working memory, reserved before its cursor sorts anything.
+  auto memory = stream_memory_.Reserve(StreamWorkingBytes(*parsed, request),
+                                     "this stream", control.check);
+  if (!memory.ok()) return ToGrpcStatus(memory.status());
+  auto job = engine_.Start(*parsed, control);
   if (!job.ok()) return ToGrpcStatus(job.status());
 
   v1::SampleResponse response;
@@ -271,6 +296,9 @@ grpc::Status SamplerService::GetCacheStats(grpc::ServerContext* context,
     response->set_generation_threads(options_.limits.generation_threads);
     response->set_max_message_bytes(options_.max_message_bytes);
     response->set_write_timeout_seconds(options_.write_timeout_seconds);
+    response->set_stream_memory_bytes(stream_memory_.budget_bytes());
+    response->set_stream_memory_reserved(stream_memory_.reserved_bytes());
+    response->set_stream_memory_waits(stream_memory_.waits());
     response->set_max_concurrent_builds(options_.max_concurrent_builds);
     response->set_max_queued_builds(options_.max_queued_builds);
     response->set_builds_running(s.builds_running);

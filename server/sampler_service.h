@@ -20,6 +20,7 @@
 #include "server/metrics.h"
 #include "server/model_store.h"
 #include "server/server_options.h"
+#include "server/stream_memory.h"
 #include "server/stream_watchdog.h"
 #include "server/token_auth.h"
 #include "server/tree_cache.h"
@@ -71,6 +72,7 @@ class SamplerService final : public ::sfcsampler::v1::Sampler::Service {
   // Set when the service itself checks the token (plaintext ports).
   const std::unique_ptr<const TokenAuthenticator> authenticator_;
   StreamWatchdog watchdog_;
+  StreamMemory stream_memory_;
 
   std::atomic<uint32_t> active_streams_{0};
   std::atomic<bool> draining_{false};

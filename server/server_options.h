@@ -34,6 +34,9 @@ struct ServerOptions {
   // Largest message the server sends, in bytes; batches are sized to fit it.
   // 4 MiB is what stock gRPC clients accept by default.
   uint32_t max_message_bytes = 4 << 20;
+  // Working memory of all streams together (sorting non-monotone sequences,
+  // batches, messages): streams wait for it; server/stream_memory.h.
+  uint64_t stream_memory_bytes = uint64_t{512} << 20;
   double request_deadline_seconds = 600;       // longest a Sample stream may run
   // A stream whose write waits this long for a reader that does not read is
   // cut and its slot freed.

@@ -2,6 +2,7 @@
 // curve-tree cache. SIGTERM or SIGINT shuts it down gracefully: it stops
 // accepting, lets in-flight streams finish within --shutdown-grace, then
 // cancels them.
+#include <malloc.h>
 #include <signal.h>
 
 #include <fstream>
@@ -13,6 +14,13 @@
 #include "spdlog/spdlog.h"
 
 int main(int argc, char** argv) {
+  // Large buffers (sorted index ranges, batches, messages, tree arrays) come
+  // and go with requests. A fixed mmap threshold gives each back to the
+  // system when freed; glibc's default raises the threshold after the first
+  // such free, and the heap then keeps the freed pages, so resident memory
+  // would not fall back to what the budgets hold (cache_bytes,
+  // stream_memory_bytes).
+  mallopt(M_MMAP_THRESHOLD, 1 << 20);
   sfc::ServerOptions o;
   std::string token_file, log_level = "info";
   CLI::App app{"sfcsampler-server: density-controlled surface sampling over gRPC"};
@@ -43,6 +51,10 @@ int main(int argc, char** argv) {
   app.add_option("--max-message-bytes", o.max_message_bytes,
                  "largest message sent, bytes; batches are sized to fit (4 MiB: what stock gRPC "
                  "clients accept)")
+      ->capture_default_str();
+  app.add_option("--stream-memory-bytes", o.stream_memory_bytes,
+                 "working memory of all streams together (sorting random/van der Corput/progressive "
+                 "ranges: 16 bytes a sample; batches and messages); streams wait for it")
       ->capture_default_str();
   app.add_option("--max-concurrent-builds", o.max_concurrent_builds, "tree builds at once")
       ->capture_default_str()

@@ -5,16 +5,19 @@
 # densities, counts, ranges, shards and regions spot-checked against an
 # in-process run; cancels; slow readers; client deadlines; bad requests), and
 # prints its table: outcomes by status code, unexpected outcomes (target 0),
-# samples/s, and the server's peak RSS against its cache budget (target:
-# within budget + 20%). Exits 1 on any unexpected outcome.
+# samples/s, and the server's peak RSS against its memory budgets, trees
+# plus streams' working memory (target: within budget + 20%). Exits 1 on any
+# unexpected outcome.
 #   bash tools/soak.sh [SECONDS] [STREAMS]      (defaults 60 and 64)
-# SFC_SOAK_CACHE_BYTES (default 256 MiB) sets the server's cache budget;
+# SFC_SOAK_CACHE_BYTES (default 256 MiB) sets the server's cache budget and
+# SFC_SOAK_STREAM_BYTES (default 64 MiB) its streams' working memory;
 # SFC_SOAK_SERVER_FLAGS adds server flags.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-60}"
 streams="${2:-64}"
 cache_bytes="${SFC_SOAK_CACHE_BYTES:-268435456}"
+stream_bytes="${SFC_SOAK_STREAM_BYTES:-67108864}"
 bash tools/build.sh
 server=build/server/sfcsampler-server
 dir=$(mktemp -d)
@@ -29,6 +32,8 @@ slots=$((streams + (streams + 7) / 8))
 flags=(--address 127.0.0.1:0 --health-address "" --metrics-address ""
        --cache-bytes "$cache_bytes" --max-tree-leaves 4194304 --max-count 2000000
        --max-concurrent-streams "$slots" --request-deadline 120 --shutdown-grace 5)
+# A budget for streams' working memory, where this server has one.
+if "$server" --help 2>&1 | grep -q -- --stream-memory-bytes; then flags+=(--stream-memory-bytes "$stream_bytes"); fi
 # A write timeout for stalled readers, where this server has one.
 if "$server" --help 2>&1 | grep -q -- --write-timeout; then flags+=(--write-timeout 5); fi
 # shellcheck disable=SC2206

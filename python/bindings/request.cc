@@ -43,7 +43,8 @@ PyRequest MakeRequest(std::string surface, std::string density, std::string curv
                       std::string estimator, double tolerance, int depth_cap, double rho,
                       uint64_t count, uint64_t seed, std::string sequence, uint64_t tree_count,
                       uint64_t begin, uint64_t end, const py::object& shard, std::string region,
-                      bool normals, bool density_column, bool curve_position) {
+                      bool normals, bool density_column, bool curve_position, bool face,
+                      bool triangle) {
   PyRequest r;
   RequestFlags& f = r.flags;
   f.surface = std::move(surface);
@@ -64,6 +65,8 @@ PyRequest MakeRequest(std::string surface, std::string density, std::string curv
   f.normals = normals;
   f.density_column = density_column;
   f.curve_position = curve_position;
+  f.face = face;
+  f.triangle = triangle;
   auto parsed = ToSampleRequest(f);
   ThrowIfError(parsed.status());
   r.request = *std::move(parsed);
@@ -88,7 +91,8 @@ sequence: jittered | equal | random | vandercorput | progressive.
 tree_count: size the tree for this many samples (0 = count).
 begin, end: index range [begin, end) (end 0 = count); or shard "i/K" or (i, K).
 region: "uv:U0,U1,V0,V1" or "box:X0,Y0,Z0,X1,Y1,Z1" (only samples inside).
-normals, density_column, curve_position: the optional columns.
+normals, density_column, curve_position: the optional columns; face (CAD
+models) and triangle (meshes: u, v are then barycentric) the model columns.
 Raises sfcsampler.InvalidArgumentError for malformed values.)doc")
       .def(py::init(&MakeRequest), py::kw_only(), py::arg("surface") = d.surface,
            py::arg("density") = d.density, py::arg("curve") = d.curve,
@@ -98,7 +102,8 @@ Raises sfcsampler.InvalidArgumentError for malformed values.)doc")
            py::arg("tree_count") = d.tree_count, py::arg("begin") = d.begin, py::arg("end") = d.end,
            py::arg("shard") = py::none(), py::arg("region") = d.region,
            py::arg("normals") = d.normals, py::arg("density_column") = d.density_column,
-           py::arg("curve_position") = d.curve_position)
+           py::arg("curve_position") = d.curve_position, py::arg("face") = d.face,
+           py::arg("triangle") = d.triangle)
       // The parsed request, field by field, for building the wire message.
       .def_property_readonly("surface", [](const PyRequest& r) { return r.request.tree.surface; })
       .def_property_readonly("density", [](const PyRequest& r) { return r.request.tree.density; })
@@ -146,6 +151,8 @@ Raises sfcsampler.InvalidArgumentError for malformed values.)doc")
                              [](const PyRequest& r) { return r.request.fields.density; })
       .def_property_readonly("curve_position",
                              [](const PyRequest& r) { return r.request.fields.curve_position; })
+      .def_property_readonly("face", [](const PyRequest& r) { return r.request.fields.face; })
+      .def_property_readonly("triangle", [](const PyRequest& r) { return r.request.fields.triangle; })
       .def_property_readonly(
           "surface_key", [](const PyRequest& r) { return SurfaceKey(r.request.tree); },
           "the tree key (16 hex digits) sent as x-surface-key for consistent-hash proxies")

@@ -115,6 +115,8 @@ class PyJob {
     static const char* const kNames[] = {"u",  "v",  "x",  "y",       "z",
                                          "nx", "ny", "nz", "density", "curve_position"};
     out["index"] = ToNumpy(std::move(batch.index));
+    if (fields_.face) out["face"] = ToNumpy(std::move(batch.face));
+    if (fields_.triangle) out["triangle"] = ToNumpy(std::move(batch.triangle));
     auto columns = Columns(&batch);
     for (size_t i = 0; i < columns.size(); ++i) {
       if (float32_) {

@@ -6,7 +6,7 @@ from sfcsampler import _core
 # The CLI's sample flags without dashes, '-' as '_' (client/cli/request_flags.h).
 KEYWORDS = ("surface", "density", "curve", "estimator", "tolerance", "depth_cap", "rho", "count", "seed",
             "sequence", "tree_count", "begin", "end", "shard", "region", "normals", "density_column",
-            "curve_position")
+            "curve_position", "face", "triangle")
 _TEXT = {"surface", "density", "curve", "estimator", "sequence", "region"}
 _UNSIGNED = {"count", "seed", "tree_count", "begin", "end"}
 

@@ -74,6 +74,7 @@ def sample(*, precision="float64", threads=0, **request):
       shard=None                            "i/K" or (i, K)
       region=""                             "uv:U0,U1,V0,V1" or "box:X0,Y0,Z0,X1,Y1,Z1"
       normals=False, density_column=False, curve_position=False
+      face=False, triangle=False            model columns: CAD face, mesh triangle
       precision="float64"                   or "float32" (half the memory)
       threads=0                             threads filling the arrays (0 = up to 4)
 

@@ -6,7 +6,8 @@ import numpy as np
 
 from sfcsampler.errors import DepthCapWarning
 
-COLUMNS = ("index", "u", "v", "x", "y", "z", "nx", "ny", "nz", "density", "curve_position")
+COLUMNS = ("index", "u", "v", "x", "y", "z", "nx", "ny", "nz", "density", "curve_position", "face",
+           "triangle")
 
 
 class Samples:
@@ -14,7 +15,8 @@ class Samples:
 
     index (uint64): each sample's index k in the set; u, v: unit-square
     parameters; x, y, z: the surface point; nx, ny, nz, density,
-    curve_position when asked for, else None. Float columns are float64, or
+    curve_position when asked for, else None; face (CAD models) and triangle
+    (meshes; u, v are then barycentric) as uint32 when asked for. Float columns are float64, or
     float32 with precision="float32". `tree` is the curve tree's summary
     (the wire's TreeInfo fields as a dict); `begin`, `end` the resolved index
     range; `seed` and `algorithm_version` identify the set.
