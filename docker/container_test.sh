@@ -74,6 +74,13 @@ echo "healthy; the server runs as uid $($engine exec sfcsampler-test id -u)"
   -o "$work/container.csv" || fail "no samples through the published port"
 cmp -s "$work/embedded.csv" "$work/container.csv" || fail "samples from the container differ from in-process ones"
 echo "200000 samples through 127.0.0.1:$port, byte-identical to the in-process run"
+# A mesh travels to the container once (uploaded by content hash) and samples alike.
+printf 'v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\nf 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n' > "$work/octahedron.obj"
+"$cli" sample -q --surface "obj:$work/octahedron.obj" --count 20000 --triangle -o "$work/mesh_embedded.csv"
+"$cli" sample -q --server "127.0.0.1:$port" --surface "obj:$work/octahedron.obj" --count 20000 --triangle \
+  -o "$work/mesh_container.csv" || fail "no mesh samples from the container"
+cmp -s "$work/mesh_embedded.csv" "$work/mesh_container.csv" || fail "mesh samples from the container differ"
+echo "20000 samples of an uploaded mesh, byte-identical to the in-process run"
 
 start=$(date +%s%N)
 $engine stop -t 20 sfcsampler-test > /dev/null || fail "stop failed"
