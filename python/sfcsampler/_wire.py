@@ -72,7 +72,7 @@ def _columns(buf, dtype):
 
 
 def _batch(buf, requested):
-    first_index, size, index, columns = 0, 0, [], {}
+    first_index, size, index, columns, model_columns = 0, 0, [], {}, {}
     for number, _, value in fields(buf):
         if number == 1:
             first_index = value
@@ -84,6 +84,11 @@ def _batch(buf, requested):
             columns = _columns(value, np.dtype("<f8"))
         elif number == 5:
             columns = _columns(value, np.dtype("<f4"))
+        elif number in (6, 7):  # face, triangle: packed fixed32
+            name = "face" if number == 6 else "triangle"
+            model_columns.setdefault(name, []).append(np.frombuffer(value, dtype="<u4"))
+    for name, parts in model_columns.items():
+        columns[name] = np.concatenate(parts) if len(parts) > 1 else parts[0].copy()
     if index:
         index = np.concatenate(index) if len(index) > 1 else index[0].copy()
         if len(index) != size:
@@ -103,7 +108,7 @@ def _batch(buf, requested):
 def decode_response(raw, requested):
     """(StreamHeader or None, dict of columns) of one serialized SampleResponse.
 
-    `requested` names the float columns the request asked for; a column that
+    `requested` names the columns the request asked for; a column that
     is missing or of the wrong length is DataLossError.
     """
     buf = memoryview(raw)

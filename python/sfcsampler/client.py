@@ -12,6 +12,8 @@ A Client may be used from several threads at once (grpc channels are
 thread-safe); each batches() iterator belongs to one thread.
 """
 
+import hashlib
+import os
 import time
 
 import grpc
@@ -31,6 +33,8 @@ _SEQUENCES = {"jittered": pb.SEQUENCE_JITTERED, "equal": pb.SEQUENCE_EQUAL,
               "random": pb.SEQUENCE_RANDOM, "vandercorput": pb.SEQUENCE_VAN_DER_CORPUT,
               "progressive": pb.SEQUENCE_PROGRESSIVE}
 _PRECISIONS = {"float64": pb.PRECISION_FLOAT64, "float32": pb.PRECISION_FLOAT32}
+_MODEL_FORMATS = ("step", "iges", "nurbs", "obj", "ply")
+_UPLOAD_CHUNK = 1 << 20  # the server takes chunks of up to 1 MiB
 
 
 def _tree_spec(request, spec):
@@ -108,6 +112,54 @@ class Client:
             metadata.append(("authorization", "Bearer " + self._token))
         return metadata
 
+    def upload(self, spec):
+        """Makes sure the server holds the model FORMAT:PATH (step, iges, nurbs, obj, ply).
+
+        Hashes the file, asks the server whether it has those bytes, uploads
+        them only if not, and returns "FORMAT:sha256=<hex>", the spec the
+        server knows the model by. Other specs are returned unchanged.
+        """
+        fmt, colon, reference = spec.partition(":")
+        if not colon or fmt not in _MODEL_FORMATS:
+            return spec
+        local = None
+        if reference.startswith("sha256="):
+            digest = reference[len("sha256="):]
+        else:
+            try:
+                with open(reference, "rb") as f:
+                    local = f.read()
+            except OSError as e:
+                raise InvalidArgumentError(3, f'cannot read the model "{reference}": {e}') from e
+            digest = hashlib.sha256(local).hexdigest()
+        metadata = self._metadata("")
+        try:
+            return self._stub.FindModel(pb.FindModelRequest(sha256=digest, format=fmt),
+                                        timeout=self._timeout, metadata=metadata).spec
+        except grpc.RpcError as e:
+            if e.code() != grpc.StatusCode.NOT_FOUND or local is None:
+                raise _error(e) from None
+        name = os.path.basename(reference)
+
+        def chunks():
+            for offset in range(0, max(len(local), 1), _UPLOAD_CHUNK):
+                first = offset == 0
+                yield pb.ModelChunk(format=fmt if first else "", name=name if first else "",
+                                    data=local[offset:offset + _UPLOAD_CHUNK])
+        try:
+            return self._stub.UploadModel(chunks(), timeout=self._timeout, metadata=metadata).spec
+        except grpc.RpcError as e:
+            raise _error(e) from None
+
+    def _with_model(self, request):
+        """`request` with a model file's surface replaced by the spec the server knows it by."""
+        surface = request.get("surface")
+        if isinstance(surface, str):
+            uploaded = self.upload(surface)
+            if uploaded != surface:
+                request = dict(request, surface=uploaded)
+        return request
+
     def _wire_request(self, request, precision, batch_size, begin_end):
         w = pb.SampleRequest()
         _tree_spec(request, w.tree)
@@ -130,6 +182,8 @@ class Client:
         w.normals = request.normals
         w.density = request.density_column
         w.curve_position = request.curve_position
+        w.face = request.face
+        w.triangle = request.triangle
         w.precision = _PRECISIONS[precision]
         w.batch_size = batch_size
         return w
@@ -151,11 +205,12 @@ class Client:
         if precision not in _PRECISIONS:
             raise InvalidArgumentError(3, "precision must be float64 or float32")
         batch_size = batch_size or self._batch_size
-        req = make_request(request)
+        req = make_request(self._with_model(request))
         requested = [name for name, on in (("u", 1), ("v", 1), ("x", 1), ("y", 1), ("z", 1),
                                            ("nx", req.normals), ("ny", req.normals),
                                            ("nz", req.normals), ("density", req.density_column),
-                                           ("curve_position", req.curve_position)) if on]
+                                           ("curve_position", req.curve_position),
+                                           ("face", req.face), ("triangle", req.triangle)) if on]
         range_end = req.index_range[1]
         metadata = self._metadata(req.surface_key)
         first = None          # the first stream's header
@@ -239,7 +294,7 @@ class Client:
 
     def prepare(self, **request):
         """Builds (or finds in the server's cache) the request's tree; returns its summary."""
-        req = make_request(request)
+        req = make_request(self._with_model(request))
         w = pb.PrepareRequest(count=req.tree_count or req.count)
         _tree_spec(req, w.tree)
         try:

@@ -164,3 +164,25 @@ def test_tls_and_token(tmp_path):
             sfcsampler.Client(target, tls_roots=str(tmp_path / "missing.pem"))
     finally:
         stop(proc)
+
+
+OCTAHEDRON = ("v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n"
+              "f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n")
+
+
+def test_a_mesh_is_uploaded_once_and_samples_as_in_process(server, tmp_path):
+    path = tmp_path / "octahedron.obj"
+    path.write_text(OCTAHEDRON)
+    request = dict(surface=f"obj:{path}", count=4000, triangle=True, density="expr:1+z*z")
+    with sfcsampler.Client(server) as client:
+        spec = client.upload(f"obj:{path}")
+        assert spec.startswith("obj:sha256=")
+        uploads = client.cache_stats().get("model_uploads", 0)
+        remote = client.sample(**request)
+        assert client.cache_stats().get("model_uploads", 0) == uploads  # found, not sent again
+        by_hash = client.sample(**dict(request, surface=spec))
+    local = sfcsampler.sample(**request)
+    assert remote.triangle.dtype == np.uint32 and len(remote.triangle) == 4000
+    for name in ("x", "y", "z", "u", "v", "triangle"):
+        assert np.array_equal(getattr(remote, name), getattr(local, name)), name
+        assert np.array_equal(getattr(by_hash, name), getattr(local, name)), name
