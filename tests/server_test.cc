@@ -209,6 +209,50 @@ TEST(Server, EmbeddedAndWireSamplesAreIdentical) {
   ExpectEqual(*wire, local);
 }
 
+// Every value column, through the pipelined stream, in each encoding and
+// precision: float64 carries the embedded engine's bits, float32 exactly
+// their float rounding. Small batches make many messages pass the pipeline.
+TEST(Server, EveryEncodingAndPrecisionCarriesTheEmbeddedEnginesSamples) {
+  for (int depth : {1, 3}) {
+    ServerOptions options = LoopbackOptions();
+    options.stream_pipeline_depth = depth;
+    Running r = StartServer(options);
+    SampleRequest request = Request("torus", 30000, 8);
+    request.tree.density = "gaussian:floor=0.1";
+    request.fields.normal = request.fields.density = request.fields.curve_position = true;
+    DirectTreeSource source;
+    SamplingEngine engine({}, &source);
+    auto job = engine.Start(request);
+    ASSERT_TRUE(job.ok());
+    SampleBatch local;
+    while (*job->cursor->Next(4096, &local) > 0) {
+    }
+    for (auto encoding : {v1::COLUMN_ENCODING_RAW, v1::COLUMN_ENCODING_PACKED}) {
+      for (auto precision : {v1::PRECISION_FLOAT64, v1::PRECISION_FLOAT32}) {
+        ClientOptions co;
+        co.target = "127.0.0.1:" + std::to_string(r.server->port());
+        co.column_encoding = encoding;
+        co.precision = precision;
+        co.batch_size = 777;
+        auto wire = Fetch(**SamplerClient::Connect(co), request);
+        ASSERT_TRUE(wire.ok()) << wire.status();
+        ASSERT_EQ(wire->index, local.index);
+        for (auto column : {&SampleBatch::u, &SampleBatch::v, &SampleBatch::x, &SampleBatch::y,
+                            &SampleBatch::z, &SampleBatch::nx, &SampleBatch::ny, &SampleBatch::nz,
+                            &SampleBatch::density, &SampleBatch::curve_position}) {
+          ASSERT_EQ(((*wire).*column).size(), local.size());
+          for (size_t i = 0; i < local.size(); ++i) {
+            const double expected = precision == v1::PRECISION_FLOAT64
+                                        ? (local.*column)[i]
+                                        : static_cast<double>(static_cast<float>((local.*column)[i]));
+            ASSERT_EQ(((*wire).*column)[i], expected) << "sample " << i << " depth " << depth;
+          }
+        }
+      }
+    }
+  }
+}
+
 TEST(Server, ASecondRequestHitsAndEightConcurrentFirstRequestsBuildOnce) {
   Running r = StartServer(LoopbackOptions());
   std::vector<std::thread> threads;
