@@ -1,8 +1,12 @@
 // Service benchmarks; prints a Markdown table. Everything runs in this
 // process over loopback TCP: a real sfcsampler server, the C++ client
 // library, and a raw-bytes gRPC stream as the baseline measured in the same
-// run.
+// run. To tell the stream's own cost from generation's, the same request is
+// also timed in process (generation alone, the server's thread count) and
+// through a bench-only service that streams the wire path without
+// generating (one batch generated first, encoded into every message).
 //   stream_benchmark [samples]   (default 10^7)
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -12,6 +16,8 @@
 
 #include "bench/raw_stream.grpc.pb.h"
 #include "client/sampler_client.h"
+#include "engine/sampling_engine.h"
+#include "proto/convert.h"
 #include "grpcpp/create_channel.h"
 #include "grpcpp/server_builder.h"
 #include "server/sampler_server.h"
@@ -35,6 +41,44 @@ class RawStreamService final : public sfcsampler::bench::RawStream::Service {
     return grpc::Status::OK;
   }
 };
+
+// The Sample RPC's wire path without generation: every message is encoded
+// (ToProto, as the server does) from one batch generated beforehand, with
+// its indices moved on, and written; the client decodes it as usual.
+class WireOnlyService final : public v1::Sampler::Service {
+ public:
+  explicit WireOnlyService(SampleBatch batch) : batch_(std::move(batch)) {}
+  grpc::Status Sample(grpc::ServerContext* context, const v1::SampleRequest* request,
+                      grpc::ServerWriter<v1::SampleResponse>* writer) override {
+    v1::SampleResponse response;
+    response.mutable_header()->set_begin(0);
+    response.mutable_header()->set_end(request->count());
+    response.mutable_header()->set_expected_samples(static_cast<int64_t>(request->count()));
+    SampleBatch batch = batch_;
+    for (uint64_t sent = 0; sent < request->count();) {
+      const size_t n = std::min<uint64_t>(batch_.size(), request->count() - sent);
+      if (n < batch.size()) batch = SampleBatch(), batch.AppendFrom(batch_, 0, n);
+      for (size_t i = 0; i < n; ++i) batch.index[i] = sent + i;
+      response.mutable_batch()->Clear();
+      ToProto(batch, SampleFields{}, request->precision(), response.mutable_batch(), request->column_encoding());
+      if (!writer->Write(response)) break;
+      response.clear_header();
+      sent += n;
+    }
+    return grpc::Status::OK;
+  }
+
+ private:
+  const SampleBatch batch_;
+};
+
+// The fastest of `runs` calls of `seconds` (the machine is shared and noisy).
+template <typename F>
+double Best(F seconds, int runs = 2) {
+  double best = seconds();
+  for (int i = 1; i < runs; ++i) best = std::min(best, seconds());
+  return best;
+}
 
 // Seconds to receive `total` bytes over a raw stream.
 double RawSeconds(const std::string& target, uint64_t total, uint32_t chunk) {
@@ -81,6 +125,30 @@ double StreamSeconds(SamplerClient& client, const SampleRequest& request, uint64
   return Since(start);
 }
 
+// Seconds to generate `request` in process from a tree built beforehand,
+// in batches of `batch` with `threads` generation threads, as a server does.
+double GenerationSeconds(const SampleRequest& request, int threads, uint32_t batch,
+                         SampleBatch* first_batch = nullptr) {
+  DirectTreeSource source;
+  EngineLimits limits;
+  limits.generation_threads = threads;
+  limits.max_tree_leaves = uint64_t{1} << 26;
+  SamplingEngine engine(limits, &source);
+  auto job = engine.Start(request);
+  if (!job.ok()) {
+    std::fprintf(stderr, "generation failed: %s\n", job.status().ToString().c_str());
+    std::exit(1);
+  }
+  SampleBatch b;
+  const auto start = Clock::now();
+  for (bool first = true;; first = false) {
+    b.Clear();
+    if (*job->cursor->Next(batch, &b) == 0) break;
+    if (first && first_batch) *first_batch = b;
+  }
+  return Since(start);
+}
+
 int Run(uint64_t n) {
   ServerOptions options;
   options.address = "127.0.0.1:0";
@@ -91,47 +159,95 @@ int Run(uint64_t n) {
   const std::string target = "127.0.0.1:" + std::to_string(server->port());
 
   RawStreamService raw;
+
+  std::printf("| measurement | value |\n|---|---:|\n");
+  const uint32_t batch = 65536;
+  const SampleRequest sphere = Request("sphere", "uniform", n);
+  SampleBatch one_batch;
+  GenerationSeconds(Request("sphere", "uniform", batch), 1, batch, &one_batch);
+
+  WireOnlyService wire_only(one_batch);
   grpc::ServerBuilder builder;
   int raw_port = 0;
   builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &raw_port);
   builder.RegisterService(&raw);
   auto raw_server = builder.BuildAndStart();
   const std::string raw_target = "127.0.0.1:" + std::to_string(raw_port);
+  grpc::ServerBuilder wire_builder;
+  int wire_port = 0;
+  wire_builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &wire_port);
+  wire_builder.RegisterService(&wire_only);
+  auto wire_server = wire_builder.BuildAndStart();
+  const std::string wire_target = "127.0.0.1:" + std::to_string(wire_port);
 
-  std::printf("| measurement | value |\n|---|---:|\n");
-  const uint32_t batch = 65536;
   for (auto precision : {v1::PRECISION_FLOAT32, v1::PRECISION_FLOAT64}) {
-    ClientOptions co;
-    co.target = target;
-    co.precision = precision;
-    co.batch_size = batch;
-    auto client = *SamplerClient::Connect(co);
-    const SampleRequest request = Request("sphere", "uniform", n);
-    uint64_t received = 0;
-    StreamSeconds(*client, request, &received);  // warm: build and cache the tree
-    const double seconds = StreamSeconds(*client, request, &received);
-    const size_t value_bytes = precision == v1::PRECISION_FLOAT32 ? 4 : 8;
-    const uint64_t payload = received * 5 * value_bytes;
-    const double raw_seconds = RawSeconds(raw_target, payload, static_cast<uint32_t>(batch * 5 * value_bytes));
     const char* name = precision == v1::PRECISION_FLOAT32 ? "float32" : "float64";
-    std::printf("| %s: %llu samples streamed (sphere, cached tree) | %.2f M samples/s (%.0f MB/s) |\n", name,
-                static_cast<unsigned long long>(received), received / seconds / 1e6, payload / seconds / 1e6);
+    const size_t value_bytes = precision == v1::PRECISION_FLOAT32 ? 4 : 8;
+    const uint64_t payload = n * 5 * value_bytes;
+    const double raw_seconds = Best([&] {
+      return RawSeconds(raw_target, payload, static_cast<uint32_t>(batch * 5 * value_bytes));
+    });
     std::printf("| %s: raw bytes stream of the same %llu MB | %.0f MB/s |\n", name,
                 static_cast<unsigned long long>(payload / 1000000), payload / raw_seconds / 1e6);
-    std::printf("| %s: ratio samples / raw | %.2f |\n", name, raw_seconds / seconds);
+    // Measured next to the streams it explains (the machine's load drifts).
+    const double generation =
+        Best([&] { return GenerationSeconds(sphere, options.limits.generation_threads, batch); });
+    std::printf("| generation alone, in process: the same %llu sphere samples, %d threads | %.2f M samples/s |\n",
+                static_cast<unsigned long long>(n), options.limits.generation_threads, n / generation / 1e6);
+    for (auto encoding : {v1::COLUMN_ENCODING_RAW, v1::COLUMN_ENCODING_PACKED}) {
+      const char* how = encoding == v1::COLUMN_ENCODING_RAW ? "raw columns" : "packed columns";
+      ClientOptions co;
+      co.target = target;
+      co.precision = precision;
+      co.batch_size = batch;
+      co.column_encoding = encoding;
+      auto client = *SamplerClient::Connect(co);
+      uint64_t received = 0;
+      StreamSeconds(*client, sphere, &received);  // warm: build and cache the tree
+      const double seconds = Best([&] { return StreamSeconds(*client, sphere, &received); });
+      std::printf("| %s, %s: %llu samples streamed (sphere, cached tree) | %.2f M samples/s (%.0f MB/s) |\n",
+                  name, how, static_cast<unsigned long long>(received), received / seconds / 1e6,
+                  payload / seconds / 1e6);
+      std::printf("| %s, %s: ratio stream / raw bytes | %.2f |\n", name, how, raw_seconds / seconds);
+      if (encoding == v1::COLUMN_ENCODING_RAW) {
+        std::printf("| %s, %s: ratio stream / generation alone | %.2f |\n", name, how, generation / seconds);
+      }
+      co.target = wire_target;
+      auto wire_client = *SamplerClient::Connect(co);
+      const double wire_seconds = Best([&] { return StreamSeconds(*wire_client, sphere, &received); });
+      std::printf("| %s, %s: wire path only (no generation), ratio to raw bytes | %.2f (%.1f M samples/s) |\n",
+                  name, how, raw_seconds / wire_seconds, received / wire_seconds / 1e6);
+    }
   }
 
   {
-    ClientOptions co;
-    co.target = target;
-    auto client = *SamplerClient::Connect(co);
+    // Cold: a fresh server each time, so the tree is built; then the same
+    // request again from its cache. The best of three of each.
     const SampleRequest request = Request("eight", "gaussian:floor=0.05", 1'000'000);
     uint64_t received = 0;
-    const double first = StreamSeconds(*client, request, &received);
-    const double hit = StreamSeconds(*client, request, &received);
+    double first = 1e9, hit = 1e9, fixed = 1e9;
+    for (int i = 0; i < 3; ++i) {
+      auto fresh = *SamplerServer::Start(options);
+      ClientOptions co;
+      co.target = "127.0.0.1:" + std::to_string(fresh->port());
+      auto client = *SamplerClient::Connect(co);
+      first = std::min(first, StreamSeconds(*client, request, &received));
+      hit = std::min(hit, StreamSeconds(*client, request, &received));
+      // A hit that streams one sample: the request's fixed cost (lookup,
+      // header, round trip).
+      fixed = std::min(fixed, StreamSeconds(*client, SamplerClient::Range(request, 0, 1), &received));
+      fresh->Shutdown(1);
+    }
     std::printf("| first request, 10^6 samples, eight surface, curvature density | %.3f s |\n", first);
     std::printf("| the same request again (cache hit) | %.3f s |\n", hit);
     std::printf("| first / hit | %.1fx |\n", first / hit);
+    // Where the hit's time goes: generating the same samples in process from
+    // a tree built beforehand.
+    const double generate = std::min(GenerationSeconds(request, options.limits.generation_threads, 65536),
+                                     GenerationSeconds(request, options.limits.generation_threads, 65536));
+    std::printf("| of the hit: generating the 10^6 samples in process, %d threads | %.3f s |\n",
+                options.limits.generation_threads, generate);
+    std::printf("| of the hit: a hit streaming 1 sample (lookup, header, round trip) | %.4f s |\n", fixed);
   }
 
   {
@@ -162,6 +278,7 @@ int Run(uint64_t n) {
   }
   server->Shutdown(1);
   raw_server->Shutdown();
+  wire_server->Shutdown();
   return 0;
 }
 

@@ -575,31 +575,38 @@ TEST(Server, TheServerDeadlineEndsLongStreams) {
   ExpectStatus(result.status(), absl::StatusCode::kDeadlineExceeded, "resume after the last index");
 }
 
+// With any pipeline depth: the producer stops at the full queue, the RPC
+// thread's blocked write is what the watchdog cuts.
 TEST(Server, AReaderThatStopsReadingIsCutAndFreesItsSlot) {
-  ServerOptions options = LoopbackOptions();
-  options.write_timeout_seconds = 0.3;
-  options.max_concurrent_streams = 1;
-  ClientOptions co;
-  co.batch_size = 16384;
-  Running r = StartServer(options, co);
-  std::atomic<bool> freed{false};
-  std::atomic<double> stalled{0};
-  auto result = r.client->Sample(Request("plane", 4'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
-    // Stop reading: the server's writes block on flow control. Its slot
-    // must come free while this client still holds the stream open.
-    const auto until = std::chrono::steady_clock::now() + milliseconds(5000);
-    while (std::chrono::steady_clock::now() < until && !freed) {
-      freed = r.server->service().active_streams() == 0;
-      std::this_thread::sleep_for(milliseconds(10));
-    }
-    stalled = r.server->metrics().stalled_streams();
-    return absl::OkStatus();
-  });
-  EXPECT_TRUE(freed) << "the stalled stream still held its slot after 5 s";
-  EXPECT_EQ(stalled.load(), 1.0);
-  EXPECT_FALSE(result.ok());
-  // The slot serves the next client at once.
-  EXPECT_TRUE(Fetch(*r.client, Request("torus", 1000)).ok());
+  for (int depth : {1, 2, 4}) {
+    ServerOptions options = LoopbackOptions();
+    options.write_timeout_seconds = 0.3;
+    options.max_concurrent_streams = 1;
+    options.stream_pipeline_depth = depth;
+    ClientOptions co;
+    co.batch_size = 16384;
+    Running r = StartServer(options, co);
+    std::atomic<bool> freed{false};
+    std::atomic<double> stalled{0};
+    auto result = r.client->Sample(Request("plane", 4'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
+      // Stop reading: the server's writes block on flow control. Its slot
+      // must come free while this client still holds the stream open.
+      const auto until = std::chrono::steady_clock::now() + milliseconds(5000);
+      while (std::chrono::steady_clock::now() < until && !freed) {
+        freed = r.server->service().active_streams() == 0;
+        std::this_thread::sleep_for(milliseconds(10));
+      }
+      stalled = r.server->metrics().stalled_streams();
+      return absl::OkStatus();
+    });
+    EXPECT_TRUE(freed) << "the stalled stream still held its slot after 5 s, depth " << depth;
+    EXPECT_EQ(stalled.load(), 1.0) << "depth " << depth;
+    EXPECT_FALSE(result.ok());
+    // Generation stopped with the queue: far fewer than the 4 M samples.
+    EXPECT_LT(r.server->metrics().samples_streamed(), 2'000'000.0);
+    // The slot serves the next client at once.
+    EXPECT_TRUE(Fetch(*r.client, Request("torus", 1000)).ok());
+  }
 }
 
 TEST(Server, AModelIsUploadedOnceAndNamedByItsHash) {
