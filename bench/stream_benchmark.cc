@@ -157,6 +157,10 @@ int Run(uint64_t n) {
   options.limits.max_tree_leaves = uint64_t{1} << 26;
   auto server = *SamplerServer::Start(options);
   const std::string target = "127.0.0.1:" + std::to_string(server->port());
+  ServerOptions unpipelined_options = options;
+  unpipelined_options.stream_pipeline_depth = 0;
+  auto unpipelined = *SamplerServer::Start(unpipelined_options);
+  const std::string unpipelined_target = "127.0.0.1:" + std::to_string(unpipelined->port());
 
   RawStreamService raw;
 
@@ -194,29 +198,43 @@ int Run(uint64_t n) {
         Best([&] { return GenerationSeconds(sphere, options.limits.generation_threads, batch); });
     std::printf("| generation alone, in process: the same %llu sphere samples, %d threads | %.2f M samples/s |\n",
                 static_cast<unsigned long long>(n), options.limits.generation_threads, n / generation / 1e6);
-    for (auto encoding : {v1::COLUMN_ENCODING_RAW, v1::COLUMN_ENCODING_PACKED}) {
-      const char* how = encoding == v1::COLUMN_ENCODING_RAW ? "raw columns" : "packed columns";
+    // The stream as it ran before (generation between writes, packed
+    // columns: a server with no pipeline), then pipelined with each encoding.
+    struct Setup {
+      const char* how;
+      const std::string* target;
+      v1::ColumnEncoding encoding;
+    } setups[] = {{"no pipeline, packed columns (as before)", &unpipelined_target, v1::COLUMN_ENCODING_PACKED},
+                  {"pipelined, packed columns", &target, v1::COLUMN_ENCODING_PACKED},
+                  {"pipelined, raw columns", &target, v1::COLUMN_ENCODING_RAW}};
+    for (const Setup& setup : setups) {
       ClientOptions co;
-      co.target = target;
+      co.target = *setup.target;
       co.precision = precision;
       co.batch_size = batch;
-      co.column_encoding = encoding;
+      co.column_encoding = setup.encoding;
       auto client = *SamplerClient::Connect(co);
       uint64_t received = 0;
       StreamSeconds(*client, sphere, &received);  // warm: build and cache the tree
       const double seconds = Best([&] { return StreamSeconds(*client, sphere, &received); });
       std::printf("| %s, %s: %llu samples streamed (sphere, cached tree) | %.2f M samples/s (%.0f MB/s) |\n",
-                  name, how, static_cast<unsigned long long>(received), received / seconds / 1e6,
+                  name, setup.how, static_cast<unsigned long long>(received), received / seconds / 1e6,
                   payload / seconds / 1e6);
-      std::printf("| %s, %s: ratio stream / raw bytes | %.2f |\n", name, how, raw_seconds / seconds);
-      if (encoding == v1::COLUMN_ENCODING_RAW) {
-        std::printf("| %s, %s: ratio stream / generation alone | %.2f |\n", name, how, generation / seconds);
-      }
+      std::printf("| %s, %s: ratio stream / raw bytes; stream / generation alone | %.2f; %.2f |\n", name,
+                  setup.how, raw_seconds / seconds, generation / seconds);
+    }
+    for (auto encoding : {v1::COLUMN_ENCODING_PACKED, v1::COLUMN_ENCODING_RAW}) {
+      ClientOptions co;
       co.target = wire_target;
+      co.precision = precision;
+      co.batch_size = batch;
+      co.column_encoding = encoding;
       auto wire_client = *SamplerClient::Connect(co);
+      uint64_t received = 0;
       const double wire_seconds = Best([&] { return StreamSeconds(*wire_client, sphere, &received); });
       std::printf("| %s, %s: wire path only (no generation), ratio to raw bytes | %.2f (%.1f M samples/s) |\n",
-                  name, how, raw_seconds / wire_seconds, received / wire_seconds / 1e6);
+                  name, encoding == v1::COLUMN_ENCODING_RAW ? "raw columns" : "packed columns",
+                  raw_seconds / wire_seconds, received / wire_seconds / 1e6);
     }
   }
 
@@ -277,6 +295,7 @@ int Run(uint64_t n) {
                 total / seconds / 1e6);
   }
   server->Shutdown(1);
+  unpipelined->Shutdown(1);
   raw_server->Shutdown();
   wire_server->Shutdown();
   return 0;

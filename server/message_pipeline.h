@@ -4,6 +4,9 @@
 // already made, so generation no longer waits for each blocking Write and
 // Write no longer waits for generation.
 //
+// Depth 0 is no pipeline: Next() makes each message on the caller's thread,
+// between writes (how streams ran before the pipeline; kept to measure it).
+//
 // Memory is bounded: at most `depth` finished messages wait in the queue,
 // one is being made and one written, so a stream holds at most depth + 2
 // messages (and its producer's one SampleBatch). Written messages come back
@@ -49,7 +52,7 @@ class MessagePipeline {
 
   // Starts the producer. The stream's first message is always made (with an
   // empty batch if there are no samples); later ones only while `produce`
-  // returns samples. depth >= 1.
+  // returns samples. depth >= 0 (0: no producer thread, see above).
   MessagePipeline(int depth, Produce produce);
   // Stops the producer (it finishes the batch it is making) and joins it.
   ~MessagePipeline();
@@ -65,6 +68,10 @@ class MessagePipeline {
 
  private:
   void Run() ABSL_LOCKS_EXCLUDED(mu_);
+  // Makes one message with `produce_` (in `response`, or a new one when
+  // null) and appends what follows from it to `out`: the message (unless a
+  // later empty one), then the end if the stream is over.
+  void Step(std::unique_ptr<::sfcsampler::v1::SampleResponse> response, std::vector<Item>* out);
 
   // Constant after construction.
   const size_t depth_;
@@ -75,6 +82,9 @@ class MessagePipeline {
   std::vector<std::unique_ptr<::sfcsampler::v1::SampleResponse>> free_ ABSL_GUARDED_BY(mu_);
   bool stopping_ ABSL_GUARDED_BY(mu_) = false;
   std::thread thread_;
+  // The producer's own (Run's thread, or Next's caller at depth 0).
+  bool first_ = true;
+  bool ended_ = false;
 };
 
 }  // namespace sfc

@@ -46,7 +46,7 @@ BuildControl RequestControl(const grpc::ServerContext* context, Clock::time_poin
 // range (16 bytes a sample), the producer's batch (per sample the index and
 // the columns in float64, the model columns uint32), and the messages of its
 // pipeline, at most pipeline_depth + 2 (queued, being made, being written;
-// MessagePipeline), each per sample the columns on the wire (float32 if
+// MessagePipeline; one without a pipeline), each per sample the columns on the wire (float32 if
 // asked; indices listed, at most). The batch is the requested size, or the
 // largest the server would choose. An invalid range counts nothing here:
 // Start refuses it.
@@ -59,7 +59,7 @@ uint64_t StreamWorkingBytes(const SampleRequest& request, const v1::SampleReques
   const uint64_t columns = 5 + (f.normal ? 3 : 0) + (f.density ? 1 : 0) + (f.curve_position ? 1 : 0);
   const uint64_t index_columns = (f.face ? 1 : 0) + (f.triangle ? 1 : 0);
   const uint64_t width = wire.precision() == v1::PRECISION_FLOAT32 ? 4 : 8;
-  const uint64_t messages = static_cast<uint64_t>(std::max(pipeline_depth, 1)) + 2;
+  const uint64_t messages = pipeline_depth <= 0 ? 1 : static_cast<uint64_t>(pipeline_depth) + 2;
   const uint64_t per_sample =
       (8 + 8 * columns + 4 * index_columns) + messages * (8 + width * columns + 4 * index_columns);
   const uint64_t batch = wire.batch_size() != 0 ? wire.batch_size() : kDefaultBatchSize;

@@ -57,9 +57,10 @@ int main(int argc, char** argv) {
                  "ranges: 16 bytes a sample; batches and messages); streams wait for it")
       ->capture_default_str();
   app.add_option("--stream-pipeline-depth", o.stream_pipeline_depth,
-                 "messages a stream generates ahead of its writes (it holds at most this + 2)")
+                 "messages a stream generates ahead of its writes (it holds at most this + 2); 0: "
+                 "generate between writes on the RPC thread")
       ->capture_default_str()
-      ->check(CLI::Range(1, 16));
+      ->check(CLI::Range(0, 16));
   app.add_option("--max-concurrent-builds", o.max_concurrent_builds, "tree builds at once")
       ->capture_default_str()
       ->check(CLI::Range(1, 64));

@@ -44,7 +44,7 @@ std::vector<MessagePipeline::Item> Drain(MessagePipeline& pipeline) {
 }
 
 TEST(MessagePipeline, DeliversEveryBatchInOrderThenTheEnd) {
-  for (int depth : {1, 2, 5}) {
+  for (int depth : {0, 1, 2, 5}) {
     for (uint64_t total : {0u, 1u, 7u, 100u, 101u}) {
       std::atomic<int> calls{0};
       MessagePipeline pipeline(depth, Counting(total, 10, &calls));
@@ -68,17 +68,30 @@ TEST(MessagePipeline, DeliversEveryBatchInOrderThenTheEnd) {
 }
 
 TEST(MessagePipeline, AnErrorEndsTheStreamAfterTheMessagesBeforeIt) {
-  int call = 0;
-  MessagePipeline pipeline(2, [&](v1::SampleBatch* out) -> absl::StatusOr<size_t> {
-    if (++call == 3) return absl::InvalidArgumentError("not finite at a sample");
-    out->set_size(5);
-    return 5;
-  });
-  std::vector<MessagePipeline::Item> items = Drain(pipeline);
-  ASSERT_EQ(items.size(), 3u);
-  EXPECT_EQ(items[0].samples + items[1].samples, 10u);
-  EXPECT_EQ(items[2].response, nullptr);
-  EXPECT_EQ(items[2].status.code(), absl::StatusCode::kInvalidArgument);
+  for (int depth : {0, 2}) {
+    int call = 0;
+    MessagePipeline pipeline(depth, [&](v1::SampleBatch* out) -> absl::StatusOr<size_t> {
+      if (++call == 3) return absl::InvalidArgumentError("not finite at a sample");
+      out->set_size(5);
+      return 5;
+    });
+    std::vector<MessagePipeline::Item> items = Drain(pipeline);
+    ASSERT_EQ(items.size(), 3u);
+    EXPECT_EQ(items[0].samples + items[1].samples, 10u);
+    EXPECT_EQ(items[2].response, nullptr);
+    EXPECT_EQ(items[2].status.code(), absl::StatusCode::kInvalidArgument);
+  }
+}
+
+TEST(MessagePipeline, WithoutAPipelineNothingIsMadeBeforeItIsAskedFor) {
+  std::atomic<int> calls{0};
+  MessagePipeline pipeline(0, Counting(uint64_t{1} << 40, 1000, &calls));
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_EQ(calls.load(), 0);
+  for (int i = 1; i <= 3; ++i) {
+    ASSERT_TRUE(pipeline.Next(absl::ZeroDuration()).has_value());
+    EXPECT_EQ(calls.load(), i);
+  }
 }
 
 TEST(MessagePipeline, AConsumerThatTakesNothingStopsTheProducerAtTheDepth) {

@@ -213,7 +213,7 @@ TEST(Server, EmbeddedAndWireSamplesAreIdentical) {
 // precision: float64 carries the embedded engine's bits, float32 exactly
 // their float rounding. Small batches make many messages pass the pipeline.
 TEST(Server, EveryEncodingAndPrecisionCarriesTheEmbeddedEnginesSamples) {
-  for (int depth : {1, 3}) {
+  for (int depth : {0, 1, 3}) {
     ServerOptions options = LoopbackOptions();
     options.stream_pipeline_depth = depth;
     Running r = StartServer(options);
@@ -575,10 +575,10 @@ TEST(Server, TheServerDeadlineEndsLongStreams) {
   ExpectStatus(result.status(), absl::StatusCode::kDeadlineExceeded, "resume after the last index");
 }
 
-// With any pipeline depth: the producer stops at the full queue, the RPC
-// thread's blocked write is what the watchdog cuts.
+// With any pipeline depth (0: none): the producer stops at the full queue,
+// the RPC thread's blocked write is what the watchdog cuts.
 TEST(Server, AReaderThatStopsReadingIsCutAndFreesItsSlot) {
-  for (int depth : {1, 2, 4}) {
+  for (int depth : {0, 1, 2, 4}) {
     ServerOptions options = LoopbackOptions();
     options.write_timeout_seconds = 0.3;
     options.max_concurrent_streams = 1;
