@@ -184,8 +184,18 @@ int Run(uint64_t n) {
   auto wire_server = wire_builder.BuildAndStart();
   const std::string wire_target = "127.0.0.1:" + std::to_string(wire_port);
 
-  for (auto precision : {v1::PRECISION_FLOAT32, v1::PRECISION_FLOAT64}) {
-    const char* name = precision == v1::PRECISION_FLOAT32 ? "float32" : "float64";
+  // Each stream next to the raw bytes and the generation it is bounded by.
+  struct Case {
+    const char* surface;
+    const SampleRequest* request;
+    v1::Precision precision;
+  } cases[] = {{"sphere", &sphere, v1::PRECISION_FLOAT32},
+               {"sphere", &sphere, v1::PRECISION_FLOAT64}};
+  for (const Case& c : cases) {
+    const v1::Precision precision = c.precision;
+    const SampleRequest& request = *c.request;
+    const std::string label = std::string(c.surface) + (precision == v1::PRECISION_FLOAT32 ? ", float32" : ", float64");
+    const char* name = label.c_str();
     const size_t value_bytes = precision == v1::PRECISION_FLOAT32 ? 4 : 8;
     const uint64_t payload = n * 5 * value_bytes;
     const double raw_seconds = Best([&] {
@@ -195,9 +205,9 @@ int Run(uint64_t n) {
                 static_cast<unsigned long long>(payload / 1000000), payload / raw_seconds / 1e6);
     // Measured next to the streams it explains (the machine's load drifts).
     const double generation =
-        Best([&] { return GenerationSeconds(sphere, options.limits.generation_threads, batch); });
-    std::printf("| generation alone, in process: the same %llu sphere samples, %d threads | %.2f M samples/s |\n",
-                static_cast<unsigned long long>(n), options.limits.generation_threads, n / generation / 1e6);
+        Best([&] { return GenerationSeconds(request, options.limits.generation_threads, batch); });
+    std::printf("| %s: generation alone, in process, the same %llu samples, %d threads | %.2f M samples/s |\n",
+                name, static_cast<unsigned long long>(n), options.limits.generation_threads, n / generation / 1e6);
     // The stream as it ran before (generation between writes, packed
     // columns: a server with no pipeline), then pipelined with each encoding.
     struct Setup {
@@ -215,9 +225,9 @@ int Run(uint64_t n) {
       co.column_encoding = setup.encoding;
       auto client = *SamplerClient::Connect(co);
       uint64_t received = 0;
-      StreamSeconds(*client, sphere, &received);  // warm: build and cache the tree
-      const double seconds = Best([&] { return StreamSeconds(*client, sphere, &received); });
-      std::printf("| %s, %s: %llu samples streamed (sphere, cached tree) | %.2f M samples/s (%.0f MB/s) |\n",
+      StreamSeconds(*client, request, &received);  // warm: build and cache the tree
+      const double seconds = Best([&] { return StreamSeconds(*client, request, &received); });
+      std::printf("| %s, %s: %llu samples streamed (cached tree) | %.2f M samples/s (%.0f MB/s) |\n",
                   name, setup.how, static_cast<unsigned long long>(received), received / seconds / 1e6,
                   payload / seconds / 1e6);
       std::printf("| %s, %s: ratio stream / raw bytes; stream / generation alone | %.2f; %.2f |\n", name,
@@ -231,7 +241,7 @@ int Run(uint64_t n) {
       co.column_encoding = encoding;
       auto wire_client = *SamplerClient::Connect(co);
       uint64_t received = 0;
-      const double wire_seconds = Best([&] { return StreamSeconds(*wire_client, sphere, &received); });
+      const double wire_seconds = Best([&] { return StreamSeconds(*wire_client, request, &received); });
       std::printf("| %s, %s: wire path only (no generation), ratio to raw bytes | %.2f (%.1f M samples/s) |\n",
                   name, encoding == v1::COLUMN_ENCODING_RAW ? "raw columns" : "packed columns",
                   raw_seconds / wire_seconds, received / wire_seconds / 1e6);
