@@ -67,7 +67,10 @@ absl::Status SampleCursor::PlanRegion(uint64_t begin, uint64_t end) {
   const Sampler& sampler = *sampler_;
   if (!sampler.sequence().monotone()) {
     // Index order is not curve order.
-    order_ = IndicesInCurveOrder(begin, end, [&](uint64_t k) { return sampler.MassCoordinate(k); });
+    const Sequence& sequence = sampler.sequence();
+    order_ = IndicesInCurveOrder(
+        begin, end, [&](uint64_t k) { return sampler.MassCoordinate(k); },
+        [&](uint64_t k) { return sequence.InWindow(k); });
     use_order_ = true;
     return absl::OkStatus();
   }

@@ -92,7 +92,9 @@ absl::Status MeshSampleCursor::Plan(uint64_t begin, uint64_t end) {
   const MeshCurveTree& tree = sampler.tree();
   if (!sampler.sequence().monotone()) {
     // Index order is not curve order.
-    order_ = IndicesInCurveOrder(begin, end, [&](uint64_t k) { return sampler.MassCoordinate(k); });
+    order_ = IndicesInCurveOrder(
+        begin, end, [&](uint64_t k) { return sampler.MassCoordinate(k); },
+        [](uint64_t) { return true; });
     use_order_ = true;
     return absl::OkStatus();
   }

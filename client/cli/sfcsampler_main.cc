@@ -81,8 +81,9 @@ struct Verbosity {
 // The tree summary and the depth-cap warnings, on stderr; the same for the
 // embedded mode (converted with ToProto) and the wire.
 void PrintTreeInfo(const ::sfcsampler::v1::TreeInfo& t, const Verbosity& verbosity = {}) {
-  if (!verbosity.quiet && t.kind() == "mesh") {
-    std::fprintf(stderr, "mesh tree %s (%s): %llu leaves, %llu bytes\n", t.key_with_grade().c_str(),
+  if (!verbosity.quiet && (t.kind() == "mesh" || t.kind() == "model")) {
+    std::fprintf(stderr, "%s tree %s (%s): %llu leaves, %llu bytes\n", t.kind().c_str(),
+                 t.key_with_grade().c_str(),
                  t.cache_hit() ? "cache hit" : "built", static_cast<unsigned long long>(t.leaves()),
                  static_cast<unsigned long long>(t.bytes()));
     return;
