@@ -341,6 +341,18 @@ int RunUpload(const std::vector<std::string>& specs, const Connection& conn) {
   return 0;
 }
 
+// The faces of CAD models, read in process (the file is on this machine).
+int RunInspect(const std::vector<std::string>& specs) {
+  DirectTreeSource source;
+  SamplingEngine engine(EngineLimits{}, &source, &LocalModels());
+  for (const std::string& spec : specs) {
+    auto table = engine.DescribeModel(spec);
+    if (!table.ok()) return Fail(table.status());
+    std::printf("%s", table->c_str());
+  }
+  return 0;
+}
+
 struct EvalFlags {
   std::string setting = "fast";
   int l_min = 0, l_max = 0;
@@ -571,6 +583,11 @@ int main(int argc, char** argv) {
   add_connection(upload);
 
   app.add_subcommand("surfaces", "list the surfaces, densities, curves and sequences with their formulas");
+  std::vector<std::string> inspect_specs;
+  CLI::App* inspect = app.add_subcommand(
+      "inspect", "list a CAD model's faces (index as in the face column, type, trimmed area, "
+                 "parameter box, orientation, trim) and the order the curve visits them");
+  inspect->add_option("models", inspect_specs, "step:FILE, iges:FILE or nurbs:FILE")->required();
 
   sfc::EvalFlags eval_flags;
   CLI::App* eval = app.add_subcommand("eval", "run the paper's discrepancy protocol and compare slopes with Tables 1-2");
@@ -603,6 +620,7 @@ int main(int argc, char** argv) {
   if (cache->parsed()) return sfc::RunCache(conn);
   if (health->parsed()) return sfc::RunHealth(conn);
   if (upload->parsed()) return sfc::RunUpload(upload_specs, conn);
+  if (inspect->parsed()) return sfc::RunInspect(inspect_specs);
   if (eval->parsed()) return sfc::RunEval(eval_flags, conn);
   if (render->parsed()) return sfc::RunRender(flags, render_flags, conn);
   return sfc::RunSurfaces();
