@@ -10,20 +10,56 @@
 namespace sfc::cad {
 namespace {
 
-// The model's density on one face, zero outside its trimmed region. Face
-// surfaces take the face's unit square, so point.u, point.v are the face's.
-class TrimmedDensity final : public Density {
+}  // namespace
+
+// Where a trimmed face's unit square lies relative to its trim, on a
+// kSide x kSide grid of cells classified once (Face::Classify, which is
+// conservative): a point in a cell wholly inside or outside is answered from
+// the grid, and only points in cells the boundary may cross ask the kernel.
+class TrimGrid {
  public:
-  TrimmedDensity(const Face* face, std::shared_ptr<const Density> inner)
-      : face_(face), inner_(std::move(inner)) {}
-  bool NeedsCurvature() const override { return inner_->NeedsCurvature(); }
-  double Value(const SurfacePoint& point) const override {
-    if (face_->trimmed() && !face_->Contains(point.u, point.v)) return 0;
-    return inner_->Value(point);
+  static constexpr int kSide = 128;
+  explicit TrimGrid(const Face* face) : face_(face), cells_(kSide * kSide) {
+    for (int i = 0; i < kSide; ++i) {
+      for (int j = 0; j < kSide; ++j) {
+        cells_[i * kSide + j] = face->Classify(double(i) / kSide, double(i + 1) / kSide,
+                                               double(j) / kSide, double(j + 1) / kSide);
+      }
+    }
+  }
+  // Face::Contains(s, t), the same answer.
+  bool Contains(double s, double t) const {
+    const int i = std::min(kSide - 1, std::max(0, static_cast<int>(s * kSide)));
+    const int j = std::min(kSide - 1, std::max(0, static_cast<int>(t * kSide)));
+    switch (cells_[i * kSide + j]) {
+      case CellState::kInside: return true;
+      case CellState::kOutside: return false;
+      case CellState::kStraddles: break;
+    }
+    return face_->Contains(s, t);
   }
 
  private:
   const Face* face_;  // owned by the model, which the tree keeps alive
+  std::vector<CellState> cells_;
+};
+
+namespace {
+
+// The model's density on one face, zero outside its trimmed region. Face
+// surfaces take the face's unit square, so point.u, point.v are the face's.
+class TrimmedDensity final : public Density {
+ public:
+  TrimmedDensity(std::shared_ptr<const TrimGrid> trim, std::shared_ptr<const Density> inner)
+      : trim_(std::move(trim)), inner_(std::move(inner)) {}
+  bool NeedsCurvature() const override { return inner_->NeedsCurvature(); }
+  double Value(const SurfacePoint& point) const override {
+    if (trim_ && !trim_->Contains(point.u, point.v)) return 0;
+    return inner_->Value(point);
+  }
+
+ private:
+  std::shared_ptr<const TrimGrid> trim_;  // null: the face is not trimmed
   std::shared_ptr<const Density> inner_;
 };
 
@@ -69,7 +105,8 @@ absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
     Piece piece;
     piece.face = f;
     piece.surface = face.shared_surface();
-    piece.density = std::make_shared<TrimmedDensity>(&face, density);
+    if (face.trimmed()) piece.trim = std::make_shared<const TrimGrid>(&face);
+    piece.density = std::make_shared<TrimmedDensity>(piece.trim, density);
     ASSIGN_OR_RETURN(const CurveTreeOptions o, options_after(leaves));
     auto coarse = CurveTree::Build(*piece.surface, *piece.density, o, 0, control_after(bytes));
     if (!coarse.ok()) {
@@ -186,9 +223,9 @@ absl::Status ModelSampleCursor::OpenPiece() {
 }
 
 void ModelSampleCursor::KeepInTrim(const ModelTree::Piece& piece, size_t i, SampleBatch* b) {
-  const Face& face = tree_->model().faces()[piece.face];
+  const TrimGrid* trim = piece.trim.get();
   const double s = b->u[i], t = b->v[i];
-  if (!face.trimmed() || face.Contains(s, t)) return;
+  if (!trim || trim->Contains(s, t)) return;
   // The nearest inside point on growing circles (16 directions each, in a
   // fixed order), clamped to the square.
   constexpr int kDirections = 16;
@@ -199,7 +236,7 @@ void ModelSampleCursor::KeepInTrim(const ModelTree::Piece& piece, size_t i, Samp
       const double a = 2 * M_PI * d / kDirections;
       const double cs = std::clamp(s + r * std::cos(a), 0.0, 1.0);
       const double ct = std::clamp(t + r * std::sin(a), 0.0, 1.0);
-      if (face.Contains(cs, ct)) best_s = cs, best_t = ct, found = true;
+      if (trim->Contains(cs, ct)) best_s = cs, best_t = ct, found = true;
     }
   }
   if (!found) return;  // a face with mass has inside points; not reached

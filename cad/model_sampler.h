@@ -47,12 +47,15 @@
 
 namespace sfc::cad {
 
+class TrimGrid;  // a trimmed face's cells classified once (model_sampler.cc)
+
 class ModelTree {
  public:
   // One face's part of the curve.
   struct Piece {
     int face = 0;  // index into Model::faces()
     std::shared_ptr<const Surface> surface;
+    std::shared_ptr<const TrimGrid> trim;    // null for an untrimmed face
     std::shared_ptr<const Density> density;  // the model's density, zero outside the trim
     std::shared_ptr<const CurveTree> tree;
     double lo = 0, hi = 1;  // the piece's window of q: [S_{f-1}/S, S_f/S)
