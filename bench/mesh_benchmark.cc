@@ -126,15 +126,6 @@ std::vector<Vec3> IidOnSphere(const TriangleMesh& mesh, size_t n, uint64_t seed)
   return out;
 }
 
-double Slope(const std::vector<double>& n, const std::vector<double>& d) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  const double k = n.size();
-  for (size_t i = 0; i < n.size(); ++i) {
-    const double x = std::log(n[i]), y = std::log(d[i]);
-    sx += x, sy += y, sxx += x * x, sxy += x * y;
-  }
-  return (k * sxy - sx * sy) / (k * sxx - sx * sx);
-}
 
 }  // namespace
 }  // namespace sfc
@@ -190,7 +181,7 @@ int main(int argc, char** argv) {
       std::printf("| %llu | %.3e | %.3e |\n", static_cast<unsigned long long>(n), d_ours, d_iid);
     }
   }
-  std::printf("| slope | %.3f | %.3f |\n", Slope(ns, ours), Slope(ns, iid));
+  std::printf("| slope | %.3f | %.3f |\n", LogLogSlope(ns, ours), LogLogSlope(ns, iid));
   double lo = HUGE_VAL, hi = 0;
   for (size_t t = 0; t < sphere.triangles.size(); ++t) {
     // Spherical over flat area of each triangle (Van Oosterom-Strackee excess).

@@ -15,6 +15,7 @@
 #include "engine/sampling_engine.h"
 #include "evaluation/discrepancy.h"
 #include "gtest/gtest.h"
+#include "tests/engine_helpers.h"
 
 namespace sfc {
 namespace {
@@ -33,12 +34,6 @@ std::string Fixture(fx::Solid solid, cad::ModelFormat format = cad::ModelFormat:
   return path;
 }
 
-std::string WriteTemp(const std::string& name, const std::string& bytes) {
-  const std::string path = ::testing::TempDir() + "/" + name;
-  std::ofstream(path, std::ios::binary) << bytes;
-  return path;
-}
-
 struct Engine {
   DirectTreeSource source;
   FileModelSource files;
@@ -50,19 +45,6 @@ struct Engine {
     return limits;
   }
 };
-
-SampleBatch DrawAll(const SamplingEngine& engine, const SampleRequest& r) {
-  auto job = engine.Start(r);
-  EXPECT_TRUE(job.ok()) << job.status();
-  SampleBatch all;
-  if (!job.ok()) return all;
-  while (true) {
-    auto n = job->cursor->Next(7000, &all);
-    EXPECT_TRUE(n.ok()) << n.status();
-    if (!n.ok() || *n == 0) break;
-  }
-  return all;
-}
 
 SampleRequest ModelRequest(const std::string& surface, uint64_t count, uint64_t seed = 3) {
   SampleRequest r;
@@ -115,17 +97,6 @@ TEST(EngineCad, FacesGetSamplesInProportionToTheirExactAreas) {
   }
 }
 
-// Least-squares slope of log D against log N.
-double Slope(const std::vector<double>& ns, const std::vector<double>& ds) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  const double m = ns.size();
-  for (size_t i = 0; i < ns.size(); ++i) {
-    const double x = std::log(ns[i]), y = std::log(ds[i]);
-    sx += x, sy += y, sxx += x * x, sxy += x * y;
-  }
-  return (m * sxy - sx * sy) / (m * sxx - sx * sx);
-}
-
 TEST(EngineCad, AStepSphereSamplesAsWellAsTheBuiltInSphere) {
   Engine e;
   const std::string step = "step:" + Fixture(fx::Solid::kSphere);
@@ -151,7 +122,7 @@ TEST(EngineCad, AStepSphereSamplesAsWellAsTheBuiltInSphere) {
       ns.push_back(n), model_d.push_back(dm), builtin_d.push_back(db);
     }
   }
-  const double model_slope = Slope(ns, model_d), builtin_slope = Slope(ns, builtin_d);
+  const double model_slope = LogLogSlope(ns, model_d), builtin_slope = LogLogSlope(ns, builtin_d);
   RecordProperty("step_sphere_slope", std::to_string(model_slope));
   RecordProperty("builtin_sphere_slope", std::to_string(builtin_slope));
   std::printf("spherical-triangle discrepancy slope, N = 64..24576: STEP sphere %.3f, built-in %.3f\n",

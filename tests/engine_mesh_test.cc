@@ -11,6 +11,7 @@
 
 #include "engine/sampling_engine.h"
 #include "gtest/gtest.h"
+#include "tests/engine_helpers.h"
 #include "mesh/icosphere.h"
 #include "mesh/mesh_writer.h"
 
@@ -37,25 +38,6 @@ class MemoryModels final : public ModelSource {
  private:
   std::map<std::string, StoredModel> models_;
 };
-
-std::string WriteTemp(const std::string& name, const std::string& bytes) {
-  const std::string path = ::testing::TempDir() + "/" + name;
-  std::ofstream(path, std::ios::binary) << bytes;
-  return path;
-}
-
-SampleBatch DrawAll(const SamplingEngine& engine, const SampleRequest& r) {
-  auto job = engine.Start(r);
-  EXPECT_TRUE(job.ok()) << job.status();
-  SampleBatch all;
-  if (!job.ok()) return all;
-  while (true) {
-    auto n = job->cursor->Next(5000, &all);
-    EXPECT_TRUE(n.ok()) << n.status();
-    if (!n.ok() || *n == 0) break;
-  }
-  return all;
-}
 
 SampleRequest MeshRequest(const std::string& surface, uint64_t count) {
   SampleRequest r;
