@@ -42,6 +42,9 @@ if [ -n "$fixtures" ]; then
   "$fixtures" "$tmp" > /dev/null
   models="--surface step:$tmp/box_with_hole.step --density mean:floor=0.05 --count 5000 --face --normals"
   "$cli" inspect "step:$tmp/box_with_hole.step" | grep -q "8 faces" || fail "inspect the box with a hole"
+  # eval's model mode, over the wire: the STEP sphere's slope is as steep as the built-in's.
+  slope=$("$cli" eval --model "step:$tmp/sphere.step" --seeds 1 --server "$addr" | awk -F'|' '/slope/ {gsub(/[* ]/, "", $3); print $3}')
+  awk -v s="$slope" 'BEGIN { exit !(s != "" && s <= -0.65) }' || fail "eval --model: slope '$slope'"
 fi
 
 for args in "--surface torus --density gaussian:floor=0.1 --count 20000 --seed 4" \
