@@ -216,7 +216,8 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
 #ifdef SFC_HAVE_MESH
   if (job.tree.kind == TreeKind::kMesh) {
     ASSIGN_OR_RETURN(job.cursor, MeshCursor(*job.tree.lookup.any, std::move(sequence), job.begin,
-                                            job.end, request.region, request.fields));
+                                            job.end, request.region, request.fields,
+                                            limits_.generation_threads));
     return job;
   }
 #endif

@@ -81,6 +81,39 @@ TEST(EngineMesh, AFileAndItsHashGiveTheSameSamplesOnTheirTriangles) {
   }
 }
 
+TEST(EngineMesh, LargeBatchesOnTwoThreadsAreTheSameSamples) {
+  const std::string path = WriteTemp("engine_mesh_threads.ply", MeshToPly(MakeIcosphere(3), true));
+  DirectTreeSource source;
+  FileModelSource files;
+  EngineLimits one, two;
+  one.generation_threads = 1, two.generation_threads = 2;
+  SamplingEngine a({one}, &source, &files), b({two}, &source, &files);
+  SampleRequest r = MeshRequest("ply:" + path, 100000);
+  r.tree.density = "mean:floor=0.1";
+  r.fields.density = r.fields.curve_position = true;
+  auto draw = [&](const SamplingEngine& engine, size_t batch) {
+    auto job = engine.Start(r);
+    EXPECT_TRUE(job.ok()) << job.status();
+    SampleBatch all;
+    while (job.ok()) {
+      auto n = job->cursor->Next(batch, &all);
+      EXPECT_TRUE(n.ok()) << n.status();
+      if (!n.ok() || *n == 0) break;
+    }
+    return all;
+  };
+  const SampleBatch serial = draw(a, 30000), parallel = draw(b, 30000), small = draw(b, 1000);
+  ASSERT_EQ(serial.size(), 100000u);
+  for (const SampleBatch* other : {&parallel, &small}) {
+    EXPECT_EQ(other->index, serial.index);
+    EXPECT_EQ(other->x, serial.x);
+    EXPECT_EQ(other->u, serial.u);
+    EXPECT_EQ(other->density, serial.density);
+    EXPECT_EQ(other->curve_position, serial.curve_position);
+    EXPECT_EQ(other->triangle, serial.triangle);
+  }
+}
+
 TEST(EngineMesh, ADensityInXYZMovesSamplesWhereItIsLarger) {
   const std::string path = WriteTemp("engine_mesh_density.obj", MeshToObj(MakeIcosphere(3)));
   DirectTreeSource source;
