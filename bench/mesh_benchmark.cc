@@ -1,5 +1,5 @@
 // Mesh sampling figures, printed as tables (not a ctest; run by hand):
-//   ./build/bench/mesh_benchmark [count=1000000] [repeats=3]
+//   ./build/bench/mesh_benchmark [count=1000000] [repeats=3] [threads=1]
 // 1. Speed: `count` samples on the 81 920-triangle icosphere, read from a
 //    binary PLY file: cold (read + parse + tree + samples) and warm (samples
 //    from the built tree), for the uniform density and |H| + 0.1. Each figure
@@ -51,8 +51,11 @@ std::string ReadAll(const std::string& path) {
 
 // Draws [0, n) into one batch (index, u, v, x, y, z: like Open3D's output
 // for a mesh without normals, plus our index and barycentric columns).
+int g_threads = 1;  // the cursor's threads (argv[3])
+
 size_t DrawAll(const std::shared_ptr<const MeshSampler>& sampler, SampleBatch* batch) {
-  auto cursor = MeshSampleCursor::Create(sampler, 0, sampler->sequence().count(), {}, {});
+  auto cursor =
+      MeshSampleCursor::Create(sampler, 0, sampler->sequence().count(), {}, {}, g_threads);
   if (!cursor.ok()) {
     std::fprintf(stderr, "%s\n", cursor.status().ToString().c_str());
     std::exit(1);
@@ -126,15 +129,6 @@ std::vector<Vec3> IidOnSphere(const TriangleMesh& mesh, size_t n, uint64_t seed)
   return out;
 }
 
-double Slope(const std::vector<double>& n, const std::vector<double>& d) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  const double k = n.size();
-  for (size_t i = 0; i < n.size(); ++i) {
-    const double x = std::log(n[i]), y = std::log(d[i]);
-    sx += x, sy += y, sxx += x * x, sxy += x * y;
-  }
-  return (k * sxy - sx * sy) / (k * sxx - sx * sx);
-}
 
 }  // namespace
 }  // namespace sfc
@@ -143,6 +137,7 @@ int main(int argc, char** argv) {
   using namespace sfc;
   const uint64_t count = argc > 1 ? std::stoull(argv[1]) : 1000000;
   const int repeats = argc > 2 ? std::stoi(argv[2]) : 3;
+  g_threads = argc > 3 ? std::stoi(argv[3]) : 1;
   const TriangleMesh sphere = MakeIcosphere(6);
   const auto dir = std::filesystem::temp_directory_path() /
                    ("sfc_mesh_bench_" + std::to_string(::getpid()));
@@ -190,7 +185,7 @@ int main(int argc, char** argv) {
       std::printf("| %llu | %.3e | %.3e |\n", static_cast<unsigned long long>(n), d_ours, d_iid);
     }
   }
-  std::printf("| slope | %.3f | %.3f |\n", Slope(ns, ours), Slope(ns, iid));
+  std::printf("| slope | %.3f | %.3f |\n", LogLogSlope(ns, ours), LogLogSlope(ns, iid));
   double lo = HUGE_VAL, hi = 0;
   for (size_t t = 0; t < sphere.triangles.size(); ++t) {
     // Spherical over flat area of each triangle (Van Oosterom-Strackee excess).

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """sfcsampler's mesh sampling against Open3D's, side by side on one mesh.
 
-Usage: python3 bench/mesh_vs_open3d.py [BUILD_DIR=build] [COUNT=1000000] [POISSON_COUNT=2000]
+Usage: python3 bench/mesh_vs_open3d.py [BUILD_DIR=build] [COUNT=1000000] [POISSON_COUNT=2000] [THREADS=1]
 
 Makes the 81 920-triangle icosphere (a subdivided icosahedron pushed to the
 unit sphere, built the same way as mesh/icosphere.cc, which mesh_benchmark
@@ -9,7 +9,7 @@ uses) and writes it as binary PLY with Open3D, then times:
   - Open3D read_triangle_mesh + sample_points_uniformly(COUNT): i.i.d. points;
   - Open3D sample_points_poisson_disk(POISSON_COUNT) (slow: run with fewer
     points and reported per point);
-  - build/bench/mesh_benchmark COUNT 3: our cold (read + parse + tree +
+  - build/bench/mesh_benchmark COUNT 3 THREADS: our cold (read + parse + tree +
     samples) and warm times.
 and prints the ratios. Installs python3-open3d from Debian when missing
 (apt-get, as root or with sudo). Timings are wall-clock medians of 3 runs.
@@ -89,6 +89,7 @@ def main():
     build = sys.argv[1] if len(sys.argv) > 1 else "build"
     count = int(sys.argv[2]) if len(sys.argv) > 2 else 1000000
     poisson_count = int(sys.argv[3]) if len(sys.argv) > 3 else 2000
+    threads = int(sys.argv[4]) if len(sys.argv) > 4 else 1
     ensure_open3d()
     import open3d as o3d
     o3d.utility.set_verbosity_level(o3d.utility.VerbosityLevel.Error)
@@ -110,13 +111,15 @@ def main():
         poisson = median_time(
             lambda: loaded.sample_points_poisson_disk(number_of_points=poisson_count), repeats=1)
 
-        out = subprocess.run([os.path.join(build, "bench", "mesh_benchmark"), str(count), "3"],
+        out = subprocess.run([os.path.join(build, "bench", "mesh_benchmark"), str(count), "3",
+                              str(threads)],
                              check=True, capture_output=True, text=True).stdout
         row = next(l for l in out.splitlines() if l.startswith("| uniform"))
         cells = [c.strip() for c in row.strip("|").split("|")]
         ours = {"cold": (float(cells[5]), float(cells[7])), "warm": (float(cells[6]), float(cells[8]))}
 
-        print(f"# {count} samples on the icosphere ({len(faces)} triangles); medians of 3 runs")
+        print(f"# {count} samples on the icosphere ({len(faces)} triangles); medians of 3 runs; "
+              f"our cursor on {threads} thread(s)")
         print("| method | wall s | cpu s | ours / it, wall | ours / it, cpu |")
         print("|---|---:|---:|---:|---:|")
         print(f"| sfcsampler cold (read + parse + tree + samples) | {ours['cold'][0]:.3f} | "

@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <thread>
 
 #include "absl/strings/str_format.h"
 #include "core/status_macros.h"
+#include "core/worker_pool.h"
 
 namespace sfc {
 
@@ -67,7 +67,10 @@ absl::Status SampleCursor::PlanRegion(uint64_t begin, uint64_t end) {
   const Sampler& sampler = *sampler_;
   if (!sampler.sequence().monotone()) {
     // Index order is not curve order.
-    order_ = IndicesInCurveOrder(begin, end, [&](uint64_t k) { return sampler.MassCoordinate(k); });
+    const Sequence& sequence = sampler.sequence();
+    order_ = IndicesInCurveOrder(
+        begin, end, [&](uint64_t k) { return sampler.MassCoordinate(k); },
+        [&](uint64_t k) { return sequence.InWindow(k); });
     use_order_ = true;
     return absl::OkStatus();
   }
@@ -196,25 +199,22 @@ absl::StatusOr<size_t> SampleCursor::Next(size_t max, SampleBatch* batch) {
 }
 
 absl::Status SampleCursor::EmitParallel(uint64_t k0, uint64_t k1, SampleBatch* batch) {
+  // threads_ contiguous parts of [k0, k1), on the shared pool; part 0 goes
+  // straight into `batch` with the cursor's own leaf cache, the others into
+  // their own batches, appended in order: the same samples for any split.
   const int n = threads_;
   std::vector<SampleBatch> parts(n - 1);
   std::vector<absl::Status> status(n);
-  std::vector<std::thread> workers;
   auto bound = [&](int i) { return k0 + (k1 - k0) * i / n; };
-  for (int i = 1; i < n; ++i) {
-    workers.emplace_back([&, i] {
-      LeafCache cache;
-      bool kept;
-      for (uint64_t k = bound(i); k < bound(i + 1) && status[i].ok(); ++k) {
-        status[i] = Emit(k, cache, &parts[i - 1], &kept);
-      }
-    });
-  }
-  bool kept;
-  for (uint64_t k = bound(0); k < bound(1) && status[0].ok(); ++k) {
-    status[0] = Emit(k, cache_, batch, &kept);
-  }
-  for (auto& w : workers) w.join();
+  WorkerPool::Shared().ParallelFor(n, [&](int i) {
+    LeafCache local;
+    LeafCache& cache = i == 0 ? cache_ : local;
+    SampleBatch* out = i == 0 ? batch : &parts[i - 1];
+    bool kept;
+    for (uint64_t k = bound(i); k < bound(i + 1) && status[i].ok(); ++k) {
+      status[i] = Emit(k, cache, out, &kept);
+    }
+  });
   for (const absl::Status& st : status) RETURN_IF_ERROR(st);
   for (const SampleBatch& part : parts) batch->Append(part);
   return absl::OkStatus();

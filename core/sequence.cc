@@ -38,7 +38,7 @@ double OwenScrambledRadicalInverse(uint64_t k, uint64_t seed) {
 
 }  // namespace
 
-double Sequence::At(uint64_t k) const {
+double Sequence::Raw(uint64_t k) const {
   switch (kind_) {
     case SequenceKind::kJittered:
       return (static_cast<double>(k) + CounterUniform(seed_, kJitterStream, k)) /

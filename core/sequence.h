@@ -42,24 +42,52 @@ class Sequence {
   bool monotone() const { return kind_ == SequenceKind::kJittered || kind_ == SequenceKind::kEqual; }
 
   // q_k in [0,1]. REQUIRES: k < count() (the radical-inverse kinds accept any
-  // k < 2^32: they do not depend on count).
-  double At(uint64_t k) const;
+  // k < 2^32: they do not depend on count). For a window, (q_k - lo)/(hi - lo).
+  double At(uint64_t k) const {
+    const double q = Raw(k);
+    return windowed_ ? (q - lo_) / (hi_ - lo_) : q;
+  }
+
+  // The part of the sequence with lo <= q_k < hi (hi = 1 also takes q_k = 1),
+  // rescaled to [0, 1): the samples of one piece of a surface made of pieces
+  // that share one equalisation (a CAD model's faces, cad/model_sampler.h).
+  // Windows [a, b) and [b, c) made with the same double b split the samples
+  // exactly. REQUIRES: 0 <= lo < hi <= 1.
+  Sequence Window(double lo, double hi) const {
+    Sequence w = *this;
+    w.windowed_ = true, w.lo_ = lo, w.hi_ = hi;
+    return w;
+  }
+  // True when q_k lies in the window (always without one).
+  bool InWindow(uint64_t k) const {
+    if (!windowed_) return true;
+    const double q = Raw(k);
+    return q >= lo_ && (q < hi_ || (hi_ == 1 && q == 1));
+  }
+  bool windowed() const { return windowed_; }
 
  private:
+  double Raw(uint64_t k) const;  // q_k
+
   SequenceKind kind_;
   uint64_t count_;
   uint64_t seed_;
+  bool windowed_ = false;
+  double lo_ = 0, hi_ = 1;
 };
 
 // The indices [begin, end) in curve order, for sequences that are not
-// monotone in k: sorted by `mass_coordinate(k)` (q_k S_M), ties by index.
-// Holds 16 bytes an index while it sorts.
-template <typename MassCoordinate>
+// monotone in k: sorted by `mass_coordinate(k)` (q_k S_M), ties by index;
+// only those `keep(k)` accepts (a window's). Holds 16 bytes an index while it
+// sorts.
+template <typename MassCoordinate, typename Keep>
 std::vector<uint64_t> IndicesInCurveOrder(uint64_t begin, uint64_t end,
-                                          const MassCoordinate& mass_coordinate) {
+                                          const MassCoordinate& mass_coordinate, const Keep& keep) {
   std::vector<std::pair<double, uint64_t>> keyed;
   keyed.reserve(end - begin);
-  for (uint64_t k = begin; k < end; ++k) keyed.emplace_back(mass_coordinate(k), k);
+  for (uint64_t k = begin; k < end; ++k) {
+    if (keep(k)) keyed.emplace_back(mass_coordinate(k), k);
+  }
   std::sort(keyed.begin(), keyed.end());
   std::vector<uint64_t> order;
   order.reserve(keyed.size());

@@ -81,6 +81,15 @@ printf 'v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\nf 1 3 5\nf 3 2 
   -o "$work/mesh_container.csv" || fail "no mesh samples from the container"
 cmp -s "$work/mesh_embedded.csv" "$work/mesh_container.csv" || fail "mesh samples from the container differ"
 echo "20000 samples of an uploaded mesh, byte-identical to the in-process run"
+# A CAD model likewise, when this build has CAD models.
+if [ -x "$build/cad/make_cad_fixtures" ]; then
+  "$build/cad/make_cad_fixtures" "$work" > /dev/null
+  "$cli" sample -q --surface "step:$work/box_with_hole.step" --count 20000 --face -o "$work/cad_embedded.csv"
+  "$cli" sample -q --server "127.0.0.1:$port" --surface "step:$work/box_with_hole.step" --count 20000 \
+    --face -o "$work/cad_container.csv" || fail "no CAD samples from the container"
+  cmp -s "$work/cad_embedded.csv" "$work/cad_container.csv" || fail "CAD samples from the container differ"
+  echo "20000 samples of an uploaded STEP model, byte-identical to the in-process run"
+fi
 
 start=$(date +%s%N)
 $engine stop -t 20 sfcsampler-test > /dev/null || fail "stop failed"

@@ -129,11 +129,11 @@ absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::
 absl::StatusOr<std::unique_ptr<BatchCursor>> MeshCursor(const AnyTree& tree, Sequence sequence,
                                                         uint64_t begin, uint64_t end,
                                                         const Region& region,
-                                                        const SampleFields& fields) {
+                                                        const SampleFields& fields, int threads) {
   auto mesh_tree = TreeAs<MeshCurveTree>(&tree);
   if (!mesh_tree) return absl::InternalError("a mesh request found a tree of another kind");
   auto sampler = std::make_shared<const MeshSampler>(std::move(mesh_tree), std::move(sequence));
-  ASSIGN_OR_RETURN(auto cursor, MeshSampleCursor::Create(sampler, begin, end, region, fields));
+  ASSIGN_OR_RETURN(auto cursor, MeshSampleCursor::Create(sampler, begin, end, region, fields, threads));
   return std::make_unique<MeshBatchCursor>(std::move(cursor), fields.triangle);
 }
 

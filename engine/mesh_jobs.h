@@ -42,11 +42,12 @@ absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::
 // A cursor over samples [begin, end) of `sequence` on the mesh tree held by
 // `tree`, inside `region`, with `fields` (u, v are the barycentric
 // coordinates of the triangle's corners 1 and 2; fields.triangle adds the
-// triangle column). Errors as MeshSampleCursor::Create.
+// triangle column); `threads` fill large batches. Errors as
+// MeshSampleCursor::Create.
 absl::StatusOr<std::unique_ptr<BatchCursor>> MeshCursor(const AnyTree& tree, Sequence sequence,
                                                         uint64_t begin, uint64_t end,
                                                         const Region& region,
-                                                        const SampleFields& fields);
+                                                        const SampleFields& fields, int threads);
 
 }  // namespace sfc
 

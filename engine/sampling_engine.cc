@@ -7,45 +7,88 @@
 #ifdef SFC_HAVE_MESH
 #include "engine/mesh_jobs.h"
 #endif
+#ifdef SFC_HAVE_CAD
+#include "engine/cad_jobs.h"
+#endif
 
 namespace sfc {
 
 SamplingEngine::SamplingEngine(EngineLimits limits, TreeSource* source, const ModelSource* models)
     : limits_(limits), source_(source), models_(models) {}
 
+const char* TreeKindName(TreeKind kind) {
+  switch (kind) {
+    case TreeKind::kSurface: return "surface";
+    case TreeKind::kMesh: return "mesh";
+    case TreeKind::kCadModel: return "model";
+  }
+  return "surface";
+}
+
 absl::StatusOr<PreparedTree> SamplingEngine::PrepareModel(const ModelSpec& model,
                                                           const TreeSpec& spec, uint64_t count,
                                                           const BuildControl& caller) const {
   const bool mesh = model.format == ModelFormat::kObj || model.format == ModelFormat::kPly;
-  if (!mesh) {
-    return absl::UnimplementedError(absl::StrFormat(
-        "sampling %s models is not available in this release: servers store uploaded models "
-        "(sfcsampler upload) and the model libraries read them, but surfaces made from them come "
-        "in the next one; use a mesh, a catalogue surface or an expr: surface",
-        ModelFormatName(model.format)));
-  }
 #ifndef SFC_HAVE_MESH
-  return absl::UnimplementedError(
-      "this build of sfcsampler has no mesh support (configured with SFC_BUILD_MESH=OFF)");
-#else
+  if (mesh) {
+    return absl::UnimplementedError(
+        "this build of sfcsampler has no mesh support (configured with SFC_BUILD_MESH=OFF)");
+  }
+#endif
+#ifndef SFC_HAVE_CAD
+  if (!mesh) {
+    return absl::UnimplementedError(
+        "this build of sfcsampler has no CAD support (configured with SFC_BUILD_CAD=OFF)");
+  }
+#endif
   if (!models_) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "\"%s\" names a model, and this engine has no model source to read it from",
         spec.surface));
   }
   ASSIGN_OR_RETURN(const StoredModel stored, models_->Resolve(model));
-  ASSIGN_OR_RETURN(MeshTreeRecipe recipe,
-                   MeshTreeFor(stored, spec.density, spec.options.tolerance,
-                               limits_.max_tree_leaves, loaded_.get()));
-  CurveTreeOptions options;  // a mesh's curve has no options but the tolerance
-  options.tolerance = spec.options.tolerance;
   PreparedTree prepared;
-  prepared.kind = TreeKind::kMesh;
-  prepared.key = MakeTreeKey(stored.Spec(), recipe.canonical_density, options);
   prepared.grade = CurveTree::GradeFor(count);
-  ASSIGN_OR_RETURN(prepared.lookup,
-                   source_->Get(prepared.key, prepared.grade, recipe.factory, caller));
+  TreeFactory factory;
+  if (mesh) {
+#ifdef SFC_HAVE_MESH
+    ASSIGN_OR_RETURN(MeshTreeRecipe recipe,
+                     MeshTreeFor(stored, spec.density, spec.options.tolerance,
+                                 limits_.max_tree_leaves, loaded_.get()));
+    CurveTreeOptions options;  // a mesh's curve has no options but the tolerance
+    options.tolerance = spec.options.tolerance;
+    prepared.kind = TreeKind::kMesh;
+    prepared.key = MakeTreeKey(stored.Spec(), recipe.canonical_density, options);
+    factory = std::move(recipe.factory);
+#endif
+  } else {
+#ifdef SFC_HAVE_CAD
+    CurveTreeOptions options = spec.options;
+    options.max_leaves = limits_.max_tree_leaves;
+    ASSIGN_OR_RETURN(CadTreeRecipe recipe,
+                     CadTreeFor(stored, spec.density, options, loaded_.get()));
+    prepared.kind = TreeKind::kCadModel;
+    prepared.key = MakeTreeKey(stored.Spec(), recipe.canonical_density, options);
+    factory = std::move(recipe.factory);
+#endif
+  }
+  ASSIGN_OR_RETURN(prepared.lookup, source_->Get(prepared.key, prepared.grade, factory, caller));
   return prepared;
+}
+
+absl::StatusOr<std::string> SamplingEngine::DescribeModel(const std::string& spec) const {
+  ASSIGN_OR_RETURN(const std::optional<ModelSpec> model, ParseModelSpec(spec));
+  if (!model || model->format == ModelFormat::kObj || model->format == ModelFormat::kPly) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "\"%s\" is not a CAD model; inspect takes step:FILE, iges:FILE or nurbs:FILE", spec));
+  }
+#ifndef SFC_HAVE_CAD
+  return absl::UnimplementedError(
+      "this build of sfcsampler has no CAD support (configured with SFC_BUILD_CAD=OFF)");
+#else
+  if (!models_) return absl::InvalidArgumentError("this engine has no model source");
+  ASSIGN_OR_RETURN(const StoredModel stored, models_->Resolve(*model));
+  return DescribeCadModel(stored, loaded_.get());
 #endif
 }
 
@@ -173,7 +216,16 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
 #ifdef SFC_HAVE_MESH
   if (job.tree.kind == TreeKind::kMesh) {
     ASSIGN_OR_RETURN(job.cursor, MeshCursor(*job.tree.lookup.any, std::move(sequence), job.begin,
-                                            job.end, request.region, request.fields));
+                                            job.end, request.region, request.fields,
+                                            limits_.generation_threads));
+    return job;
+  }
+#endif
+#ifdef SFC_HAVE_CAD
+  if (job.tree.kind == TreeKind::kCadModel) {
+    ASSIGN_OR_RETURN(job.cursor, CadCursor(*job.tree.lookup.any, sequence, job.begin, job.end,
+                                           request.region, request.fields,
+                                           limits_.generation_threads));
     return job;
   }
 #endif

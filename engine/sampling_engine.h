@@ -22,8 +22,12 @@
 namespace sfc {
 
 // What a tree is over: a parametric surface (catalogue, expression; its
-// CurveTree is lookup.tree) or a triangle mesh (lookup.any holds its tree).
-enum class TreeKind { kSurface, kMesh };
+// CurveTree is lookup.tree), a triangle mesh or a CAD model (lookup.any holds
+// its trees).
+enum class TreeKind { kSurface, kMesh, kCadModel };
+
+// "surface", "mesh", "model" (TreeInfo.kind).
+const char* TreeKindName(TreeKind kind);
 
 struct PreparedTree {
   TreeKey key;
@@ -70,6 +74,13 @@ class SamplingEngine {
  private:
   absl::StatusOr<PreparedTree> PrepareModel(const ModelSpec& model, const TreeSpec& spec,
                                             uint64_t count, const BuildControl& caller) const;
+
+ public:
+  // The faces of the CAD model `spec` names, as a table (sfcsampler
+  // inspect). INVALID_ARGUMENT for a spec that is not a CAD model.
+  absl::StatusOr<std::string> DescribeModel(const std::string& spec) const;
+
+ private:
 
   const EngineLimits limits_;
   TreeSource* const source_;

@@ -219,4 +219,14 @@ double ParameterRectDiscrepancy(const std::vector<Point2>& uv,
   return worst;
 }
 
+double LogLogSlope(const std::vector<double>& n, const std::vector<double>& d) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  const double m = static_cast<double>(n.size());
+  for (size_t i = 0; i < n.size(); ++i) {
+    const double x = std::log(n[i]), y = std::log(d[i]);
+    sx += x, sy += y, sxx += x * x, sxy += x * y;
+  }
+  return (m * sxy - sx * sy) / (m * sxx - sx * sx);
+}
+
 }  // namespace sfc

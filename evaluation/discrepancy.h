@@ -42,6 +42,10 @@ double AnchoredTriangleArea(double a, double b);
 // Area of the quarter disc of radius r intersected with the unit square.
 double QuarterDiscArea(double r);
 
+// Least-squares slope of log d against log n (the protocol's convergence
+// rate). REQUIRES: n.size() == d.size() >= 2, all values > 0.
+double LogLogSlope(const std::vector<double>& n, const std::vector<double>& d);
+
 // Spherical triangles on the unit sphere: `triangles` triangles with vertices
 // uniform on the sphere (from `seed`), area by Girard's theorem (the spherical
 // excess, computed as in Van Oosterom and Strackee 1983). Points must be unit

@@ -1,10 +1,13 @@
 #include "mesh/mesh_sampler.h"
 
+#include "core/worker_pool.h"
+
 #include <algorithm>
 #include <cmath>
 
 #include "absl/strings/str_format.h"
 #include "core/status_macros.h"
+#include "core/worker_pool.h"
 
 namespace sfc {
 
@@ -67,7 +70,7 @@ MeshSample MeshSampler::At(uint64_t k) const {
 
 absl::StatusOr<std::unique_ptr<MeshSampleCursor>> MeshSampleCursor::Create(
     std::shared_ptr<const MeshSampler> sampler, uint64_t begin, uint64_t end,
-    const Region& region, const SampleFields& fields) {
+    const Region& region, const SampleFields& fields, int threads) {
   const uint64_t count = sampler->sequence().count();
   if (begin > end || end > count) {
     return absl::InvalidArgumentError(absl::StrFormat(
@@ -83,6 +86,7 @@ absl::StatusOr<std::unique_ptr<MeshSampleCursor>> MeshSampleCursor::Create(
   RETURN_IF_ERROR(region.Validate());
   auto cursor =
       std::unique_ptr<MeshSampleCursor>(new MeshSampleCursor(std::move(sampler), region, fields));
+  cursor->threads_ = std::max(1, threads);
   RETURN_IF_ERROR(cursor->Plan(begin, end));
   return cursor;
 }
@@ -92,7 +96,9 @@ absl::Status MeshSampleCursor::Plan(uint64_t begin, uint64_t end) {
   const MeshCurveTree& tree = sampler.tree();
   if (!sampler.sequence().monotone()) {
     // Index order is not curve order.
-    order_ = IndicesInCurveOrder(begin, end, [&](uint64_t k) { return sampler.MassCoordinate(k); });
+    order_ = IndicesInCurveOrder(
+        begin, end, [&](uint64_t k) { return sampler.MassCoordinate(k); },
+        [](uint64_t) { return true; });
     use_order_ = true;
     return absl::OkStatus();
   }
@@ -120,6 +126,41 @@ absl::Status MeshSampleCursor::Plan(uint64_t begin, uint64_t end) {
 
 absl::StatusOr<size_t> MeshSampleCursor::Next(size_t max, SampleBatch* batch,
                                               MeshSampleColumns* mesh_columns) {
+  // A large stretch of a plain index range goes to the shared pool in
+  // contiguous parts, each drawn by a cursor of its own (a sample is a pure
+  // function of k, so the parts are the samples one cursor would draw).
+  if (threads_ > 1 && !use_order_ && region_.kind == Region::Kind::kAll &&
+      segment_ < segments_.size() && max >= kParallelMin &&
+      segments_[segment_].end - next_k_ >= kParallelMin) {
+    const uint64_t k0 = next_k_, k1 = k0 + std::min<uint64_t>(max, segments_[segment_].end - k0);
+    const int n = threads_;
+    std::vector<SampleBatch> parts(n);
+    std::vector<MeshSampleColumns> columns(n);
+    std::vector<absl::Status> status(n);
+    WorkerPool::Shared().ParallelFor(n, [&](int i) {
+      const uint64_t a = k0 + (k1 - k0) * i / n, b = k0 + (k1 - k0) * (i + 1) / n;
+      MeshSampleCursor part(sampler_, region_, fields_);
+      part.segments_.push_back({a, b});
+      part.next_k_ = a;
+      auto got = part.Next(b - a, &parts[i], mesh_columns ? &columns[i] : nullptr);
+      status[i] = got.status();
+    });
+    for (const absl::Status& st : status) RETURN_IF_ERROR(st);
+    for (int i = 0; i < n; ++i) {
+      batch->Append(parts[i]);
+      if (mesh_columns) {
+        mesh_columns->triangle.insert(mesh_columns->triangle.end(), columns[i].triangle.begin(),
+                                      columns[i].triangle.end());
+        mesh_columns->w.insert(mesh_columns->w.end(), columns[i].w.begin(), columns[i].w.end());
+      }
+    }
+    next_k_ = k1;
+    if (next_k_ >= segments_[segment_].end && ++segment_ < segments_.size()) {
+      next_k_ = segments_[segment_].begin;
+    }
+    cached_leaf_ = SIZE_MAX;
+    return static_cast<size_t>(k1 - k0);
+  }
   const MeshSampler& sampler = *sampler_;
   const MeshCurveTree& tree = sampler.tree();
   const MeshSurface& surface = tree.surface();

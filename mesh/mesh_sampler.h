@@ -86,10 +86,12 @@ class MeshSampleCursor {
   // square: use a 3D box). For monotone sequences (jittered, equal) the cost
   // is proportional to the samples emitted plus the triangles whose bounding
   // boxes meet the region; other sequences sort the range into curve order
-  // first (O(n log n), n = end - begin).
+  // first (O(n log n), n = end - begin). `threads` > 1 lets Next() fill large
+  // batches of plain index ranges on the shared worker pool
+  // (core/worker_pool.h); the samples do not change.
   static absl::StatusOr<std::unique_ptr<MeshSampleCursor>> Create(
       std::shared_ptr<const MeshSampler> sampler, uint64_t begin, uint64_t end,
-      const Region& region, const SampleFields& fields);
+      const Region& region, const SampleFields& fields, int threads = 1);
 
   // Appends up to `max` samples to `batch` (not cleared) and, when given, the
   // mesh columns to `mesh_columns`; returns how many; 0 once exhausted.
@@ -115,6 +117,9 @@ class MeshSampleCursor {
   std::vector<uint64_t> order_;    // other sequences: indices in curve order
   size_t order_pos_ = 0;
   bool use_order_ = false;
+  int threads_ = 1;
+  // Batches of at least this many samples of a plain range go to the pool.
+  static constexpr uint64_t kParallelMin = 8192;
   size_t cached_leaf_ = SIZE_MAX;  // the last leaf decoded
   MeshCurveTree::Cell cached_cell_;
   std::vector<MeshCurveTree::Cell> chunk_cells_;  // the cells of one chunk of samples

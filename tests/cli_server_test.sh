@@ -6,6 +6,7 @@ set -euo pipefail
 cli="$1"
 server="$2"
 probe="$3"
+fixtures="${4:-}"  # make_cad_fixtures, when the build has CAD models
 tmp=$(mktemp -d)
 pid=""
 cleanup() { [ -n "$pid" ] && kill "$pid" 2>/dev/null; rm -rf "$tmp"; }
@@ -35,8 +36,20 @@ set -e
 # bytes over the wire as in process.
 printf 'v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\nf 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n' > "$tmp/octahedron.obj"
 
+models=""
+if [ -n "$fixtures" ]; then
+  # A CAD model too: the box with a fillet and a hole, STEP, with its faces.
+  "$fixtures" "$tmp" > /dev/null
+  models="--surface step:$tmp/box_with_hole.step --density mean:floor=0.05 --count 5000 --face --normals"
+  "$cli" inspect "step:$tmp/box_with_hole.step" | grep -q "8 faces" || fail "inspect the box with a hole"
+  # eval's model mode, over the wire: the STEP sphere's slope is as steep as the built-in's.
+  slope=$("$cli" eval --model "step:$tmp/sphere.step" --seeds 1 --server "$addr" | awk -F'|' '/slope/ {gsub(/[* ]/, "", $3); print $3}')
+  awk -v s="$slope" 'BEGIN { exit !(s != "" && s <= -0.65) }' || fail "eval --model: slope '$slope'"
+fi
+
 for args in "--surface torus --density gaussian:floor=0.1 --count 20000 --seed 4" \
             "--surface obj:$tmp/octahedron.obj --density expr:1+x*x --count 5000 --triangle --normals" \
+            ${models:+"$models"} \
             "--surface sphere --count 20000 --region box:0,0,0,1,1,1 --normals --curve-position" \
             "--surface plane --density expr:u+v --count 5000 --sequence progressive --shard 1/3"; do
   # shellcheck disable=SC2086

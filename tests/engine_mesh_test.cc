@@ -11,6 +11,7 @@
 
 #include "engine/sampling_engine.h"
 #include "gtest/gtest.h"
+#include "tests/engine_helpers.h"
 #include "mesh/icosphere.h"
 #include "mesh/mesh_writer.h"
 
@@ -37,25 +38,6 @@ class MemoryModels final : public ModelSource {
  private:
   std::map<std::string, StoredModel> models_;
 };
-
-std::string WriteTemp(const std::string& name, const std::string& bytes) {
-  const std::string path = ::testing::TempDir() + "/" + name;
-  std::ofstream(path, std::ios::binary) << bytes;
-  return path;
-}
-
-SampleBatch DrawAll(const SamplingEngine& engine, const SampleRequest& r) {
-  auto job = engine.Start(r);
-  EXPECT_TRUE(job.ok()) << job.status();
-  SampleBatch all;
-  if (!job.ok()) return all;
-  while (true) {
-    auto n = job->cursor->Next(5000, &all);
-    EXPECT_TRUE(n.ok()) << n.status();
-    if (!n.ok() || *n == 0) break;
-  }
-  return all;
-}
 
 SampleRequest MeshRequest(const std::string& surface, uint64_t count) {
   SampleRequest r;
@@ -96,6 +78,39 @@ TEST(EngineMesh, AFileAndItsHashGiveTheSameSamplesOnTheirTriangles) {
     ASSERT_NEAR(p.x, a.x[i], 1e-12);
     ASSERT_NEAR(p.y, a.y[i], 1e-12);
     ASSERT_NEAR(p.z, a.z[i], 1e-12);
+  }
+}
+
+TEST(EngineMesh, LargeBatchesOnTwoThreadsAreTheSameSamples) {
+  const std::string path = WriteTemp("engine_mesh_threads.ply", MeshToPly(MakeIcosphere(3), true));
+  DirectTreeSource source;
+  FileModelSource files;
+  EngineLimits one, two;
+  one.generation_threads = 1, two.generation_threads = 2;
+  SamplingEngine a({one}, &source, &files), b({two}, &source, &files);
+  SampleRequest r = MeshRequest("ply:" + path, 100000);
+  r.tree.density = "mean:floor=0.1";
+  r.fields.density = r.fields.curve_position = true;
+  auto draw = [&](const SamplingEngine& engine, size_t batch) {
+    auto job = engine.Start(r);
+    EXPECT_TRUE(job.ok()) << job.status();
+    SampleBatch all;
+    while (job.ok()) {
+      auto n = job->cursor->Next(batch, &all);
+      EXPECT_TRUE(n.ok()) << n.status();
+      if (!n.ok() || *n == 0) break;
+    }
+    return all;
+  };
+  const SampleBatch serial = draw(a, 30000), parallel = draw(b, 30000), small = draw(b, 1000);
+  ASSERT_EQ(serial.size(), 100000u);
+  for (const SampleBatch* other : {&parallel, &small}) {
+    EXPECT_EQ(other->index, serial.index);
+    EXPECT_EQ(other->x, serial.x);
+    EXPECT_EQ(other->u, serial.u);
+    EXPECT_EQ(other->density, serial.density);
+    EXPECT_EQ(other->curve_position, serial.curve_position);
+    EXPECT_EQ(other->triangle, serial.triangle);
   }
 }
 

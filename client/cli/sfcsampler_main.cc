@@ -22,6 +22,7 @@
 #include "core/status_macros.h"
 #include "engine/model_source.h"
 #include "engine/sampling_engine.h"
+#include "evaluation/discrepancy.h"
 #include "evaluation/plot.h"
 #include "evaluation/protocol.h"
 #include "render/render.h"
@@ -81,8 +82,9 @@ struct Verbosity {
 // The tree summary and the depth-cap warnings, on stderr; the same for the
 // embedded mode (converted with ToProto) and the wire.
 void PrintTreeInfo(const ::sfcsampler::v1::TreeInfo& t, const Verbosity& verbosity = {}) {
-  if (!verbosity.quiet && t.kind() == "mesh") {
-    std::fprintf(stderr, "mesh tree %s (%s): %llu leaves, %llu bytes\n", t.key_with_grade().c_str(),
+  if (!verbosity.quiet && (t.kind() == "mesh" || t.kind() == "model")) {
+    std::fprintf(stderr, "%s tree %s (%s): %llu leaves, %llu bytes\n", t.kind().c_str(),
+                 t.key_with_grade().c_str(),
                  t.cache_hit() ? "cache hit" : "built", static_cast<unsigned long long>(t.leaves()),
                  static_cast<unsigned long long>(t.bytes()));
     return;
@@ -340,15 +342,89 @@ int RunUpload(const std::vector<std::string>& specs, const Connection& conn) {
   return 0;
 }
 
+// The faces of CAD models, read in process (the file is on this machine).
+int RunInspect(const std::vector<std::string>& specs) {
+  DirectTreeSource source;
+  SamplingEngine engine(EngineLimits{}, &source, &LocalModels());
+  for (const std::string& spec : specs) {
+    auto table = engine.DescribeModel(spec);
+    if (!table.ok()) return Fail(table.status());
+    std::printf("%s", table->c_str());
+  }
+  return 0;
+}
+
 struct EvalFlags {
   std::string setting = "fast";
   int l_min = 0, l_max = 0;
   std::vector<std::string> plane, sphere;
   std::string out_dir = "eval-out";
   uint64_t seed = 1;
+  std::string model;  // model mode: a sphere-shaped model spec against the built-in sphere
+  int seeds = 2;
 };
 
+// Model mode (issue 11): the spherical-triangle discrepancy of a model that is
+// a sphere (a STEP, IGES or NURBS sphere, or a mesh of one) against the
+// built-in sphere, N = 64 .. 24576, the mean over `seeds` seeds, and both
+// slopes. Points are projected onto the unit sphere about the centre of their
+// bounding box; the model's own deviation from a sphere shows as
+// discrepancy. Sets come from the server with --server.
+int RunEvalModel(const EvalFlags& f, const Connection& conn) {
+  auto discrepancy = [&](const std::string& surface, uint64_t n,
+                         uint64_t seed) -> absl::StatusOr<double> {
+    SampleRequest request;
+    request.tree.surface = surface;
+    request.count = n;
+    request.seed = seed;
+    SampleBatch all;
+    Progress quiet(false);
+    std::string provenance;
+    RETURN_IF_ERROR(StreamSamples(
+        request, conn, 0, v1::PRECISION_FLOAT64, Verbosity{true, true}, &quiet,
+        [&](std::optional<uint64_t>, const SampleBatch& batch) {
+          all.Append(batch);
+          return absl::OkStatus();
+        },
+        &provenance));
+    Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < all.size(); ++i) {
+      lo = {std::min(lo.x, all.x[i]), std::min(lo.y, all.y[i]), std::min(lo.z, all.z[i])};
+      hi = {std::max(hi.x, all.x[i]), std::max(hi.y, all.y[i]), std::max(hi.z, all.z[i])};
+    }
+    const Vec3 centre = (lo + hi) * 0.5;
+    std::vector<Vec3> points;
+    for (size_t i = 0; i < all.size(); ++i) {
+      const Vec3 d = Vec3{all.x[i], all.y[i], all.z[i]} - centre;
+      points.push_back(d * (1 / Norm(d)));
+    }
+    return SphericalTriangleDiscrepancy(points);
+  };
+  std::vector<double> ns, model_d, sphere_d;
+  std::printf("spherical-triangle discrepancy, mean of %d seeds\n\n| N | %s | built-in sphere |\n"
+              "|---:|---:|---:|\n",
+              f.seeds, f.model.c_str());
+  for (int l = 6; l <= 14; ++l) {
+    for (uint64_t n : {uint64_t{1} << l, (uint64_t{3} << l) / 2}) {
+      if (n > 24576) continue;
+      double dm = 0, ds = 0;
+      for (int i = 0; i < f.seeds; ++i) {
+        auto m = discrepancy(f.model, n, f.seed + i);
+        if (!m.ok()) return Fail(m.status());
+        auto b = discrepancy("sphere", n, f.seed + i);
+        if (!b.ok()) return Fail(b.status());
+        dm += *m / f.seeds, ds += *b / f.seeds;
+      }
+      ns.push_back(n), model_d.push_back(dm), sphere_d.push_back(ds);
+      std::printf("| %llu | %.4g | %.4g |\n", static_cast<unsigned long long>(n), dm, ds);
+    }
+  }
+  std::printf("| slope | **%.3f** | %.3f |\n", LogLogSlope(ns, model_d), LogLogSlope(ns, sphere_d));
+  return 0;
+}
+
 int RunEval(const EvalFlags& f, const Connection& conn) {
+  if (!f.model.empty()) return RunEvalModel(f, conn);
   ProtocolOptions options;
   std::unique_ptr<SamplerClient> client;
   if (!conn.server.empty()) {
@@ -570,6 +646,11 @@ int main(int argc, char** argv) {
   add_connection(upload);
 
   app.add_subcommand("surfaces", "list the surfaces, densities, curves and sequences with their formulas");
+  std::vector<std::string> inspect_specs;
+  CLI::App* inspect = app.add_subcommand(
+      "inspect", "list a CAD model's faces (index as in the face column, type, trimmed area, "
+                 "parameter box, orientation, trim) and the order the curve visits them");
+  inspect->add_option("models", inspect_specs, "step:FILE, iges:FILE or nurbs:FILE")->required();
 
   sfc::EvalFlags eval_flags;
   CLI::App* eval = app.add_subcommand("eval", "run the paper's discrepancy protocol and compare slopes with Tables 1-2");
@@ -583,6 +664,10 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   eval->add_option("--out-dir", eval_flags.out_dir, "where the CSV, the slope tables and the plots go")->capture_default_str();
   eval->add_option("--seed", eval_flags.seed, "seed of the random and jittered sets")->capture_default_str();
+  eval->add_option("--model", eval_flags.model,
+                   "model mode: a sphere-shaped model (step:sphere.step, ply:icosphere.ply, ...) "
+                   "against the built-in sphere, spherical-triangle discrepancy, N = 64..24576");
+  eval->add_option("--seeds", eval_flags.seeds, "model mode: seeds averaged per N")->capture_default_str();
   add_connection(eval);
 
   sfc::RenderFlags render_flags;
@@ -602,6 +687,7 @@ int main(int argc, char** argv) {
   if (cache->parsed()) return sfc::RunCache(conn);
   if (health->parsed()) return sfc::RunHealth(conn);
   if (upload->parsed()) return sfc::RunUpload(upload_specs, conn);
+  if (inspect->parsed()) return sfc::RunInspect(inspect_specs);
   if (eval->parsed()) return sfc::RunEval(eval_flags, conn);
   if (render->parsed()) return sfc::RunRender(flags, render_flags, conn);
   return sfc::RunSurfaces();

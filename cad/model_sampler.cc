@@ -1,0 +1,289 @@
+#include "cad/model_sampler.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_format.h"
+#include "core/status_macros.h"
+
+namespace sfc::cad {
+namespace {
+
+}  // namespace
+
+// Where a trimmed face's unit square lies relative to its trim, on a
+// kSide x kSide grid of cells classified once (Face::Classify, which is
+// conservative): a point in a cell wholly inside or outside is answered from
+// the grid, and only points in cells the boundary may cross ask the kernel.
+class TrimGrid {
+ public:
+  static constexpr int kSide = 128;
+  explicit TrimGrid(const Face* face) : face_(face), cells_(kSide * kSide) {
+    for (int i = 0; i < kSide; ++i) {
+      for (int j = 0; j < kSide; ++j) {
+        cells_[i * kSide + j] = face->Classify(double(i) / kSide, double(i + 1) / kSide,
+                                               double(j) / kSide, double(j + 1) / kSide);
+      }
+    }
+  }
+  // Face::Contains(s, t), the same answer.
+  bool Contains(double s, double t) const {
+    const int i = std::min(kSide - 1, std::max(0, static_cast<int>(s * kSide)));
+    const int j = std::min(kSide - 1, std::max(0, static_cast<int>(t * kSide)));
+    switch (cells_[i * kSide + j]) {
+      case CellState::kInside: return true;
+      case CellState::kOutside: return false;
+      case CellState::kStraddles: break;
+    }
+    return face_->Contains(s, t);
+  }
+
+ private:
+  const Face* face_;  // owned by the model, which the tree keeps alive
+  std::vector<CellState> cells_;
+};
+
+namespace {
+
+// The model's density on one face, zero outside its trimmed region. Face
+// surfaces take the face's unit square, so point.u, point.v are the face's.
+class TrimmedDensity final : public Density {
+ public:
+  TrimmedDensity(std::shared_ptr<const TrimGrid> trim, std::shared_ptr<const Density> inner)
+      : trim_(std::move(trim)), inner_(std::move(inner)) {}
+  bool NeedsCurvature() const override { return inner_->NeedsCurvature(); }
+  double Value(const SurfacePoint& point) const override {
+    if (trim_ && !trim_->Contains(point.u, point.v)) return 0;
+    return inner_->Value(point);
+  }
+
+ private:
+  std::shared_ptr<const TrimGrid> trim_;  // null: the face is not trimmed
+  std::shared_ptr<const Density> inner_;
+};
+
+// A face the core tree cannot sample because it has nothing to sample: no
+// area (a degenerate face), or no density mass inside its trim.
+bool HasNothingToSample(const absl::Status& status) {
+  return status.code() == absl::StatusCode::kInvalidArgument &&
+         (absl::StrContains(status.message(), "zero area") ||
+          absl::StrContains(status.message(), "integrates to") ||
+          absl::StrContains(status.message(), "to one point"));
+}
+
+}  // namespace
+
+absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
+    std::shared_ptr<const Model> model, std::shared_ptr<const Density> density,
+    const CurveTreeOptions& options, uint64_t count, const BuildControl& control) {
+  auto tree = std::shared_ptr<ModelTree>(new ModelTree());
+  tree->model_ = model;
+  // Stage one: every face's coarse tree (grade 0), for its mass.
+  std::vector<double> masses;
+  uint64_t leaves = 0, bytes = 0;
+  auto control_after = [&](uint64_t bytes_before) {
+    BuildControl c = control;
+    if (control.charge) {
+      c.charge = [charge = control.charge, bytes_before](uint64_t b) { return charge(bytes_before + b); };
+    }
+    return c;
+  };
+  auto options_after = [&](uint64_t leaves_before) -> absl::StatusOr<CurveTreeOptions> {
+    if (leaves_before >= options.max_leaves) {
+      return absl::ResourceExhaustedError(absl::StrFormat(
+          "the model \"%s\" needs more than %d leaves (max_tree_leaves) over its %d faces; ask "
+          "for fewer samples or a coarser tree",
+          model->name(), options.max_leaves, model->faces().size()));
+    }
+    CurveTreeOptions o = options;
+    o.max_leaves = options.max_leaves - leaves_before;
+    return o;
+  };
+  for (int f : model->curve_order()) {
+    const Face& face = model->faces()[f];
+    Piece piece;
+    piece.face = f;
+    piece.surface = face.shared_surface();
+    if (face.trimmed()) piece.trim = std::make_shared<const TrimGrid>(&face);
+    piece.density = std::make_shared<TrimmedDensity>(piece.trim, density);
+    ASSIGN_OR_RETURN(const CurveTreeOptions o, options_after(leaves));
+    auto coarse = CurveTree::Build(*piece.surface, *piece.density, o, 0, control_after(bytes));
+    if (!coarse.ok()) {
+      if (HasNothingToSample(coarse.status())) {
+        ++tree->skipped_faces_;
+        continue;
+      }
+      return absl::Status(coarse.status().code(),
+                          absl::StrFormat("face %d of \"%s\": %s", f, model->name(),
+                                          coarse.status().message()));
+    }
+    piece.tree = *std::move(coarse);
+    masses.push_back(piece.tree->total_mass());
+    leaves += piece.tree->leaf_count();
+    bytes += piece.tree->bytes();
+    tree->pieces_.push_back(std::move(piece));
+  }
+  double total = 0;
+  for (double m : masses) total += m;
+  if (tree->pieces_.empty() || !(total > 0)) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the model \"%s\" has no face to sample: its %d faces have no area or no density mass",
+        model->name(), model->faces().size()));
+  }
+  // Stage two: each face's tree refined for the samples its share brings.
+  leaves = 0, bytes = 0;
+  for (size_t i = 0; i < tree->pieces_.size(); ++i) {
+    Piece& piece = tree->pieces_[i];
+    const double share = masses[i] / total;
+    const uint64_t samples = static_cast<uint64_t>(std::ceil(static_cast<double>(count) * share));
+    const int grade = CurveTree::GradeFor(std::max<uint64_t>(1, samples));
+    if (grade > 0) {
+      // Each face's build is bounded by the budget left when it was made;
+      // the sum is checked below.
+      auto refined = piece.tree->Refined(*piece.surface, *piece.density, grade, control_after(bytes));
+      if (!refined.ok()) {
+        return absl::Status(refined.status().code(),
+                            absl::StrFormat("face %d of \"%s\": %s", piece.face, model->name(),
+                                            refined.status().message()));
+      }
+      piece.tree = *std::move(refined);
+    }
+    leaves += piece.tree->leaf_count();
+    bytes += piece.tree->bytes();
+    if (leaves > options.max_leaves) return options_after(leaves).status();
+  }
+  // The windows, from the refined masses; one double per boundary, so
+  // neighbouring windows split the samples exactly.
+  total = 0;
+  for (const Piece& piece : tree->pieces_) total += piece.tree->total_mass();
+  double running = 0;
+  for (size_t i = 0; i < tree->pieces_.size(); ++i) {
+    Piece& piece = tree->pieces_[i];
+    piece.lo = i == 0 ? 0.0 : tree->pieces_[i - 1].hi;
+    running += piece.tree->total_mass();
+    piece.hi = i + 1 == tree->pieces_.size() ? 1.0 : running / total;
+  }
+  tree->leaves_ = leaves;
+  tree->bytes_ = bytes;
+  return std::shared_ptr<const ModelTree>(std::move(tree));
+}
+
+absl::StatusOr<std::unique_ptr<ModelSampleCursor>> ModelSampleCursor::Create(
+    std::shared_ptr<const ModelTree> tree, Sequence sequence, uint64_t begin, uint64_t end,
+    const Region& region, const SampleFields& fields, int threads) {
+  if (begin > end || end > sequence.count()) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the index range [%d, %d) is not inside the set of %d samples; it needs begin <= end <= "
+        "count",
+        begin, end, sequence.count()));
+  }
+  RETURN_IF_ERROR(region.Validate());
+  if (region.kind == Region::Kind::kParameterRect) {
+    return absl::InvalidArgumentError(
+        "a CAD model has one parameter square per face, so a uv: region is ambiguous; use a 3D "
+        "box (box:X0,Y0,Z0,X1,Y1,Z1)");
+  }
+  auto cursor = std::unique_ptr<ModelSampleCursor>(
+      new ModelSampleCursor(std::move(tree), sequence, region, fields, std::max(1, threads)));
+  cursor->begin_ = begin;
+  cursor->end_ = end;
+  return cursor;
+}
+
+uint64_t ModelSampleCursor::FirstIndexAtOrAbove(double q) const {
+  uint64_t lo = 0, hi = sequence_.count();
+  while (lo < hi) {
+    const uint64_t mid = lo + (hi - lo) / 2;
+    if (sequence_.At(mid) >= q) {
+      hi = mid;
+    } else {
+      lo = mid + 1;
+    }
+  }
+  return lo;
+}
+
+absl::Status ModelSampleCursor::OpenPiece() {
+  const ModelTree::Piece& piece = tree_->pieces()[piece_];
+  const Sequence window = sequence_.Window(piece.lo, piece.hi);
+  uint64_t kb = begin_, ke = end_;
+  if (sequence_.monotone()) {
+    // The piece's samples are one index range: those with q_k in its window.
+    const size_t last = tree_->pieces().size() - 1;
+    kb = std::max(begin_, piece_ == 0 ? 0 : FirstIndexAtOrAbove(piece.lo));
+    ke = std::min(end_, piece_ == last ? sequence_.count() : FirstIndexAtOrAbove(piece.hi));
+    ke = std::max(kb, ke);
+  }
+  auto sampler = std::make_shared<const Sampler>(piece.tree, piece.surface, piece.density, window);
+  SampleFields core_fields = fields_;
+  core_fields.face = core_fields.triangle = false;
+  ASSIGN_OR_RETURN(cursor_, SampleCursor::Create(sampler, kb, ke, Region{}, core_fields, threads_));
+  return absl::OkStatus();
+}
+
+void ModelSampleCursor::KeepInTrim(const ModelTree::Piece& piece, size_t i, SampleBatch* b) {
+  const TrimGrid* trim = piece.trim.get();
+  const double s = b->u[i], t = b->v[i];
+  if (!trim || trim->Contains(s, t)) return;
+  // The nearest inside point on growing circles (16 directions each, in a
+  // fixed order), clamped to the square.
+  constexpr int kDirections = 16;
+  double best_s = s, best_t = t;
+  bool found = false;
+  for (double r = 1e-9; r <= 2 && !found; r *= 2) {
+    for (int d = 0; d < kDirections && !found; ++d) {
+      const double a = 2 * M_PI * d / kDirections;
+      const double cs = std::clamp(s + r * std::cos(a), 0.0, 1.0);
+      const double ct = std::clamp(t + r * std::sin(a), 0.0, 1.0);
+      if (trim->Contains(cs, ct)) best_s = cs, best_t = ct, found = true;
+    }
+  }
+  if (!found) return;  // a face with mass has inside points; not reached
+  ++moved_;
+  b->u[i] = best_s, b->v[i] = best_t;
+  const bool curvature = fields_.density && piece.density->NeedsCurvature();
+  const SurfaceJet jet = piece.surface->Jet(best_s, best_t, curvature ? 2 : 1);
+  b->x[i] = jet.p.x, b->y[i] = jet.p.y, b->z[i] = jet.p.z;
+  if (fields_.normal || fields_.density) {
+    const SurfaceGeometry geo = GeometryOf(jet);
+    if (fields_.normal) b->nx[i] = geo.normal.x, b->ny[i] = geo.normal.y, b->nz[i] = geo.normal.z;
+    if (fields_.density) {
+      SurfacePoint point;
+      point.u = best_s, point.v = best_t, point.p = jet.p, point.normal = geo.normal;
+      point.gaussian_curvature = geo.gaussian_curvature;
+      point.mean_curvature = geo.mean_curvature;
+      b->density[i] = piece.density->Value(point);
+    }
+  }
+}
+
+absl::StatusOr<size_t> ModelSampleCursor::Next(size_t max, SampleBatch* batch) {
+  size_t got = 0;
+  const double pieces = static_cast<double>(tree_->pieces().size());
+  while (got < max && piece_ < tree_->pieces().size()) {
+    if (!cursor_) RETURN_IF_ERROR(OpenPiece());
+    scratch_.Clear();
+    ASSIGN_OR_RETURN(const size_t n, cursor_->Next(max - got, &scratch_));
+    if (n == 0) {
+      cursor_.reset();
+      ++piece_;
+      continue;
+    }
+    const ModelTree::Piece& piece = tree_->pieces()[piece_];
+    for (size_t i = 0; i < n; ++i) KeepInTrim(piece, i, &scratch_);
+    if (fields_.curve_position) {
+      for (double& c : scratch_.curve_position) c = (piece_ + c) / pieces;
+    }
+    for (size_t i = 0; i < n; ++i) {
+      const Vec3 p{scratch_.x[i], scratch_.y[i], scratch_.z[i]};
+      if (!region_.Contains(scratch_.u[i], scratch_.v[i], p)) continue;
+      batch->AppendFrom(scratch_, i, i + 1);
+      if (fields_.face) batch->face.push_back(static_cast<uint32_t>(piece.face));
+      ++got;
+    }
+  }
+  return got;
+}
+
+}  // namespace sfc::cad

@@ -1,0 +1,56 @@
+// One bounded pool of worker threads shared by every cursor in the process
+// (issue 9: "one bounded worker pool shared by all streams, not threads
+// started per batch"). A parallel loop hands its tasks to whichever workers
+// are free and runs the rest on the calling thread, so it always finishes,
+// even when every worker is busy with other streams' loops; the total number
+// of threads stays the pool's size plus the callers.
+//
+// Which thread runs a task never matters to the result: tasks write to their
+// own outputs, which the caller joins in task order.
+//
+// Thread-safety: thread-safe.
+#ifndef SFCSAMPLER_CORE_WORKER_POOL_H_
+#define SFCSAMPLER_CORE_WORKER_POOL_H_
+
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace sfc {
+
+class WorkerPool {
+ public:
+  // The process's pool: hardware threads - 1 workers (at least 1, at most 63).
+  static WorkerPool& Shared();
+
+  explicit WorkerPool(int workers);
+  ~WorkerPool();
+  WorkerPool(const WorkerPool&) = delete;
+  WorkerPool& operator=(const WorkerPool&) = delete;
+
+  // Runs task(0) .. task(n - 1), each exactly once, on the caller and on free
+  // workers; returns when all have finished.
+  void ParallelFor(int n, const std::function<void(int)>& task);
+
+  int workers() const { return static_cast<int>(threads_.size()); }
+
+ private:
+  struct Loop;
+  void Work();
+  // Claims and runs tasks of `loop` until none is left unclaimed.
+  static void RunTasks(Loop& loop);
+
+  std::mutex mu_;
+  std::condition_variable wake_;
+  std::deque<std::shared_ptr<Loop>> queue_;  // one entry per task offered to a worker
+  bool stopping_ = false;
+  std::vector<std::thread> threads_;
+};
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_CORE_WORKER_POOL_H_
