@@ -192,18 +192,26 @@ TEST(Server, AResumeOnAServerOfAnotherReleaseFailsInsteadOfMixingSets) {
   ExpectStatus(result.status(), absl::StatusCode::kFailedPrecondition, "sfcsampler-older-release");
 }
 
+// All samples of a request from the embedded engine, in process.
+SampleBatch Embedded(const SampleRequest& request) {
+  DirectTreeSource source;
+  SamplingEngine engine({}, &source);
+  auto job = engine.Start(request);
+  EXPECT_TRUE(job.ok()) << job.status();
+  SampleBatch local;
+  if (job.ok()) {
+    while (*job->cursor->Next(4096, &local) > 0) {
+    }
+  }
+  return local;
+}
+
 TEST(Server, EmbeddedAndWireSamplesAreIdentical) {
   Running r = StartServer(LoopbackOptions());
   SampleRequest request = Request("monkey_saddle", 5000, 3);
   request.tree.density = "gaussian:floor=0.1";
   request.region = Region::Box({-0.5, -0.5, -1}, {0.5, 0.5, 1});
-  DirectTreeSource source;
-  SamplingEngine engine({}, &source);
-  auto job = engine.Start(request);
-  ASSERT_TRUE(job.ok());
-  SampleBatch local;
-  while (*job->cursor->Next(4096, &local) > 0) {
-  }
+  const SampleBatch local = Embedded(request);
   auto wire = Fetch(*r.client, request);
   ASSERT_TRUE(wire.ok());
   ExpectEqual(*wire, local);
@@ -220,13 +228,7 @@ TEST(Server, EveryEncodingAndPrecisionCarriesTheEmbeddedEnginesSamples) {
     SampleRequest request = Request("torus", 30000, 8);
     request.tree.density = "gaussian:floor=0.1";
     request.fields.normal = request.fields.density = request.fields.curve_position = true;
-    DirectTreeSource source;
-    SamplingEngine engine({}, &source);
-    auto job = engine.Start(request);
-    ASSERT_TRUE(job.ok());
-    SampleBatch local;
-    while (*job->cursor->Next(4096, &local) > 0) {
-    }
+    const SampleBatch local = Embedded(request);
     for (auto encoding : {v1::COLUMN_ENCODING_RAW, v1::COLUMN_ENCODING_PACKED}) {
       for (auto precision : {v1::PRECISION_FLOAT64, v1::PRECISION_FLOAT32}) {
         ClientOptions co;
