@@ -17,9 +17,9 @@
 #include "bench/raw_stream.grpc.pb.h"
 #include "client/sampler_client.h"
 #include "engine/sampling_engine.h"
-#include "proto/convert.h"
 #include "grpcpp/create_channel.h"
 #include "grpcpp/server_builder.h"
+#include "proto/convert.h"
 #include "server/sampler_server.h"
 
 namespace sfc {
@@ -28,7 +28,9 @@ namespace {
 namespace v1 = ::sfcsampler::v1;
 using Clock = std::chrono::steady_clock;
 
-double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double Since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
 
 class RawStreamService final : public sfcsampler::bench::RawStream::Service {
   grpc::Status Stream(grpc::ServerContext*, const sfcsampler::bench::RawRequest* request,
@@ -60,7 +62,8 @@ class WireOnlyService final : public v1::Sampler::Service {
       if (n < batch.size()) batch = SampleBatch(), batch.AppendFrom(batch_, 0, n);
       for (size_t i = 0; i < n; ++i) batch.index[i] = sent + i;
       response.mutable_batch()->Clear();
-      ToProto(batch, SampleFields{}, request->precision(), response.mutable_batch(), request->column_encoding());
+      ToProto(batch, SampleFields{}, request->precision(), response.mutable_batch(),
+              request->column_encoding());
       if (!writer->Write(response)) break;
       response.clear_header();
       sent += n;
@@ -194,7 +197,8 @@ int Run(uint64_t n) {
   for (const Case& c : cases) {
     const v1::Precision precision = c.precision;
     const SampleRequest& request = *c.request;
-    const std::string label = std::string(c.surface) + (precision == v1::PRECISION_FLOAT32 ? ", float32" : ", float64");
+    const std::string label =
+        std::string(c.surface) + (precision == v1::PRECISION_FLOAT32 ? ", float32" : ", float64");
     const char* name = label.c_str();
     const size_t value_bytes = precision == v1::PRECISION_FLOAT32 ? 4 : 8;
     const uint64_t payload = n * 5 * value_bytes;
@@ -206,15 +210,19 @@ int Run(uint64_t n) {
     // Measured next to the streams it explains (the machine's load drifts).
     const double generation =
         Best([&] { return GenerationSeconds(request, options.limits.generation_threads, batch); });
-    std::printf("| %s: generation alone, in process, the same %llu samples, %d threads | %.2f M samples/s |\n",
-                name, static_cast<unsigned long long>(n), options.limits.generation_threads, n / generation / 1e6);
+    std::printf(
+        "| %s: generation alone, in process, the same %llu samples, %d threads | %.2f M samples/s "
+        "|\n",
+        name, static_cast<unsigned long long>(n), options.limits.generation_threads,
+        n / generation / 1e6);
     // The stream as it ran before (generation between writes, packed
     // columns: a server with no pipeline), then pipelined with each encoding.
     struct Setup {
       const char* how;
       const std::string* target;
       v1::ColumnEncoding encoding;
-    } setups[] = {{"no pipeline, packed columns (as before)", &unpipelined_target, v1::COLUMN_ENCODING_PACKED},
+    } setups[] = {{"no pipeline, packed columns (as before)", &unpipelined_target,
+                   v1::COLUMN_ENCODING_PACKED},
                   {"pipelined, packed columns", &target, v1::COLUMN_ENCODING_PACKED},
                   {"pipelined, raw columns", &target, v1::COLUMN_ENCODING_RAW}};
     for (const Setup& setup : setups) {
@@ -227,11 +235,12 @@ int Run(uint64_t n) {
       uint64_t received = 0;
       StreamSeconds(*client, request, &received);  // warm: build and cache the tree
       const double seconds = Best([&] { return StreamSeconds(*client, request, &received); });
-      std::printf("| %s, %s: %llu samples streamed (cached tree) | %.2f M samples/s (%.0f MB/s) |\n",
-                  name, setup.how, static_cast<unsigned long long>(received), received / seconds / 1e6,
-                  payload / seconds / 1e6);
-      std::printf("| %s, %s: ratio stream / raw bytes; stream / generation alone | %.2f; %.2f |\n", name,
-                  setup.how, raw_seconds / seconds, generation / seconds);
+      std::printf(
+          "| %s, %s: %llu samples streamed (cached tree) | %.2f M samples/s (%.0f MB/s) |\n", name,
+          setup.how, static_cast<unsigned long long>(received), received / seconds / 1e6,
+          payload / seconds / 1e6);
+      std::printf("| %s, %s: ratio stream / raw bytes; stream / generation alone | %.2f; %.2f |\n",
+                  name, setup.how, raw_seconds / seconds, generation / seconds);
     }
     for (auto encoding : {v1::COLUMN_ENCODING_PACKED, v1::COLUMN_ENCODING_RAW}) {
       ClientOptions co;
@@ -241,10 +250,13 @@ int Run(uint64_t n) {
       co.column_encoding = encoding;
       auto wire_client = *SamplerClient::Connect(co);
       uint64_t received = 0;
-      const double wire_seconds = Best([&] { return StreamSeconds(*wire_client, request, &received); });
-      std::printf("| %s, %s: wire path only (no generation), ratio to raw bytes | %.2f (%.1f M samples/s) |\n",
-                  name, encoding == v1::COLUMN_ENCODING_RAW ? "raw columns" : "packed columns",
-                  raw_seconds / wire_seconds, received / wire_seconds / 1e6);
+      const double wire_seconds =
+          Best([&] { return StreamSeconds(*wire_client, request, &received); });
+      std::printf(
+          "| %s, %s: wire path only (no generation), ratio to raw bytes | %.2f (%.1f M samples/s) "
+          "|\n",
+          name, encoding == v1::COLUMN_ENCODING_RAW ? "raw columns" : "packed columns",
+          raw_seconds / wire_seconds, received / wire_seconds / 1e6);
     }
   }
 
@@ -263,19 +275,23 @@ int Run(uint64_t n) {
       hit = std::min(hit, StreamSeconds(*client, request, &received));
       // A hit that streams one sample: the request's fixed cost (lookup,
       // header, round trip).
-      fixed = std::min(fixed, StreamSeconds(*client, SamplerClient::Range(request, 0, 1), &received));
+      fixed =
+          std::min(fixed, StreamSeconds(*client, SamplerClient::Range(request, 0, 1), &received));
       fresh->Shutdown(1);
     }
-    std::printf("| first request, 10^6 samples, eight surface, curvature density | %.3f s |\n", first);
+    std::printf("| first request, 10^6 samples, eight surface, curvature density | %.3f s |\n",
+                first);
     std::printf("| the same request again (cache hit) | %.3f s |\n", hit);
     std::printf("| first / hit | %.1fx |\n", first / hit);
     // Where the hit's time goes: generating the same samples in process from
     // a tree built beforehand.
-    const double generate = std::min(GenerationSeconds(request, options.limits.generation_threads, 65536),
-                                     GenerationSeconds(request, options.limits.generation_threads, 65536));
+    const double generate =
+        std::min(GenerationSeconds(request, options.limits.generation_threads, 65536),
+                 GenerationSeconds(request, options.limits.generation_threads, 65536));
     std::printf("| of the hit: generating the 10^6 samples in process, %d threads | %.3f s |\n",
                 options.limits.generation_threads, generate);
-    std::printf("| of the hit: a hit streaming 1 sample (lookup, header, round trip) | %.4f s |\n", fixed);
+    std::printf("| of the hit: a hit streaming 1 sample (lookup, header, round trip) | %.4f s |\n",
+                fixed);
   }
 
   {
@@ -301,8 +317,9 @@ int Run(uint64_t n) {
     const double seconds = Since(start);
     uint64_t total = 0;
     for (uint64_t g : got) total += g;
-    std::printf("| 16 concurrent clients x 10^6 samples (torus, cached) | %.2f M samples/s aggregate |\n",
-                total / seconds / 1e6);
+    std::printf(
+        "| 16 concurrent clients x 10^6 samples (torus, cached) | %.2f M samples/s aggregate |\n",
+        total / seconds / 1e6);
   }
   server->Shutdown(1);
   unpipelined->Shutdown(1);

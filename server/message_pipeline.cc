@@ -44,7 +44,9 @@ void MessagePipeline::Run() {
     std::unique_ptr<v1::SampleResponse> response;
     {
       absl::MutexLock lock(&mu_);
-      auto room = [this]() ABSL_SHARED_LOCKS_REQUIRED(mu_) { return stopping_ || queue_.size() < depth_; };
+      auto room = [this]() ABSL_SHARED_LOCKS_REQUIRED(mu_) {
+        return stopping_ || queue_.size() < depth_;
+      };
       mu_.Await(absl::Condition(&room));
       if (stopping_) return;
       if (!free_.empty()) {

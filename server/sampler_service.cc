@@ -46,8 +46,8 @@ BuildControl RequestControl(const grpc::ServerContext* context, Clock::time_poin
 // range (16 bytes a sample), the producer's batch (per sample the index and
 // the columns in float64, the model columns uint32), and the messages of its
 // pipeline, at most pipeline_depth + 2 (queued, being made, being written;
-// MessagePipeline; one without a pipeline), each per sample the columns on the wire (float32 if
-// asked; indices listed, at most). The batch is the requested size, or the
+// MessagePipeline; one without a pipeline), each per sample the columns on
+// the wire (float32 if asked; indices listed, at most). The batch is the requested size, or the
 // largest the server would choose. An invalid range counts nothing here:
 // Start refuses it.
 uint64_t StreamWorkingBytes(const SampleRequest& request, const v1::SampleRequest& wire,
@@ -139,8 +139,9 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
   }
   const BuildControl control = RequestControl(context, deadline, options_.request_deadline_seconds);
   // The stream's working memory, reserved before its cursor sorts anything.
-  auto memory = stream_memory_.Reserve(StreamWorkingBytes(*parsed, request, options_.stream_pipeline_depth),
-                                     "this stream", control.check);
+  auto memory = stream_memory_.Reserve(
+      StreamWorkingBytes(*parsed, request, options_.stream_pipeline_depth), "this stream",
+      control.check);
   if (!memory.ok()) return ToGrpcStatus(memory.status());
   auto job = engine_.Start(*parsed, control);
   if (!job.ok()) return ToGrpcStatus(job.status());
