@@ -75,6 +75,17 @@ class WireOnlyService final : public v1::Sampler::Service {
   const SampleBatch batch_;
 };
 
+// A plain gRPC server with `service` on a free loopback port, its address in `target`.
+std::unique_ptr<grpc::Server> StartLoopback(grpc::Service* service, std::string* target) {
+  grpc::ServerBuilder builder;
+  int port = 0;
+  builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
+  builder.RegisterService(service);
+  auto server = builder.BuildAndStart();
+  *target = "127.0.0.1:" + std::to_string(port);
+  return server;
+}
+
 // The fastest of `runs` calls of `seconds` (the machine is shared and noisy).
 template <typename F>
 double Best(F seconds, int runs = 2) {
@@ -174,18 +185,9 @@ int Run(uint64_t n) {
   GenerationSeconds(Request("sphere", "uniform", batch), 1, batch, &one_batch);
 
   WireOnlyService wire_only(one_batch);
-  grpc::ServerBuilder builder;
-  int raw_port = 0;
-  builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &raw_port);
-  builder.RegisterService(&raw);
-  auto raw_server = builder.BuildAndStart();
-  const std::string raw_target = "127.0.0.1:" + std::to_string(raw_port);
-  grpc::ServerBuilder wire_builder;
-  int wire_port = 0;
-  wire_builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &wire_port);
-  wire_builder.RegisterService(&wire_only);
-  auto wire_server = wire_builder.BuildAndStart();
-  const std::string wire_target = "127.0.0.1:" + std::to_string(wire_port);
+  std::string raw_target, wire_target;
+  auto raw_server = StartLoopback(&raw, &raw_target);
+  auto wire_server = StartLoopback(&wire_only, &wire_target);
 
   // Each stream next to the raw bytes and the generation it is bounded by.
   struct Case {
