@@ -124,72 +124,78 @@ absl::Status MeshSampleCursor::Plan(uint64_t begin, uint64_t end) {
   return absl::OkStatus();
 }
 
+// The columns this cursor fills, sized to `rows` past their rows before this
+// call (`at`, and `mesh_at` for the mesh columns), growing or shrinking.
+void MeshSampleCursor::Resize(size_t at, size_t mesh_at, size_t rows, SampleBatch* batch,
+                              MeshSampleColumns* mesh_columns) const {
+  const size_t mesh_rows = mesh_at + rows;
+  rows += at;
+  batch->index.resize(rows);
+  for (auto* column : {&batch->u, &batch->v, &batch->x, &batch->y, &batch->z}) column->resize(rows);
+  if (fields_.normal) {
+    for (auto* column : {&batch->nx, &batch->ny, &batch->nz}) column->resize(rows);
+  }
+  if (fields_.density) batch->density.resize(rows);
+  if (fields_.curve_position) batch->curve_position.resize(rows);
+  if (mesh_columns != nullptr) {
+    mesh_columns->triangle.resize(mesh_rows);
+    mesh_columns->w.resize(mesh_rows);
+  }
+}
+
 absl::StatusOr<size_t> MeshSampleCursor::Next(size_t max, SampleBatch* batch,
                                               MeshSampleColumns* mesh_columns) {
+  const size_t at = batch->size();
+  const size_t mesh_at = mesh_columns != nullptr ? mesh_columns->size() : 0;
+  // At most the indices left.
+  uint64_t left = use_order_ ? order_.size() - order_pos_ : 0;
+  if (!use_order_) {
+    for (size_t i = segment_; i < segments_.size(); ++i) {
+      left += segments_[i].end -
+              (i == segment_ ? std::max(next_k_, segments_[i].begin) : segments_[i].begin);
+    }
+  }
+  const size_t want = static_cast<size_t>(std::min<uint64_t>(left, max));
+  Resize(at, mesh_at, want, batch, mesh_columns);  // written in place, then trimmed
+
   // A large stretch of a plain index range goes to the shared pool in
-  // contiguous parts, each drawn by a cursor of its own (a sample is a pure
-  // function of k, so the parts are the samples one cursor would draw).
+  // contiguous parts, each drawn by a cursor of its own straight into its
+  // rows of the columns (a sample is a pure function of k, so the parts are
+  // the samples one cursor would draw).
   if (threads_ > 1 && !use_order_ && region_.kind == Region::Kind::kAll &&
-      segment_ < segments_.size() && max >= kParallelMin &&
+      segment_ < segments_.size() && want >= kParallelMin &&
       segments_[segment_].end - next_k_ >= kParallelMin) {
-    const uint64_t k0 = next_k_, k1 = k0 + std::min<uint64_t>(max, segments_[segment_].end - k0);
+    const uint64_t k0 = next_k_, k1 = k0 + std::min<uint64_t>(want, segments_[segment_].end - k0);
     const int n = threads_;
-    std::vector<SampleBatch> parts(n);
-    std::vector<MeshSampleColumns> columns(n);
     std::vector<absl::Status> status(n);
     WorkerPool::Shared().ParallelFor(n, [&](int i) {
       const uint64_t a = k0 + (k1 - k0) * i / n, b = k0 + (k1 - k0) * (i + 1) / n;
       MeshSampleCursor part(sampler_, region_, fields_);
       part.segments_.push_back({a, b});
       part.next_k_ = a;
-      auto got = part.Next(b - a, &parts[i], mesh_columns ? &columns[i] : nullptr);
-      status[i] = got.status();
+      status[i] = part.Emit(b - a, batch, mesh_columns, at + (a - k0), mesh_at + (a - k0)).status();
     });
     for (const absl::Status& st : status) RETURN_IF_ERROR(st);
-    for (int i = 0; i < n; ++i) {
-      batch->Append(parts[i]);
-      if (mesh_columns) {
-        mesh_columns->triangle.insert(mesh_columns->triangle.end(), columns[i].triangle.begin(),
-                                      columns[i].triangle.end());
-        mesh_columns->w.insert(mesh_columns->w.end(), columns[i].w.begin(), columns[i].w.end());
-      }
-    }
     next_k_ = k1;
     if (next_k_ >= segments_[segment_].end && ++segment_ < segments_.size()) {
       next_k_ = segments_[segment_].begin;
     }
     cached_leaf_ = SIZE_MAX;
+    Resize(at, mesh_at, k1 - k0, batch, mesh_columns);
     return static_cast<size_t>(k1 - k0);
   }
+  auto emitted = Emit(want, batch, mesh_columns, at, mesh_at);
+  Resize(at, mesh_at, emitted.ok() ? *emitted : 0, batch, mesh_columns);
+  return emitted;
+}
+
+absl::StatusOr<size_t> MeshSampleCursor::Emit(size_t max, SampleBatch* batch,
+                                              MeshSampleColumns* mesh_columns, size_t at,
+                                              size_t mesh_at) {
   const MeshSampler& sampler = *sampler_;
   const MeshCurveTree& tree = sampler.tree();
   const MeshSurface& surface = tree.surface();
   const auto& ends = tree.mass_ends();
-  {
-    // Reserve what this call can emit (at most the indices left), so large
-    // batches grow once instead of by doubling.
-    uint64_t left = use_order_ ? order_.size() - order_pos_ : 0;
-    if (!use_order_) {
-      for (size_t i = segment_; i < segments_.size(); ++i) {
-        left += segments_[i].end - (i == segment_ ? std::max(next_k_, segments_[i].begin)
-                                                  : segments_[i].begin);
-      }
-    }
-    const size_t want = batch->size() + static_cast<size_t>(std::min<uint64_t>(left, max));
-    for (auto* column : {&batch->u, &batch->v, &batch->x, &batch->y, &batch->z}) {
-      column->reserve(want);
-    }
-    batch->index.reserve(want);
-    if (fields_.normal) {
-      for (auto* column : {&batch->nx, &batch->ny, &batch->nz}) column->reserve(want);
-    }
-    if (fields_.density) batch->density.reserve(want);
-    if (fields_.curve_position) batch->curve_position.reserve(want);
-    if (mesh_columns != nullptr) {
-      mesh_columns->triangle.reserve(mesh_columns->size() + (want - batch->size()));
-      mesh_columns->w.reserve(mesh_columns->size() + (want - batch->size()));
-    }
-  }
   // Samples go in chunks: first their leaves and fractions, then their
   // descents together (MeshCurveTree::DescendMany), then the columns.
   constexpr size_t kChunk = 32;
@@ -245,17 +251,18 @@ absl::StatusOr<size_t> MeshSampleCursor::Next(size_t max, SampleBatch* batch,
       const Vec3 position = surface.Point(triangle, bary);
       if (!region_.Contains(0, 0, position)) continue;
       const uint64_t k = ks[i];
-      batch->index.push_back(k);
-      batch->u.push_back(bary[1]);
-      batch->v.push_back(bary[2]);
-      batch->x.push_back(position.x);
-      batch->y.push_back(position.y);
-      batch->z.push_back(position.z);
+      const size_t row = at + emitted;
+      batch->index[row] = k;
+      batch->u[row] = bary[1];
+      batch->v[row] = bary[2];
+      batch->x[row] = position.x;
+      batch->y[row] = position.y;
+      batch->z[row] = position.z;
       if (fields_.normal) {
         const Vec3 nrm = surface.Normal(triangle, bary);
-        batch->nx.push_back(nrm.x);
-        batch->ny.push_back(nrm.y);
-        batch->nz.push_back(nrm.z);
+        batch->nx[row] = nrm.x;
+        batch->ny[row] = nrm.y;
+        batch->nz[row] = nrm.z;
       }
       if (fields_.density) {
         const double d = tree.density().uniform()
@@ -266,14 +273,14 @@ absl::StatusOr<size_t> MeshSampleCursor::Next(size_t max, SampleBatch* batch,
               "the density '%s' is %g at sample %d (%g, %g, %g); it must be finite and >= 0",
               tree.density().spec(), d, k, position.x, position.y, position.z));
         }
-        batch->density.push_back(d);
+        batch->density[row] = d;
       }
       if (fields_.curve_position) {
-        batch->curve_position.push_back((cells[i]->rank + area_positions[i]) / triangles);
+        batch->curve_position[row] = (cells[i]->rank + area_positions[i]) / triangles;
       }
       if (mesh_columns != nullptr) {
-        mesh_columns->triangle.push_back(triangle);
-        mesh_columns->w.push_back(bary[0]);
+        mesh_columns->triangle[mesh_at + emitted] = triangle;
+        mesh_columns->w[mesh_at + emitted] = bary[0];
       }
       ++emitted;
     }

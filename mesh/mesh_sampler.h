@@ -104,6 +104,13 @@ class MeshSampleCursor {
   MeshSampleCursor(std::shared_ptr<const MeshSampler> sampler, Region region, SampleFields fields)
       : sampler_(std::move(sampler)), region_(region), fields_(fields) {}
   absl::Status Plan(uint64_t begin, uint64_t end);
+  // Writes up to `max` samples into rows at, at + 1, ... of the batch's
+  // columns (mesh_at, ... of the mesh columns), which hold them already
+  // (Resize); returns how many.
+  absl::StatusOr<size_t> Emit(size_t max, SampleBatch* batch, MeshSampleColumns* mesh_columns,
+                              size_t at, size_t mesh_at);
+  void Resize(size_t at, size_t mesh_at, size_t rows, SampleBatch* batch,
+              MeshSampleColumns* mesh_columns) const;
 
   struct Segment {
     uint64_t begin, end;
