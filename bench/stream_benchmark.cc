@@ -1,8 +1,12 @@
 // Service benchmarks; prints a Markdown table. Everything runs in this
 // process over loopback TCP: a real sfcsampler server, the C++ client
 // library, and a raw-bytes gRPC stream as the baseline measured in the same
-// run.
+// run. To tell the stream's own cost from generation's, the same request is
+// also timed in process (generation alone, the server's thread count) and
+// through a bench-only service that streams the wire path without
+// generating (one batch generated first, encoded into every message).
 //   stream_benchmark [samples]   (default 10^7)
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -12,8 +16,10 @@
 
 #include "bench/raw_stream.grpc.pb.h"
 #include "client/sampler_client.h"
+#include "engine/sampling_engine.h"
 #include "grpcpp/create_channel.h"
 #include "grpcpp/server_builder.h"
+#include "proto/convert.h"
 #include "server/sampler_server.h"
 
 namespace sfc {
@@ -22,7 +28,9 @@ namespace {
 namespace v1 = ::sfcsampler::v1;
 using Clock = std::chrono::steady_clock;
 
-double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double Since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
 
 class RawStreamService final : public sfcsampler::bench::RawStream::Service {
   grpc::Status Stream(grpc::ServerContext*, const sfcsampler::bench::RawRequest* request,
@@ -35,6 +43,56 @@ class RawStreamService final : public sfcsampler::bench::RawStream::Service {
     return grpc::Status::OK;
   }
 };
+
+// The Sample RPC's wire path without generation: every message is encoded
+// (ToProto, as the server does) from one batch generated beforehand, with
+// its indices moved on, and written; the client decodes it as usual.
+class WireOnlyService final : public v1::Sampler::Service {
+ public:
+  explicit WireOnlyService(SampleBatch batch) : batch_(std::move(batch)) {}
+  grpc::Status Sample(grpc::ServerContext* context, const v1::SampleRequest* request,
+                      grpc::ServerWriter<v1::SampleResponse>* writer) override {
+    v1::SampleResponse response;
+    response.mutable_header()->set_begin(0);
+    response.mutable_header()->set_end(request->count());
+    response.mutable_header()->set_expected_samples(static_cast<int64_t>(request->count()));
+    SampleBatch batch = batch_;
+    for (uint64_t sent = 0; sent < request->count();) {
+      const size_t n = std::min<uint64_t>(batch_.size(), request->count() - sent);
+      if (n < batch.size()) batch = SampleBatch(), batch.AppendFrom(batch_, 0, n);
+      for (size_t i = 0; i < n; ++i) batch.index[i] = sent + i;
+      response.mutable_batch()->Clear();
+      ToProto(batch, SampleFields{}, request->precision(), response.mutable_batch(),
+              request->column_encoding());
+      if (!writer->Write(response)) break;
+      response.clear_header();
+      sent += n;
+    }
+    return grpc::Status::OK;
+  }
+
+ private:
+  const SampleBatch batch_;
+};
+
+// A plain gRPC server with `service` on a free loopback port, its address in `target`.
+std::unique_ptr<grpc::Server> StartLoopback(grpc::Service* service, std::string* target) {
+  grpc::ServerBuilder builder;
+  int port = 0;
+  builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
+  builder.RegisterService(service);
+  auto server = builder.BuildAndStart();
+  *target = "127.0.0.1:" + std::to_string(port);
+  return server;
+}
+
+// The fastest of `runs` calls of `seconds` (the machine is shared and noisy).
+template <typename F>
+double Best(F seconds, int runs = 2) {
+  double best = seconds();
+  for (int i = 1; i < runs; ++i) best = std::min(best, seconds());
+  return best;
+}
 
 // Seconds to receive `total` bytes over a raw stream.
 double RawSeconds(const std::string& target, uint64_t total, uint32_t chunk) {
@@ -81,6 +139,30 @@ double StreamSeconds(SamplerClient& client, const SampleRequest& request, uint64
   return Since(start);
 }
 
+// Seconds to generate `request` in process from a tree built beforehand,
+// in batches of `batch` with `threads` generation threads, as a server does.
+double GenerationSeconds(const SampleRequest& request, int threads, uint32_t batch,
+                         SampleBatch* first_batch = nullptr) {
+  DirectTreeSource source;
+  EngineLimits limits;
+  limits.generation_threads = threads;
+  limits.max_tree_leaves = uint64_t{1} << 26;
+  SamplingEngine engine(limits, &source);
+  auto job = engine.Start(request);
+  if (!job.ok()) {
+    std::fprintf(stderr, "generation failed: %s\n", job.status().ToString().c_str());
+    std::exit(1);
+  }
+  SampleBatch b;
+  const auto start = Clock::now();
+  for (bool first = true;; first = false) {
+    b.Clear();
+    if (*job->cursor->Next(batch, &b) == 0) break;
+    if (first && first_batch) *first_batch = b;
+  }
+  return Since(start);
+}
+
 int Run(uint64_t n) {
   ServerOptions options;
   options.address = "127.0.0.1:0";
@@ -89,49 +171,129 @@ int Run(uint64_t n) {
   options.limits.max_tree_leaves = uint64_t{1} << 26;
   auto server = *SamplerServer::Start(options);
   const std::string target = "127.0.0.1:" + std::to_string(server->port());
+  ServerOptions unpipelined_options = options;
+  unpipelined_options.stream_pipeline_depth = 0;
+  auto unpipelined = *SamplerServer::Start(unpipelined_options);
+  const std::string unpipelined_target = "127.0.0.1:" + std::to_string(unpipelined->port());
 
   RawStreamService raw;
-  grpc::ServerBuilder builder;
-  int raw_port = 0;
-  builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &raw_port);
-  builder.RegisterService(&raw);
-  auto raw_server = builder.BuildAndStart();
-  const std::string raw_target = "127.0.0.1:" + std::to_string(raw_port);
 
   std::printf("| measurement | value |\n|---|---:|\n");
   const uint32_t batch = 65536;
-  for (auto precision : {v1::PRECISION_FLOAT32, v1::PRECISION_FLOAT64}) {
-    ClientOptions co;
-    co.target = target;
-    co.precision = precision;
-    co.batch_size = batch;
-    auto client = *SamplerClient::Connect(co);
-    const SampleRequest request = Request("sphere", "uniform", n);
-    uint64_t received = 0;
-    StreamSeconds(*client, request, &received);  // warm: build and cache the tree
-    const double seconds = StreamSeconds(*client, request, &received);
+  const SampleRequest sphere = Request("sphere", "uniform", n);
+  SampleBatch one_batch;
+  GenerationSeconds(Request("sphere", "uniform", batch), 1, batch, &one_batch);
+
+  WireOnlyService wire_only(one_batch);
+  std::string raw_target, wire_target;
+  auto raw_server = StartLoopback(&raw, &raw_target);
+  auto wire_server = StartLoopback(&wire_only, &wire_target);
+
+  // Each stream next to the raw bytes and the generation it is bounded by.
+  struct Case {
+    const char* surface;
+    const SampleRequest* request;
+    v1::Precision precision;
+  } cases[] = {{"sphere", &sphere, v1::PRECISION_FLOAT32},
+               {"sphere", &sphere, v1::PRECISION_FLOAT64}};
+  for (const Case& c : cases) {
+    const v1::Precision precision = c.precision;
+    const SampleRequest& request = *c.request;
+    const std::string label =
+        std::string(c.surface) + (precision == v1::PRECISION_FLOAT32 ? ", float32" : ", float64");
+    const char* name = label.c_str();
     const size_t value_bytes = precision == v1::PRECISION_FLOAT32 ? 4 : 8;
-    const uint64_t payload = received * 5 * value_bytes;
-    const double raw_seconds = RawSeconds(raw_target, payload, static_cast<uint32_t>(batch * 5 * value_bytes));
-    const char* name = precision == v1::PRECISION_FLOAT32 ? "float32" : "float64";
-    std::printf("| %s: %llu samples streamed (sphere, cached tree) | %.2f M samples/s (%.0f MB/s) |\n", name,
-                static_cast<unsigned long long>(received), received / seconds / 1e6, payload / seconds / 1e6);
+    const uint64_t payload = n * 5 * value_bytes;
+    const double raw_seconds = Best([&] {
+      return RawSeconds(raw_target, payload, static_cast<uint32_t>(batch * 5 * value_bytes));
+    });
     std::printf("| %s: raw bytes stream of the same %llu MB | %.0f MB/s |\n", name,
                 static_cast<unsigned long long>(payload / 1000000), payload / raw_seconds / 1e6);
-    std::printf("| %s: ratio samples / raw | %.2f |\n", name, raw_seconds / seconds);
+    // Measured next to the streams it explains (the machine's load drifts).
+    const double generation =
+        Best([&] { return GenerationSeconds(request, options.limits.generation_threads, batch); });
+    std::printf(
+        "| %s: generation alone, in process, the same %llu samples, %d threads | %.2f M samples/s "
+        "|\n",
+        name, static_cast<unsigned long long>(n), options.limits.generation_threads,
+        n / generation / 1e6);
+    // The stream as it ran before (generation between writes, packed
+    // columns: a server with no pipeline), then pipelined with each encoding.
+    struct Setup {
+      const char* how;
+      const std::string* target;
+      v1::ColumnEncoding encoding;
+    } setups[] = {{"no pipeline, packed columns (as before)", &unpipelined_target,
+                   v1::COLUMN_ENCODING_PACKED},
+                  {"pipelined, packed columns", &target, v1::COLUMN_ENCODING_PACKED},
+                  {"pipelined, raw columns", &target, v1::COLUMN_ENCODING_RAW}};
+    for (const Setup& setup : setups) {
+      ClientOptions co;
+      co.target = *setup.target;
+      co.precision = precision;
+      co.batch_size = batch;
+      co.column_encoding = setup.encoding;
+      auto client = *SamplerClient::Connect(co);
+      uint64_t received = 0;
+      StreamSeconds(*client, request, &received);  // warm: build and cache the tree
+      const double seconds = Best([&] { return StreamSeconds(*client, request, &received); });
+      std::printf(
+          "| %s, %s: %llu samples streamed (cached tree) | %.2f M samples/s (%.0f MB/s) |\n", name,
+          setup.how, static_cast<unsigned long long>(received), received / seconds / 1e6,
+          payload / seconds / 1e6);
+      std::printf("| %s, %s: ratio stream / raw bytes; stream / generation alone | %.2f; %.2f |\n",
+                  name, setup.how, raw_seconds / seconds, generation / seconds);
+    }
+    for (auto encoding : {v1::COLUMN_ENCODING_PACKED, v1::COLUMN_ENCODING_RAW}) {
+      ClientOptions co;
+      co.target = wire_target;
+      co.precision = precision;
+      co.batch_size = batch;
+      co.column_encoding = encoding;
+      auto wire_client = *SamplerClient::Connect(co);
+      uint64_t received = 0;
+      const double wire_seconds =
+          Best([&] { return StreamSeconds(*wire_client, request, &received); });
+      std::printf(
+          "| %s, %s: wire path only (no generation), ratio to raw bytes | %.2f (%.1f M samples/s) "
+          "|\n",
+          name, encoding == v1::COLUMN_ENCODING_RAW ? "raw columns" : "packed columns",
+          raw_seconds / wire_seconds, received / wire_seconds / 1e6);
+    }
   }
 
   {
-    ClientOptions co;
-    co.target = target;
-    auto client = *SamplerClient::Connect(co);
+    // Cold: a fresh server each time, so the tree is built; then the same
+    // request again from its cache. The best of three of each.
     const SampleRequest request = Request("eight", "gaussian:floor=0.05", 1'000'000);
     uint64_t received = 0;
-    const double first = StreamSeconds(*client, request, &received);
-    const double hit = StreamSeconds(*client, request, &received);
-    std::printf("| first request, 10^6 samples, eight surface, curvature density | %.3f s |\n", first);
+    double first = 1e9, hit = 1e9, fixed = 1e9;
+    for (int i = 0; i < 3; ++i) {
+      auto fresh = *SamplerServer::Start(options);
+      ClientOptions co;
+      co.target = "127.0.0.1:" + std::to_string(fresh->port());
+      auto client = *SamplerClient::Connect(co);
+      first = std::min(first, StreamSeconds(*client, request, &received));
+      hit = std::min(hit, StreamSeconds(*client, request, &received));
+      // A hit that streams one sample: the request's fixed cost (lookup,
+      // header, round trip).
+      fixed =
+          std::min(fixed, StreamSeconds(*client, SamplerClient::Range(request, 0, 1), &received));
+      fresh->Shutdown(1);
+    }
+    std::printf("| first request, 10^6 samples, eight surface, curvature density | %.3f s |\n",
+                first);
     std::printf("| the same request again (cache hit) | %.3f s |\n", hit);
     std::printf("| first / hit | %.1fx |\n", first / hit);
+    // Where the hit's time goes: generating the same samples in process from
+    // a tree built beforehand.
+    const double generate =
+        std::min(GenerationSeconds(request, options.limits.generation_threads, 65536),
+                 GenerationSeconds(request, options.limits.generation_threads, 65536));
+    std::printf("| of the hit: generating the 10^6 samples in process, %d threads | %.3f s |\n",
+                options.limits.generation_threads, generate);
+    std::printf("| of the hit: a hit streaming 1 sample (lookup, header, round trip) | %.4f s |\n",
+                fixed);
   }
 
   {
@@ -157,11 +319,14 @@ int Run(uint64_t n) {
     const double seconds = Since(start);
     uint64_t total = 0;
     for (uint64_t g : got) total += g;
-    std::printf("| 16 concurrent clients x 10^6 samples (torus, cached) | %.2f M samples/s aggregate |\n",
-                total / seconds / 1e6);
+    std::printf(
+        "| 16 concurrent clients x 10^6 samples (torus, cached) | %.2f M samples/s aggregate |\n",
+        total / seconds / 1e6);
   }
   server->Shutdown(1);
+  unpipelined->Shutdown(1);
   raw_server->Shutdown();
+  wire_server->Shutdown();
   return 0;
 }
 

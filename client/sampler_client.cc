@@ -150,6 +150,7 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
     v1::SampleRequest wire = ToProto(next);
     wire.set_precision(options_.precision);
     wire.set_batch_size(options_.batch_size);
+    wire.set_column_encoding(options_.column_encoding);
     grpc::ClientContext context;
     Decorate(&context, key);
     auto reader = stub_->Sample(&context, wire);

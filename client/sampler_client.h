@@ -40,6 +40,10 @@ struct ClientOptions {
   double deadline_seconds = 0;             // per RPC; 0 = none
   ::sfcsampler::v1::Precision precision = ::sfcsampler::v1::PRECISION_FLOAT64;
   uint32_t batch_size = 0;                 // samples per message; 0 = the server chooses
+  // How columns travel: raw little-endian bytes (one memcpy a column at each
+  // end) or packed repeated fields. Servers that predate raw columns send
+  // packed ones whatever is asked; the client reads both.
+  ::sfcsampler::v1::ColumnEncoding column_encoding = ::sfcsampler::v1::COLUMN_ENCODING_RAW;
 };
 
 struct StreamSummary {

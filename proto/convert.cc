@@ -2,7 +2,11 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
+#include <string>
+#include <type_traits>
 
+#include "absl/base/config.h"
 #include "absl/strings/str_format.h"
 #include "core/status_macros.h"
 
@@ -29,6 +33,111 @@ void PutColumns(const SampleBatch& b, const SampleFields& fields, Columns* c) {
   }
   if (fields.density) Put(b.density, c->mutable_density());
   if (fields.curve_position) Put(b.curve_position, c->mutable_curve_position());
+}
+
+#if defined(ABSL_IS_LITTLE_ENDIAN)
+constexpr bool kLittleEndian = true;
+#else
+constexpr bool kLittleEndian = false;
+#endif
+
+// The IEEE 754 bits of `value` as T (double or float), little-endian, at `p`.
+template <typename T>
+void StoreLittleEndian(double value, char* p) {
+  using Bits = std::conditional_t<sizeof(T) == 8, uint64_t, uint32_t>;
+  const T t = static_cast<T>(value);
+  Bits bits;
+  std::memcpy(&bits, &t, sizeof bits);
+  for (size_t b = 0; b < sizeof bits; ++b) p[b] = static_cast<char>(bits >> (8 * b));
+}
+
+template <typename T>
+double LoadLittleEndian(const char* p) {
+  using Bits = std::conditional_t<sizeof(T) == 8, uint64_t, uint32_t>;
+  Bits bits = 0;
+  for (size_t b = 0; b < sizeof bits; ++b) bits |= static_cast<Bits>(static_cast<unsigned char>(p[b])) << (8 * b);
+  T t;
+  std::memcpy(&t, &bits, sizeof t);
+  return t;
+}
+
+// A raw column: the values of `from` as little-endian T, back to back.
+template <typename T>
+void PutRaw(const std::vector<double>& from, std::string* to) {
+  to->resize(from.size() * sizeof(T));
+  char* p = to->data();
+  if (std::is_same_v<T, double> && kLittleEndian) {
+    std::memcpy(p, from.data(), to->size());
+    return;
+  }
+  if (kLittleEndian) {  // float32: convert, and store in host order
+    for (size_t i = 0; i < from.size(); ++i) {
+      const float f = static_cast<float>(from[i]);
+      std::memcpy(p + i * sizeof(float), &f, sizeof f);
+    }
+    return;
+  }
+  for (size_t i = 0; i < from.size(); ++i) StoreLittleEndian<T>(from[i], p + i * sizeof(T));
+}
+
+template <typename T>
+void PutRawColumns(const SampleBatch& b, const SampleFields& fields, v1::RawColumns* c) {
+  PutRaw<T>(b.u, c->mutable_u());
+  PutRaw<T>(b.v, c->mutable_v());
+  PutRaw<T>(b.x, c->mutable_x());
+  PutRaw<T>(b.y, c->mutable_y());
+  PutRaw<T>(b.z, c->mutable_z());
+  if (fields.normal) {
+    PutRaw<T>(b.nx, c->mutable_nx());
+    PutRaw<T>(b.ny, c->mutable_ny());
+    PutRaw<T>(b.nz, c->mutable_nz());
+  }
+  if (fields.density) PutRaw<T>(b.density, c->mutable_density());
+  if (fields.curve_position) PutRaw<T>(b.curve_position, c->mutable_curve_position());
+}
+
+// Appends the n little-endian T values of `from` to `to`.
+template <typename T>
+absl::Status TakeRaw(const char* name, const std::string& from, size_t n, std::vector<double>* to) {
+  if (from.size() != n * sizeof(T)) {
+    return absl::DataLossError(absl::StrFormat("a batch's raw column %s has %d bytes for %d samples of %d bytes",
+                                               name, from.size(), n, sizeof(T)));
+  }
+  const size_t old = to->size();
+  to->resize(old + n);
+  double* q = to->data() + old;
+  const char* p = from.data();
+  if (std::is_same_v<T, double> && kLittleEndian) {
+    std::memcpy(q, p, from.size());
+  } else if (kLittleEndian) {
+    for (size_t i = 0; i < n; ++i) {
+      float f;
+      std::memcpy(&f, p + i * sizeof(float), sizeof f);
+      q[i] = f;
+    }
+  } else {
+    for (size_t i = 0; i < n; ++i) q[i] = LoadLittleEndian<T>(p + i * sizeof(T));
+  }
+  return absl::OkStatus();
+}
+
+template <typename T>
+absl::Status TakeRawColumns(const v1::RawColumns& c, const SampleFields& fields, size_t n, SampleBatch* b) {
+  RETURN_IF_ERROR(TakeRaw<T>("u", c.u(), n, &b->u));
+  RETURN_IF_ERROR(TakeRaw<T>("v", c.v(), n, &b->v));
+  RETURN_IF_ERROR(TakeRaw<T>("x", c.x(), n, &b->x));
+  RETURN_IF_ERROR(TakeRaw<T>("y", c.y(), n, &b->y));
+  RETURN_IF_ERROR(TakeRaw<T>("z", c.z(), n, &b->z));
+  if (fields.normal) {
+    RETURN_IF_ERROR(TakeRaw<T>("nx", c.nx(), n, &b->nx));
+    RETURN_IF_ERROR(TakeRaw<T>("ny", c.ny(), n, &b->ny));
+    RETURN_IF_ERROR(TakeRaw<T>("nz", c.nz(), n, &b->nz));
+  }
+  if (fields.density) RETURN_IF_ERROR(TakeRaw<T>("density", c.density(), n, &b->density));
+  if (fields.curve_position) {
+    RETURN_IF_ERROR(TakeRaw<T>("curve_position", c.curve_position(), n, &b->curve_position));
+  }
+  return absl::OkStatus();
 }
 
 template <typename Column>
@@ -138,6 +247,9 @@ absl::StatusOr<SampleRequest> FromProto(const v1::SampleRequest& p) {
   if (p.precision() != v1::PRECISION_FLOAT64 && p.precision() != v1::PRECISION_FLOAT32) {
     return absl::InvalidArgumentError(absl::StrFormat("unknown precision %d", p.precision()));
   }
+  if (p.column_encoding() != v1::COLUMN_ENCODING_PACKED && p.column_encoding() != v1::COLUMN_ENCODING_RAW) {
+    return absl::InvalidArgumentError(absl::StrFormat("unknown column encoding %d", p.column_encoding()));
+  }
   r.count = p.count();
   r.seed = p.seed();
   r.tree_count = p.tree_count();
@@ -194,7 +306,7 @@ v1::SampleRequest ToProto(const SampleRequest& r) {
 }
 
 void ToProto(const SampleBatch& b, const SampleFields& fields, v1::Precision precision,
-             v1::SampleBatch* out) {
+             v1::SampleBatch* out, v1::ColumnEncoding encoding) {
   const size_t n = b.size();
   out->set_size(static_cast<uint32_t>(n));
   bool consecutive = true;
@@ -204,7 +316,15 @@ void ToProto(const SampleBatch& b, const SampleFields& fields, v1::Precision pre
     out->mutable_index()->Reserve(static_cast<int>(n));
     for (uint64_t k : b.index) out->mutable_index()->AddAlreadyReserved(k);
   }
-  if (precision == v1::PRECISION_FLOAT32) {
+  if (encoding == v1::COLUMN_ENCODING_RAW) {
+    v1::RawColumns* raw = out->mutable_raw();
+    raw->set_precision(precision);
+    if (precision == v1::PRECISION_FLOAT32) {
+      PutRawColumns<float>(b, fields, raw);
+    } else {
+      PutRawColumns<double>(b, fields, raw);
+    }
+  } else if (precision == v1::PRECISION_FLOAT32) {
     PutColumns(b, fields, out->mutable_f32());
   } else {
     PutColumns(b, fields, out->mutable_f64());
@@ -221,9 +341,10 @@ uint32_t MaxSamplesPerMessage(const SampleFields& fields, v1::Precision precisio
   const size_t index_columns = (fields.face ? 1 : 0) + (fields.triangle ? 1 : 0);
   const size_t per_sample = columns * width + index_columns * sizeof(uint32_t) +
                             (indices_listed ? sizeof(uint64_t) : 0);
-  // Each packed column costs a tag and a length (at most 1 + 5 bytes); the
-  // batch's own fields and the two message wrappers at most 64 more.
-  const size_t fixed = reserved_bytes + 6 * (columns + index_columns + 1) + 64;
+  // Each packed or raw column costs a tag and a length (at most 1 + 5
+  // bytes); the batch's own fields, RawColumns.precision and the two message
+  // wrappers at most 72 more.
+  const size_t fixed = reserved_bytes + 6 * (columns + index_columns + 1) + 72;
   if (max_message_bytes <= fixed) return 0;
   return static_cast<uint32_t>(std::min<size_t>((max_message_bytes - fixed) / per_sample, UINT32_MAX));
 }
@@ -234,21 +355,38 @@ absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fiel
     return absl::DataLossError(absl::StrFormat("a batch has %d indices for %d samples", in.index_size(), n));
   }
   if (n == 0) return absl::OkStatus();
-  if (!in.has_f64() && !in.has_f32()) return absl::DataLossError("a batch has no columns");
+  if (!in.has_f64() && !in.has_f32() && !in.has_raw()) return absl::DataLossError("a batch has no columns");
+  const bool raw32 = in.has_raw() && in.raw().precision() == v1::PRECISION_FLOAT32;
+  if (in.has_raw() && !raw32 && in.raw().precision() != v1::PRECISION_FLOAT64) {
+    return absl::DataLossError(absl::StrFormat("a batch's raw columns have unknown precision %d",
+                                               in.raw().precision()));
+  }
   // `size` is just a number on the wire; only the columns bound what it may
   // make us allocate, so check them before appending any index.
-  const size_t u_values = in.has_f64() ? in.f64().u_size() : in.f32().u_size();
-  if (u_values != n) {
+  if (in.has_raw()) {
+    const size_t width = raw32 ? sizeof(float) : sizeof(double);
+    if (in.raw().u().size() != n * width) {
+      return absl::DataLossError(absl::StrFormat(
+          "a batch's raw column u has %d bytes for %d samples of %d bytes", in.raw().u().size(), n, width));
+    }
+  } else if (const size_t u_values = in.has_f64() ? in.f64().u_size() : in.f32().u_size(); u_values != n) {
     return absl::DataLossError(
         absl::StrFormat("a batch's column u has %d values for %d samples", u_values, n));
   }
   if (in.index_size() == 0) {
-    for (size_t i = 0; i < n; ++i) out->index.push_back(in.first_index() + i);
+    const size_t old = out->index.size();
+    out->index.resize(old + n);
+    for (size_t i = 0; i < n; ++i) out->index[old + i] = in.first_index() + i;
   } else {
     out->index.insert(out->index.end(), in.index().begin(), in.index().end());
   }
-  RETURN_IF_ERROR(in.has_f64() ? TakeColumns(in.f64(), fields, n, out)
-                                : TakeColumns(in.f32(), fields, n, out));
+  if (in.has_raw()) {
+    RETURN_IF_ERROR(raw32 ? TakeRawColumns<float>(in.raw(), fields, n, out)
+                          : TakeRawColumns<double>(in.raw(), fields, n, out));
+  } else {
+    RETURN_IF_ERROR(in.has_f64() ? TakeColumns(in.f64(), fields, n, out)
+                                  : TakeColumns(in.f32(), fields, n, out));
+  }
   if (fields.face) RETURN_IF_ERROR(TakeIndexColumn("face", in.face(), n, &out->face));
   if (fields.triangle) RETURN_IF_ERROR(TakeIndexColumn("triangle", in.triangle(), n, &out->triangle));
   return absl::OkStatus();

@@ -24,10 +24,13 @@ absl::StatusOr<SampleRequest> FromProto(const v1::SampleRequest& request);
 v1::TreeSpec ToProto(const TreeSpec& spec);
 v1::SampleRequest ToProto(const SampleRequest& request);
 
-// Fills `out` with `batch` in the requested precision. Consecutive indices
-// are sent as first_index alone.
+// Fills `out` with `batch` in the requested precision and column encoding
+// (packed repeated fields, or little-endian bytes columns as the proto's
+// RawColumns documents). Consecutive indices are sent as first_index alone.
+// `out` should be clear; its strings and arrays keep their capacity, so a
+// message reused for the next batch allocates nothing.
 void ToProto(const SampleBatch& batch, const SampleFields& fields, v1::Precision precision,
-             v1::SampleBatch* out);
+             v1::SampleBatch* out, v1::ColumnEncoding encoding = v1::COLUMN_ENCODING_PACKED);
 // The largest number of samples one SampleResponse may carry so that it
 // serialises to at most `max_message_bytes`, given the requested columns,
 // precision, whether the batch lists its indices (regions and sequences not
@@ -36,8 +39,9 @@ void ToProto(const SampleBatch& batch, const SampleFields& fields, v1::Precision
 uint32_t MaxSamplesPerMessage(const SampleFields& fields, v1::Precision precision,
                               bool indices_listed, size_t reserved_bytes, size_t max_message_bytes);
 
-// Appends the samples of `in` to `out`. DATA_LOSS when a column has the
-// wrong length or a requested column is missing.
+// Appends the samples of `in` to `out`, whichever encoding and precision it
+// uses (a raw column is one memcpy on little-endian hosts). DATA_LOSS when a
+// column has the wrong length or a requested column is missing.
 absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fields, SampleBatch* out);
 
 void ToProto(const PreparedTree& tree, v1::TreeInfo* out);

@@ -4,7 +4,9 @@
 
 #include "absl/strings/str_format.h"
 #include "catalog/catalog.h"
+#include "core/status_macros.h"
 #include "proto/convert.h"
+#include "server/message_pipeline.h"
 #include "spdlog/spdlog.h"
 
 namespace sfc {
@@ -41,12 +43,15 @@ BuildControl RequestControl(const grpc::ServerContext* context, Clock::time_poin
 }
 
 // What a stream holds while it runs: the sort of a non-monotone sequence's
-// range (16 bytes a sample), and one batch with its message: per sample the
-// index and the columns in the batch (float64, the model columns uint32),
-// and the same on the wire (float32 if asked; indices listed, at most). The
-// batch is the requested size, or the largest the server would choose. An
-// invalid range counts nothing here: Start refuses it.
-uint64_t StreamWorkingBytes(const SampleRequest& request, const v1::SampleRequest& wire) {
+// range (16 bytes a sample), the producer's batch (per sample the index and
+// the columns in float64, the model columns uint32), and the messages of its
+// pipeline, at most pipeline_depth + 2 (queued, being made, being written;
+// MessagePipeline; one without a pipeline), each per sample the columns on
+// the wire (float32 if asked; indices listed, at most). The batch is the requested size, or the
+// largest the server would choose. An invalid range counts nothing here:
+// Start refuses it.
+uint64_t StreamWorkingBytes(const SampleRequest& request, const v1::SampleRequest& wire,
+                            int pipeline_depth) {
   const auto range = SamplingEngine::ResolveRange(request);
   const uint64_t n = range.ok() ? range->second - range->first : 0;
   const uint64_t sort = Sequence(request.sequence, 1, 0).monotone() ? 0 : 16 * n;
@@ -54,7 +59,9 @@ uint64_t StreamWorkingBytes(const SampleRequest& request, const v1::SampleReques
   const uint64_t columns = 5 + (f.normal ? 3 : 0) + (f.density ? 1 : 0) + (f.curve_position ? 1 : 0);
   const uint64_t index_columns = (f.face ? 1 : 0) + (f.triangle ? 1 : 0);
   const uint64_t width = wire.precision() == v1::PRECISION_FLOAT32 ? 4 : 8;
-  const uint64_t per_sample = (8 + 8 * columns + 4 * index_columns) + (8 + width * columns + 4 * index_columns);
+  const uint64_t messages = pipeline_depth <= 0 ? 1 : static_cast<uint64_t>(pipeline_depth) + 2;
+  const uint64_t per_sample =
+      (8 + 8 * columns + 4 * index_columns) + messages * (8 + width * columns + 4 * index_columns);
   const uint64_t batch = wire.batch_size() != 0 ? wire.batch_size() : kDefaultBatchSize;
   return sort + per_sample * std::min(n, batch);
 }
@@ -132,21 +139,21 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
   }
   const BuildControl control = RequestControl(context, deadline, options_.request_deadline_seconds);
   // The stream's working memory, reserved before its cursor sorts anything.
-  auto memory = stream_memory_.Reserve(StreamWorkingBytes(*parsed, request),
-                                     "this stream", control.check);
+  auto memory = stream_memory_.Reserve(
+      StreamWorkingBytes(*parsed, request, options_.stream_pipeline_depth), "this stream",
+      control.check);
   if (!memory.ok()) return ToGrpcStatus(memory.status());
   auto job = engine_.Start(*parsed, control);
   if (!job.ok()) return ToGrpcStatus(job.status());
 
-  v1::SampleResponse response;
-  v1::StreamHeader* header = response.mutable_header();
-  ToProto(job->tree, header->mutable_tree());
-  header->set_algorithm_version(options_.algorithm_version);
-  header->set_seed(parsed->seed);
-  *header->mutable_request() = request;
-  header->set_begin(job->begin);
-  header->set_end(job->end);
-  header->set_expected_samples(parsed->region.kind == Region::Kind::kAll
+  v1::StreamHeader header;
+  ToProto(job->tree, header.mutable_tree());
+  header.set_algorithm_version(options_.algorithm_version);
+  header.set_seed(parsed->seed);
+  *header.mutable_request() = request;
+  header.set_begin(job->begin);
+  header.set_end(job->end);
+  header.set_expected_samples(parsed->region.kind == Region::Kind::kAll
                                    ? static_cast<int64_t>(job->end - job->begin)
                                    : -1);
 
@@ -154,12 +161,12 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
   const bool indices_listed =
       parsed->region.kind != Region::Kind::kAll || !Sequence(parsed->sequence, 1, 0).monotone();
   const uint32_t fits = MaxSamplesPerMessage(parsed->fields, request.precision(), indices_listed,
-                                             header->ByteSizeLong(), options_.max_message_bytes);
+                                             header.ByteSizeLong(), options_.max_message_bytes);
   if (fits == 0) {
     return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
                         absl::StrFormat("the stream header alone is %d bytes, more than the server's "
                                         "max_message_bytes of %d; use shorter specs",
-                                        header->ByteSizeLong(), options_.max_message_bytes));
+                                        header.ByteSizeLong(), options_.max_message_bytes));
   }
   if (request.batch_size() > fits) {
     return grpc::Status(
@@ -198,32 +205,47 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
     return grpc::Status(grpc::StatusCode::CANCELLED, otherwise);
   };
 
-  SampleBatch batch;
+  // Generation runs on the pipeline's producer thread, one batch ahead of
+  // (at most stream_pipeline_depth messages ahead of) the writes here. The
+  // pipeline is declared last so that it stops before what it uses goes.
+  SampleBatch batch;  // the producer's
+  BatchCursor* const cursor = job->cursor.get();
+  const SampleFields fields = parsed->fields;
+  const v1::Precision precision = request.precision();
+  const v1::ColumnEncoding encoding = request.column_encoding();
+  MessagePipeline pipeline(options_.stream_pipeline_depth,
+                           [&batch, cursor, fields, precision, encoding,
+                            batch_size](v1::SampleBatch* out) -> absl::StatusOr<size_t> {
+                             batch.Clear();
+                             ASSIGN_OR_RETURN(const size_t n, cursor->Next(batch_size, &batch));
+                             ToProto(batch, fields, precision, out, encoding);
+                             return n;
+                           });
   bool first = true;
   while (true) {
     if (context->IsCancelled()) return cut_status("the client cancelled the stream");
     if (Clock::now() > deadline) return deadline_status();
-    batch.Clear();
-    auto n = job->cursor->Next(batch_size, &batch);
-    if (!n.ok()) {
-      const absl::Status s = n.status();
+    // Wait in short steps, so that a cancel or the deadline is seen while a
+    // batch is being generated.
+    std::optional<MessagePipeline::Item> item = pipeline.Next(absl::Milliseconds(50));
+    if (!item) continue;
+    if (!item->response) {
+      const absl::Status& s = item->status;
+      if (s.ok()) break;
       return grpc::Status(static_cast<grpc::StatusCode>(s.code()),
                           absl::StrFormat("%s (after %d samples were sent)", s.message(), *sent));
     }
-    if (*n == 0 && !first) break;
-    response.mutable_batch()->Clear();
-    ToProto(batch, parsed->fields, request.precision(), response.mutable_batch());
-    watch->BeginWrite();
-    const bool written = writer->Write(response);
-    watch->EndWrite();
-    if (!written) return cut_status("the client went away mid-stream");
-    *sent += *n;
-    metrics_->AddSamples(*n);
     if (first) {
-      response.clear_header();
+      *item->response->mutable_header() = std::move(header);
       first = false;
     }
-    if (*n == 0) break;
+    watch->BeginWrite();
+    const bool written = writer->Write(*item->response);
+    watch->EndWrite();
+    if (!written) return cut_status("the client went away mid-stream");
+    *sent += item->samples;
+    metrics_->AddSamples(item->samples);
+    pipeline.Recycle(std::move(item->response));
   }
   context->AddTrailingMetadata("x-samples-sent", std::to_string(*sent));
   return grpc::Status::OK;
@@ -299,6 +321,7 @@ grpc::Status SamplerService::GetCacheStats(grpc::ServerContext* context,
     response->set_stream_memory_bytes(stream_memory_.budget_bytes());
     response->set_stream_memory_reserved(stream_memory_.reserved_bytes());
     response->set_stream_memory_waits(stream_memory_.waits());
+    response->set_stream_pipeline_depth(options_.stream_pipeline_depth);
     response->set_max_concurrent_builds(options_.max_concurrent_builds);
     response->set_max_queued_builds(options_.max_queued_builds);
     response->set_builds_running(s.builds_running);

@@ -1,10 +1,13 @@
 // The sfcsampler.v1.Sampler service: a thin adapter that parses requests into
 // engine types, calls the engine, and converts results and errors.
 //
-// Sample streams use the synchronous API: each Write blocks until HTTP/2 flow
-// control accepts the message, so a slow reader holds at most one batch in
-// the server, and a cancelled or disconnected client makes the next Write
-// fail at once, which ends the stream and frees its cursor and tree. A reader
+// Sample streams use the synchronous API with generation pipelined: a
+// producer thread per stream generates and encodes its messages while the
+// RPC thread writes them (MessagePipeline, at most stream_pipeline_depth
+// ready). Each Write blocks until HTTP/2 flow control accepts the message,
+// so a slow reader holds at most depth + 2 messages in the server, and a
+// cancelled or disconnected client makes the next Write fail at once, which
+// ends the stream and frees its cursor and tree. A reader
 // that stops reading is cut after the write timeout (StreamWatchdog). Every
 // message stays within max_message_bytes: the batch size follows from the
 // requested columns.

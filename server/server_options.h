@@ -37,6 +37,11 @@ struct ServerOptions {
   // Working memory of all streams together (sorting non-monotone sequences,
   // batches, messages): streams wait for it; server/stream_memory.h.
   uint64_t stream_memory_bytes = uint64_t{512} << 20;
+  // Messages a stream may have ready ahead of its writes (generation runs
+  // on its own thread, server/message_pipeline.h); a stream holds at most
+  // this + 2 messages. 0: no pipeline, generation between writes on the RPC
+  // thread (one message).
+  int stream_pipeline_depth = 2;
   double request_deadline_seconds = 600;       // longest a Sample stream may run
   // A stream whose write waits this long for a reader that does not read is
   // cut and its slot freed.

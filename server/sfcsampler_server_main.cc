@@ -56,6 +56,11 @@ int main(int argc, char** argv) {
                  "working memory of all streams together (sorting random/van der Corput/progressive "
                  "ranges: 16 bytes a sample; batches and messages); streams wait for it")
       ->capture_default_str();
+  app.add_option("--stream-pipeline-depth", o.stream_pipeline_depth,
+                 "messages a stream generates ahead of its writes (it holds at most this + 2); 0: "
+                 "generate between writes on the RPC thread")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 16));
   app.add_option("--max-concurrent-builds", o.max_concurrent_builds, "tree builds at once")
       ->capture_default_str()
       ->check(CLI::Range(1, 64));

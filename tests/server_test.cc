@@ -192,21 +192,67 @@ TEST(Server, AResumeOnAServerOfAnotherReleaseFailsInsteadOfMixingSets) {
   ExpectStatus(result.status(), absl::StatusCode::kFailedPrecondition, "sfcsampler-older-release");
 }
 
+// All samples of a request from the embedded engine, in process.
+SampleBatch Embedded(const SampleRequest& request) {
+  DirectTreeSource source;
+  SamplingEngine engine({}, &source);
+  auto job = engine.Start(request);
+  EXPECT_TRUE(job.ok()) << job.status();
+  SampleBatch local;
+  if (job.ok()) {
+    while (*job->cursor->Next(4096, &local) > 0) {
+    }
+  }
+  return local;
+}
+
 TEST(Server, EmbeddedAndWireSamplesAreIdentical) {
   Running r = StartServer(LoopbackOptions());
   SampleRequest request = Request("monkey_saddle", 5000, 3);
   request.tree.density = "gaussian:floor=0.1";
   request.region = Region::Box({-0.5, -0.5, -1}, {0.5, 0.5, 1});
-  DirectTreeSource source;
-  SamplingEngine engine({}, &source);
-  auto job = engine.Start(request);
-  ASSERT_TRUE(job.ok());
-  SampleBatch local;
-  while (*job->cursor->Next(4096, &local) > 0) {
-  }
+  const SampleBatch local = Embedded(request);
   auto wire = Fetch(*r.client, request);
   ASSERT_TRUE(wire.ok());
   ExpectEqual(*wire, local);
+}
+
+// Every value column, through the pipelined stream, in each encoding and
+// precision: float64 carries the embedded engine's bits, float32 exactly
+// their float rounding. Small batches make many messages pass the pipeline.
+TEST(Server, EveryEncodingAndPrecisionCarriesTheEmbeddedEnginesSamples) {
+  for (int depth : {0, 1, 3}) {
+    ServerOptions options = LoopbackOptions();
+    options.stream_pipeline_depth = depth;
+    Running r = StartServer(options);
+    SampleRequest request = Request("torus", 30000, 8);
+    request.tree.density = "gaussian:floor=0.1";
+    request.fields.normal = request.fields.density = request.fields.curve_position = true;
+    const SampleBatch local = Embedded(request);
+    for (auto encoding : {v1::COLUMN_ENCODING_RAW, v1::COLUMN_ENCODING_PACKED}) {
+      for (auto precision : {v1::PRECISION_FLOAT64, v1::PRECISION_FLOAT32}) {
+        ClientOptions co;
+        co.target = "127.0.0.1:" + std::to_string(r.server->port());
+        co.column_encoding = encoding;
+        co.precision = precision;
+        co.batch_size = 777;
+        auto wire = Fetch(**SamplerClient::Connect(co), request);
+        ASSERT_TRUE(wire.ok()) << wire.status();
+        ASSERT_EQ(wire->index, local.index);
+        for (auto column : {&SampleBatch::u, &SampleBatch::v, &SampleBatch::x, &SampleBatch::y,
+                            &SampleBatch::z, &SampleBatch::nx, &SampleBatch::ny, &SampleBatch::nz,
+                            &SampleBatch::density, &SampleBatch::curve_position}) {
+          ASSERT_EQ(((*wire).*column).size(), local.size());
+          for (size_t i = 0; i < local.size(); ++i) {
+            const double expected = precision == v1::PRECISION_FLOAT64
+                                        ? (local.*column)[i]
+                                        : static_cast<double>(static_cast<float>((local.*column)[i]));
+            ASSERT_EQ(((*wire).*column)[i], expected) << "sample " << i << " depth " << depth;
+          }
+        }
+      }
+    }
+  }
 }
 
 TEST(Server, ASecondRequestHitsAndEightConcurrentFirstRequestsBuildOnce) {
@@ -531,31 +577,38 @@ TEST(Server, TheServerDeadlineEndsLongStreams) {
   ExpectStatus(result.status(), absl::StatusCode::kDeadlineExceeded, "resume after the last index");
 }
 
+// With any pipeline depth (0: none): the producer stops at the full queue,
+// the RPC thread's blocked write is what the watchdog cuts.
 TEST(Server, AReaderThatStopsReadingIsCutAndFreesItsSlot) {
-  ServerOptions options = LoopbackOptions();
-  options.write_timeout_seconds = 0.3;
-  options.max_concurrent_streams = 1;
-  ClientOptions co;
-  co.batch_size = 16384;
-  Running r = StartServer(options, co);
-  std::atomic<bool> freed{false};
-  std::atomic<double> stalled{0};
-  auto result = r.client->Sample(Request("plane", 4'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
-    // Stop reading: the server's writes block on flow control. Its slot
-    // must come free while this client still holds the stream open.
-    const auto until = std::chrono::steady_clock::now() + milliseconds(5000);
-    while (std::chrono::steady_clock::now() < until && !freed) {
-      freed = r.server->service().active_streams() == 0;
-      std::this_thread::sleep_for(milliseconds(10));
-    }
-    stalled = r.server->metrics().stalled_streams();
-    return absl::OkStatus();
-  });
-  EXPECT_TRUE(freed) << "the stalled stream still held its slot after 5 s";
-  EXPECT_EQ(stalled.load(), 1.0);
-  EXPECT_FALSE(result.ok());
-  // The slot serves the next client at once.
-  EXPECT_TRUE(Fetch(*r.client, Request("torus", 1000)).ok());
+  for (int depth : {0, 1, 2, 4}) {
+    ServerOptions options = LoopbackOptions();
+    options.write_timeout_seconds = 0.3;
+    options.max_concurrent_streams = 1;
+    options.stream_pipeline_depth = depth;
+    ClientOptions co;
+    co.batch_size = 16384;
+    Running r = StartServer(options, co);
+    std::atomic<bool> freed{false};
+    std::atomic<double> stalled{0};
+    auto result = r.client->Sample(Request("plane", 4'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
+      // Stop reading: the server's writes block on flow control. Its slot
+      // must come free while this client still holds the stream open.
+      const auto until = std::chrono::steady_clock::now() + milliseconds(5000);
+      while (std::chrono::steady_clock::now() < until && !freed) {
+        freed = r.server->service().active_streams() == 0;
+        std::this_thread::sleep_for(milliseconds(10));
+      }
+      stalled = r.server->metrics().stalled_streams();
+      return absl::OkStatus();
+    });
+    EXPECT_TRUE(freed) << "the stalled stream still held its slot after 5 s, depth " << depth;
+    EXPECT_EQ(stalled.load(), 1.0) << "depth " << depth;
+    EXPECT_FALSE(result.ok());
+    // Generation stopped with the queue: far fewer than the 4 M samples.
+    EXPECT_LT(r.server->metrics().samples_streamed(), 2'000'000.0);
+    // The slot serves the next client at once.
+    EXPECT_TRUE(Fetch(*r.client, Request("torus", 1000)).ok());
+  }
 }
 
 TEST(Server, AModelIsUploadedOnceAndNamedByItsHash) {

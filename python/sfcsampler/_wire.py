@@ -1,7 +1,8 @@
 """Decodes a Sample stream's messages straight into NumPy arrays.
 
-A SampleBatch's columns are packed repeated doubles (or floats) on the wire,
-so each column is one contiguous little-endian run of bytes: numpy.frombuffer
+A SampleBatch's columns are packed repeated doubles (or floats), or raw
+little-endian `bytes` columns (RawColumns, COLUMN_ENCODING_RAW); either way
+each column is one contiguous little-endian run of bytes: numpy.frombuffer
 reads it (one memcpy per column) without creating a Python float per value,
 which the protobuf message API would. The StreamHeader (small, first message only) goes through
 the generated sampler_pb2. Pure functions.
@@ -71,6 +72,26 @@ def _columns(buf, dtype):
     return {name: parts[0].copy() if len(parts) == 1 else np.concatenate(parts) for name, parts in pieces.items()}
 
 
+def _raw_columns(buf):
+    """RawColumns: each column one run of little-endian values, float64 or
+    float32 as its precision field (11) says; numpy.frombuffer reads each."""
+    views, precision = {}, 0
+    for number, wire_type, value in fields(buf):
+        if 1 <= number <= 10 and wire_type == 2:
+            views[_COLUMN_NAMES[number]] = value
+        elif number == 11 and wire_type == 0:
+            precision = value
+    if precision not in (0, 1):
+        raise DataLossError(15, f"raw columns of unknown precision {precision}")
+    dtype = np.dtype("<f4" if precision == 1 else "<f8")
+    out = {}
+    for name, view in views.items():
+        if len(view) % dtype.itemsize:
+            raise DataLossError(15, f"a raw column {name} of {len(view)} bytes is not whole {dtype} values")
+        out[name] = np.frombuffer(view, dtype=dtype).copy()  # writable, and frees the message
+    return out
+
+
 def _batch(buf, requested):
     first_index, size, index, columns, model_columns = 0, 0, [], {}, {}
     for number, _, value in fields(buf):
@@ -84,6 +105,8 @@ def _batch(buf, requested):
             columns = _columns(value, np.dtype("<f8"))
         elif number == 5:
             columns = _columns(value, np.dtype("<f4"))
+        elif number == 8:
+            columns = _raw_columns(value)
         elif number in (6, 7):  # face, triangle: packed fixed32
             name = "face" if number == 6 else "triangle"
             model_columns.setdefault(name, []).append(np.frombuffer(value, dtype="<u4"))

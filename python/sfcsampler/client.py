@@ -33,6 +33,7 @@ _SEQUENCES = {"jittered": pb.SEQUENCE_JITTERED, "equal": pb.SEQUENCE_EQUAL,
               "random": pb.SEQUENCE_RANDOM, "vandercorput": pb.SEQUENCE_VAN_DER_CORPUT,
               "progressive": pb.SEQUENCE_PROGRESSIVE}
 _PRECISIONS = {"float64": pb.PRECISION_FLOAT64, "float32": pb.PRECISION_FLOAT32}
+_ENCODINGS = {"raw": pb.COLUMN_ENCODING_RAW, "packed": pb.COLUMN_ENCODING_PACKED}
 _MODEL_FORMATS = ("step", "iges", "nurbs", "obj", "ply")
 _UPLOAD_CHUNK = 1 << 20  # the server takes chunks of up to 1 MiB
 
@@ -56,7 +57,8 @@ class Client:
     """A connection to an sfcsampler-server.
 
     Client("host:port", token=None, tls=False, tls_roots=None, timeout=None,
-           precision="float64", batch_size=0, max_resumes=5, resume_backoff=0.2)
+           precision="float64", batch_size=0, max_resumes=5, resume_backoff=0.2,
+           encoding="raw")
 
     token: bearer token (the server's --token-file contents). tls: connect
     with TLS (system roots); tls_roots: a PEM file of roots to trust (implies
@@ -65,13 +67,20 @@ class Client:
     float64 ones rounded). batch_size: samples per message (0: as many as fit
     the server's max_message_bytes with the requested columns). A stream broken
     by UNAVAILABLE is resumed up to max_resumes times, waiting resume_backoff
-    seconds first and doubling.
+    seconds first and doubling. encoding: how columns travel, "raw"
+    (little-endian bytes columns) or "packed" (repeated fields); both decode
+    with one numpy.frombuffer a column, and a server that predates raw
+    columns sends packed ones whatever is asked.
     """
 
     def __init__(self, target, token=None, tls=False, tls_roots=None, timeout=None,
-                 precision="float64", batch_size=0, max_resumes=5, resume_backoff=0.2):
+                 precision="float64", batch_size=0, max_resumes=5, resume_backoff=0.2,
+                 encoding="raw"):
         if precision not in _PRECISIONS:
             raise InvalidArgumentError(3, "precision must be float64 or float32")
+        if encoding not in _ENCODINGS:
+            raise InvalidArgumentError(3, "encoding must be raw or packed")
+        self._encoding = _ENCODINGS[encoding]
         options = [("grpc.max_receive_message_length", -1)]
         if tls or tls_roots:
             roots = None
@@ -186,6 +195,7 @@ class Client:
         w.triangle = request.triangle
         w.precision = _PRECISIONS[precision]
         w.batch_size = batch_size
+        w.column_encoding = self._encoding
         return w
 
     def batches(self, *, precision=None, batch_size=None, **request):

@@ -35,6 +35,21 @@ def test_float32_and_batches(server):
     assert parts[0].x.flags.writeable  # a copy, not a view of the message
 
 
+@pytest.mark.parametrize("precision", ["float64", "float32"])
+def test_raw_and_packed_columns_decode_to_the_embedded_arrays(server, precision):
+    kwargs = dict(surface="torus", density="gaussian:floor=0.1", count=20000, seed=4,
+                  normals=True, density_column=True, curve_position=True)
+    embedded = sfcsampler.sample(precision=precision, **kwargs)
+    for encoding in ("raw", "packed"):
+        with sfcsampler.Client(server, batch_size=3000, encoding=encoding) as client:
+            remote = client.sample(precision=precision, **kwargs)
+        for name, column in embedded.columns().items():
+            got = getattr(remote, name)
+            assert got.dtype == column.dtype, (encoding, name)
+            # Bit for bit: compare the bytes, not the values.
+            assert got.tobytes() == column.tobytes(), (encoding, name)
+
+
 def test_empty_region(server):
     with sfcsampler.Client(server) as client:
         s = client.sample(surface="sphere", count=1000, region="box:5,5,5,6,6,6")
