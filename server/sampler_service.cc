@@ -59,7 +59,9 @@ uint64_t StreamWorkingBytes(const SampleRequest& request, const v1::SampleReques
   const uint64_t columns = 5 + (f.normal ? 3 : 0) + (f.density ? 1 : 0) + (f.curve_position ? 1 : 0);
   const uint64_t index_columns = (f.face ? 1 : 0) + (f.triangle ? 1 : 0);
   const uint64_t width = wire.precision() == v1::PRECISION_FLOAT32 ? 4 : 8;
-  const uint64_t messages = pipeline_depth <= 0 ? 1 : static_cast<uint64_t>(pipeline_depth) + 2;
+  // The messages the stream holds, plus the serialized copy gRPC keeps of the
+  // one being written until the transport has sent it.
+  const uint64_t messages = (pipeline_depth <= 0 ? 1 : static_cast<uint64_t>(pipeline_depth) + 2) + 1;
   const uint64_t per_sample =
       (8 + 8 * columns + 4 * index_columns) + messages * (8 + width * columns + 4 * index_columns);
   const uint64_t batch = wire.batch_size() != 0 ? wire.batch_size() : kDefaultBatchSize;

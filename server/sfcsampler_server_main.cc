@@ -21,6 +21,9 @@ int main(int argc, char** argv) {
   // would not fall back to what the budgets hold (cache_bytes,
   // stream_memory_bytes).
   mallopt(M_MMAP_THRESHOLD, 1 << 20);
+  // Each stream's producer thread would otherwise get a malloc arena of its
+  // own (up to 8 per core), each keeping the pages its frees leave behind.
+  mallopt(M_ARENA_MAX, 2);
   sfc::ServerOptions o;
   std::string token_file, log_level = "info";
   CLI::App app{"sfcsampler-server: density-controlled surface sampling over gRPC"};
