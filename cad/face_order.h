@@ -15,9 +15,6 @@
 
 namespace sfc::cad {
 
-// Index of the cell (x, y, z), each in [0, 2^bits), along the 3D Hilbert curve
-// of order `bits`. REQUIRES: 1 <= bits <= 21. A bijection onto [0, 2^(3 bits)).
-uint64_t HilbertIndex3(uint32_t x, uint32_t y, uint32_t z, int bits);
 
 // A permutation of 0..points.size()-1: the points in 3D Hilbert order.
 std::vector<int> HilbertOrder(const std::vector<Vec3>& points);

@@ -30,16 +30,7 @@ size_t Sampler::LeafForMass(double m) const {
 }
 
 uint64_t Sampler::FirstIndexAtOrAbove(double m) const {
-  uint64_t lo = 0, hi = sequence_.count();
-  while (lo < hi) {
-    const uint64_t mid = lo + (hi - lo) / 2;
-    if (MassCoordinate(mid) >= m) {
-      hi = mid;
-    } else {
-      lo = mid + 1;
-    }
-  }
-  return lo;
+  return FirstIndexWhere(sequence_.count(), [&](uint64_t k) { return MassCoordinate(k) >= m; });
 }
 
 SampleCursor::SampleCursor(std::shared_ptr<const Sampler> sampler, Region region,

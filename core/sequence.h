@@ -76,6 +76,23 @@ class Sequence {
   double lo_ = 0, hi_ = 1;
 };
 
+// The first k in [0, count) for which reached(k) holds, for a predicate that
+// is false and then true along k (such as q_k S_M >= m for a monotone
+// sequence); count if none. O(log count) calls.
+template <typename Reached>
+uint64_t FirstIndexWhere(uint64_t count, const Reached& reached) {
+  uint64_t lo = 0, hi = count;
+  while (lo < hi) {
+    const uint64_t mid = lo + (hi - lo) / 2;
+    if (reached(mid)) {
+      hi = mid;
+    } else {
+      lo = mid + 1;
+    }
+  }
+  return lo;
+}
+
 // The indices [begin, end) in curve order, for sequences that are not
 // monotone in k: sorted by `mass_coordinate(k)` (q_k S_M), ties by index;
 // only those `keep(k)` accepts (a window's). Holds 16 bytes an index while it

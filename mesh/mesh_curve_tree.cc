@@ -4,8 +4,8 @@
 #include <cmath>
 
 #include "absl/strings/str_format.h"
+#include "core/hilbert3d.h"
 #include "core/status_macros.h"
-#include "mesh/internal/hilbert3d.h"
 
 namespace sfc {
 namespace {
@@ -156,7 +156,7 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
     auto q = [&](double v, double l) {
       return static_cast<uint32_t>(std::clamp((v - l) * scale, 0.0, cells - 1));
     };
-    keyed.emplace_back(mesh_internal::HilbertKey3(q(c.x, lo.x), q(c.y, lo.y), q(c.z, lo.z), bits),
+    keyed.emplace_back(HilbertKey3(q(c.x, lo.x), q(c.y, lo.y), q(c.z, lo.z), bits),
                        t);
   }
   std::sort(keyed.begin(), keyed.end());

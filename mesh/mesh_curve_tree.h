@@ -2,7 +2,7 @@
 // steps 1-2, carried from the parameter square to a mesh).
 //
 // The curve. Triangles are visited in the 3D Hilbert order of their
-// centroids (Skilling 2004; mesh/internal/hilbert3d.h; 2^21 cells per
+// centroids (Skilling 2004; core/hilbert3d.h; 2^21 cells per
 // axis), so consecutive
 // triangles are close in space, and each triangle carries its own
 // Sierpinski-type curve: its first split is at the midpoint of its longest

@@ -1,7 +1,5 @@
 #include "mesh/mesh_sampler.h"
 
-#include "core/worker_pool.h"
-
 #include <algorithm>
 #include <cmath>
 
@@ -28,16 +26,7 @@ size_t MeshSampler::LeafForMass(double m) const {
 }
 
 uint64_t MeshSampler::FirstIndexAtOrAbove(double m) const {
-  uint64_t lo = 0, hi = sequence_.count();
-  while (lo < hi) {
-    const uint64_t mid = lo + (hi - lo) / 2;
-    if (MassCoordinate(mid) >= m) {
-      hi = mid;
-    } else {
-      lo = mid + 1;
-    }
-  }
-  return lo;
+  return FirstIndexWhere(sequence_.count(), [&](uint64_t k) { return MassCoordinate(k) >= m; });
 }
 
 double MeshSampler::FractionInLeaf(double m, size_t l) const {

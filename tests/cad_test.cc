@@ -89,26 +89,6 @@ double ClassifiedArea(const Face& face, int n) {
   return sum / (double(n) * n);
 }
 
-TEST(FaceOrder, HilbertIndexIsABijectionWithUnitSteps) {
-  const int bits = 3, side = 1 << bits;
-  std::vector<std::array<int, 3>> cell(side * side * side, {-1, -1, -1});
-  for (int x = 0; x < side; ++x) {
-    for (int y = 0; y < side; ++y) {
-      for (int z = 0; z < side; ++z) {
-        const uint64_t h = HilbertIndex3(x, y, z, bits);
-        ASSERT_LT(h, cell.size());
-        ASSERT_EQ(cell[h][0], -1) << "index " << h << " twice";
-        cell[h] = {x, y, z};
-      }
-    }
-  }
-  for (size_t h = 1; h < cell.size(); ++h) {
-    const int step = std::abs(cell[h][0] - cell[h - 1][0]) + std::abs(cell[h][1] - cell[h - 1][1]) +
-                     std::abs(cell[h][2] - cell[h - 1][2]);
-    EXPECT_EQ(step, 1) << "between indices " << h - 1 << " and " << h;
-  }
-}
-
 TEST(FaceOrder, HilbertOrderIsAShortPermutation) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> uniform(-3, 5);

@@ -2,10 +2,13 @@
 // consecutive cells, start and end corners, and table consistency.
 #include "core/curve.h"
 
+#include <algorithm>
+#include <array>
 #include <cstdlib>
 #include <set>
 #include <vector>
 
+#include "core/hilbert3d.h"
 #include "gtest/gtest.h"
 
 namespace sfc {
@@ -123,6 +126,21 @@ INSTANTIATE_TEST_SUITE_P(AllCurves, CurveTest,
                          ::testing::Values(CurveType::kHilbert, CurveType::kHilbert2,
                                            CurveType::kPeano),
                          [](const auto& info) { return std::string(CurveName(info.param)); });
+
+TEST(Hilbert3d, ConsecutiveKeysAreFaceAdjacentCells) {
+  const int bits = 3, n = 1 << bits;
+  std::vector<std::pair<uint64_t, std::array<int, 3>>> cells;
+  for (int x = 0; x < n; ++x)
+    for (int y = 0; y < n; ++y)
+      for (int z = 0; z < n; ++z) cells.push_back({HilbertKey3(x, y, z, bits), {x, y, z}});
+  std::sort(cells.begin(), cells.end());
+  for (size_t i = 0; i < cells.size(); ++i) {
+    ASSERT_EQ(cells[i].first, i);  // a bijection onto [0, n^3)
+    if (i == 0) continue;
+    const auto &a = cells[i - 1].second, &b = cells[i].second;
+    EXPECT_EQ(std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) + std::abs(a[2] - b[2]), 1) << i;
+  }
+}
 
 }  // namespace
 }  // namespace sfc

@@ -16,7 +16,6 @@
 #include "mesh/curvature.h"
 #include "mesh/icosphere.h"
 #include "mesh/iid_points.h"
-#include "mesh/internal/hilbert3d.h"
 #include "mesh/mesh_curve_tree.h"
 #include "mesh/mesh_sampler.h"
 
@@ -60,21 +59,6 @@ Drawn Draw(const std::shared_ptr<const MeshSampler>& sampler, uint64_t begin, ui
 }
 
 Vec3 At(const SampleBatch& b, size_t i) { return {b.x[i], b.y[i], b.z[i]}; }
-
-TEST(Hilbert3d, ConsecutiveKeysAreFaceAdjacentCells) {
-  const int bits = 3, n = 1 << bits;
-  std::vector<std::pair<uint64_t, std::array<int, 3>>> cells;
-  for (int x = 0; x < n; ++x)
-    for (int y = 0; y < n; ++y)
-      for (int z = 0; z < n; ++z) cells.push_back({mesh_internal::HilbertKey3(x, y, z, bits), {x, y, z}});
-  std::sort(cells.begin(), cells.end());
-  for (size_t i = 0; i < cells.size(); ++i) {
-    ASSERT_EQ(cells[i].first, i);  // a bijection onto [0, n^3)
-    if (i == 0) continue;
-    const auto &a = cells[i - 1].second, &b = cells[i].second;
-    EXPECT_EQ(std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) + std::abs(a[2] - b[2]), 1) << i;
-  }
-}
 
 TEST(MeshCurvature, SphereHasUnitCurvatureAndGaussBonnetHolds) {
   const TriangleMesh sphere = MakeIcosphere(4);

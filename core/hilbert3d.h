@@ -2,17 +2,20 @@
 // J. Skilling, "Programming the Hilbert curve", AIP Conf. Proc. 707 (2004):
 // the axes are turned into the "transposed" Hilbert index by undoing the
 // excess work, Gray-encoded, and the bits interleaved into one 63-bit key.
-// Consecutive keys are face-adjacent cells (the tests check it).
+// Consecutive keys are face-adjacent cells (the tests check it). It orders
+// the pieces of a surface made of pieces along one curve: a mesh's triangles
+// (mesh/mesh_curve_tree.h) and a CAD model's faces (cad/face_order.h).
 //
 // Thread-safety: pure functions.
-#ifndef SFCSAMPLER_MESH_INTERNAL_HILBERT3D_H_
-#define SFCSAMPLER_MESH_INTERNAL_HILBERT3D_H_
+#ifndef SFCSAMPLER_CORE_HILBERT3D_H_
+#define SFCSAMPLER_CORE_HILBERT3D_H_
 
 #include <cstdint>
 
-namespace sfc::mesh_internal {
+namespace sfc {
 
-// REQUIRES: 1 <= bits <= 21 and x, y, z < 2^bits.
+// A bijection of the cells onto [0, 2^(3 bits)). REQUIRES: 1 <= bits <= 21 and
+// x, y, z < 2^bits.
 inline uint64_t HilbertKey3(uint32_t x, uint32_t y, uint32_t z, int bits = 21) {
   uint32_t a[3] = {x, y, z};
   const uint32_t m = 1u << (bits - 1);
@@ -41,6 +44,6 @@ inline uint64_t HilbertKey3(uint32_t x, uint32_t y, uint32_t z, int bits = 21) {
   return key;
 }
 
-}  // namespace sfc::mesh_internal
+}  // namespace sfc
 
-#endif  // SFCSAMPLER_MESH_INTERNAL_HILBERT3D_H_
+#endif  // SFCSAMPLER_CORE_HILBERT3D_H_
