@@ -10,56 +10,20 @@
 namespace sfc::cad {
 namespace {
 
-}  // namespace
-
-// Where a trimmed face's unit square lies relative to its trim, on a
-// kSide x kSide grid of cells classified once (Face::Classify, which is
-// conservative): a point in a cell wholly inside or outside is answered from
-// the grid, and only points in cells the boundary may cross ask the kernel.
-class TrimGrid {
- public:
-  static constexpr int kSide = 128;
-  explicit TrimGrid(const Face* face) : face_(face), cells_(kSide * kSide) {
-    for (int i = 0; i < kSide; ++i) {
-      for (int j = 0; j < kSide; ++j) {
-        cells_[i * kSide + j] = face->Classify(double(i) / kSide, double(i + 1) / kSide,
-                                               double(j) / kSide, double(j + 1) / kSide);
-      }
-    }
-  }
-  // Face::Contains(s, t), the same answer.
-  bool Contains(double s, double t) const {
-    const int i = std::min(kSide - 1, std::max(0, static_cast<int>(s * kSide)));
-    const int j = std::min(kSide - 1, std::max(0, static_cast<int>(t * kSide)));
-    switch (cells_[i * kSide + j]) {
-      case CellState::kInside: return true;
-      case CellState::kOutside: return false;
-      case CellState::kStraddles: break;
-    }
-    return face_->Contains(s, t);
-  }
-
- private:
-  const Face* face_;  // owned by the model, which the tree keeps alive
-  std::vector<CellState> cells_;
-};
-
-namespace {
-
 // The model's density on one face, zero outside its trimmed region. Face
 // surfaces take the face's unit square, so point.u, point.v are the face's.
 class TrimmedDensity final : public Density {
  public:
-  TrimmedDensity(std::shared_ptr<const TrimGrid> trim, std::shared_ptr<const Density> inner)
-      : trim_(std::move(trim)), inner_(std::move(inner)) {}
+  TrimmedDensity(const Face* face, std::shared_ptr<const Density> inner)
+      : face_(face), inner_(std::move(inner)) {}
   bool NeedsCurvature() const override { return inner_->NeedsCurvature(); }
   double Value(const SurfacePoint& point) const override {
-    if (trim_ && !trim_->Contains(point.u, point.v)) return 0;
+    if (face_->trimmed() && !face_->Contains(point.u, point.v)) return 0;
     return inner_->Value(point);
   }
 
  private:
-  std::shared_ptr<const TrimGrid> trim_;  // null: the face is not trimmed
+  const Face* face_;  // owned by the model, which the tree keeps alive
   std::shared_ptr<const Density> inner_;
 };
 
@@ -79,9 +43,8 @@ absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
     const CurveTreeOptions& options, uint64_t count, const BuildControl& control) {
   auto tree = std::shared_ptr<ModelTree>(new ModelTree());
   tree->model_ = model;
-  // Stage one: every face's coarse tree (grade 0), for its mass.
-  std::vector<double> masses;
-  uint64_t leaves = 0, bytes = 0;
+  uint64_t leaves = 0, bytes = 0;  // of the faces' trees so far
+  // The caller's control, told the bytes of the faces' trees built before.
   auto control_after = [&](uint64_t bytes_before) {
     BuildControl c = control;
     if (control.charge) {
@@ -89,74 +52,70 @@ absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
     }
     return c;
   };
-  auto options_after = [&](uint64_t leaves_before) -> absl::StatusOr<CurveTreeOptions> {
-    if (leaves_before >= options.max_leaves) {
-      return absl::ResourceExhaustedError(absl::StrFormat(
-          "the model \"%s\" needs more than %d leaves (max_tree_leaves) over its %d faces; ask "
-          "for fewer samples or a coarser tree",
-          model->name(), options.max_leaves, model->faces().size()));
-    }
-    CurveTreeOptions o = options;
-    o.max_leaves = options.max_leaves - leaves_before;
-    return o;
+  auto over_budget = [&] {
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "the model \"%s\" needs more than %d leaves (max_tree_leaves) over its %d faces; ask "
+        "for fewer samples or a coarser tree",
+        model->name(), options.max_leaves, model->faces().size()));
   };
+  auto on_face = [&](int f, const absl::Status& status) {
+    return absl::Status(status.code(), absl::StrFormat("face %d of \"%s\": %s", f, model->name(),
+                                                       status.message()));
+  };
+  // Stage one: every face's coarse tree (grade 0), for its mass.
   for (int f : model->curve_order()) {
     const Face& face = model->faces()[f];
     Piece piece;
     piece.face = f;
     piece.surface = face.shared_surface();
-    if (face.trimmed()) piece.trim = std::make_shared<const TrimGrid>(&face);
-    piece.density = std::make_shared<TrimmedDensity>(piece.trim, density);
-    ASSIGN_OR_RETURN(const CurveTreeOptions o, options_after(leaves));
+    piece.density = std::make_shared<TrimmedDensity>(&face, density);
+    if (leaves >= options.max_leaves) return over_budget();
+    CurveTreeOptions o = options;
+    o.max_leaves = options.max_leaves - leaves;  // what the faces before left
     auto coarse = CurveTree::Build(*piece.surface, *piece.density, o, 0, control_after(bytes));
     if (!coarse.ok()) {
       if (HasNothingToSample(coarse.status())) {
         ++tree->skipped_faces_;
         continue;
       }
-      return absl::Status(coarse.status().code(),
-                          absl::StrFormat("face %d of \"%s\": %s", f, model->name(),
-                                          coarse.status().message()));
+      return on_face(f, coarse.status());
     }
     piece.tree = *std::move(coarse);
-    masses.push_back(piece.tree->total_mass());
     leaves += piece.tree->leaf_count();
     bytes += piece.tree->bytes();
     tree->pieces_.push_back(std::move(piece));
   }
-  double total = 0;
-  for (double m : masses) total += m;
-  if (tree->pieces_.empty() || !(total > 0)) {
+  auto total_mass = [&] {
+    double total = 0;
+    for (const Piece& piece : tree->pieces_) total += piece.tree->total_mass();
+    return total;
+  };
+  const double coarse_total = total_mass();
+  if (tree->pieces_.empty() || !(coarse_total > 0)) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "the model \"%s\" has no face to sample: its %d faces have no area or no density mass",
         model->name(), model->faces().size()));
   }
-  // Stage two: each face's tree refined for the samples its share brings.
+  // Stage two: each face's tree refined for the samples its coarse share
+  // brings. Each refinement is bounded by the budget its coarse build was
+  // given; the sum is checked as they go.
   leaves = 0, bytes = 0;
-  for (size_t i = 0; i < tree->pieces_.size(); ++i) {
-    Piece& piece = tree->pieces_[i];
-    const double share = masses[i] / total;
+  for (Piece& piece : tree->pieces_) {
+    const double share = piece.tree->total_mass() / coarse_total;
     const uint64_t samples = static_cast<uint64_t>(std::ceil(static_cast<double>(count) * share));
     const int grade = CurveTree::GradeFor(std::max<uint64_t>(1, samples));
     if (grade > 0) {
-      // Each face's build is bounded by the budget left when it was made;
-      // the sum is checked below.
       auto refined = piece.tree->Refined(*piece.surface, *piece.density, grade, control_after(bytes));
-      if (!refined.ok()) {
-        return absl::Status(refined.status().code(),
-                            absl::StrFormat("face %d of \"%s\": %s", piece.face, model->name(),
-                                            refined.status().message()));
-      }
+      if (!refined.ok()) return on_face(piece.face, refined.status());
       piece.tree = *std::move(refined);
     }
     leaves += piece.tree->leaf_count();
     bytes += piece.tree->bytes();
-    if (leaves > options.max_leaves) return options_after(leaves).status();
+    if (leaves > options.max_leaves) return over_budget();
   }
   // The windows, from the refined masses; one double per boundary, so
   // neighbouring windows split the samples exactly.
-  total = 0;
-  for (const Piece& piece : tree->pieces_) total += piece.tree->total_mass();
+  const double total = total_mass();
   double running = 0;
   for (size_t i = 0; i < tree->pieces_.size(); ++i) {
     Piece& piece = tree->pieces_[i];
@@ -191,19 +150,6 @@ absl::StatusOr<std::unique_ptr<ModelSampleCursor>> ModelSampleCursor::Create(
   return cursor;
 }
 
-uint64_t ModelSampleCursor::FirstIndexAtOrAbove(double q) const {
-  uint64_t lo = 0, hi = sequence_.count();
-  while (lo < hi) {
-    const uint64_t mid = lo + (hi - lo) / 2;
-    if (sequence_.At(mid) >= q) {
-      hi = mid;
-    } else {
-      lo = mid + 1;
-    }
-  }
-  return lo;
-}
-
 absl::Status ModelSampleCursor::OpenPiece() {
   const ModelTree::Piece& piece = tree_->pieces()[piece_];
   const Sequence window = sequence_.Window(piece.lo, piece.hi);
@@ -211,8 +157,11 @@ absl::Status ModelSampleCursor::OpenPiece() {
   if (sequence_.monotone()) {
     // The piece's samples are one index range: those with q_k in its window.
     const size_t last = tree_->pieces().size() - 1;
-    kb = std::max(begin_, piece_ == 0 ? 0 : FirstIndexAtOrAbove(piece.lo));
-    ke = std::min(end_, piece_ == last ? sequence_.count() : FirstIndexAtOrAbove(piece.hi));
+    auto first_reaching = [&](double q) {
+      return FirstIndexWhere(sequence_.count(), [&](uint64_t k) { return sequence_.At(k) >= q; });
+    };
+    kb = std::max(begin_, piece_ == 0 ? 0 : first_reaching(piece.lo));
+    ke = std::min(end_, piece_ == last ? sequence_.count() : first_reaching(piece.hi));
     ke = std::max(kb, ke);
   }
   auto sampler = std::make_shared<const Sampler>(piece.tree, piece.surface, piece.density, window);
@@ -223,9 +172,9 @@ absl::Status ModelSampleCursor::OpenPiece() {
 }
 
 void ModelSampleCursor::KeepInTrim(const ModelTree::Piece& piece, size_t i, SampleBatch* b) {
-  const TrimGrid* trim = piece.trim.get();
+  const Face& face = tree_->model().faces()[piece.face];
   const double s = b->u[i], t = b->v[i];
-  if (!trim || trim->Contains(s, t)) return;
+  if (!face.trimmed() || face.Contains(s, t)) return;
   // The nearest inside point on growing circles (16 directions each, in a
   // fixed order), clamped to the square.
   constexpr int kDirections = 16;
@@ -236,7 +185,7 @@ void ModelSampleCursor::KeepInTrim(const ModelTree::Piece& piece, size_t i, Samp
       const double a = 2 * M_PI * d / kDirections;
       const double cs = std::clamp(s + r * std::cos(a), 0.0, 1.0);
       const double ct = std::clamp(t + r * std::sin(a), 0.0, 1.0);
-      if (trim->Contains(cs, ct)) best_s = cs, best_t = ct, found = true;
+      if (face.Contains(cs, ct)) best_s = cs, best_t = ct, found = true;
     }
   }
   if (!found) return;  // a face with mass has inside points; not reached

@@ -20,7 +20,9 @@
 // which does not know the boundary; a sample that lands outside its face's
 // trimmed region is moved to the nearest point inside (a deterministic search
 // on growing circles in the face's unit square, from 1e-9 of the square), and
-// its point, normal and density are evaluated there. No sample leaves its
+// its point, normal and density are evaluated there (Face::Contains answers
+// from a grid classified once, so the kernel is asked only near a trim). No
+// sample leaves its
 // face; the few moved ones are counted (ModelSampleCursor::moved()).
 //
 // Columns: u, v are the face's own unit-square parameters; `face` is the
@@ -47,15 +49,12 @@
 
 namespace sfc::cad {
 
-class TrimGrid;  // a trimmed face's cells classified once (model_sampler.cc)
-
 class ModelTree {
  public:
   // One face's part of the curve.
   struct Piece {
     int face = 0;  // index into Model::faces()
     std::shared_ptr<const Surface> surface;
-    std::shared_ptr<const TrimGrid> trim;    // null for an untrimmed face
     std::shared_ptr<const Density> density;  // the model's density, zero outside the trim
     std::shared_ptr<const CurveTree> tree;
     double lo = 0, hi = 1;  // the piece's window of q: [S_{f-1}/S, S_f/S)
@@ -105,8 +104,6 @@ class ModelSampleCursor {
                     SampleFields fields, int threads)
       : tree_(std::move(tree)), sequence_(sequence), region_(region), fields_(fields),
         threads_(threads) {}
-  // The first k in [0, count) with q_k >= q (q_k is non-decreasing).
-  uint64_t FirstIndexAtOrAbove(double q) const;
   absl::Status OpenPiece();
   // Moves sample i of `b` into the trim of `piece` if it lies outside.
   void KeepInTrim(const ModelTree::Piece& piece, size_t i, SampleBatch* b);

@@ -150,8 +150,26 @@ bool FaceTrim::CrossesBoundary(const Box2& cell) const {
   return false;
 }
 
+void FaceTrim::BuildGrid() const {
+  grid_.resize(kGridSide * kGridSide);
+  for (int i = 0; i < kGridSide; ++i) {
+    for (int j = 0; j < kGridSide; ++j) {
+      grid_[i * kGridSide + j] = Classify(double(i) / kGridSide, double(i + 1) / kGridSide,
+                                          double(j) / kGridSide, double(j + 1) / kGridSide);
+    }
+  }
+}
+
 bool FaceTrim::Contains(double s, double t) const {
   if (!trimmed_) return true;
+  std::call_once(grid_once_, [this] { BuildGrid(); });
+  const int i = std::clamp(static_cast<int>(s * kGridSide), 0, kGridSide - 1);
+  const int j = std::clamp(static_cast<int>(t * kGridSide), 0, kGridSide - 1);
+  switch (grid_[i * kGridSide + j]) {
+    case CellState::kInside: return true;
+    case CellState::kOutside: return false;
+    case CellState::kStraddles: break;
+  }
   auto classifier = classifiers_.Take();
   try {
     return classifier->Perform(gp_Pnt2d(map_.U(s), map_.V(t))) != TopAbs_OUT;

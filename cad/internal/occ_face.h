@@ -16,6 +16,7 @@
 #include <TopoDS_Face.hxx>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "absl/base/thread_annotations.h"
@@ -130,8 +131,13 @@ class FaceTrim {
 
   static constexpr double kLeafSize = 1.0 / 2048;
   static constexpr int kMaxDepth = 16;
+  // Contains() answers from a kGridSide x kGridSide grid of cells classified
+  // once, on first use (Classify: conservative), and asks the kernel only for
+  // points in cells the trim may cross.
+  static constexpr int kGridSide = 128;
 
  private:
+  void BuildGrid() const;
   struct Node {
     Box2 box;
     int first_child = -1;  // children at first_child, first_child + 1; -1 for a leaf
@@ -147,6 +153,8 @@ class FaceTrim {
   bool missing_pcurve_ = false;  // an edge without a p-curve: every cell near nothing is unknown
   bool trimmed_ = true;
   mutable LeasePool<BRepTopAdaptor_FClass2d> classifiers_;  // thread-safe
+  mutable std::once_flag grid_once_;
+  mutable std::vector<CellState> grid_;  // row s, column t; filled by BuildGrid
 };
 
 }  // namespace sfc::cad
