@@ -1,5 +1,6 @@
 // Mesh sampling figures, printed as tables (not a ctest; run by hand):
-//   ./build/bench/mesh_benchmark [count=1000000] [repeats=3] [threads=1]
+//   ./build/bench/mesh_benchmark [count=1000000] [repeats=3] [threads=1] [speed]
+// ("speed" prints the uniform row of table 1 only.)
 // 1. Speed: `count` samples on the 81 920-triangle icosphere, read from a
 //    binary PLY file: cold (read + parse + tree + samples) and warm (samples
 //    from the built tree), for the uniform density and |H| + 0.1. Each figure
@@ -150,7 +151,9 @@ int main(int argc, char** argv) {
   std::printf("| density | leaves | read+parse s | tree s | samples s | cold total s | warm s | "
               "cold cpu s | warm cpu s | warm M samples/s (cpu) |\n"
               "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  const bool quality = argc <= 4 || std::string(argv[4]) != "speed";
   for (bool curvature : {false, true}) {
+    if (curvature && !quality) break;
     std::vector<double> rp, tr, sc, cold, warm, cpu_cold, cpu_warm;
     size_t leaves = 0;
     for (int r = 0; r < repeats; ++r) {
@@ -166,6 +169,10 @@ int main(int argc, char** argv) {
                 count / Median(cpu_warm) / 1e6);
   }
 
+  if (!quality) {
+    std::filesystem::remove_all(dir);
+    return 0;
+  }
   std::printf("\n# spherical-triangle discrepancy, 128 triangles, mean of 4 seeds\n");
   std::printf("| N | ours | i.i.d. on the mesh |\n|---:|---:|---:|\n");
   auto surface = MeshSurface::Create(sphere, false);

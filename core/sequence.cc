@@ -55,6 +55,27 @@ double Sequence::Raw(uint64_t k) const {
   return 0;
 }
 
+void Sequence::AtMany(uint64_t k0, size_t n, double* out) const {
+  const double count = static_cast<double>(count_);
+  switch (kind_) {
+    case SequenceKind::kJittered:
+      for (size_t i = 0; i < n; ++i) {
+        const uint64_t k = k0 + i;
+        out[i] = (static_cast<double>(k) + CounterUniform(seed_, kJitterStream, k)) / count;
+      }
+      break;
+    case SequenceKind::kEqual:
+      for (size_t i = 0; i < n; ++i) out[i] = (static_cast<double>(k0 + i) + 0.5) / count;
+      break;
+    default:
+      for (size_t i = 0; i < n; ++i) out[i] = Raw(k0 + i);
+      break;
+  }
+  if (windowed_) {
+    for (size_t i = 0; i < n; ++i) out[i] = (out[i] - lo_) / (hi_ - lo_);
+  }
+}
+
 std::string_view SequenceName(SequenceKind kind) {
   switch (kind) {
     case SequenceKind::kJittered:

@@ -7,6 +7,7 @@
 #define SFCSAMPLER_CORE_SEQUENCE_H_
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string_view>
@@ -47,6 +48,10 @@ class Sequence {
     const double q = Raw(k);
     return windowed_ ? (q - lo_) / (hi_ - lo_) : q;
   }
+
+  // out[i] = At(k0 + i) for i < n, bit for bit, in one call: the loop runs
+  // per kind, so a batch pays the dispatch once. REQUIRES: k0 + n <= count().
+  void AtMany(uint64_t k0, size_t n, double* out) const;
 
   // The part of the sequence with lo <= q_k < hi (hi = 1 also takes q_k = 1),
   // rescaled to [0, 1): the samples of one piece of a surface made of pieces

@@ -149,16 +149,18 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
   const double cells = std::ldexp(1.0, bits);
   const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
   const double scale = extent > 0 ? (cells - 1) / extent : 0;
-  std::vector<std::pair<uint64_t, uint32_t>> keyed;
-  keyed.reserve(live.size());
-  for (uint32_t t : live) {
-    const Vec3 c = centroid[t];
+  std::vector<uint32_t> qx(live.size()), qy(live.size()), qz(live.size());
+  for (size_t i = 0; i < live.size(); ++i) {
+    const Vec3 c = centroid[live[i]];
     auto q = [&](double v, double l) {
       return static_cast<uint32_t>(std::clamp((v - l) * scale, 0.0, cells - 1));
     };
-    keyed.emplace_back(HilbertKey3(q(c.x, lo.x), q(c.y, lo.y), q(c.z, lo.z), bits),
-                       t);
+    qx[i] = q(c.x, lo.x), qy[i] = q(c.y, lo.y), qz[i] = q(c.z, lo.z);
   }
+  std::vector<uint64_t> keys(live.size());
+  HilbertKeys3(live.size(), qx.data(), qy.data(), qz.data(), keys.data(), bits);
+  std::vector<std::pair<uint64_t, uint32_t>> keyed(live.size());
+  for (size_t i = 0; i < live.size(); ++i) keyed[i] = {keys[i], live[i]};
   std::sort(keyed.begin(), keyed.end());
   const size_t ranks = keyed.size();
   tree->rank_triangle_.resize(ranks);
@@ -453,19 +455,45 @@ void MeshCurveTree::Descend(const Cell& cell, double t, std::array<double, 3>* b
   for (int i = 0; i < 3; ++i) (*bary)[i] = e[i] + ca * (x[i] - e[i]) + cb * (a[i] - e[i]);
 }
 
-void MeshCurveTree::BuildBoxes() {
+namespace {
+
+// The bounding box hierarchy's leaves hold this many consecutive ranks: 1/8
+// of the memory and build time of one leaf per triangle, for a per-triangle
+// test inside the leaves a query does not settle.
+constexpr size_t kRanksPerBox = 8;
+
+void AppendRun(size_t a, size_t e, std::vector<std::pair<size_t, size_t>>* runs) {
+  if (!runs->empty() && runs->back().second == a) {
+    runs->back().second = e;
+  } else {
+    runs->emplace_back(a, e);
+  }
+}
+
+}  // namespace
+
+MeshCurveTree::Box MeshCurveTree::TriangleBox(size_t r) const {
   const TriangleMesh& mesh = surface_->mesh();
+  Box b{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
+  for (uint32_t v : mesh.triangles[rank_triangle_[r]]) {
+    const Vec3& p = mesh.positions[v];
+    b.lo = {std::min(b.lo.x, p.x), std::min(b.lo.y, p.y), std::min(b.lo.z, p.z)};
+    b.hi = {std::max(b.hi.x, p.x), std::max(b.hi.y, p.y), std::max(b.hi.z, p.z)};
+  }
+  return b;
+}
+
+void MeshCurveTree::BuildBoxes() {
+  const size_t ranks = rank_triangle_.size();
   box_leaves_ = 1;
-  while (box_leaves_ < rank_triangle_.size()) box_leaves_ *= 2;
+  while (box_leaves_ * kRanksPerBox < ranks) box_leaves_ *= 2;
   const Box empty{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
   boxes_.assign(2 * box_leaves_, empty);
-  for (size_t r = 0; r < rank_triangle_.size(); ++r) {
-    Box& b = boxes_[box_leaves_ + r];
-    for (uint32_t v : mesh.triangles[rank_triangle_[r]]) {
-      const Vec3& p = mesh.positions[v];
-      b.lo = {std::min(b.lo.x, p.x), std::min(b.lo.y, p.y), std::min(b.lo.z, p.z)};
-      b.hi = {std::max(b.hi.x, p.x), std::max(b.hi.y, p.y), std::max(b.hi.z, p.z)};
-    }
+  for (size_t r = 0; r < ranks; ++r) {
+    Box& b = boxes_[box_leaves_ + r / kRanksPerBox];
+    const Box t = TriangleBox(r);
+    b.lo = {std::min(b.lo.x, t.lo.x), std::min(b.lo.y, t.lo.y), std::min(b.lo.z, t.lo.z)};
+    b.hi = {std::max(b.hi.x, t.hi.x), std::max(b.hi.y, t.hi.y), std::max(b.hi.z, t.hi.z)};
   }
   for (size_t i = box_leaves_ - 1; i >= 1; --i) {
     const Box &a = boxes_[2 * i], &b = boxes_[2 * i + 1];
@@ -476,25 +504,28 @@ void MeshCurveTree::BuildBoxes() {
 
 void MeshCurveTree::RanksMeetingBox(const Vec3& lo, const Vec3& hi,
                                     std::vector<std::pair<size_t, size_t>>* runs) const {
-  CollectRuns(1, 0, box_leaves_, lo, hi, runs);
+  CollectRuns(1, 0, box_leaves_ * kRanksPerBox, lo, hi, runs);
 }
 
 void MeshCurveTree::CollectRuns(size_t node, size_t node_lo, size_t node_hi, const Vec3& lo,
                                 const Vec3& hi,
                                 std::vector<std::pair<size_t, size_t>>* runs) const {
+  auto meets = [&](const Box& b) {
+    return !(b.lo.x > hi.x || b.hi.x < lo.x || b.lo.y > hi.y || b.hi.y < lo.y || b.lo.z > hi.z ||
+             b.hi.z < lo.z);
+  };
   const Box& b = boxes_[node];
-  if (b.lo.x > hi.x || b.hi.x < lo.x || b.lo.y > hi.y || b.hi.y < lo.y || b.lo.z > hi.z ||
-      b.hi.z < lo.z || node_lo >= rank_triangle_.size()) {
-    return;
-  }
+  if (!meets(b) || node_lo >= rank_triangle_.size()) return;
+  const size_t end = std::min(node_hi, rank_triangle_.size());
   const bool inside = b.lo.x >= lo.x && b.hi.x <= hi.x && b.lo.y >= lo.y && b.hi.y <= hi.y &&
                       b.lo.z >= lo.z && b.hi.z <= hi.z;
-  if (inside || node >= box_leaves_) {
-    const size_t a = node_lo, e = std::min(node_hi, rank_triangle_.size());
-    if (!runs->empty() && runs->back().second == a) {
-      runs->back().second = e;
-    } else {
-      runs->emplace_back(a, e);
+  if (inside) {
+    AppendRun(node_lo, end, runs);
+    return;
+  }
+  if (node >= box_leaves_) {
+    for (size_t r = node_lo; r < end; ++r) {
+      if (meets(TriangleBox(r))) AppendRun(r, r + 1, runs);
     }
     return;
   }

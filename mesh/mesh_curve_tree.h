@@ -146,6 +146,7 @@ class MeshCurveTree {
     Vec3 lo, hi;
   };
   MeshCurveTree() = default;
+  Box TriangleBox(size_t rank) const;  // of its vertices
   void BuildBoxes();
   void CollectRuns(size_t node, size_t node_lo, size_t node_hi, const Vec3& lo, const Vec3& hi,
                    std::vector<std::pair<size_t, size_t>>* runs) const;
@@ -162,7 +163,8 @@ class MeshCurveTree {
   std::vector<uint8_t> leaf_depth_;
   std::vector<std::array<double, 3>> leaf_density_;  // empty for uniform density
   std::vector<double> mass_ends_;
-  // Bounding boxes over ranks: a complete binary tree, node 1 the root.
+  // Bounding boxes over runs of ranks: a complete binary tree, node 1 the
+  // root, whose leaves hold kRanksPerBox ranks each.
   std::vector<Box> boxes_;
   size_t box_leaves_ = 0;
   Stats stats_;

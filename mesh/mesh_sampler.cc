@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "absl/strings/str_format.h"
+#include "core/column_memory.h"
 #include "core/status_macros.h"
 #include "core/worker_pool.h"
 
@@ -27,14 +28,6 @@ size_t MeshSampler::LeafForMass(double m) const {
 
 uint64_t MeshSampler::FirstIndexAtOrAbove(double m) const {
   return FirstIndexWhere(sequence_.count(), [&](uint64_t k) { return MassCoordinate(k) >= m; });
-}
-
-double MeshSampler::FractionInLeaf(double m, size_t l) const {
-  const double begin = tree_->mass_begin(l);
-  const double t = (m - begin) / (tree_->mass_ends()[l] - begin);
-  if (!(t >= 0)) return 0;
-  if (!(t < 1)) return std::nextafter(1.0, 0.0);
-  return t;
 }
 
 MeshSample MeshSampler::AtMass(uint64_t k, double m, size_t l,
@@ -119,16 +112,18 @@ void MeshSampleCursor::Resize(size_t at, size_t mesh_at, size_t rows, SampleBatc
                               MeshSampleColumns* mesh_columns) const {
   const size_t mesh_rows = mesh_at + rows;
   rows += at;
-  batch->index.resize(rows);
-  for (auto* column : {&batch->u, &batch->v, &batch->x, &batch->y, &batch->z}) column->resize(rows);
-  if (fields_.normal) {
-    for (auto* column : {&batch->nx, &batch->ny, &batch->nz}) column->resize(rows);
+  ResizeColumn(&batch->index, rows);
+  for (auto* column : {&batch->u, &batch->v, &batch->x, &batch->y, &batch->z}) {
+    ResizeColumn(column, rows);
   }
-  if (fields_.density) batch->density.resize(rows);
-  if (fields_.curve_position) batch->curve_position.resize(rows);
+  if (fields_.normal) {
+    for (auto* column : {&batch->nx, &batch->ny, &batch->nz}) ResizeColumn(column, rows);
+  }
+  if (fields_.density) ResizeColumn(&batch->density, rows);
+  if (fields_.curve_position) ResizeColumn(&batch->curve_position, rows);
   if (mesh_columns != nullptr) {
-    mesh_columns->triangle.resize(mesh_rows);
-    mesh_columns->w.resize(mesh_rows);
+    ResizeColumn(&mesh_columns->triangle, mesh_rows);
+    ResizeColumn(&mesh_columns->w, mesh_rows);
   }
 }
 
@@ -194,6 +189,8 @@ absl::StatusOr<size_t> MeshSampleCursor::Emit(size_t max, SampleBatch* batch,
   std::array<double, 3> barys[kChunk];
   chunk_cells_.reserve(kChunk + 1);  // pointers into it stay valid for a chunk
   const double triangles = static_cast<double>(tree.triangle_count());
+  const Sequence& sequence = sampler.sequence();
+  const double total = tree.total_mass();
   size_t emitted = 0;
   bool exhausted = false;
   while (emitted < max && !exhausted) {
@@ -201,37 +198,42 @@ absl::StatusOr<size_t> MeshSampleCursor::Emit(size_t max, SampleBatch* batch,
     if (cached_leaf_ != SIZE_MAX) chunk_cells_.push_back(cached_cell_);
     const size_t want = std::min(kChunk, max - emitted);
     size_t n = 0;
-    while (n < want) {
-      uint64_t k;
-      if (use_order_) {
-        if (order_pos_ >= order_.size()) {
-          exhausted = true;
-          break;
-        }
-        k = order_[order_pos_++];
-      } else {
-        while (segment_ < segments_.size() && next_k_ >= segments_[segment_].end) {
-          if (++segment_ < segments_.size()) next_k_ = segments_[segment_].begin;
-        }
-        if (segment_ >= segments_.size()) {
-          exhausted = true;
-          break;
-        }
-        k = next_k_++;
+    double ms[kChunk];
+    if (use_order_) {
+      while (n < want && order_pos_ < order_.size()) {
+        ks[n] = order_[order_pos_++];
+        ms[n] = sampler.MassCoordinate(ks[n]);
+        ++n;
       }
-      const double m = sampler.MassCoordinate(k);
+      exhausted = n < want;
+    } else {
+      while (segment_ < segments_.size() && next_k_ >= segments_[segment_].end) {
+        if (++segment_ < segments_.size()) next_k_ = segments_[segment_].begin;
+      }
+      if (segment_ < segments_.size()) {
+        // A run of consecutive indices inside one segment: their q_k in one call.
+        n = static_cast<size_t>(std::min<uint64_t>(want, segments_[segment_].end - next_k_));
+        sequence.AtMany(next_k_, n, ms);
+        for (size_t i = 0; i < n; ++i) ks[i] = next_k_ + i, ms[i] *= total;
+        next_k_ += n;
+      } else {
+        exhausted = true;
+      }
+    }
+    for (size_t i = 0; i < n; ++i) {
+      const double m = ms[i];
       if (cached_leaf_ == SIZE_MAX || !(m >= tree.mass_begin(cached_leaf_) && m < ends[cached_leaf_])) {
-        const size_t l = sampler.LeafForMass(m);
+        const size_t l = cached_leaf_ != SIZE_MAX && m >= ends[cached_leaf_]
+                             ? sampler.LeafForMassAfter(cached_leaf_, m)
+                             : sampler.LeafForMass(m);
         if (l != cached_leaf_) {
           cached_leaf_ = l;
           cached_cell_ = tree.LeafCell(l);
           chunk_cells_.push_back(cached_cell_);
         }
       }
-      ks[n] = k;
-      ts[n] = sampler.FractionInLeaf(m, cached_leaf_);
-      cells[n] = &chunk_cells_.back();
-      ++n;
+      ts[i] = sampler.FractionInLeaf(m, cached_leaf_);
+      cells[i] = &chunk_cells_.back();
     }
     MeshCurveTree::DescendMany(n, cells, ts, barys, area_positions);
     for (size_t i = 0; i < n; ++i) {

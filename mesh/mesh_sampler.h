@@ -19,6 +19,7 @@
 #ifndef SFCSAMPLER_MESH_MESH_SAMPLER_H_
 #define SFCSAMPLER_MESH_MESH_SAMPLER_H_
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -63,12 +64,29 @@ class MeshSampler {
   double MassCoordinate(uint64_t k) const { return sequence_.At(k) * tree_->total_mass(); }
   // The leaf holding mass coordinate m (zero-mass leaves are never chosen).
   size_t LeafForMass(double m) const;
+  // The same leaf, found by walking forward from leaf `from` when m lies at
+  // most a few leaves past it (samples and leaves advance together), else
+  // by LeafForMass. REQUIRES: from < leaf_count() and m >= mass_ends()[from].
+  size_t LeafForMassAfter(size_t from, double m) const {
+    const auto& ends = tree_->mass_ends();
+    const size_t stop = std::min(ends.size(), from + 9);
+    for (size_t l = from + 1; l < stop; ++l) {
+      if (ends[l] > m) return l;
+    }
+    return LeafForMass(m);
+  }
   // First k in [0, count) whose mass coordinate is >= m (monotone sequences).
   uint64_t FirstIndexAtOrAbove(double m) const;
   // Sample k. REQUIRES: k < sequence().count().
   MeshSample At(uint64_t k) const;
   // Sample k's fraction of leaf l's mass, in [0, 1).
-  double FractionInLeaf(double m, size_t l) const;
+  double FractionInLeaf(double m, size_t l) const {
+    const double begin = tree_->mass_begin(l);
+    const double t = (m - begin) / (tree_->mass_ends()[l] - begin);
+    if (!(t >= 0)) return 0;
+    if (!(t < 1)) return 0x1.fffffffffffffp-1;  // the largest double below 1
+    return t;
+  }
   // Sample at mass coordinate m inside leaf l with cell `cell` (= LeafCell(l)).
   MeshSample AtMass(uint64_t k, double m, size_t l, const MeshCurveTree::Cell& cell) const;
 

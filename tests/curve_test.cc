@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdlib>
+#include <random>
 #include <set>
 #include <vector>
 
@@ -139,6 +140,24 @@ TEST(Hilbert3d, ConsecutiveKeysAreFaceAdjacentCells) {
     if (i == 0) continue;
     const auto &a = cells[i - 1].second, &b = cells[i].second;
     EXPECT_EQ(std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) + std::abs(a[2] - b[2]), 1) << i;
+  }
+}
+
+TEST(Hilbert3d, KeysOfManyPointsAreTheKeysOfEachPoint) {
+  // HilbertKeys3 runs 16 lanes at a time: sizes around that, every bit count.
+  std::mt19937_64 rng(5);
+  for (int bits = 1; bits <= 21; ++bits) {
+    for (size_t n : {size_t{1}, size_t{15}, size_t{16}, size_t{17}, size_t{100}}) {
+      std::vector<uint32_t> x(n), y(n), z(n);
+      for (size_t i = 0; i < n; ++i) {
+        x[i] = rng() >> (64 - bits), y[i] = rng() >> (64 - bits), z[i] = rng() >> (64 - bits);
+      }
+      std::vector<uint64_t> keys(n);
+      HilbertKeys3(n, x.data(), y.data(), z.data(), keys.data(), bits);
+      for (size_t i = 0; i < n; ++i) {
+        ASSERT_EQ(keys[i], HilbertKey3(x[i], y[i], z[i], bits)) << bits << " bits, point " << i;
+      }
+    }
   }
 }
 

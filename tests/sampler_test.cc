@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <set>
+#include <vector>
 
 #include "gtest/gtest.h"
 #include "tests/test_util.h"
@@ -259,6 +260,21 @@ TEST(Sequence, JitteredSamplesStayInTheirStrataAndAreMonotone) {
     ASSERT_LE(q * n, static_cast<double>(k + 1));
     ASSERT_GE(q, previous);
     previous = q;
+  }
+}
+
+TEST(Sequence, AtManyGivesTheBitsOfAtForEveryKindAndWindow) {
+  for (SequenceKind kind : {SequenceKind::kJittered, SequenceKind::kEqual, SequenceKind::kRandom,
+                            SequenceKind::kVanDerCorput, SequenceKind::kProgressive}) {
+    const Sequence plain(kind, 5000, 7);
+    for (const Sequence& seq : {plain, plain.Window(0.25, 0.75)}) {
+      std::vector<double> many(1000);
+      seq.AtMany(3000, many.size(), many.data());
+      for (size_t i = 0; i < many.size(); ++i) {
+        ASSERT_EQ(many[i], seq.At(3000 + i))  // exact: no tolerance
+            << SequenceName(kind) << " k " << 3000 + i;
+      }
+    }
   }
 }
 

@@ -1,0 +1,37 @@
+// Output columns large enough to be worth 2 MiB pages. A column of a million
+// samples is 8 MB: with 4 KiB pages its first write takes ~2 000 page faults,
+// which cost about as much as drawing the samples (mesh_benchmark: 77 ms
+// against 55 ms for 10^6 samples). Where the kernel's transparent huge pages
+// are in "madvise" mode (Debian's default), large columns ask for them.
+//
+// Thread-safety: ResizeColumn is as thread-safe as the vector it resizes.
+#ifndef SFCSAMPLER_CORE_COLUMN_MEMORY_H_
+#define SFCSAMPLER_CORE_COLUMN_MEMORY_H_
+
+#include <cstddef>
+#include <vector>
+
+namespace sfc {
+
+// Columns of at least this many bytes are backed by huge pages.
+inline constexpr size_t kHugePageColumnBytes = size_t{4} << 20;
+
+// Advises the kernel to back the whole 2 MiB pages inside [data, data +
+// bytes) with huge pages (madvise MADV_HUGEPAGE). A hint: no effect where
+// the kernel or the platform lacks them.
+void AdviseHugePages(void* data, size_t bytes);
+
+// column->resize(rows), first reserving a large column's memory with the
+// huge-page advice, before any of it is touched.
+template <class T>
+void ResizeColumn(std::vector<T>* column, size_t rows) {
+  if (rows > column->capacity() && rows * sizeof(T) >= kHugePageColumnBytes) {
+    column->reserve(rows);
+    AdviseHugePages(column->data(), column->capacity() * sizeof(T));
+  }
+  column->resize(rows);
+}
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_CORE_COLUMN_MEMORY_H_
