@@ -54,6 +54,12 @@ class CacheStatsCollector final : public prometheus::Collectable {
     add("sfcsampler_builds_running", "Tree builds running now", T::Gauge, s.builds_running);
     add("sfcsampler_building_bytes", "Bytes of trees being built (counted against the cache budget)",
         T::Gauge, s.building_bytes);
+    add("sfcsampler_retired_tree_bytes",
+        "Bytes of evicted trees that streams still hold (counted against the cache budget)",
+        T::Gauge, s.retired_bytes);
+    add("sfcsampler_tree_revivals_total",
+        "Evicted trees a request took back into the cache while a stream still held them",
+        T::Counter, s.revivals);
     add("sfcsampler_builds_queued", "Tree builds waiting for a builder thread", T::Gauge,
         s.builds_queued);
     add("sfcsampler_builds_stopped_total",

@@ -328,6 +328,10 @@ grpc::Status SamplerService::GetCacheStats(grpc::ServerContext* context,
     response->set_max_queued_builds(options_.max_queued_builds);
     response->set_builds_running(s.builds_running);
     response->set_building_bytes(s.building_bytes);
+    response->set_retired_tree_bytes(s.retired_bytes);
+    response->set_retired_trees(s.retired_trees);
+    response->set_tree_revivals(s.revivals);
+    response->set_retired_tree_waits(s.retired_waits);
     response->set_builds_queued(s.builds_queued);
     response->set_builds_stopped(s.builds_stopped);
     response->set_builds_failed(s.builds_failed);

@@ -10,6 +10,7 @@
 
 #include "CLI/CLI.hpp"
 #include "absl/strings/strip.h"
+#include "server/memory_trimmer.h"
 #include "server/sampler_server.h"
 #include "spdlog/spdlog.h"
 
@@ -25,6 +26,7 @@ int main(int argc, char** argv) {
   // own (up to 8 per core), each keeping the pages its frees leave behind.
   mallopt(M_ARENA_MAX, 2);
   sfc::ServerOptions o;
+  int trim_interval_ms = 200;
   std::string token_file, log_level = "info";
   CLI::App app{"sfcsampler-server: density-controlled surface sampling over gRPC"};
   app.add_option("--address", o.address, "host:port of the sampler service")->capture_default_str();
@@ -93,10 +95,15 @@ int main(int argc, char** argv) {
   app.add_option("--tls-client-ca", o.tls_client_ca_file,
                  "PEM CA certificates; clients must present a certificate they signed (mutual TLS)");
   app.add_option("--token-file", token_file, "file holding the bearer token every sampler RPC must carry");
+  app.add_option("--trim-interval-ms", trim_interval_ms,
+                 "how often freed heap memory is given back to the system (malloc_trim); 0 = never")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--log-level", log_level, "trace | debug | info | warn | error")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   spdlog::set_level(spdlog::level::from_str(log_level));
+  sfc::MemoryTrimmer trimmer{std::chrono::milliseconds(trim_interval_ms)};
   if (!token_file.empty()) {
     std::ifstream in(token_file);
     std::string token((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

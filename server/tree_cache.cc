@@ -4,6 +4,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/time/clock.h"
 #include "absl/time/time.h"
 
 namespace sfc {
@@ -37,6 +38,20 @@ absl::StatusOr<TreeLookup> TreeCache::Get(const TreeKey& key, int grade, const T
       lru_.splice(lru_.begin(), lru_, it->second.lru);
       ++stats_.hits;
       return TreeLookup{it->second.tree, TreeAs<CurveTree>(it->second.tree.get()), true, false};
+    }
+    if (auto it = retired_.find(id); it != retired_.end()) {
+      // Evicted while a stream held it: take it back rather than build a copy.
+      std::shared_ptr<const AnyTree> tree = it->second.tree.lock();
+      const Retired retired = it->second;
+      stats_.retired_bytes -= retired.bytes;
+      retired_.erase(it);
+      if (tree != nullptr) {
+        ++stats_.revivals;
+        ++stats_.hits;
+        Insert(id, tree, retired.bytes, retired.canonical, retired.grade);
+        EvictOverBudget();  // may retire it again at once: it is still held
+        return TreeLookup{tree, TreeAs<CurveTree>(tree.get()), true, false};
+      }
     }
     if (stopping_) {
       return absl::UnavailableError("the server is shutting down; retry on another replica or later");
@@ -75,7 +90,8 @@ absl::StatusOr<TreeLookup> TreeCache::Get(const TreeKey& key, int grade, const T
       if (auto g = grades_.find(key.canonical); g != grades_.end() && factory.refine) {
         auto below = g->second.lower_bound(grade);
         if (below != g->second.begin()) {
-          job->coarser = entries_.at(absl::StrCat(key.canonical, "#g", *std::prev(below))).tree;
+          job->coarser_grade = *std::prev(below);
+          job->coarser = entries_.at(absl::StrCat(key.canonical, "#g", job->coarser_grade)).tree;
         }
       }
       pending_.emplace(id, job);
@@ -149,14 +165,36 @@ absl::Status TreeCache::Charge(Job& job, uint64_t bytes) {
   absl::MutexLock lock(&mu_);
   stats_.building_bytes = stats_.building_bytes - job.charged + bytes;
   job.charged = bytes;
-  EvictOverBudget();
-  if (stats_.building_bytes > options_.budget_bytes) {
-    return absl::ResourceExhaustedError(absl::StrFormat(
-        "the trees being built need more than the server's tree memory of %d bytes (cache_bytes): "
-        "retry later, or ask for fewer samples",
-        options_.budget_bytes));
+  while (true) {
+    EvictOverBudget();
+    if (stats_.building_bytes > options_.budget_bytes) {
+      return absl::ResourceExhaustedError(absl::StrFormat(
+          "the trees being built need more than the server's tree memory of %d bytes "
+          "(cache_bytes): retry later, or ask for fewer samples",
+          options_.budget_bytes));
+    }
+    // Room that evicted trees still held by streams take: wait for the
+    // streams to end (a refinement's own coarser tree is not waited for).
+    uint64_t retired = stats_.retired_bytes;
+    if (job.coarser != nullptr) {
+      if (auto it = retired_.find(absl::StrCat(job.canonical, "#g", job.coarser_grade));
+          it != retired_.end() && it->second.raw == job.coarser.get()) {
+        retired -= it->second.bytes;
+      }
+    }
+    if (stats_.building_bytes + retired <= options_.budget_bytes) return absl::OkStatus();
+    if (stopping_) {
+      return absl::UnavailableError("the server is shutting down; the tree build was stopped");
+    }
+    if (job.waiters == 0) {
+      return absl::CancelledError(
+          "every request waiting for this tree has gone; its build was stopped");
+    }
+    ++stats_.retired_waits;
+    mu_.Unlock();
+    absl::SleepFor(kWaitPoll);
+    mu_.Lock();
   }
-  return absl::OkStatus();
 }
 
 void TreeCache::Run(Job& job) {
@@ -174,6 +212,12 @@ void TreeCache::Run(Job& job) {
   } catch (const std::exception& e) {
     result = absl::InternalError(absl::StrCat("the tree build failed: ", e.what()));
   }
+  if (result.ok()) {
+    // The build's charges lag its growth: the finished tree takes its exact
+    // room before it enters the cache (and waits, like a growing build, for
+    // room that held evicted trees take).
+    if (absl::Status room = Charge(job, (*result)->bytes()); !room.ok()) result = room;
+  }
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   {
     absl::MutexLock lock(&mu_);
@@ -190,11 +234,7 @@ void TreeCache::Finish(Job& job, Result result, double seconds) {
   stats_.build_seconds += seconds;
   if (result.ok()) {
     ++(job.coarser ? stats_.refinements : stats_.builds);
-    lru_.push_front(job.id);
-    const uint64_t bytes = (*result)->bytes();
-    entries_.emplace(job.id, Entry{*result, bytes, job.canonical, job.grade, lru_.begin()});
-    grades_[job.canonical].insert(job.grade);
-    stats_.bytes += bytes;
+    Insert(job.id, *result, (*result)->bytes(), job.canonical, job.grade);
     EvictOverBudget();
   } else if (IsStop(result.status())) {
     ++stats_.builds_stopped;
@@ -234,13 +274,40 @@ void TreeCache::Stop() {
   }
 }
 
+void TreeCache::Insert(const std::string& id, std::shared_ptr<const AnyTree> tree, uint64_t bytes,
+                       const std::string& canonical, int grade) {
+  lru_.push_front(id);
+  entries_.emplace(id, Entry{std::move(tree), bytes, canonical, grade, lru_.begin()});
+  grades_[canonical].insert(grade);
+  stats_.bytes += bytes;
+}
+
+void TreeCache::PruneRetired() {
+  for (auto it = retired_.begin(); it != retired_.end();) {
+    if (it->second.tree.expired()) {
+      stats_.retired_bytes -= it->second.bytes;
+      it = retired_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+}
+
 void TreeCache::EvictOverBudget() {
-  while (stats_.bytes + stats_.building_bytes > options_.budget_bytes && !lru_.empty()) {
+  PruneRetired();
+  while (stats_.bytes + stats_.building_bytes + stats_.retired_bytes > options_.budget_bytes &&
+         !lru_.empty()) {
     auto it = entries_.find(lru_.back());
-    stats_.bytes -= it->second.bytes;
-    auto grades = grades_.find(it->second.canonical);
-    grades->second.erase(it->second.grade);
+    Entry& entry = it->second;
+    stats_.bytes -= entry.bytes;
+    auto grades = grades_.find(entry.canonical);
+    grades->second.erase(entry.grade);
     if (grades->second.empty()) grades_.erase(grades);
+    if (entry.tree.use_count() > 1) {  // a stream or a refinement holds it
+      stats_.retired_bytes += entry.bytes;
+      retired_[it->first] = Retired{entry.tree, entry.tree.get(), entry.bytes, entry.canonical,
+                                    entry.grade};
+    }
     entries_.erase(it);
     lru_.pop_back();
     ++stats_.evictions;
@@ -251,6 +318,12 @@ TreeCacheStats TreeCache::stats() const {
   absl::MutexLock lock(&mu_);
   TreeCacheStats s = stats_;
   s.entries = entries_.size();
+  s.retired_bytes = s.retired_trees = 0;  // those still held now
+  for (const auto& [id, retired] : retired_) {
+    if (retired.tree.expired()) continue;
+    s.retired_bytes += retired.bytes;
+    ++s.retired_trees;
+  }
   s.builds_queued = queue_.size();
   return s;
 }

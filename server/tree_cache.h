@@ -7,7 +7,10 @@
 // the same tree instead of building anew (the result is the same tree, see
 // core/curve_tree.h). The cache holds at most budget_bytes of trees and evicts
 // the least recently used; trees (of any kind: engine/tree_source.h AnyTree) are shared as shared_ptrs, so
-// a stream keeps its tree alive through eviction.
+// a stream keeps its tree alive through eviction. Such an evicted tree still
+// takes memory: it stays counted against budget_bytes ("retired") until the
+// last holder lets go, and a request for it takes it back into the cache
+// instead of building a second copy.
 //
 // Builds are bounded:
 //  - they run on max_concurrent_builds threads of the cache's own; at most
@@ -17,9 +20,11 @@
 //    build that no request wants any more stops at its next BuildControl
 //    check; Stop() (shutdown) stops them all;
 //  - trees being built count against budget_bytes as they grow: cached trees
-//    are evicted to make room, and a build that would push the builds in
-//    progress past the budget on their own fails with RESOURCE_EXHAUSTED, so
-//    cached plus growing trees stay within the budget;
+//    are evicted to make room, a build that would push the builds in
+//    progress past the budget on their own fails with RESOURCE_EXHAUSTED, and
+//    one that needs room that retired trees hold waits (with its checks) for
+//    their streams to end, so cached, retired and growing trees stay within
+//    the budget;
 //  - a build that failed (budget, bad surface) is remembered for
 //    failure_ttl_seconds, so identical requests get its error at once instead
 //    of repeating it;
@@ -64,6 +69,10 @@ struct TreeCacheStats {
   uint64_t entries = 0;
   uint64_t bytes = 0;           // of cached trees
   uint64_t building_bytes = 0;  // of trees being built, now
+  uint64_t retired_bytes = 0;   // of evicted trees that requests still hold, now
+  uint64_t retired_trees = 0;   // now
+  uint64_t revivals = 0;        // retired trees taken back into the cache by a request
+  uint64_t retired_waits = 0;   // times a build waited for retired trees to be let go
   double build_seconds = 0;
   uint64_t builds_running = 0;    // now
   uint64_t builds_queued = 0;     // now, waiting for a builder thread
@@ -110,11 +119,20 @@ class TreeCache final : public TreeSource {
     int grade = 0;
     TreeFactory factory;                       // the first requester's; owns its data
     std::shared_ptr<const AnyTree> coarser;    // refine this one, if set
+    int coarser_grade = 0;
     // Guarded by the cache's mu_.
     int waiters = 0;
     uint64_t charged = 0;  // bytes the build holds, as it last said
     bool started = false, done = false;
     Result result;
+  };
+  // An evicted tree that something (a stream, a refinement) still holds.
+  struct Retired {
+    std::weak_ptr<const AnyTree> tree;
+    const AnyTree* raw;  // identity, for a refinement's own coarser tree
+    uint64_t bytes;
+    std::string canonical;
+    int grade;
   };
   struct Failure {
     absl::Status status;
@@ -129,6 +147,11 @@ class TreeCache final : public TreeSource {
   // Counts `bytes` for a growing build; evicts for room or refuses.
   absl::Status Charge(Job& job, uint64_t bytes) ABSL_LOCKS_EXCLUDED(mu_);
   void EvictOverBudget() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Drops the retired trees nobody holds any more from the count.
+  void PruneRetired() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Puts a cached tree at the front of the LRU, counted in bytes.
+  void Insert(const std::string& id, std::shared_ptr<const AnyTree> tree, uint64_t bytes,
+              const std::string& canonical, int grade) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   void Forget(const std::shared_ptr<Job>& job) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
 
   // Constant after construction.
@@ -142,6 +165,7 @@ class TreeCache final : public TreeSource {
   std::deque<std::shared_ptr<Job>> queue_ ABSL_GUARDED_BY(mu_);  // not yet started
   std::map<std::string, std::set<int>> grades_ ABSL_GUARDED_BY(mu_);  // canonical -> cached grades
   std::unordered_map<std::string, Failure> failures_ ABSL_GUARDED_BY(mu_);
+  std::unordered_map<std::string, Retired> retired_ ABSL_GUARDED_BY(mu_);  // by id
   bool stopping_ ABSL_GUARDED_BY(mu_) = false;
   TreeCacheStats stats_ ABSL_GUARDED_BY(mu_);
   std::vector<std::thread> builders_;  // started in the constructor, joined by Stop()

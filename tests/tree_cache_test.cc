@@ -3,6 +3,9 @@
 #include "server/tree_cache.h"
 
 #include <atomic>
+#include <chrono>
+#include <memory>
+#include <utility>
 #include <new>
 #include <stdexcept>
 #include <thread>
@@ -126,6 +129,86 @@ TEST(TreeCache, AfterStopMissesAreUnavailableButHitsAreServed) {
   EXPECT_EQ(cache.Get(Key("t"), 4, Real("torus", &calls), {}).status().code(),
             absl::StatusCode::kUnavailable);
   EXPECT_EQ(calls.load(), 1);
+}
+
+// The bytes of the sphere's and the torus's trees at `grade`, from a cache
+// of their own.
+std::pair<uint64_t, uint64_t> SphereAndTorusBytes(int grade) {
+  TreeCache probe(TreeCacheOptions{});
+  std::atomic<int> calls{0};
+  return {(*probe.Get(Key("s"), grade, Real("sphere", &calls), {})).any->bytes(),
+          (*probe.Get(Key("t"), grade, Real("torus", &calls), {})).any->bytes()};
+}
+
+TEST(TreeCache, AnEvictedTreeAStreamHoldsStaysCountedAndARequestTakesItBack) {
+  const int grade = 16;
+  const auto [sphere_bytes, torus_bytes] = SphereAndTorusBytes(grade);
+  TreeCacheOptions options;
+  options.budget_bytes = sphere_bytes + torus_bytes - 1;  // not both at once
+  TreeCache cache(options);
+  std::atomic<int> calls{0};
+  auto held = cache.Get(Key("s"), grade, Real("sphere", &calls), {});  // a stream's tree
+  ASSERT_TRUE(held.ok()) << held.status();
+  // The torus's build evicts the sphere for room, but the stream still holds
+  // it: it stays counted, and the build waits for it, until its request
+  // gives up.
+  std::atomic<bool> give_up{false};
+  BuildControl caller;
+  caller.check = [&]() -> absl::Status {
+    return give_up ? absl::DeadlineExceededError("mine") : absl::OkStatus();
+  };
+  absl::StatusOr<TreeLookup> torus = absl::UnknownError("not yet");
+  std::thread torus_request(
+      [&] { torus = cache.Get(Key("t"), grade, Real("torus", &calls), caller); });
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (cache.stats().retired_waits == 0 && std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  TreeCacheStats s = cache.stats();
+  EXPECT_GT(s.retired_waits, 0u);
+  EXPECT_EQ(s.retired_trees, 1u);
+  EXPECT_EQ(s.retired_bytes, sphere_bytes);
+  EXPECT_EQ(s.entries, 0u);
+  // A request for the held sphere takes it back: no second build.
+  auto again = cache.Get(Key("s"), grade, Real("sphere", &calls), {});
+  ASSERT_TRUE(again.ok()) << again.status();
+  EXPECT_TRUE(again->cache_hit);
+  EXPECT_EQ(again->any.get(), held->any.get());
+  EXPECT_GE(cache.stats().revivals, 1u);
+  give_up = true;
+  torus_request.join();
+  EXPECT_EQ(torus.status().code(), absl::StatusCode::kDeadlineExceeded);
+  EXPECT_EQ(calls.load(), 2);  // the sphere once, the torus once
+  cache.Stop();  // joins the builder, which stops at its next check
+  s = cache.stats();
+  EXPECT_EQ(s.builds_running, 0u);
+  EXPECT_EQ(s.building_bytes, 0u);
+}
+
+TEST(TreeCache, ABuildWaitsForTheRoomAHeldEvictedTreeTakesUntilItsStreamEnds) {
+  const int grade = 16;
+  const auto [sphere_bytes, torus_bytes] = SphereAndTorusBytes(grade);
+  TreeCacheOptions options;
+  options.budget_bytes = sphere_bytes + torus_bytes - 1;
+  TreeCache cache(options);
+  std::atomic<int> calls{0};
+  auto held = std::make_unique<absl::StatusOr<TreeLookup>>(
+      cache.Get(Key("s"), grade, Real("sphere", &calls), {}));
+  ASSERT_TRUE(held->ok());
+  std::thread stream_ends([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    held.reset();
+  });
+  const auto start = std::chrono::steady_clock::now();
+  auto torus = cache.Get(Key("t"), grade, Real("torus", &calls), {});
+  const auto waited = std::chrono::steady_clock::now() - start;
+  stream_ends.join();
+  ASSERT_TRUE(torus.ok()) << torus.status();
+  const TreeCacheStats s = cache.stats();
+  EXPECT_GT(s.retired_waits, 0u);
+  EXPECT_GE(waited, std::chrono::milliseconds(250));  // it did wait for the stream
+  EXPECT_EQ(s.retired_bytes, 0u);
+  EXPECT_EQ(s.bytes, torus_bytes);
 }
 
 }  // namespace
