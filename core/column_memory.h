@@ -1,8 +1,8 @@
 // Output columns large enough to be worth 2 MiB pages. A column of a million
-// samples is 8 MB: with 4 KiB pages its first write takes ~2 000 page faults,
-// which cost about as much as drawing the samples (mesh_benchmark: 77 ms
-// against 55 ms for 10^6 samples). Where the kernel's transparent huge pages
-// are in "madvise" mode (Debian's default), large columns ask for them.
+// samples is 8 MB: with 4 KiB pages its first write takes ~2 000 page faults
+// (mesh_benchmark, 10^6 samples cold: 77 ms with 4 KiB pages, 64 ms with this
+// advice). Where the kernel's transparent huge pages are in "madvise" mode
+// (Debian's default), large columns ask for them.
 //
 // Thread-safety: ResizeColumn is as thread-safe as the vector it resizes.
 #ifndef SFCSAMPLER_CORE_COLUMN_MEMORY_H_

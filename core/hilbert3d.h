@@ -15,8 +15,6 @@
 
 namespace sfc {
 
-// A bijection of the cells onto [0, 2^(3 bits)). REQUIRES: 1 <= bits <= 21 and
-// x, y, z < 2^bits.
 namespace hilbert3d_internal {
 
 // Spreads the low 21 bits of v to every third bit (bit i to bit 3 i).
@@ -30,40 +28,45 @@ inline uint64_t Spread3(uint32_t v) {
   return x;
 }
 
+// One level q of the inverse undo, branch-free: for each axis i, if its bit
+// q is set, invert a0's lower bits, else exchange the lower bits of a0 and a_i
+// (a no-op for i = 0).
+inline void UndoLevel(uint32_t q, uint32_t& a0, uint32_t& a1, uint32_t& a2) {
+  const uint32_t p = q - 1;
+  auto axis = [&](uint32_t& ai) {
+    const uint32_t set = 0u - ((ai & q) != 0);
+    a0 ^= p & set;
+    const uint32_t t = (a0 ^ ai) & p & ~set;
+    a0 ^= t;
+    ai ^= t;
+  };
+  a0 ^= p & (0u - ((a0 & q) != 0));
+  axis(a1);
+  axis(a2);
+}
+
+// Gray-encodes the undone axes and interleaves them: bit b of axis i goes to
+// key bit 3 b + (2 - i). m = 2^(bits - 1).
+inline uint64_t GrayInterleave(uint32_t m, uint32_t a0, uint32_t a1, uint32_t a2) {
+  a1 ^= a0;
+  a2 ^= a1;
+  uint32_t t = 0;
+  for (uint32_t q = m; q > 1; q >>= 1) t ^= (q - 1) & (0u - ((a2 & q) != 0));
+  return Spread3(a0 ^ t) << 2 | Spread3(a1 ^ t) << 1 | Spread3(a2 ^ t);
+}
+
 }  // namespace hilbert3d_internal
 
 // A bijection of the cells onto [0, 2^(3 bits)). REQUIRES: 1 <= bits <= 21 and
 // x, y, z < 2^bits. Branch-free: the cells' bits are data, not control flow.
 inline uint64_t HilbertKey3(uint32_t x, uint32_t y, uint32_t z, int bits = 21) {
-  uint32_t a0 = x, a1 = y, a2 = z;
   const uint32_t m = 1u << (bits - 1);
-  for (uint32_t q = m; q > 1; q >>= 1) {  // inverse undo
-    const uint32_t p = q - 1;
-    // Axis i: if its bit q is set, invert a0's lower bits, else exchange
-    // the lower bits of a0 and a_i (a no-op for i = 0).
-    auto step = [&](uint32_t& ai) {
-      const uint32_t set = 0u - ((ai & q) != 0);
-      a0 ^= p & set;
-      const uint32_t t = (a0 ^ ai) & p & ~set;
-      a0 ^= t;
-      ai ^= t;
-    };
-    a0 ^= p & (0u - ((a0 & q) != 0));
-    step(a1);
-    step(a2);
-  }
-  a1 ^= a0;  // Gray encode
-  a2 ^= a1;
-  uint32_t t = 0;
-  for (uint32_t q = m; q > 1; q >>= 1) t ^= (q - 1) & (0u - ((a2 & q) != 0));
-  a0 ^= t, a1 ^= t, a2 ^= t;
-  // Bit b of axis i goes to key bit 3 b + (2 - i).
-  using hilbert3d_internal::Spread3;
-  return Spread3(a0) << 2 | Spread3(a1) << 1 | Spread3(a2);
+  for (uint32_t q = m; q > 1; q >>= 1) hilbert3d_internal::UndoLevel(q, x, y, z);
+  return hilbert3d_internal::GrayInterleave(m, x, y, z);
 }
 
 // HilbertKey3 of n points at once (out[i] for x[i], y[i], z[i]), the same
-// keys: the steps run lane by lane, which the compiler vectorises.
+// keys: each level runs across 16 points, which the compiler vectorises.
 inline void HilbertKeys3(size_t n, const uint32_t* x, const uint32_t* y, const uint32_t* z,
                          uint64_t* out, int bits = 21) {
   constexpr size_t kLanes = 16;
@@ -73,26 +76,10 @@ inline void HilbertKeys3(size_t n, const uint32_t* x, const uint32_t* y, const u
     uint32_t a0[kLanes] = {}, a1[kLanes] = {}, a2[kLanes] = {};
     for (size_t j = 0; j < lanes; ++j) a0[j] = x[base + j], a1[j] = y[base + j], a2[j] = z[base + j];
     for (uint32_t q = m; q > 1; q >>= 1) {
-      const uint32_t p = q - 1;
-      for (size_t j = 0; j < kLanes; ++j) {
-        uint32_t b0 = a0[j], b1 = a1[j], b2 = a2[j];
-        b0 ^= p & (0u - ((b0 & q) != 0));
-        uint32_t set = 0u - ((b1 & q) != 0);
-        b0 ^= p & set;
-        uint32_t t = (b0 ^ b1) & p & ~set;
-        b0 ^= t, b1 ^= t;
-        set = 0u - ((b2 & q) != 0);
-        b0 ^= p & set;
-        t = (b0 ^ b2) & p & ~set;
-        b0 ^= t, b2 ^= t;
-        a0[j] = b0, a1[j] = b1, a2[j] = b2;
-      }
+      for (size_t j = 0; j < kLanes; ++j) hilbert3d_internal::UndoLevel(q, a0[j], a1[j], a2[j]);
     }
     for (size_t j = 0; j < lanes; ++j) {
-      uint32_t b0 = a0[j], b1 = a1[j] ^ b0, b2 = a2[j] ^ b1, t = 0;
-      for (uint32_t q = m; q > 1; q >>= 1) t ^= (q - 1) & (0u - ((b2 & q) != 0));
-      using hilbert3d_internal::Spread3;
-      out[base + j] = Spread3(b0 ^ t) << 2 | Spread3(b1 ^ t) << 1 | Spread3(b2 ^ t);
+      out[base + j] = hilbert3d_internal::GrayInterleave(m, a0[j], a1[j], a2[j]);
     }
   }
 }

