@@ -6,47 +6,7 @@
 namespace sfc {
 namespace {
 
-// Lagrange basis polynomial i on the Gauss nodes at x.
-double Basis(int i, double x) {
-  double p = 1;
-  for (int k = 0; k < 3; ++k) {
-    if (k != i) p *= (x - kGaussNode[k]) / (kGaussNode[i] - kGaussNode[k]);
-  }
-  return p;
-}
-
-// Its leading (x^2) coefficient.
-double BasisLead(int i) {
-  double p = 1;
-  for (int k = 0; k < 3; ++k) {
-    if (k != i) p /= kGaussNode[i] - kGaussNode[k];
-  }
-  return p;
-}
-
-// The basis polynomials' coefficients: L_i(x) = k0 + k1 x + k2 x^2.
-struct BasisTable {
-  double k[3][3];
-  BasisTable() {
-    for (int i = 0; i < 3; ++i) {
-      const double l0 = Basis(i, 0), l1 = Basis(i, 1), lead = BasisLead(i);
-      k[i][0] = l0;
-      k[i][2] = lead;
-      k[i][1] = l1 - l0 - lead;
-    }
-  }
-};
-
-// int_a^b L_i = d L_i(mid) + lead d^3 / 12, exact for a quadratic and free of
-// the cancellation of b^3 - a^3 on tiny intervals.
-void BasisIntegrals(double a, double b, double out[3]) {
-  static const BasisTable table;
-  const double d = b - a, mid = (a + b) / 2, d3 = d * d * d / 12;
-  for (int i = 0; i < 3; ++i) {
-    const double* k = table.k[i];
-    out[i] = d * (k[0] + mid * (k[1] + mid * k[2])) + k[2] * d3;
-  }
-}
+using leaf_model_internal::BasisIntegrals;
 
 template <typename T>
 double Quadratic(const T* c, double x0, double x1, double y0, double y1) {
@@ -119,35 +79,20 @@ double ModelIntegral(const LeafModel& model, LeafModel::Kind kind, int grid, dou
   return sum;
 }
 
-void SubSquareIntegrals(const LeafModel& model, LeafModel::Kind kind, int grid, double x0,
-                        double y0, double side, double out[9]) {
+namespace leaf_model_internal {
+
+void PiecewiseSubSquareIntegrals(const LeafModel& model, int grid, double x0, double y0,
+                                 double side, double out[9]) {
   const double step = side / grid;
-  if (kind == LeafModel::Kind::kPiecewise) {
-    for (int i = 0; i < grid; ++i) {
-      for (int j = 0; j < grid; ++j) {
-        out[i * grid + j] = ModelIntegral(model, kind, grid, x0 + i * step, x0 + (i + 1) * step,
-                                          y0 + j * step, y0 + (j + 1) * step);
-      }
-    }
-    return;
-  }
-  double ix[3][3], iy[3][3];
-  for (int i = 0; i < grid; ++i) {
-    BasisIntegrals(x0 + i * step, x0 + (i + 1) * step, ix[i]);
-    BasisIntegrals(y0 + i * step, y0 + (i + 1) * step, iy[i]);
-  }
   for (int i = 0; i < grid; ++i) {
     for (int j = 0; j < grid; ++j) {
-      double sum = 0;
-      for (int a = 0; a < 3; ++a) {
-        const double row = model.c[3 * a] * iy[j][0] + model.c[3 * a + 1] * iy[j][1] +
-                           model.c[3 * a + 2] * iy[j][2];
-        sum += ix[i][a] * row;
-      }
-      out[i * grid + j] = sum;
+      out[i * grid + j] = ModelIntegral(model, LeafModel::Kind::kPiecewise, grid, x0 + i * step,
+                                        x0 + (i + 1) * step, y0 + j * step, y0 + (j + 1) * step);
     }
   }
 }
+
+}  // namespace leaf_model_internal
 
 double QuadraticIntegral(const double values[9], double x0, double x1, double y0, double y1) {
   return Quadratic(values, x0, x1, y0, y1);

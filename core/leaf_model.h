@@ -49,11 +49,95 @@ struct LeafModel {
 double ModelIntegral(const LeafModel& model, LeafModel::Kind kind, int grid, double x0, double x1,
                      double y0, double y1);
 
+namespace leaf_model_internal {
+
+// The Lagrange basis polynomials on the Gauss nodes, L_i(x) = k[i][0] +
+// k[i][1] x + k[i][2] x^2, computed at compile time (the same bits as at run
+// time: IEEE arithmetic, no contraction).
+struct BasisTable {
+  double k[3][3];
+};
+constexpr double Basis(int i, double x) {
+  double p = 1;
+  for (int k = 0; k < 3; ++k) {
+    if (k != i) p *= (x - kGaussNode[k]) / (kGaussNode[i] - kGaussNode[k]);
+  }
+  return p;
+}
+constexpr double BasisLead(int i) {  // the x^2 coefficient
+  double p = 1;
+  for (int k = 0; k < 3; ++k) {
+    if (k != i) p /= kGaussNode[i] - kGaussNode[k];
+  }
+  return p;
+}
+constexpr BasisTable MakeBasisTable() {
+  BasisTable table{};
+  for (int i = 0; i < 3; ++i) {
+    const double l0 = Basis(i, 0), l1 = Basis(i, 1), lead = BasisLead(i);
+    table.k[i][0] = l0;
+    table.k[i][2] = lead;
+    table.k[i][1] = l1 - l0 - lead;
+  }
+  return table;
+}
+inline constexpr BasisTable kBasisTable = MakeBasisTable();
+
+// int_a^b L_i = d L_i(mid) + lead d^3 / 12, exact for a quadratic and free of
+// the cancellation of b^3 - a^3 on tiny intervals.
+inline void BasisIntegrals(double a, double b, double out[3]) {
+  const double d = b - a, mid = (a + b) / 2, d3 = d * d * d / 12;
+  for (int i = 0; i < 3; ++i) {
+    const double* k = kBasisTable.k[i];
+    out[i] = d * (k[0] + mid * (k[1] + mid * k[2])) + k[2] * d3;
+  }
+}
+
+void PiecewiseSubSquareIntegrals(const LeafModel& model, int grid, double x0, double y0,
+                                 double side, double out[9]);
+
+}  // namespace leaf_model_internal
+
 // The integrals over the grid x grid sub-squares of the square
 // [x0, x0 + side] x [y0, y0 + side]: out[i * grid + j] for the sub-square i
-// along x, j along y. Shares the 1D integrals between sub-squares.
-void SubSquareIntegrals(const LeafModel& model, LeafModel::Kind kind, int grid, double x0,
-                        double y0, double side, double out[9]);
+// along x, j along y. Shares the 1D integrals, and each y row of the
+// quadratic, between sub-squares. Inline: the sampler's descent calls it once
+// per model level. REQUIRES: grid is 2 or 3 (the curves' grids).
+template <int kGrid>
+inline void SubSquareIntegralsOnGrid(const LeafModel& model, LeafModel::Kind kind, double x0,
+                                     double y0, double side, double out[9]) {
+  using leaf_model_internal::BasisIntegrals;
+  if (kind == LeafModel::Kind::kPiecewise) {
+    leaf_model_internal::PiecewiseSubSquareIntegrals(model, kGrid, x0, y0, side, out);
+    return;
+  }
+  const double step = side / kGrid;
+  double ix[kGrid][3], row[kGrid][3];  // row[j][a] = sum_b c[3a + b] int_{y-cell j} L_b
+  for (int j = 0; j < kGrid; ++j) {
+    double iy[3];
+    BasisIntegrals(y0 + j * step, y0 + (j + 1) * step, iy);
+    for (int a = 0; a < 3; ++a) {
+      row[j][a] = model.c[3 * a] * iy[0] + model.c[3 * a + 1] * iy[1] + model.c[3 * a + 2] * iy[2];
+    }
+  }
+  for (int i = 0; i < kGrid; ++i) BasisIntegrals(x0 + i * step, x0 + (i + 1) * step, ix[i]);
+  for (int i = 0; i < kGrid; ++i) {
+    for (int j = 0; j < kGrid; ++j) {
+      double sum = 0;
+      for (int a = 0; a < 3; ++a) sum += ix[i][a] * row[j][a];
+      out[i * kGrid + j] = sum;
+    }
+  }
+}
+
+inline void SubSquareIntegrals(const LeafModel& model, LeafModel::Kind kind, int grid, double x0,
+                               double y0, double side, double out[9]) {
+  if (grid == 2) {
+    SubSquareIntegralsOnGrid<2>(model, kind, x0, y0, side, out);
+  } else {
+    SubSquareIntegralsOnGrid<3>(model, kind, x0, y0, side, out);
+  }
+}
 
 // The same for unnormalised quadratic node values (double precision), used by
 // the tree's error test.

@@ -5,6 +5,7 @@
 #include <functional>
 
 #include "absl/strings/str_format.h"
+#include "core/column_memory.h"
 #include "core/status_macros.h"
 #include "core/worker_pool.h"
 
@@ -15,19 +16,7 @@ Sampler::Sampler(std::shared_ptr<const CurveTree> tree, std::shared_ptr<const Su
     : tree_(std::move(tree)),
       surface_(std::move(surface)),
       density_(std::move(density)),
-      sequence_(sequence) {
-  last_positive_leaf_ = tree_->leaf_count() - 1;
-  while (last_positive_leaf_ > 0 &&
-         !(tree_->mass_end(last_positive_leaf_) > tree_->mass_begin(last_positive_leaf_))) {
-    --last_positive_leaf_;
-  }
-}
-
-size_t Sampler::LeafForMass(double m) const {
-  const size_t l = tree_->FirstLeafEndingAbove(m);
-  // q_k S_M can round up to S_M itself: it then belongs to the last leaf with mass.
-  return l >= tree_->leaf_count() ? last_positive_leaf_ : l;
-}
+      sequence_(sequence) {}
 
 uint64_t Sampler::FirstIndexAtOrAbove(double m) const {
   return FirstIndexWhere(sequence_.count(), [&](uint64_t k) { return MassCoordinate(k) >= m; });
@@ -35,7 +24,7 @@ uint64_t Sampler::FirstIndexAtOrAbove(double m) const {
 
 SampleCursor::SampleCursor(std::shared_ptr<const Sampler> sampler, Region region,
                            SampleFields fields)
-    : sampler_(std::move(sampler)), region_(region), fields_(fields) {}
+    : sampler_(std::move(sampler)), region_(region), fields_(fields), walk_(sampler_->tree()) {}
 
 absl::StatusOr<std::unique_ptr<SampleCursor>> SampleCursor::Create(
     std::shared_ptr<const Sampler> sampler, uint64_t begin, uint64_t end, const Region& region,
@@ -157,194 +146,178 @@ absl::Status SampleCursor::PlanRegion(uint64_t begin, uint64_t end) {
 }
 
 absl::StatusOr<size_t> SampleCursor::Next(size_t max, SampleBatch* batch) {
-  // Large batches inside one plain index range can be split over threads.
+  // Large runs inside one plain index range are split over threads.
   constexpr size_t kMinParallel = 8192;
-  if (threads_ > 1 && !use_order_ && region_.kind == Region::Kind::kAll && max >= kMinParallel &&
-      segment_ < segments_.size() && segments_[segment_].end - next_k_ >= max) {
-    const uint64_t k0 = next_k_;
-    RETURN_IF_ERROR(EmitParallel(k0, k0 + max, batch));
-    next_k_ += max;
-    if (next_k_ >= segments_[segment_].end && ++segment_ < segments_.size()) {
-      next_k_ = segments_[segment_].begin;
-    }
-    return max;
-  }
   size_t produced = 0;
   while (produced < max) {
-    uint64_t k;
+    // The next run: at most the samples still wanted, inside one segment. A
+    // region keeps fewer than it is handed, so runs repeat until max are kept.
+    size_t kept;
     if (use_order_) {
       if (order_pos_ >= order_.size()) break;
-      k = order_[order_pos_++];
+      const size_t n = std::min<size_t>(max - produced, order_.size() - order_pos_);
+      ASSIGN_OR_RETURN(kept, Generate(0, order_.data() + order_pos_, n, batch));
+      order_pos_ += n;
     } else {
       if (segment_ >= segments_.size()) break;
-      k = next_k_++;
+      const size_t n = std::min<uint64_t>(max - produced, segments_[segment_].end - next_k_);
+      if (threads_ > 1 && region_.kind == Region::Kind::kAll && n >= kMinParallel) {
+        RETURN_IF_ERROR(GenerateParallel(next_k_, n, batch));
+        kept = n;
+      } else {
+        ASSIGN_OR_RETURN(kept, Generate(next_k_, nullptr, n, batch));
+      }
+      next_k_ += n;
       if (next_k_ >= segments_[segment_].end && ++segment_ < segments_.size()) {
         next_k_ = segments_[segment_].begin;
       }
     }
-    bool kept = false;
-    RETURN_IF_ERROR(Emit(k, cache_, batch, &kept));
     produced += kept;
   }
   return produced;
 }
 
-absl::Status SampleCursor::EmitParallel(uint64_t k0, uint64_t k1, SampleBatch* batch) {
-  // threads_ contiguous parts of [k0, k1), on the shared pool; part 0 goes
-  // straight into `batch` with the cursor's own leaf cache, the others into
-  // their own batches, appended in order: the same samples for any split.
-  const int n = threads_;
-  std::vector<SampleBatch> parts(n - 1);
-  std::vector<absl::Status> status(n);
-  auto bound = [&](int i) { return k0 + (k1 - k0) * i / n; };
-  WorkerPool::Shared().ParallelFor(n, [&](int i) {
-    LeafCache local;
-    LeafCache& cache = i == 0 ? cache_ : local;
-    SampleBatch* out = i == 0 ? batch : &parts[i - 1];
-    bool kept;
-    for (uint64_t k = bound(i); k < bound(i + 1) && status[i].ok(); ++k) {
-      status[i] = Emit(k, cache, out, &kept);
+SampleCursor::Rows SampleCursor::Rows::From(size_t offset) const {
+  auto at = [offset](double* column) { return column == nullptr ? nullptr : column + offset; };
+  return {index + offset, at(u),  at(v),  at(x),       at(y),
+          at(z),          at(nx), at(ny), at(nz),      at(density),
+          at(curve_position)};
+}
+
+SampleCursor::Rows SampleCursor::Grow(SampleBatch* batch, size_t n) const {
+  const size_t s0 = batch->size(), rows = s0 + n;
+  auto grow = [&](std::vector<double>* column, bool wanted) -> double* {
+    if (!wanted) return nullptr;
+    ResizeColumn(column, rows);
+    return column->data() + s0;
+  };
+  ResizeColumn(&batch->index, rows);
+  Rows out;
+  out.index = batch->index.data() + s0;
+  out.u = grow(&batch->u, true), out.v = grow(&batch->v, true);
+  out.x = grow(&batch->x, true), out.y = grow(&batch->y, true), out.z = grow(&batch->z, true);
+  out.nx = grow(&batch->nx, fields_.normal), out.ny = grow(&batch->ny, fields_.normal);
+  out.nz = grow(&batch->nz, fields_.normal);
+  out.density = grow(&batch->density, fields_.density);
+  out.curve_position = grow(&batch->curve_position, fields_.curve_position);
+  return out;
+}
+
+void SampleCursor::Truncate(SampleBatch* batch, size_t rows) const {
+  batch->index.resize(rows);
+  for (auto* column : {&batch->u, &batch->v, &batch->x, &batch->y, &batch->z}) column->resize(rows);
+  if (fields_.normal) {
+    for (auto* column : {&batch->nx, &batch->ny, &batch->nz}) column->resize(rows);
+  }
+  if (fields_.density) batch->density.resize(rows);
+  if (fields_.curve_position) batch->curve_position.resize(rows);
+}
+
+absl::StatusOr<size_t> SampleCursor::Generate(uint64_t k0, const uint64_t* order, size_t n,
+                                              SampleBatch* batch) {
+  const size_t s0 = batch->size();
+  const Rows out = Grow(batch, n);
+  if (absl::Status st = Fill(k0, order, n, walk_, out); !st.ok()) {
+    Truncate(batch, s0);
+    return st;
+  }
+  if (region_.kind == Region::Kind::kAll) return n;
+  // Keep the rows inside the region, in order.
+  size_t kept = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (!region_.Contains(out.u[i], out.v[i], {out.x[i], out.y[i], out.z[i]})) continue;
+    if (kept != i) {
+      out.index[kept] = out.index[i];
+      for (double* column : {out.u, out.v, out.x, out.y, out.z, out.nx, out.ny, out.nz,
+                             out.density, out.curve_position}) {
+        if (column != nullptr) column[kept] = column[i];
+      }
+    }
+    ++kept;
+  }
+  Truncate(batch, s0 + kept);
+  return kept;
+}
+
+absl::Status SampleCursor::GenerateParallel(uint64_t k0, size_t n, SampleBatch* batch) {
+  // threads_ contiguous parts of the run, on the shared pool, each filling its
+  // own rows of the grown columns; part 0 with the cursor's walk, the others
+  // with their own. The walk is a pure function of the mass coordinate, so
+  // the bytes are the same for any split.
+  const size_t s0 = batch->size();
+  const Rows out = Grow(batch, n);
+  const int parts = threads_;
+  std::vector<absl::Status> status(parts);
+  auto bound = [&](int i) { return n * i / parts; };
+  WorkerPool::Shared().ParallelFor(parts, [&](int i) {
+    const size_t begin = bound(i), count = bound(i + 1) - begin;
+    if (i == 0) {
+      status[i] = Fill(k0, nullptr, count, walk_, out);
+    } else {
+      LeafWalk walk(sampler_->tree());
+      status[i] = Fill(k0 + begin, nullptr, count, walk, out.From(begin));
     }
   });
-  for (const absl::Status& st : status) RETURN_IF_ERROR(st);
-  for (const SampleBatch& part : parts) batch->Append(part);
+  for (const absl::Status& st : status) {
+    if (!st.ok()) {
+      Truncate(batch, s0);
+      return st;
+    }
+  }
   return absl::OkStatus();
 }
 
-absl::Status SampleCursor::Emit(uint64_t k, LeafCache& cache, SampleBatch* batch, bool* kept) const {
+absl::Status SampleCursor::Fill(uint64_t k0, const uint64_t* order, size_t n, LeafWalk& walk,
+                                const Rows& out) const {
   const Sampler& sampler = *sampler_;
-  const CurveTree& tree = sampler.tree();
-  const Curve& curve = tree.curve();
-  const double m = sampler.MassCoordinate(k);
-
-  // Consecutive samples fall in the same or a nearby later leaf: gallop
-  // forward from the last one before falling back to a full binary search.
-  const size_t leaves = tree.leaf_count();
-  size_t l = SIZE_MAX;
-  if (cache.leaf != SIZE_MAX && m >= tree.mass_begin(cache.leaf)) {
-    size_t lo = cache.leaf, step = 1, hi = lo;
-    while (hi < leaves && tree.mass_end(hi) <= m) {
-      lo = hi + 1;
-      hi = lo + step;
-      step *= 2;
+  const double total_mass = sampler.tree().total_mass();
+  // Mass coordinates q_k S_M, in x until the points overwrite them.
+  double* m = out.x;
+  if (order == nullptr) {
+    sampler.sequence().AtMany(k0, n, m);
+    for (size_t i = 0; i < n; ++i) {
+      m[i] *= total_mass;
+      out.index[i] = k0 + i;
     }
-    hi = std::min(hi, leaves);
-    l = tree.FirstLeafEndingAbove(m, lo);
-    if (l > hi || l >= leaves) l = SIZE_MAX;
-  }
-  if (l == SIZE_MAX) l = sampler.LeafForMass(m);
-  const double begin_mass = tree.mass_begin(l);
-  const double leaf_mass = tree.mass_end(l) - begin_mass;
-  if (l != cache.leaf) {
-    cache.cell = tree.LeafCell(l);
-    cache.leaf = l;
-    // Samples' worth at the tree's grade, not the sequence's count: a
-    // progressive set extended on the same tree keeps its prefix.
-    cache.samples = leaf_mass / tree.total_mass() * std::ldexp(1.0, tree.grade());
-    cache.stack.clear();
-    cache.stack.push_back({0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 1.0, cache.cell.state});
-  }
-  const double t = std::clamp((m - begin_mass) / leaf_mass, 0.0, 1.0);
-
-  // Model descent: pop to the deepest level holding t, then descend while the
-  // sub-cell carries a noticeable part of a sample.
-  auto& stack = cache.stack;
-  while (stack.size() > 1 && !(t >= stack.back().t0 && t < stack.back().t1)) stack.pop_back();
-  const LeafModel& model = tree.leaf_model(l);
-  const LeafModel::Kind kind = tree.leaf_model_kind(l);
-  const int g = curve.grid(), w = curve.arity();
-  while (static_cast<int>(stack.size()) <= kMaxModelLevels &&
-         (stack.back().t1 - stack.back().t0) * cache.samples >= kNegligibleSamples) {
-    Level& top = stack.back();
-    if (top.children == 0) {
-      // The children's t bounds from the model's exact integrals, once per level.
-      double by_grid[9], share[9], sum = 0;
-      SubSquareIntegrals(model, kind, g, top.x0, top.y0, top.side, by_grid);
-      for (int c = 0; c < w; ++c) {
-        const Curve::Child& ch = curve.ChildOf(top.state, c);
-        share[c] = std::max(0.0, by_grid[ch.dx * g + ch.dy]);
-        sum += share[c];
-      }
-      if (!(sum > 0)) break;  // the model vanishes here: pure curve bits
-      double acc = 0;
-      for (int c = 0; c < w; ++c) {
-        acc += share[c];
-        top.bounds[c] = c + 1 == w ? top.t1 : top.t0 + (top.t1 - top.t0) * (acc / sum);
-      }
-      top.children = w;
-    }
-    double t0 = top.t0;
-    int c = 0;
-    for (; c < w; ++c) {
-      const double t1 = top.bounds[c];
-      if (t < t1 && t1 > t0) {
-        const Curve::Child& ch = curve.ChildOf(top.state, c);
-        const double side = top.side / g, span = top.span / w;
-        const Level child{t0, t1, top.x0 + ch.dx * side, top.y0 + ch.dy * side, side,
-                          top.pos + c * span, span, ch.state};
-        stack.push_back(child);
-        break;
-      }
-      t0 = t1;
-    }
-    if (c == w) break;  // rounding left t past the last child: stay here
-  }
-  const Level& at = stack.back();
-  const double tr = at.t1 > at.t0 ? std::clamp((t - at.t0) / (at.t1 - at.t0), 0.0, 1.0) : 0.0;
-
-  // Analytic continuation: follow the rest of t down the sub-cell's own curve.
-  const int levels = curve.continuation_levels();
-  const uint64_t scale = curve.PowW(levels);
-  const uint64_t digits = std::min(static_cast<uint64_t>(tr * static_cast<double>(scale)), scale - 1);
-  uint64_t cx, cy;
-  int state = at.state;
-  curve.Descend(digits, levels, &cx, &cy, &state);
-  const double cell = at.side / curve.PowG(levels);
-  const double u = cache.cell.u0 + (at.x0 + (static_cast<double>(cx) + 0.5) * cell) * cache.cell.size;
-  const double v = cache.cell.v0 + (at.y0 + (static_cast<double>(cy) + 0.5) * cell) * cache.cell.size;
-
-  const bool need_jet = fields_.normal || fields_.density;
-  SurfaceJet jet;
-  if (need_jet) {
-    jet = sampler.surface().Jet(u, v, fields_.density && sampler.density().NeedsCurvature() ? 2 : 1);
   } else {
-    jet.p = sampler.surface().Point(u, v);
+    for (size_t i = 0; i < n; ++i) {
+      m[i] = sampler.MassCoordinate(order[i]);
+      out.index[i] = order[i];
+    }
   }
-  if (!IsFinite(jet.p)) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "sample %d falls at (u,v) = (%.17g, %.17g), where the surface is not finite; fix the "
-        "surface so it is defined everywhere on its box",
-        k, u, v));
-  }
-  *kept = region_.Contains(u, v, jet.p);
-  if (!*kept) return absl::OkStatus();
+  walk.Place(m, n, out.u, out.v, out.curve_position);
 
-  batch->index.push_back(k);
-  batch->u.push_back(u);
-  batch->v.push_back(v);
-  batch->x.push_back(jet.p.x);
-  batch->y.push_back(jet.p.y);
-  batch->z.push_back(jet.p.z);
-  if (need_jet) {
+  const Surface& surface = sampler.surface();
+  const Density& density = sampler.density();
+  const bool need_jet = fields_.normal || fields_.density;
+  const int jet_order = fields_.density && density.NeedsCurvature() ? 2 : 1;
+  for (size_t i = 0; i < n; ++i) {
+    const double u = out.u[i], v = out.v[i];
+    SurfaceJet jet;
+    if (need_jet) {
+      jet = surface.Jet(u, v, jet_order);
+    } else {
+      jet.p = surface.Point(u, v);
+    }
+    if (!IsFinite(jet.p)) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "sample %d falls at (u,v) = (%.17g, %.17g), where the surface is not finite; fix the "
+          "surface so it is defined everywhere on its box",
+          out.index[i], u, v));
+    }
+    out.x[i] = jet.p.x, out.y[i] = jet.p.y, out.z[i] = jet.p.z;
+    if (!need_jet) continue;
     const SurfaceGeometry geo = GeometryOf(jet);
     if (fields_.normal) {
-      batch->nx.push_back(geo.normal.x);
-      batch->ny.push_back(geo.normal.y);
-      batch->nz.push_back(geo.normal.z);
+      out.nx[i] = geo.normal.x, out.ny[i] = geo.normal.y, out.nz[i] = geo.normal.z;
     }
     if (fields_.density) {
       SurfacePoint point;
       point.u = u, point.v = v, point.p = jet.p, point.normal = geo.normal;
       point.gaussian_curvature = geo.gaussian_curvature;
       point.mean_curvature = geo.mean_curvature;
-      batch->density.push_back(sampler.density().Value(point));
+      out.density[i] = density.Value(point);
     }
-  }
-  if (fields_.curve_position) {
-    const double span = static_cast<double>(tree.leaf_end(l) - tree.leaf_start(l));
-    const double pos = at.pos + tr * at.span;
-    batch->curve_position.push_back((static_cast<double>(tree.leaf_start(l)) + pos * span) /
-                                    static_cast<double>(curve.Span(0)));
   }
   return absl::OkStatus();
 }

@@ -1,18 +1,11 @@
 // Equalisation (paper Fig. 1 line 8; ALGORITHM.md step 4) and the samples it
 // yields, by index range or region, in curve order.
 //
-// Sample k lands in the leaf l with S_{l-1} <= q_k S_M < S_l. Inside the leaf
-// it follows the leaf's model (ALGORITHM.md, "Inside a leaf, follow the
-// model"): the fraction t = (q_k S_M - S_{l-1}) / s_l descends the leaf's own
-// curve, at each level entering the child whose share of the model's exact
-// integral holds t. Once the sub-cell reached carries less than
-// kNegligibleSamples of one sample (counted at the tree's grade, so every
-// sequence on one tree places a given t alike), the rest of t is followed as pure curve
-// bits for continuation_levels() more levels (all 52 bits of t for Hilbert),
-// and the sample sits at the centre of the cell reached. The descent is kept
-// on a per-level stack that consecutive samples of one leaf share. Nothing is
-// snapped to leaf centres, and the result is a pure function of
-// (tree, sequence, k): the stack only caches values computed the same way.
+// Sample k has mass coordinate q_k S_M; core/leaf_walk.h places it in its
+// leaf and follows the leaf's model. A cursor hands the walk its samples in
+// curve order, a batch at a time: columns are sized once and filled in place,
+// the surface is evaluated over the batch, and a region drops what lies
+// outside it afterwards. The result is a pure function of (tree, sequence, k).
 //
 // Thread-safety: Sampler is immutable and thread-safe. A SampleCursor is used
 // by one thread at a time.
@@ -26,6 +19,7 @@
 #include "absl/status/statusor.h"
 #include "core/curve_tree.h"
 #include "core/density.h"
+#include "core/leaf_walk.h"
 #include "core/region.h"
 #include "core/sample_batch.h"
 #include "core/sequence.h"
@@ -46,8 +40,6 @@ class Sampler {
 
   // q_k S_M: sample k's mass coordinate along the curve.
   double MassCoordinate(uint64_t k) const { return sequence_.At(k) * tree_->total_mass(); }
-  // The leaf holding mass coordinate m (zero-mass leaves are never chosen).
-  size_t LeafForMass(double m) const;
   // First k in [0, count) whose mass coordinate is >= m, for monotone
   // sequences; count if none.
   uint64_t FirstIndexAtOrAbove(double m) const;
@@ -57,7 +49,6 @@ class Sampler {
   std::shared_ptr<const Surface> surface_;
   std::shared_ptr<const Density> density_;
   Sequence sequence_;
-  size_t last_positive_leaf_ = 0;
 };
 
 class SampleCursor {
@@ -82,37 +73,30 @@ class SampleCursor {
   absl::StatusOr<size_t> Next(size_t max, SampleBatch* batch);
 
  private:
-  // A sub-cell of the model descent: leaf-fraction interval [t0, t1), its
-  // square [x0, x0 + side) x [y0, y0 + side) in leaf units, its orientation
-  // and its start along the leaf's curve (a fraction of the leaf's span).
-  struct Level {
-    double t0, t1, x0, y0, side, pos, span;  // span: the level's share of the leaf's curve
-    int state;
-    int children = 0;  // 0 until bounds[] is filled: then the curve's arity
-    double bounds[9];  // upper t of each child, in curve order
+  // The batch's columns from one row on; null for the columns not asked for.
+  struct Rows {
+    uint64_t* index;
+    double *u, *v, *x, *y, *z, *nx, *ny, *nz, *density, *curve_position;
+    Rows From(size_t offset) const;
   };
-  // The last leaf decoded and its descent, reused by consecutive samples; one
-  // per thread.
-  struct LeafCache {
-    size_t leaf = SIZE_MAX;
-    CurveTree::Cell cell{};
-    double samples = 0;  // the leaf's mass in samples
-    std::vector<Level> stack;
-  };
-
- public:
-  // Below this many samples' worth a sub-cell's placement is pure curve bits.
-  static constexpr double kNegligibleSamples = 1.0 / 8;
-  // The model descent stops after this many levels in any case.
-  static constexpr int kMaxModelLevels = 40;
-
- private:
 
   SampleCursor(std::shared_ptr<const Sampler> sampler, Region region, SampleFields fields);
   absl::Status PlanRegion(uint64_t begin, uint64_t end);
-  absl::Status Emit(uint64_t k, LeafCache& cache, SampleBatch* batch, bool* kept) const;
-  // Emits [k0, k1) (all kept: no region) split over threads_ threads.
-  absl::Status EmitParallel(uint64_t k0, uint64_t k1, SampleBatch* batch);
+  // Grows the batch's columns by n rows and returns the new rows.
+  Rows Grow(SampleBatch* batch, size_t n) const;
+  // Shrinks the batch's columns to `rows` rows.
+  void Truncate(SampleBatch* batch, size_t rows) const;
+  // Fills n rows with samples k0 + i (order null) or order[i]; their mass
+  // coordinates must not decrease. Errors: INVALID_ARGUMENT when the surface
+  // is not finite at one.
+  absl::Status Fill(uint64_t k0, const uint64_t* order, size_t n, LeafWalk& walk,
+                    const Rows& out) const;
+  // Appends the samples k0 + i (or order[i]), i < n, that lie in the region;
+  // returns how many.
+  absl::StatusOr<size_t> Generate(uint64_t k0, const uint64_t* order, size_t n,
+                                  SampleBatch* batch);
+  // Appends [k0, k0 + n) (all kept: no region), split over threads_ threads.
+  absl::Status GenerateParallel(uint64_t k0, size_t n, SampleBatch* batch);
 
   struct Segment {
     uint64_t begin, end;
@@ -129,7 +113,7 @@ class SampleCursor {
   std::vector<uint64_t> order_;
   size_t order_pos_ = 0;
   bool use_order_ = false;
-  LeafCache cache_;
+  LeafWalk walk_;  // the cursor's own walk; parallel parts make their own
   int threads_ = 1;
 };
 
