@@ -131,6 +131,22 @@ Curve::Curve(const Definition& def)
           ChunkEntry{static_cast<uint16_t>(x), static_cast<uint16_t>(y), static_cast<uint8_t>(state)};
     }
   }
+
+  for (int a = 0; a < 8; ++a) {
+    for (int b = 0; b < 8; ++b) compose_[a][b] = static_cast<uint8_t>(Compose(a, b));
+  }
+  // Bit-parallel decoding needs a 2 x 2 curve whose children's orientations
+  // are only swaps and mirrors of both axes (true of Hilbert).
+  bit_parallel_ = arity_ == 4;
+  for (int d = 0; d < arity_ && bit_parallel_; ++d) {
+    const int o = orient[d];
+    bit_parallel_ = o == 0 || o == 1 || o == 6 || o == 7;
+    const auto mask = [](bool on) { return on ? ~uint64_t{0} : uint64_t{0}; };
+    digit_x_[d] = mask(def.order[d].i == 1);
+    digit_y_[d] = mask(def.order[d].j == 1);
+    digit_swap_[d] = mask(o & 1);
+    digit_mirror_[d] = mask(o & 6);
+  }
 }
 
 int Curve::DepthOfSpan(uint64_t span) const {

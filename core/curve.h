@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <optional>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace sfc {
@@ -73,11 +74,20 @@ class Curve {
   // from a cell with orientation `*state`. On return (*x, *y) is the reached
   // cell's position in units of g^-levels of the start cell, and *state its
   // orientation. REQUIRES: levels <= D + continuation_levels(), digits < w^levels
-  // when levels <= D.
+  // when levels <= D. Inline: the sampler's innermost step. The Hilbert curve
+  // is decoded bit-parallel (up to 32 levels), the 3x3 curves by tables;
+  // both give DescendByTables' result.
   void Descend(uint64_t digits, int levels, uint64_t* x, uint64_t* y, int* state) const {
-    // Inline: this is the sampler's innermost loop (twice per sample). The
-    // leading levels % chunk_levels_ digits go one at a time, the rest a chunk
-    // per look-up; digits are read by shifts when w is a power of two.
+    if (bit_parallel_ && levels <= 32) {
+      DescendBitParallel(digits, levels, x, y, state);
+    } else {
+      DescendByTables(digits, levels, x, y, state);
+    }
+  }
+
+  // The same by table look-ups: the leading levels % chunk_levels_ digits
+  // one at a time, the rest a chunk per look-up. The reference for Descend.
+  void DescendByTables(uint64_t digits, int levels, uint64_t* x, uint64_t* y, int* state) const {
     uint64_t px = 0, py = 0;
     int s = *state;
     int remaining = levels;
@@ -116,6 +126,52 @@ class Curve {
     uint8_t state;
   };
 
+  // The bits of `word` at even positions 0, 2, 4, ... packed into bits 0, 1, 2, ...
+  static uint64_t PackEvenBits(uint64_t word) {
+    word &= 0x5555555555555555ULL;
+    word = (word | word >> 1) & 0x3333333333333333ULL;
+    word = (word | word >> 2) & 0x0f0f0f0f0f0f0f0fULL;
+    word = (word | word >> 4) & 0x00ff00ff00ff00ffULL;
+    word = (word | word >> 8) & 0x0000ffff0000ffffULL;
+    return (word | word >> 16) & 0x00000000ffffffffULL;
+  }
+  // Bit j of the result: the parity of the bits of `word` above j.
+  static uint64_t ParityAbove(uint64_t word) {
+    for (int shift = 1; shift < 64; shift *= 2) word ^= word >> shift;
+    return word >> 1;
+  }
+
+  // Hilbert: the orientations of orientation 0's children form the abelian
+  // group {identity, swap, mirror both, swap and mirror both}, so the frame
+  // at each level is a swap and a mirror whose parities are prefix XORs of
+  // per-digit flags over the levels above; the start orientation is applied
+  // to the whole result (every orientation acts on all bit levels alike).
+  void DescendBitParallel(uint64_t digits, int levels, uint64_t* x, uint64_t* y,
+                          int* state) const {
+    const uint64_t used = levels == 64 ? ~uint64_t{0} : (uint64_t{1} << levels) - 1;
+    const uint64_t lo = PackEvenBits(digits), hi = PackEvenBits(digits >> 1);
+    // match[d]: bit j set where the digit at level bit j is d.
+    const uint64_t match[4] = {~hi & ~lo & used, ~hi & lo & used, hi & ~lo & used, hi & lo & used};
+    uint64_t qx = 0, qy = 0, swap = 0, mirror = 0;
+    for (int d = 0; d < 4; ++d) {
+      qx |= match[d] & digit_x_[d];
+      qy |= match[d] & digit_y_[d];
+      swap |= match[d] & digit_swap_[d];
+      mirror |= match[d] & digit_mirror_[d];
+    }
+    const uint64_t swap_above = ParityAbove(swap), mirror_above = ParityAbove(mirror);
+    uint64_t px = ((qx & ~swap_above) | (qy & swap_above)) ^ (mirror_above & used);
+    uint64_t py = ((qy & ~swap_above) | (qx & swap_above)) ^ (mirror_above & used);
+    const int s = *state;
+    if (s & 1) std::swap(px, py);
+    if (s & 2) px ^= used;
+    if (s & 4) py ^= used;
+    const int whole = (__builtin_parityll(swap) ? 1 : 0) | (__builtin_parityll(mirror) ? 6 : 0);
+    *x = px;
+    *y = py;
+    *state = compose_[s][whole];
+  }
+
   CurveType type_;
   int grid_, arity_, max_depth_, continuation_levels_;
   int chunk_levels_;  // levels resolved per look-up in Descend
@@ -126,6 +182,12 @@ class Curve {
   std::vector<double> pow_g_;
   std::vector<Child> children_;       // [state][child]
   std::vector<ChunkEntry> chunks_;    // [state][chunk value]
+  // Bit-parallel Hilbert decoding (DescendBitParallel): per digit of
+  // orientation 0, all-ones or zero masks of its cell's x and y and of its
+  // child's swap and mirror-both; and a o b for orientations.
+  bool bit_parallel_ = false;
+  uint64_t digit_x_[4] = {}, digit_y_[4] = {}, digit_swap_[4] = {}, digit_mirror_[4] = {};
+  uint8_t compose_[8][8] = {};
 };
 
 }  // namespace sfc
