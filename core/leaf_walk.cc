@@ -13,7 +13,10 @@ LeafWalk::LeafWalk(const CurveTree& tree)
       continuation_scale_(curve_.PowW(continuation_levels_)),
       continuation_cells_(curve_.PowG(continuation_levels_)),
       total_mass_(tree.total_mass()),
-      grade_samples_(std::ldexp(1.0, tree.grade())) {
+      grade_samples_(std::ldexp(1.0, tree.grade())),
+      inverse_cells_(1 / continuation_cells_) {
+  int exponent;
+  cells_power_of_two_ = std::frexp(continuation_cells_, &exponent) == 0.5;
   last_positive_leaf_ = tree.leaf_count() - 1;
   while (last_positive_leaf_ > 0 &&
          !(tree.mass_end(last_positive_leaf_) > tree.mass_begin(last_positive_leaf_))) {
@@ -41,7 +44,8 @@ size_t LeafWalk::LeafFor(double m) const {
 void LeafWalk::Enter(size_t l) {
   leaf_ = l;
   begin_mass_ = tree_.mass_begin(l);
-  leaf_mass_ = tree_.mass_end(l) - begin_mass_;
+  end_mass_ = tree_.mass_end(l);
+  leaf_mass_ = end_mass_ - begin_mass_;
   cell_ = tree_.LeafCell(l);
   leaf_start_ = static_cast<double>(tree_.leaf_start(l));
   leaf_span_ = static_cast<double>(tree_.leaf_end(l) - tree_.leaf_start(l));
@@ -50,21 +54,16 @@ void LeafWalk::Enter(size_t l) {
   // Samples' worth at the tree's grade, not the sequence's count: a
   // progressive set extended on the same tree keeps its prefix.
   samples_ = leaf_mass_ / total_mass_ * grade_samples_;
-  depth_ = 0;
-  Level& root = stack_[0];
-  root.t0 = 0, root.t1 = 1, root.x0 = 0, root.y0 = 0, root.side = 1, root.pos = 0, root.span = 1;
-  root.state = cell_.state;
-  root.children = 0;
 }
 
 template <int kGrid>
-bool LeafWalk::Split(Level& top) const {
-  // The children's t bounds from the model's exact integrals, once per level.
+bool LeafWalk::Split(Node& node) const {
+  // The children's t bounds from the model's exact integrals.
   constexpr int g = kGrid, w = kGrid * kGrid;
   double by_grid[9], share[9], sum = 0;
-  SubSquareIntegralsOnGrid<kGrid>(*model_, kind_, top.x0, top.y0, top.side, by_grid);
+  SubSquareIntegralsOnGrid<kGrid>(*model_, kind_, node.x0, node.y0, node.side, by_grid);
   for (int c = 0; c < w; ++c) {
-    const Curve::Child& ch = curve_.ChildOf(top.state, c);
+    const Curve::Child& ch = curve_.ChildOf(node.state, c);
     share[c] = std::max(0.0, by_grid[ch.dx * g + ch.dy]);
     sum += share[c];
   }
@@ -72,27 +71,26 @@ bool LeafWalk::Split(Level& top) const {
   double acc = 0;
   for (int c = 0; c < w; ++c) {
     acc += share[c];
-    top.bounds[c] = c + 1 == w ? top.t1 : top.t0 + (top.t1 - top.t0) * (acc / sum);
+    node.bounds[c] = c + 1 == w ? node.t1 : node.t0 + (node.t1 - node.t0) * (acc / sum);
   }
-  top.children = w;
-  top.ordered = true;
-  for (int c = 0; c + 1 < w; ++c) top.ordered = top.ordered && top.bounds[c] <= top.bounds[c + 1];
+  node.ordered = true;
+  for (int c = 0; c + 1 < w; ++c) node.ordered = node.ordered && node.bounds[c] <= node.bounds[c + 1];
   return true;
 }
 
 template <int kArity>
-int LeafWalk::ChildHolding(const Level& top, double t) const {
+int LeafWalk::ChildHolding(const Node& node, double t) {
   constexpr int w = kArity;
-  if (top.ordered) {
+  if (node.ordered) {
     // Bounds in order from t0 up: the first bound above t ends a non-empty
     // interval that holds t. Counted without branches (t falls anywhere).
     int c = 0;
-    for (int i = 0; i < w; ++i) c += top.bounds[i] <= t;
+    for (int i = 0; i < w; ++i) c += node.bounds[i] <= t;
     return c;
   }
-  double t0 = top.t0;
+  double t0 = node.t0;
   for (int c = 0; c < w; ++c) {
-    const double t1 = top.bounds[c];
+    const double t1 = node.bounds[c];
     if (t < t1 && t1 > t0) return c;
     t0 = t1;
   }
@@ -100,51 +98,99 @@ int LeafWalk::ChildHolding(const Level& top, double t) const {
 }
 
 void LeafWalk::Place(const double* m, size_t n, double* u, double* v, double* curve_position) {
-  if (grid_ == 2) {
-    PlaceOnGrid<2>(m, n, u, v, curve_position);
-  } else {
-    PlaceOnGrid<3>(m, n, u, v, curve_position);
+  size_t i = 0;
+  while (i < n) {
+    const size_t l = LeafFor(m[i]);
+    if (l != leaf_) Enter(l);
+    // The run of samples in this leaf with non-decreasing m. From m[i] on,
+    // m < S_l alone puts a sample here.
+    size_t j = i + 1;
+    while (j < n && m[j] >= m[j - 1] && (m[j] < end_mass_ || LeafFor(m[j]) == l)) ++j;
+    double* position = curve_position == nullptr ? nullptr : curve_position + i;
+    if (grid_ == 2) {
+      PlaceInLeaf<2>(m + i, j - i, u + i, v + i, position);
+    } else {
+      PlaceInLeaf<3>(m + i, j - i, u + i, v + i, position);
+    }
+    i = j;
   }
 }
 
 template <int kGrid>
-void LeafWalk::PlaceOnGrid(const double* m, size_t n, double* u, double* v,
+void LeafWalk::PlaceInLeaf(const double* m, size_t n, double* u, double* v,
                            double* curve_position) {
   constexpr int g = kGrid, w = kGrid * kGrid;
-  for (size_t i = 0; i < n; ++i) {
-    const size_t l = LeafFor(m[i]);
-    if (l != leaf_) Enter(l);
-    const double t = std::clamp((m[i] - begin_mass_) / leaf_mass_, 0.0, 1.0);
+  t_.resize(n);
+  final_.resize(n);
+  for (size_t i = 0; i < n; ++i) t_[i] = std::clamp((m[i] - begin_mass_) / leaf_mass_, 0.0, 1.0);
 
-    // Model descent: pop to the deepest level holding t, then descend while
-    // the sub-cell carries a noticeable part of a sample.
-    while (depth_ > 0 && !(t >= stack_[depth_].t0 && t < stack_[depth_].t1)) --depth_;
-    while (depth_ < kMaxModelLevels &&
-           (stack_[depth_].t1 - stack_[depth_].t0) * samples_ >= kNegligibleSamples) {
-      Level& top = stack_[depth_];
-      if (top.children == 0 && !Split<kGrid>(top)) break;
-      const int c = ChildHolding<w>(top, t);
-      if (c == w) break;  // rounding left t past the last child: stay here
-      const Curve::Child& ch = curve_.ChildOf(top.state, c);
-      const double side = top.side / g, span = top.span / w;
-      Level& child = stack_[++depth_];
-      child.t0 = c == 0 ? top.t0 : top.bounds[c - 1], child.t1 = top.bounds[c];
-      child.x0 = top.x0 + ch.dx * side, child.y0 = top.y0 + ch.dy * side, child.side = side;
-      child.pos = top.pos + c * span, child.span = span;
-      child.state = ch.state;
-      child.children = 0;
+  // Model descent, level by level: a node holding a noticeable part of a
+  // sample is split by its model's integrals, and its samples (in t order)
+  // go to the children holding them; each sample ends at the deepest node
+  // it reaches.
+  // nodes_[0, count) are the nodes so far; a level adds at most n (each
+  // child holds a sample), so room for n more is made before each level and
+  // references stay valid while it runs.
+  if (nodes_.size() < n + 1) nodes_.resize(n + 1);
+  Node& root = nodes_[0];
+  root.t0 = 0, root.t1 = 1, root.x0 = 0, root.y0 = 0, root.side = 1, root.pos = 0, root.span = 1;
+  root.state = cell_.state;
+  root.depth = 0;
+  root.begin = 0, root.end = static_cast<uint32_t>(n);
+  size_t count = 1, level_begin = 0;
+  while (level_begin < count) {
+    const size_t level_end = count;
+    if (nodes_.size() < count + n) nodes_.resize(std::max(count + n, 2 * nodes_.size()));
+    // The level's splits first: independent of each other and of the samples.
+    for (size_t q = level_begin; q < level_end; ++q) {
+      Node& node = nodes_[q];
+      node.split = node.depth < kMaxModelLevels &&
+                   (node.t1 - node.t0) * samples_ >= kNegligibleSamples && Split<kGrid>(node);
     }
-    const Level& at = stack_[depth_];
-    const double tr = at.t1 > at.t0 ? std::clamp((t - at.t0) / (at.t1 - at.t0), 0.0, 1.0) : 0.0;
+    for (size_t q = level_begin; q < level_end; ++q) {
+      const Node& node = nodes_[q];
+      if (!node.split) {
+        for (uint32_t i = node.begin; i < node.end; ++i) final_[i] = static_cast<uint32_t>(q);
+        continue;
+      }
+      const double side = node.side / g, span = node.span / w;
+      uint32_t i = node.begin;
+      while (i < node.end) {
+        const int c = ChildHolding<w>(node, t_[i]);
+        if (c == w) {  // rounding left t past the last child: it stays here
+          final_[i++] = static_cast<uint32_t>(q);
+          continue;
+        }
+        uint32_t end = i + 1;
+        while (end < node.end && ChildHolding<w>(node, t_[end]) == c) ++end;
+        const Curve::Child& ch = curve_.ChildOf(node.state, c);
+        Node& child = nodes_[count++];
+        child.t0 = c == 0 ? node.t0 : node.bounds[c - 1], child.t1 = node.bounds[c];
+        child.x0 = node.x0 + ch.dx * side, child.y0 = node.y0 + ch.dy * side, child.side = side;
+        child.pos = node.pos + c * span, child.span = span;
+        child.state = ch.state;
+        child.depth = node.depth + 1;
+        child.begin = i, child.end = end;
+        i = end;
+      }
+    }
+    level_begin = level_end;
+  }
 
-    // Analytic continuation: follow the rest of t down the sub-cell's own curve.
-    const uint64_t scale = continuation_scale_;
+  // Analytic continuation: each sample follows the rest of its t down its
+  // node's own curve and sits at the centre of the cell reached.
+  const uint64_t scale = continuation_scale_;
+  for (size_t i = 0; i < n; ++i) {
+    const Node& at = nodes_[final_[i]];
+    const double t = t_[i];
+    const double tr = at.t1 > at.t0 ? std::clamp((t - at.t0) / (at.t1 - at.t0), 0.0, 1.0) : 0.0;
     const uint64_t digits =
         std::min(static_cast<uint64_t>(tr * static_cast<double>(scale)), scale - 1);
     uint64_t cx, cy;
     int state = at.state;
     curve_.Descend(digits, continuation_levels_, &cx, &cy, &state);
-    const double cell = at.side / continuation_cells_;
+    // For Hilbert the division is by 2^26: a multiplication, with the same bits.
+    const double cell = cells_power_of_two_ ? at.side * inverse_cells_ : at.side / continuation_cells_;
     u[i] = cell_.u0 + (at.x0 + (static_cast<double>(cx) + 0.5) * cell) * cell_.size;
     v[i] = cell_.v0 + (at.y0 + (static_cast<double>(cy) + 0.5) * cell) * cell_.size;
     if (curve_position != nullptr) {

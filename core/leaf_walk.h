@@ -11,11 +11,14 @@
 // cell reached.
 //
 // Coordinates handed over in non-decreasing order make this a merge: the
-// leaf advances by a forward step, and the descent lives on a per-level stack
-// that consecutive samples share, so each model level is integrated once. The
-// result is a pure function of (tree, m): the stack only caches values that
-// are computed the same way whichever sample reaches them first, so any split
-// of a run of samples between walks gives the same bits.
+// leaf advances by a forward step, and the samples of one leaf descend
+// together, level by level: each model sub-cell that holds samples is
+// integrated once for all of them, the sub-cells of one level one after
+// another with no sample's branches in between, and the samples are then
+// split among the children in order. The result is a pure function of
+// (tree, m): a sub-cell's values are computed the same way whichever samples
+// it holds, so any split of a run of samples between calls or walks gives
+// the same bits.
 //
 // Thread-safety: a LeafWalk is used by one thread at a time; many walks may
 // share one tree.
@@ -24,6 +27,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "core/curve_tree.h"
 
@@ -48,30 +52,34 @@ class LeafWalk {
 
  private:
   // A sub-cell of the model descent: leaf-fraction interval [t0, t1), its
-  // square [x0, x0 + side) x [y0, y0 + side) in leaf units, its orientation
-  // and its start along the leaf's curve (a fraction of the leaf's span).
-  struct Level {
-    double t0, t1, x0, y0, side, pos, span;  // span: the level's share of the leaf's curve
+  // square [x0, x0 + side) x [y0, y0 + side) in leaf units, its orientation,
+  // its start along the leaf's curve (a fraction of the leaf's span), and the
+  // run's samples it holds.
+  struct Node {
+    double t0, t1, x0, y0, side, pos, span;  // span: the node's share of the leaf's curve
     int state;
-    int children;      // 0 until bounds[] is filled: then the curve's arity
-    bool ordered;      // bounds[] is non-decreasing (all but rounding corners)
-    double bounds[9];  // upper t of each child, in curve order
+    int depth;               // 0 for the leaf itself
+    uint32_t begin, end;     // its samples: [begin, end) of the run
+    bool split;              // children's bounds[] filled
+    bool ordered;            // bounds[] is non-decreasing (all but rounding corners)
+    double bounds[9];        // upper t of each child, in curve order
   };
 
   // The leaf holding m: a forward step from the current one, else a search.
   size_t LeafFor(double m) const;
-  // Makes l the current leaf, with the descent at its root.
+  // Makes l the current leaf.
   void Enter(size_t l);
-  // Fills top's child bounds from the model; false where the model vanishes.
+  // Fills the node's child bounds from the model; false where the model
+  // vanishes (its samples then follow pure curve bits from there).
   template <int kGrid>
-  bool Split(Level& top) const;
-  // The child of `top` holding t: the first whose interval [t0, bounds[c])
+  bool Split(Node& node) const;
+  // The child of `node` holding t: the first whose interval [t0, bounds[c])
   // is not empty and holds t; w when rounding left t past the last one.
   template <int kArity>
-  int ChildHolding(const Level& top, double t) const;
-  // Place for the curve of grid kGrid.
+  static int ChildHolding(const Node& node, double t);
+  // Places n samples of the current leaf with non-decreasing m.
   template <int kGrid>
-  void PlaceOnGrid(const double* m, size_t n, double* u, double* v, double* curve_position);
+  void PlaceInLeaf(const double* m, size_t n, double* u, double* v, double* curve_position);
 
   const CurveTree& tree_;
   const Curve& curve_;
@@ -79,18 +87,22 @@ class LeafWalk {
   const int continuation_levels_;
   const uint64_t continuation_scale_;  // w^continuation_levels
   const double continuation_cells_;    // g^continuation_levels
+  const double inverse_cells_;         // its inverse, exact when it is a power of two
+  bool cells_power_of_two_ = false;
   const double total_mass_;            // S_M
   const double grade_samples_;         // 2^grade: samples in S_M at the tree's grade
   size_t last_positive_leaf_ = 0;      // where m = S_M belongs
 
   size_t leaf_ = SIZE_MAX;  // the current leaf, SIZE_MAX before the first
-  double begin_mass_ = 0, leaf_mass_ = 0, samples_ = 0;
+  double begin_mass_ = 0, end_mass_ = 0, leaf_mass_ = 0, samples_ = 0;
   CurveTree::Cell cell_{};
   double leaf_start_ = 0, leaf_span_ = 0;  // curve indices, for curve_position
   const LeafModel* model_ = nullptr;
   LeafModel::Kind kind_ = LeafModel::Kind::kQuadratic;
-  int depth_ = 0;  // stack_[0..depth_] is the descent
-  Level stack_[kMaxModelLevels + 2];
+  // Scratch of PlaceInLeaf, kept to reuse its memory.
+  std::vector<double> t_;           // each sample's fraction of the leaf's mass
+  std::vector<Node> nodes_;         // the descent's sub-cells, level by level
+  std::vector<uint32_t> final_;     // each sample's deepest node
 };
 
 }  // namespace sfc
