@@ -106,25 +106,43 @@ void PiecewiseSubSquareIntegrals(const LeafModel& model, int grid, double x0, do
 template <int kGrid>
 inline void SubSquareIntegralsOnGrid(const LeafModel& model, LeafModel::Kind kind, double x0,
                                      double y0, double side, double out[9]) {
-  using leaf_model_internal::BasisIntegrals;
   if (kind == LeafModel::Kind::kPiecewise) {
     leaf_model_internal::PiecewiseSubSquareIntegrals(model, kGrid, x0, y0, side, out);
     return;
   }
+  // The 1D integrals of the basis over the kGrid cells along y (k < kGrid)
+  // and along x (k >= kGrid): BasisIntegrals' arithmetic, written as loops
+  // over the cells so the compiler pairs their divisions in vector registers.
   const double step = side / kGrid;
-  double ix[kGrid][3], row[kGrid][3];  // row[j][a] = sum_b c[3a + b] int_{y-cell j} L_b
+  constexpr int kCells = 2 * kGrid;
+  double a[kCells], b[kCells], d[kCells], mid[kCells], d3[kCells], integral[kCells][3];
+  for (int k = 0; k < kGrid; ++k) {
+    a[k] = y0 + k * step, b[k] = y0 + (k + 1) * step;
+    a[kGrid + k] = x0 + k * step, b[kGrid + k] = x0 + (k + 1) * step;
+  }
+  for (int k = 0; k < kCells; ++k) {
+    d[k] = b[k] - a[k];
+    mid[k] = (a[k] + b[k]) / 2;
+    d3[k] = d[k] * d[k] * d[k] / 12;
+  }
+  for (int k = 0; k < kCells; ++k) {
+    for (int i = 0; i < 3; ++i) {
+      const double* c = leaf_model_internal::kBasisTable.k[i];
+      integral[k][i] = d[k] * (c[0] + mid[k] * (c[1] + mid[k] * c[2])) + c[2] * d3[k];
+    }
+  }
+  double row[kGrid][3];  // row[j][a] = sum_b c[3a + b] int_{y-cell j} L_b
   for (int j = 0; j < kGrid; ++j) {
-    double iy[3];
-    BasisIntegrals(y0 + j * step, y0 + (j + 1) * step, iy);
+    const double* iy = integral[j];
     for (int a = 0; a < 3; ++a) {
       row[j][a] = model.c[3 * a] * iy[0] + model.c[3 * a + 1] * iy[1] + model.c[3 * a + 2] * iy[2];
     }
   }
-  for (int i = 0; i < kGrid; ++i) BasisIntegrals(x0 + i * step, x0 + (i + 1) * step, ix[i]);
   for (int i = 0; i < kGrid; ++i) {
+    const double* ix = integral[kGrid + i];
     for (int j = 0; j < kGrid; ++j) {
       double sum = 0;
-      for (int a = 0; a < 3; ++a) sum += ix[i][a] * row[j][a];
+      for (int a = 0; a < 3; ++a) sum += ix[a] * row[j][a];
       out[i * kGrid + j] = sum;
     }
   }

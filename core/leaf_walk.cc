@@ -68,11 +68,13 @@ bool LeafWalk::Split(Node& node) const {
     sum += share[c];
   }
   if (!(sum > 0)) return false;  // the model vanishes here: pure curve bits
-  double acc = 0;
-  for (int c = 0; c < w; ++c) {
-    acc += share[c];
-    node.bounds[c] = c + 1 == w ? node.t1 : node.t0 + (node.t1 - node.t0) * (acc / sum);
-  }
+  // bounds[c] = t0 + (t1 - t0) * (share[0] + ... + share[c]) / sum, the
+  // running sums first so the divisions pair in vector registers.
+  double acc[9], fraction[9], running = 0;
+  for (int c = 0; c < w; ++c) acc[c] = running += share[c];
+  for (int c = 0; c + 1 < w; ++c) fraction[c] = acc[c] / sum;
+  for (int c = 0; c + 1 < w; ++c) node.bounds[c] = node.t0 + (node.t1 - node.t0) * fraction[c];
+  node.bounds[w - 1] = node.t1;
   node.ordered = true;
   for (int c = 0; c + 1 < w; ++c) node.ordered = node.ordered && node.bounds[c] <= node.bounds[c + 1];
   return true;
