@@ -2,6 +2,7 @@
 // sphere; generation from a built tree; bytes per leaf). Run one core:
 //   taskset -c 0 ./build/bench/core_benchmark
 #include <memory>
+#include <string>
 
 #include "benchmark/benchmark.h"
 #include "core/builtin_surfaces.h"
@@ -88,6 +89,26 @@ BENCHMARK(BM_SampleFromBuiltTree)
     ->Args({static_cast<int>(CurveType::kHilbert), 1})
     ->Args({static_cast<int>(CurveType::kHilbert2), 0})
     ->Unit(benchmark::kMillisecond);
+
+// The same generation on `threads` threads of the shared pool (wall time):
+// batches of 64 Ki split into contiguous parts, the same bytes as one thread.
+void BM_SampleFromBuiltTreeThreads(benchmark::State& state) {
+  const uint64_t n = kMillion;
+  const int threads = static_cast<int>(state.range(0));
+  auto surface = Sphere();
+  auto density = Uniform();
+  auto tree = *CurveTree::Build(*surface, *density, {}, CurveTree::GradeFor(n));
+  auto sampler = std::make_shared<const Sampler>(tree, surface, density,
+                                                 Sequence(SequenceKind::kJittered, n, 1));
+  SampleBatch batch;
+  for (auto _ : state) {
+    auto cursor = *SampleCursor::Create(sampler, 0, n, {}, {}, threads);
+    benchmark::DoNotOptimize(Drain(*cursor, batch));
+  }
+  state.SetItemsProcessed(state.iterations() * n);
+  state.SetLabel("hilbert sphere, " + std::to_string(threads) + " threads");
+}
+BENCHMARK(BM_SampleFromBuiltTreeThreads)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 // Bytes per leaf, measured from the tree's own arrays.
 void BM_BytesPerLeaf(benchmark::State& state) {

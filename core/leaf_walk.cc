@@ -186,15 +186,19 @@ void LeafWalk::PlaceInLeaf(const double* m, size_t n, double* u, double* v,
     const Node& at = nodes_[final_[i]];
     const double t = t_[i];
     const double tr = at.t1 > at.t0 ? std::clamp((t - at.t0) / (at.t1 - at.t0), 0.0, 1.0) : 0.0;
-    const uint64_t digits =
-        std::min(static_cast<uint64_t>(tr * static_cast<double>(scale)), scale - 1);
+    // Conversions through int64_t: every value here is below 2^63, so they
+    // are exact either way, and the signed ones are single instructions.
+    const uint64_t digits = std::min(
+        static_cast<uint64_t>(static_cast<int64_t>(tr * static_cast<double>(scale))), scale - 1);
     uint64_t cx, cy;
     int state = at.state;
     curve_.Descend(digits, continuation_levels_, &cx, &cy, &state);
     // For Hilbert the division is by 2^26: a multiplication, with the same bits.
     const double cell = cells_power_of_two_ ? at.side * inverse_cells_ : at.side / continuation_cells_;
-    u[i] = cell_.u0 + (at.x0 + (static_cast<double>(cx) + 0.5) * cell) * cell_.size;
-    v[i] = cell_.v0 + (at.y0 + (static_cast<double>(cy) + 0.5) * cell) * cell_.size;
+    const double x = static_cast<double>(static_cast<int64_t>(cx));
+    const double y = static_cast<double>(static_cast<int64_t>(cy));
+    u[i] = cell_.u0 + (at.x0 + (x + 0.5) * cell) * cell_.size;
+    v[i] = cell_.v0 + (at.y0 + (y + 0.5) * cell) * cell_.size;
     if (curve_position != nullptr) {
       const double pos = at.pos + tr * at.span;
       curve_position[i] =
