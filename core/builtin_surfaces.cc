@@ -16,6 +16,10 @@ Interval Range(double lo, double hi) { return Interval::Of(lo, hi); }
 
 class Plane final : public Surface {
  public:
+  void Points(const double* u, const double* v, size_t n, double* x, double* y,
+              double* z) const override {
+    PointsOf(*this, u, v, n, x, y, z);
+  }
   Vec3 Point(double u, double v) const override { return {u, v, 0}; }
   std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override {
     return Box3{{u0, v0, 0}, {u1, v1, 0}};
@@ -31,6 +35,10 @@ class Plane final : public Surface {
 
 class Sphere final : public Surface {
  public:
+  void Points(const double* u, const double* v, size_t n, double* x, double* y,
+              double* z) const override {
+    PointsOf(*this, u, v, n, x, y, z);
+  }
   explicit Sphere(double r) : r_(r) {}
   Vec3 Point(double u, double v) const override {
     const double st = std::sin(kPi * u), ct = std::cos(kPi * u);
@@ -78,6 +86,10 @@ class Sphere final : public Surface {
 
 class Torus final : public Surface {
  public:
+  void Points(const double* u, const double* v, size_t n, double* x, double* y,
+              double* z) const override {
+    PointsOf(*this, u, v, n, x, y, z);
+  }
   Torus(double big_r, double r) : big_r_(big_r), r_(r) {}
   Vec3 Point(double u, double v) const override {
     const double a = 2 * kPi * u, b = 2 * kPi * v;
@@ -112,6 +124,10 @@ class Torus final : public Surface {
 
 class MonkeySaddle final : public Surface {
  public:
+  void Points(const double* u, const double* v, size_t n, double* x, double* y,
+              double* z) const override {
+    PointsOf(*this, u, v, n, x, y, z);
+  }
   Vec3 Point(double u, double v) const override {
     const double s = 2 * u - 1, t = 2 * v - 1;
     return {s, t, s * s * s - 3 * s * t * t};
@@ -138,6 +154,10 @@ class MonkeySaddle final : public Surface {
 
 class EightSurface final : public Surface {
  public:
+  void Points(const double* u, const double* v, size_t n, double* x, double* y,
+              double* z) const override {
+    PointsOf(*this, u, v, n, x, y, z);
+  }
   Vec3 Point(double u, double v) const override {
     const double a = 2 * kPi * u, b = kPi * v - kPi / 2;
     const double s2b = std::sin(2 * b);
@@ -168,6 +188,10 @@ class EightSurface final : public Surface {
 
 class WhitneyUmbrella final : public Surface {
  public:
+  void Points(const double* u, const double* v, size_t n, double* x, double* y,
+              double* z) const override {
+    PointsOf(*this, u, v, n, x, y, z);
+  }
   Vec3 Point(double u, double v) const override {
     const double s = 2 * u - 1, t = 2 * v - 1;
     return {s * t, s, t * t};
@@ -214,6 +238,10 @@ PowTrig SignedPowOf(double c, double dc, double e, int order) {
 
 class Superellipsoid final : public Surface {
  public:
+  void Points(const double* u, const double* v, size_t n, double* x, double* y,
+              double* z) const override {
+    PointsOf(*this, u, v, n, x, y, z);
+  }
   Superellipsoid(double e, bool reparam) : e_(e), reparam_(reparam) {}
   Vec3 Point(double u, double v) const override {
     double ca, sa, cb, sb;

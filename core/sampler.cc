@@ -289,24 +289,27 @@ absl::Status SampleCursor::Fill(uint64_t k0, const uint64_t* order, size_t n, Le
 
   const Surface& surface = sampler.surface();
   const Density& density = sampler.density();
+  auto not_finite = [&](size_t i) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "sample %d falls at (u,v) = (%.17g, %.17g), where the surface is not finite; fix the "
+        "surface so it is defined everywhere on its box",
+        out.index[i], out.u[i], out.v[i]));
+  };
   const bool need_jet = fields_.normal || fields_.density;
+  if (!need_jet) {
+    // Positions alone: one call for the batch (the mass coordinates in x are spent).
+    surface.Points(out.u, out.v, n, out.x, out.y, out.z);
+    for (size_t i = 0; i < n; ++i) {
+      if (!IsFinite(Vec3{out.x[i], out.y[i], out.z[i]})) return not_finite(i);
+    }
+    return absl::OkStatus();
+  }
   const int jet_order = fields_.density && density.NeedsCurvature() ? 2 : 1;
   for (size_t i = 0; i < n; ++i) {
     const double u = out.u[i], v = out.v[i];
-    SurfaceJet jet;
-    if (need_jet) {
-      jet = surface.Jet(u, v, jet_order);
-    } else {
-      jet.p = surface.Point(u, v);
-    }
-    if (!IsFinite(jet.p)) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "sample %d falls at (u,v) = (%.17g, %.17g), where the surface is not finite; fix the "
-          "surface so it is defined everywhere on its box",
-          out.index[i], u, v));
-    }
+    const SurfaceJet jet = surface.Jet(u, v, jet_order);
+    if (!IsFinite(jet.p)) return not_finite(i);
     out.x[i] = jet.p.x, out.y[i] = jet.p.y, out.z[i] = jet.p.z;
-    if (!need_jet) continue;
     const SurfaceGeometry geo = GeometryOf(jet);
     if (fields_.normal) {
       out.nx[i] = geo.normal.x, out.ny[i] = geo.normal.y, out.nz[i] = geo.normal.z;

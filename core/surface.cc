@@ -49,6 +49,14 @@ void Surface::JetGrid(const double* us, int nu, const double* vs, int nv, int or
   }
 }
 
+void Surface::Points(const double* u, const double* v, size_t n, double* x, double* y,
+                     double* z) const {
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 p = Point(u[i], v[i]);
+    x[i] = p.x, y[i] = p.y, z[i] = p.z;
+  }
+}
+
 Box3 BoxOf(const Interval& x, const Interval& y, const Interval& z) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   auto lo = [&](const Interval& i) { return i.maybe_nan ? -kInf : i.lo; };

@@ -9,6 +9,7 @@
 #ifndef SFCSAMPLER_CORE_SURFACE_H_
 #define SFCSAMPLER_CORE_SURFACE_H_
 
+#include <cstddef>
 #include <optional>
 
 #include "core/interval.h"
@@ -56,6 +57,12 @@ class Surface {
   virtual void JetGrid(const double* us, int nu, const double* vs, int nv, int order,
                        SurfaceJet* out) const;
 
+  // Point(u[i], v[i]) for i < n, into x[i], y[i], z[i], bit for bit: one
+  // call per batch. The default calls Point once a sample; the built-ins
+  // override it with PointsOf (no per-sample dispatch).
+  virtual void Points(const double* u, const double* v, size_t n, double* x, double* y,
+                      double* z) const;
+
   // A box that provably holds Point(u, v) for every (u, v) in the rectangle
   // [u0,u1] x [v0,v1], as Point computes it in floating point (and as Jet's p,
   // which equals it), and the exact real value of the same formula too:
@@ -64,6 +71,17 @@ class Surface {
   // REQUIRES: 0 <= u0 <= u1 <= 1 and 0 <= v0 <= v1 <= 1.
   virtual std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const;
 };
+
+// Points for a final surface class S through S::Point, inlined: what S's
+// Points override calls.
+template <class S>
+void PointsOf(const S& surface, const double* u, const double* v, size_t n, double* x, double* y,
+              double* z) {
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 p = surface.S::Point(u[i], v[i]);
+    x[i] = p.x, y[i] = p.y, z[i] = p.z;
+  }
+}
 
 // First fundamental form, normal and curvatures at one point.
 struct SurfaceGeometry {

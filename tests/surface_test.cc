@@ -2,7 +2,9 @@
 // differences of their positions (away from singular lines), and the
 // superellipsoid's jet reports its singular lines as infinite.
 #include <cmath>
+#include <cstring>
 #include <memory>
+#include <vector>
 
 #include "core/builtin_surfaces.h"
 #include "gtest/gtest.h"
@@ -64,6 +66,34 @@ TEST(BuiltinSurfaces, OtherJetsAreExact) {
   ExpectJetMatchesDifferences(*MakeEightSurface());
   ExpectJetMatchesDifferences(*MakeMonkeySaddle());
   ExpectJetMatchesDifferences(*MakeWhitneyUmbrella());
+}
+
+// The batch call is Point, bit for bit, on every built-in (including the
+// superellipsoid's singular lines, where both give the same infinities).
+TEST(BuiltinSurfaces, PointsIsPointBitForBit) {
+  std::vector<std::unique_ptr<Surface>> surfaces;
+  surfaces.push_back(MakePlane());
+  surfaces.push_back(MakeSphere(1.5));
+  surfaces.push_back(MakeTorus(1, 0.3));
+  surfaces.push_back(MakeEightSurface());
+  surfaces.push_back(MakeMonkeySaddle());
+  surfaces.push_back(MakeWhitneyUmbrella());
+  surfaces.push_back(MakeSuperellipsoid(1.0 / 3, false));
+  surfaces.push_back(MakeSuperellipsoid(0.5, true));
+  std::vector<double> u, v;
+  for (int i = 0; i <= 40; ++i) {
+    for (int j = 0; j <= 40; ++j) u.push_back(i / 40.0), v.push_back(j / 40.0);
+  }
+  const size_t n = u.size();
+  for (const auto& surface : surfaces) {
+    std::vector<double> x(n), y(n), z(n);
+    surface->Points(u.data(), v.data(), n, x.data(), y.data(), z.data());
+    for (size_t i = 0; i < n; ++i) {
+      const Vec3 p = surface->Point(u[i], v[i]);
+      const double got[3] = {x[i], y[i], z[i]}, want[3] = {p.x, p.y, p.z};
+      ASSERT_EQ(std::memcmp(got, want, sizeof(got)), 0) << "at (" << u[i] << ", " << v[i] << ")";
+    }
+  }
 }
 
 TEST(BuiltinSurfaces, SuperellipsoidSingularLinesAreInfiniteNotNaNPositions) {
