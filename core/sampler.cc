@@ -90,7 +90,7 @@ absl::Status SampleCursor::PlanRegion(uint64_t begin, uint64_t end) {
   // Parameter cell against the region. For a 3D box the cell's patch is
   // enclosed by Surface::Bound, a proven box, so a cell is skipped only when
   // none of its samples can lie in the region and taken whole only when all
-  // of them do. Emit still tests every sample it is handed.
+  // of them do. Generate still tests every sample it is handed.
   auto overlap = [&](double u0, double v0, double h) -> Overlap {
     const double cu0 = std::max(0.0, u0 - kParameterSlack);
     const double cu1 = std::min(1.0, u0 + h + kParameterSlack);
