@@ -92,8 +92,21 @@ class CurveTree::Builder {
     double mass = 0;
     double area = 0;  // the same for delta = 1 (quadrature of the area element)
     double values[9];  // quadratic: m at the Gauss nodes; piecewise: sub-square masses
+    double delta[9];   // the density at the nodes (NaN where singular)
+    float warp[2] = {1, 1};  // the quadratic's power laws (LeafModel::warp)
     bool piecewise = false;
+    bool singular = false;  // the area element is not finite at a node
+    bool varies = false;    // ... or varies by more than 2x over them
+    double area_ratio = 1;  // the largest over the smallest at the nodes
   };
+
+  // EdgeWarp probes at h 2^-kWarpProbeNear and h 2^-kWarpProbeFar from an
+  // edge, and warps for |p| >= kMinWarpPower.
+  static constexpr int kWarpProbeNear = 12, kWarpProbeFar = 20;
+  static constexpr double kMinWarpPower = 0.2;
+  // Edges are probed where the area element varies by more than this over the
+  // nodes: t^(-1/3) (a superellipsoid's poles) varies by 2x, t^(+-0.2) by 1.5x.
+  static constexpr double kWarpProbeRatio = 1.25;
 
   // Stage 1: the paper's PopulateCurveTree from the root; fills starts_ and
   // masses_ with the stage-1 leaves.
@@ -223,19 +236,53 @@ class CurveTree::Builder {
     return spread;
   }
 
-  // The cell's model: m at the 3 x 3 Gauss nodes; where the area element
-  // blows up, the masses of the mapped g x g sub-squares instead.
+  // The cell's model: m at the 3 x 3 Gauss nodes. Where the area element
+  // varies by more than 2x over them, each edge is probed for a power law
+  // (EdgeWarp) and the nodes move to the warped coordinates; where it is still
+  // singular after that, the masses of the mapped g x g sub-squares instead.
   absl::StatusOr<CellEval> Evaluate(int depth, uint64_t x, uint64_t y) {
     RETURN_IF_ERROR(Checkpoint());
     const double h = 1.0 / curve_.PowG(depth);
     const double u0 = x * h, v0 = y * h;
-    double us[3], vs[3];
-    for (int i = 0; i < 3; ++i) us[i] = u0 + kGaussNode[i] * h, vs[i] = v0 + kGaussNode[i] * h;
+    static constexpr float kNoWarp[2] = {1, 1};
+    ASSIGN_OR_RETURN(CellEval eval, EvaluateNodes(u0, v0, h, kNoWarp));
+    if (eval.singular || !(eval.area_ratio <= kWarpProbeRatio)) {
+      float warp[2];
+      ASSIGN_OR_RETURN(warp[0], EdgeWarp(u0, v0, h, 0));
+      ASSIGN_OR_RETURN(warp[1], EdgeWarp(u0, v0, h, 1));
+      if (warp[0] != 1 || warp[1] != 1) {
+        ASSIGN_OR_RETURN(CellEval warped, EvaluateNodes(u0, v0, h, warp));
+        if (!warped.singular) eval = warped;
+      }
+    }
+    // A smooth patch has nearly constant (warped) area element on a small
+    // cell; only where it varies by 2x can the quadrature be far off.
+    if (!eval.singular && !eval.varies) return eval;
+    double sub[9];
+    ASSIGN_OR_RETURN(const double triangles, SubSquareMasses(u0, v0, h, eval.delta, sub));
+    if (eval.singular || triangles > kSingularExcess * eval.mass) {
+      std::copy(sub, sub + 9, eval.values);
+      eval.mass = triangles;
+      eval.piecewise = true;
+      eval.warp[0] = eval.warp[1] = 1;
+    }
+    return eval;
+  }
+
+  // m at the 3 x 3 Gauss nodes of the cell in the coordinates warped by
+  // `warp` (the values include the warp's slopes, so their Gauss sum is the
+  // cell's mass), with `singular` where the area element is not finite at a
+  // node and `varies` where it varies by more than 2x.
+  absl::StatusOr<CellEval> EvaluateNodes(double u0, double v0, double h, const float warp[2]) {
+    double us[3], vs[3], su[3], sv[3];
+    for (int i = 0; i < 3; ++i) {
+      us[i] = u0 + Warp(warp[0], kGaussNode[i]) * h, su[i] = WarpSlope(warp[0], kGaussNode[i]);
+      vs[i] = v0 + Warp(warp[1], kGaussNode[i]) * h, sv[i] = WarpSlope(warp[1], kGaussNode[i]);
+    }
     SurfaceJet jets[9];
     surface_.JetGrid(us, 3, vs, 3, order_, jets);
     CellEval eval;
-    double delta[9];
-    bool singular = false;
+    eval.warp[0] = warp[0], eval.warp[1] = warp[1];
     double amin = INFINITY, amax = 0, gauss = 0;
     for (int i = 0; i < 3; ++i) {
       for (int j = 0; j < 3; ++j) {
@@ -244,45 +291,66 @@ class CurveTree::Builder {
         if (!IsFinite(jet.p)) return SurfaceNotFiniteError(us[i], vs[j]);
         double area;
         const SurfacePoint point = PointFromJet(jet, us[i], vs[j], order_ == 2, &area);
+        area *= su[i] * sv[j];
         if (!std::isfinite(area)) {
           // A singular line through the node: the curvatures are unusable,
-          // delta is taken from the neighbouring nodes below.
-          singular = true;
-          delta[k] = NAN;
+          // delta is taken from the neighbouring nodes (SubSquareMasses).
+          eval.singular = true;
+          eval.delta[k] = NAN;
           eval.values[k] = 0;
           continue;
         }
-        delta[k] = density_.Value(point);
-        RETURN_IF_ERROR(CheckDensityValue(delta[k], us[i], vs[j]));
+        eval.delta[k] = density_.Value(point);
+        RETURN_IF_ERROR(CheckDensityValue(eval.delta[k], us[i], vs[j]));
         amin = std::min(amin, area);
         amax = std::max(amax, area);
         eval.area += kGaussWeight[i] * kGaussWeight[j] * area * h * h;
-        eval.values[k] = delta[k] * area;
+        eval.values[k] = eval.delta[k] * area;
         gauss += kGaussWeight[i] * kGaussWeight[j] * eval.values[k];
       }
     }
     eval.mass = gauss * h * h;
-    // A smooth patch has nearly constant area element on a small cell; only
-    // where it varies by 2x can the quadrature be far off.
-    if (!singular && !(amax <= 2 * amin)) {
-      double sub[9];
-      ASSIGN_OR_RETURN(const double triangles, SubSquareMasses(u0, v0, h, delta, sub));
-      if (triangles > kSingularExcess * eval.mass) {
-        singular = true;
-        std::copy(sub, sub + 9, eval.values);
-        eval.mass = triangles;
-        eval.piecewise = true;
-        return eval;
-      }
-      return eval;
-    }
-    if (singular) {
-      double sub[9];
-      ASSIGN_OR_RETURN(eval.mass, SubSquareMasses(u0, v0, h, delta, sub));
-      std::copy(sub, sub + 9, eval.values);
-      eval.piecewise = true;
-    }
+    eval.area_ratio = amax / amin;
+    eval.varies = eval.singular || !(amax <= 2 * amin);
     return eval;
+  }
+
+  // The power law of the cell's axis `axis` (LeafModel::warp): the mass
+  // density m = delta |f_u x f_v| is probed on the axis through the cell's
+  // centre at two distances t from each edge, and its exponent p in m ~ t^p
+  // read off their ratio. An edge where m blows up (p < 0) or vanishes
+  // (p > 0) gets k = 1 / (1 + p), which makes the warped density
+  // m(W(s)) W'(s) ~ s^(k (1 + p) - 1) constant at the edge. 1 where neither
+  // edge has such a power law.
+  absl::StatusOr<float> EdgeWarp(double u0, double v0, double h, int axis) const {
+    double best_p = 0;
+    int best_side = 0;
+    for (int side = 0; side < 2; ++side) {
+      double t[2], m[2];
+      bool ok = true;
+      for (int q = 0; q < 2 && ok; ++q) {
+        const double offset = std::ldexp(h, q == 0 ? -kWarpProbeNear : -kWarpProbeFar);
+        const double edge = (axis == 0 ? u0 : v0) + side * h;
+        const double along = side == 0 ? edge + offset : edge - offset;
+        t[q] = std::fabs(along - edge);  // the distance as rounded
+        const double u = axis == 0 ? along : u0 + h / 2, v = axis == 0 ? v0 + h / 2 : along;
+        const SurfaceJet jet = surface_.Jet(u, v, order_);
+        if (!IsFinite(jet.p)) return SurfaceNotFiniteError(u, v);
+        double area;
+        const SurfacePoint point = PointFromJet(jet, u, v, order_ == 2, &area);
+        const double delta = density_.Value(point);
+        m[q] = delta * area;
+        ok = t[q] > 0 && std::isfinite(m[q]) && m[q] > 0;
+      }
+      if (!ok || !(t[1] < t[0])) continue;
+      const double p = std::log(m[1] / m[0]) / std::log(t[1] / t[0]);
+      if (std::fabs(p) > std::fabs(best_p)) best_p = p, best_side = side;
+    }
+    // Weaker power laws are left to the quadratic; below -0.95 the mass
+    // would not be finite, and above 8 the warp's own nodes crowd the far edge.
+    if (!(std::fabs(best_p) >= kMinWarpPower) || best_p < -0.95 || best_p > 8) return 1.0f;
+    const float k = static_cast<float>(1 / (1 + best_p));
+    return best_side == 0 ? k : -k;
   }
 
   // The masses of the g x g sub-squares of the cell, each the area of its
@@ -331,7 +399,7 @@ class CurveTree::Builder {
     if (eval.piecewise) return eval.values[cx * g + cy];
     return h * h * QuadraticIntegral(eval.values, static_cast<double>(cx) / g,
                                      static_cast<double>(cx + 1) / g, static_cast<double>(cy) / g,
-                                     static_cast<double>(cy + 1) / g);
+                                     static_cast<double>(cy + 1) / g, eval.warp);
   }
 
   absl::Status Refine(int depth, uint64_t start, uint64_t x, uint64_t y, int state,
@@ -383,7 +451,7 @@ class CurveTree::Builder {
     starts_.push_back(start);
     masses_.push_back(ToFixed(mass));
     models_.push_back(eval.piecewise ? LeafModel::FromPiecewise(eval.values, g)
-                                     : LeafModel::FromQuadratic(eval.values));
+                                     : LeafModel::FromQuadratic(eval.values, eval.warp));
     errors_.push_back(static_cast<float>(error));
     info_.push_back(static_cast<uint8_t>(fail | (eval.piecewise ? kPiecewiseBit : 0)));
     return absl::OkStatus();
@@ -645,7 +713,7 @@ void CurveTree::ComputeDepthRange() {
 
 void CurveTree::ComputeReport() {
   PrecisionReport& r = precision_;
-  r.mass_capped_leaves = r.small_failing_leaves = r.singular_leaves = 0;
+  r.mass_capped_leaves = r.small_failing_leaves = r.singular_leaves = r.warped_leaves = 0;
   r.error_samples = r.unresolved_error_samples = 0;
   r.singular.clear();
   r.worst.erase(std::remove_if(r.worst.begin(), r.worst.end(),
@@ -656,7 +724,9 @@ void CurveTree::ComputeReport() {
     const double error = errors_[l] / base_mass_ * n;
     r.error_samples += error;
     const bool piecewise = leaf_model_kind(l) == LeafModel::Kind::kPiecewise;
+    const bool warped = !piecewise && (models_[l].warp[0] != 1 || models_[l].warp[1] != 1);
     if (piecewise) ++r.singular_leaves;
+    if (warped) ++r.warped_leaves;
     const int fail = leaf_fail_grade(l);
     const double mass = mass_end(l) - mass_begin(l);
     const double allowance = options_.rho * kErrorShare * std::pow(n, 0.25) * mass / base_mass_;
@@ -670,7 +740,7 @@ void CurveTree::ComputeReport() {
       ++r.small_failing_leaves;
       r.unresolved_error_samples += error;
     }
-    if (piecewise) {
+    if (piecewise || warped) {
       const Cell c = LeafCell(l);
       DepthCapHit hit{DepthCapHit::Test::kSingular, c.u0, c.v0, c.size, 0, 0};
       auto pos = std::upper_bound(r.singular.begin(), r.singular.end(), hit,

@@ -40,11 +40,12 @@
 // lines (paper Sect. 5.3). Such leaves are counted and located in
 // precision().
 //
-// Leaf layout: 57 bytes per leaf: the 64-bit curve index where the leaf
+// Leaf layout: 65 bytes per leaf: the 64-bit curve index where the leaf
 // starts (its cell, depth and orientation follow from it and the next leaf's
 // start), the running mass S_l at its end in fixed point (units of
 // S_base / 2^56, so a leaf's mass is an exact difference and refinement
-// reproduces a fresh build bit for bit), the model (9 floats), its error
+// reproduces a fresh build bit for bit), the model (9 floats and its two
+// power laws), its error
 // estimate (a float) and one byte holding the model kind and the fail grade.
 //
 // Thread-safety: a built CurveTree is immutable and shared as
@@ -79,7 +80,7 @@ struct CurveTreeOptions {
   // values trade accuracy for a smaller tree.
   double rho = 1.0;
   // Budget: building or refining past this many leaves is RESOURCE_EXHAUSTED.
-  // The default, 2^22 leaves at 57 bytes, is 239 MB (228 MiB).
+  // The default, 2^22 leaves at 65 bytes, is 273 MB (260 MiB).
   uint64_t max_leaves = uint64_t{1} << 22;
 };
 
@@ -113,15 +114,20 @@ struct PrecisionReport {
   // Leaves whose error test failed but that carry fewer than kMinSamples
   // samples, so they were kept (a singular line ends this way).
   uint64_t small_failing_leaves = 0;
-  // Leaves with the piecewise model: the area element blows up there.
+  // Leaves with the piecewise model: the area element is singular there and
+  // no edge power law fits it.
   uint64_t singular_leaves = 0;
+  // Leaves whose quadratic model is warped by a power law toward a singular
+  // edge (LeafModel::warp): the area element blows up or vanishes on it.
+  uint64_t warped_leaves = 0;
   // Precision reached: the estimated model error summed over all leaves, in
   // samples of the grade's N (each leaf's e / S_base * 2^grade).
   double error_samples = 0;
   // ... and summed over the leaves the tests still wanted to split.
   double unresolved_error_samples = 0;
   std::vector<DepthCapHit> worst;     // at most kMaxReported, largest measured/limit first
-  std::vector<DepthCapHit> singular;  // at most kMaxReported singular leaves, the smallest first
+  // At most kMaxReported singular leaves (piecewise or warped), the smallest first.
+  std::vector<DepthCapHit> singular;
   static constexpr int kMaxReported = 8;
 };
 

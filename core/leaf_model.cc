@@ -29,10 +29,11 @@ double Overlap(double a0, double a1, double b0, double b1) {
 LeafModel LeafModel::Uniform() {
   LeafModel m;
   std::fill(m.c, m.c + 9, 1.0f);
+  m.warp[0] = m.warp[1] = 1;
   return m;
 }
 
-LeafModel LeafModel::FromQuadratic(const double values[9]) {
+LeafModel LeafModel::FromQuadratic(const double values[9], const float warp[2]) {
   double total = 0;
   bool ok = true;
   for (int i = 0; i < 3; ++i) {
@@ -44,6 +45,8 @@ LeafModel LeafModel::FromQuadratic(const double values[9]) {
   if (!ok || !(total > 0) || !std::isfinite(total)) return Uniform();
   LeafModel m;
   for (int k = 0; k < 9; ++k) m.c[k] = static_cast<float>(values[k] / total);
+  m.warp[0] = warp == nullptr ? 1 : warp[0];
+  m.warp[1] = warp == nullptr ? 1 : warp[1];
   return m;
 }
 
@@ -55,8 +58,7 @@ LeafModel LeafModel::FromPiecewise(const double masses[9], int grid) {
     total += masses[k];
     ok = ok && std::isfinite(masses[k]) && masses[k] >= 0;
   }
-  LeafModel m;
-  std::fill(m.c, m.c + 9, 1.0f);
+  LeafModel m = Uniform();
   if (!ok || !(total > 0) || !std::isfinite(total)) return m;
   // Density on a sub-square of area 1 / n: its share of the mass times n.
   for (int k = 0; k < n; ++k) m.c[k] = static_cast<float>(masses[k] / total * n);
@@ -65,7 +67,10 @@ LeafModel LeafModel::FromPiecewise(const double masses[9], int grid) {
 
 double ModelIntegral(const LeafModel& model, LeafModel::Kind kind, int grid, double x0, double x1,
                      double y0, double y1) {
-  if (kind == LeafModel::Kind::kQuadratic) return Quadratic(model.c, x0, x1, y0, y1);
+  if (kind == LeafModel::Kind::kQuadratic) {
+    return Quadratic(model.c, Unwarp(model.warp[0], x0), Unwarp(model.warp[0], x1),
+                     Unwarp(model.warp[1], y0), Unwarp(model.warp[1], y1));
+  }
   const double side = 1.0 / grid;
   double sum = 0;
   for (int i = 0; i < grid; ++i) {
@@ -94,7 +99,12 @@ void PiecewiseSubSquareIntegrals(const LeafModel& model, int grid, double x0, do
 
 }  // namespace leaf_model_internal
 
-double QuadraticIntegral(const double values[9], double x0, double x1, double y0, double y1) {
+double QuadraticIntegral(const double values[9], double x0, double x1, double y0, double y1,
+                         const float warp[2]) {
+  if (warp != nullptr) {
+    x0 = Unwarp(warp[0], x0), x1 = Unwarp(warp[0], x1);
+    y0 = Unwarp(warp[1], y0), y1 = Unwarp(warp[1], y1);
+  }
   return Quadratic(values, x0, x1, y0, y1);
 }
 

@@ -7,10 +7,18 @@
 //    Gauss-Legendre nodes of the cell. Its integral over the cell is the 3 x 3
 //    Gauss rule (exact for degree 5 per axis), and its integral over any
 //    sub-rectangle is a closed form. It never evaluates on the cell's edges.
+//    Where the area element blows up or vanishes on a cell edge (a singular
+//    parameterisation, paper Sect. 5.3), the quadratic lives in warped
+//    coordinates: each axis may carry a power law x = W(s) = s^k toward the
+//    singular edge, the paper's reparameterisation u = u'^3 fitted per cell
+//    (its future work, Sects. 5.3 and 6). With k = 1 / (1 + p) for a mass
+//    density ~ t^p at distance t from the edge, the warped density
+//    m(W(s)) W'(s) is smooth, so the quadrature converges and the model
+//    follows the mass piled against the line down to any sub-cell.
 //  - kPiecewise: constant on each of the g x g sub-squares of the cell (g the
-//    curve's grid), with the masses of the mapped sub-squares' triangles. Used
-//    where the area element blows up (a singular parameterisation, paper
-//    Sect. 5.3): there the quadrature does not converge, the mapped triangles do.
+//    curve's grid), with the masses of the mapped sub-squares' triangles. The
+//    fallback where the area element is singular and no edge power law fits
+//    (a singular line through the cell's interior).
 // Values are stored as floats normalised so the model integrates to 1 over the
 // cell: the leaf's mass lives in the tree's running sums, the model only shares
 // it out.
@@ -19,6 +27,7 @@
 #ifndef SFCSAMPLER_CORE_LEAF_MODEL_H_
 #define SFCSAMPLER_CORE_LEAF_MODEL_H_
 
+#include <cmath>
 #include <cstdint>
 
 namespace sfc {
@@ -34,14 +43,36 @@ struct LeafModel {
   // kPiecewise: c[i * grid + j] is the density on sub-square (i, j) of the
   // grid x grid split (i along x).
   float c[9];
+  // The power law of each axis (0: x, 1: y) for kQuadratic: 1 is none; k > 0
+  // is W(s) = s^k, the singular edge at 0; k < 0 is W(s) = 1 - (1 - s)^|k|,
+  // the singular edge at 1. The nodes of c are at W(kGaussNode).
+  float warp[2];
 
   // Normalised model of the given kind from raw values (densities at nodes,
-  // or sub-square masses): scaled so the model integrates to 1. REQUIRES: the
-  // values are finite and >= 0 with a positive integral; else a uniform model.
-  static LeafModel FromQuadratic(const double values[9]);
+  // in warped coordinates, or sub-square masses): scaled so the model
+  // integrates to 1. REQUIRES: the values are finite and >= 0 with a positive
+  // integral; else a uniform model.
+  static LeafModel FromQuadratic(const double values[9], const float warp[2] = nullptr);
   static LeafModel FromPiecewise(const double masses[9], int grid);
   static LeafModel Uniform();
 };
+
+// One axis's power law (LeafModel::warp): x = Warp(k, s), its derivative,
+// and s = Unwarp(k, x). All map [0,1] onto itself, increasing.
+inline double Warp(float k, double s) {
+  if (k == 1) return s;
+  return k > 0 ? std::pow(s, static_cast<double>(k)) : 1 - std::pow(1 - s, -static_cast<double>(k));
+}
+inline double WarpSlope(float k, double s) {
+  if (k == 1) return 1;
+  const double a = std::fabs(static_cast<double>(k));
+  return a * std::pow(k > 0 ? s : 1 - s, a - 1);
+}
+inline double Unwarp(float k, double x) {
+  if (k == 1) return x;
+  return k > 0 ? std::pow(x, 1 / static_cast<double>(k))
+               : 1 - std::pow(1 - x, -1 / static_cast<double>(k));
+}
 
 // The integral of the model over [x0, x1] x [y0, y1] (inside [0,1]^2). For
 // kQuadratic it may be negative where the quadratic dips below zero; callers
@@ -120,6 +151,14 @@ inline void SubSquareIntegralsOnGrid(const LeafModel& model, LeafModel::Kind kin
     a[k] = y0 + k * step, b[k] = y0 + (k + 1) * step;
     a[kGrid + k] = x0 + k * step, b[kGrid + k] = x0 + (k + 1) * step;
   }
+  if (model.warp[0] != 1 || model.warp[1] != 1) {
+    // The model lives in warped coordinates: integrate over the images.
+    for (int k = 0; k < kGrid; ++k) {
+      a[k] = Unwarp(model.warp[1], a[k]), b[k] = Unwarp(model.warp[1], b[k]);
+      a[kGrid + k] = Unwarp(model.warp[0], a[kGrid + k]);
+      b[kGrid + k] = Unwarp(model.warp[0], b[kGrid + k]);
+    }
+  }
   for (int k = 0; k < kCells; ++k) {
     d[k] = b[k] - a[k];
     mid[k] = (a[k] + b[k]) / 2;
@@ -157,9 +196,10 @@ inline void SubSquareIntegrals(const LeafModel& model, LeafModel::Kind kind, int
   }
 }
 
-// The same for unnormalised quadratic node values (double precision), used by
-// the tree's error test.
-double QuadraticIntegral(const double values[9], double x0, double x1, double y0, double y1);
+// The same for unnormalised quadratic node values (double precision) in the
+// coordinates warped by `warp` (null: none), used by the tree's error test.
+double QuadraticIntegral(const double values[9], double x0, double x1, double y0, double y1,
+                         const float warp[2] = nullptr);
 
 }  // namespace sfc
 

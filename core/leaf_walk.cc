@@ -12,9 +12,9 @@ LeafWalk::LeafWalk(const CurveTree& tree)
       continuation_levels_(curve_.continuation_levels()),
       continuation_scale_(curve_.PowW(continuation_levels_)),
       continuation_cells_(curve_.PowG(continuation_levels_)),
+      inverse_cells_(1 / continuation_cells_),
       total_mass_(tree.total_mass()),
-      grade_samples_(std::ldexp(1.0, tree.grade())),
-      inverse_cells_(1 / continuation_cells_) {
+      grade_samples_(std::ldexp(1.0, tree.grade())) {
   int exponent;
   cells_power_of_two_ = std::frexp(continuation_cells_, &exponent) == 0.5;
   last_positive_leaf_ = tree.leaf_count() - 1;
@@ -51,9 +51,16 @@ void LeafWalk::Enter(size_t l) {
   leaf_span_ = static_cast<double>(tree_.leaf_end(l) - tree_.leaf_start(l));
   model_ = &tree_.leaf_model(l);
   kind_ = tree_.leaf_model_kind(l);
+  warped_ = kind_ == LeafModel::Kind::kQuadratic && (model_->warp[0] != 1 || model_->warp[1] != 1);
   // Samples' worth at the tree's grade, not the sequence's count: a
   // progressive set extended on the same tree keeps its prefix.
   samples_ = leaf_mass_ / total_mass_ * grade_samples_;
+}
+
+double LeafWalk::WarpedInCell(float k, double x0, double side, double fraction) {
+  if (k == 1) return x0 + fraction * side;
+  const double s0 = Unwarp(k, x0), s1 = Unwarp(k, x0 + side);
+  return std::clamp(Warp(k, s0 + fraction * (s1 - s0)), x0, x0 + side);
 }
 
 template <int kGrid>
@@ -197,8 +204,13 @@ void LeafWalk::PlaceInLeaf(const double* m, size_t n, double* u, double* v,
     const double cell = cells_power_of_two_ ? at.side * inverse_cells_ : at.side / continuation_cells_;
     const double x = static_cast<double>(static_cast<int64_t>(cx));
     const double y = static_cast<double>(static_cast<int64_t>(cy));
-    u[i] = cell_.u0 + (at.x0 + (x + 0.5) * cell) * cell_.size;
-    v[i] = cell_.v0 + (at.y0 + (y + 0.5) * cell) * cell_.size;
+    double px = at.x0 + (x + 0.5) * cell, py = at.y0 + (y + 0.5) * cell;
+    if (warped_) {
+      px = WarpedInCell(model_->warp[0], at.x0, at.side, (x + 0.5) * inverse_cells_);
+      py = WarpedInCell(model_->warp[1], at.y0, at.side, (y + 0.5) * inverse_cells_);
+    }
+    u[i] = cell_.u0 + px * cell_.size;
+    v[i] = cell_.v0 + py * cell_.size;
     if (curve_position != nullptr) {
       const double pos = at.pos + tr * at.span;
       curve_position[i] =

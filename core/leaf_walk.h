@@ -8,7 +8,11 @@
 // sample (counted at the tree's grade, so every sequence on one tree places a
 // given t alike). The rest of t is followed as pure curve bits for
 // continuation_levels() more levels, and the sample sits at the centre of the
-// cell reached.
+// cell reached. In a leaf whose model is warped toward a singular edge
+// (LeafModel::warp) the continuation is uniform in the warped coordinates of
+// its sub-cell, where the mass is: a negligible sub-cell against the line
+// still holds its mass piled against it, and there are many of them along a
+// line.
 //
 // Coordinates handed over in non-decreasing order make this a merge: the
 // leaf advances by a forward step, and the samples of one leaf descend
@@ -65,6 +69,9 @@ class LeafWalk {
     double bounds[9];        // upper t of each child, in curve order
   };
 
+  // The point at `fraction` of [x0, x0 + side] (leaf units) in the
+  // coordinates warped by the power law k (LeafModel::warp).
+  static double WarpedInCell(float k, double x0, double side, double fraction);
   // The leaf holding m: a forward step from the current one, else a search.
   size_t LeafFor(double m) const;
   // Makes l the current leaf.
@@ -99,6 +106,7 @@ class LeafWalk {
   double leaf_start_ = 0, leaf_span_ = 0;  // curve indices, for curve_position
   const LeafModel* model_ = nullptr;
   LeafModel::Kind kind_ = LeafModel::Kind::kQuadratic;
+  bool warped_ = false;  // the model has a power law (LeafModel::warp)
   // Scratch of PlaceInLeaf, kept to reuse its memory.
   std::vector<double> t_;           // each sample's fraction of the leaf's mass
   std::vector<Node> nodes_;         // the descent's sub-cells, level by level

@@ -16,7 +16,9 @@
 namespace sfc {
 
 // Bumped whenever the same request could yield different samples.
-inline constexpr char kAlgorithmVersion[] = "sfcsampler-2";  // 2: error-controlled tree, in-leaf model descent
+// 2: error-controlled tree, in-leaf model descent; 3: per-cell power laws
+// toward singular edges (LeafModel::warp).
+inline constexpr char kAlgorithmVersion[] = "sfcsampler-3";
 
 // Everything that shapes a curve tree (the cache key) except its grade.
 struct TreeSpec {
@@ -43,7 +45,7 @@ struct SampleRequest {
 // Limits that every request is checked against (server flags).
 struct EngineLimits {
   uint64_t max_count = 100'000'000;              // largest N
-  uint64_t max_tree_leaves = uint64_t{1} << 22;  // per tree: 57 B a leaf (CurveTree::kBytesPerLeaf), 228 MiB
+  uint64_t max_tree_leaves = uint64_t{1} << 22;  // per tree: 65 B a leaf (CurveTree::kBytesPerLeaf), 260 MiB
   size_t max_spec_length = 4096;                 // surface/density spec, in characters
   int generation_threads = 1;                    // threads filling one stream's large batches
   // Sequences that are not monotone in k are sorted into curve order per

@@ -426,6 +426,7 @@ void ToProto(const PreparedTree& t, v1::TreeInfo* out) {
   out->set_error_samples(precision.error_samples);
   out->set_unresolved_error_samples(precision.unresolved_error_samples);
   out->set_singular_leaves(precision.singular_leaves);
+  out->set_warped_leaves(precision.warped_leaves);
   out->set_small_failing_leaves(precision.small_failing_leaves);
 }
 

@@ -9,7 +9,9 @@
 #include <iostream>
 
 #include "CLI/CLI.hpp"
+#include "absl/strings/str_format.h"
 #include "absl/strings/strip.h"
+#include "core/curve_tree.h"
 #include "server/memory_trimmer.h"
 #include "server/sampler_server.h"
 #include "spdlog/spdlog.h"
@@ -36,7 +38,7 @@ int main(int argc, char** argv) {
   app.add_option("--metrics-address", o.metrics_address, "host:port of Prometheus /metrics (\"\" = none)")
       ->capture_default_str();
   app.add_option("--max-count", o.limits.max_count, "largest N per request")->capture_default_str();
-  app.add_option("--max-tree-leaves", o.limits.max_tree_leaves, "largest tree, in leaves (57 bytes each)")
+  app.add_option("--max-tree-leaves", o.limits.max_tree_leaves, absl::StrFormat("largest tree, in leaves (%d bytes each)", sfc::CurveTree::kBytesPerLeaf))
       ->capture_default_str();
   app.add_option("--max-spec-length", o.limits.max_spec_length, "longest surface or density spec, characters")
       ->capture_default_str();

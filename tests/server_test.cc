@@ -647,7 +647,7 @@ TEST(Server, TheStreamHeaderSaysWhereTheParameterisationIsSingularAndThePrecisio
   ASSERT_TRUE(Fetch(*r.client, Request("superellipsoid", 24576), &hard).ok());
   ASSERT_TRUE(Fetch(*r.client, Request("torus", 24576), &smooth).ok());
   const v1::TreeInfo& t = hard.header.tree();
-  EXPECT_GT(t.singular_leaves(), 0u);
+  EXPECT_GT(t.warped_leaves(), 0u);
   ASSERT_GT(t.singular_size(), 0);
   for (const v1::DepthCapWarning& w : t.singular()) {
     EXPECT_EQ(w.test(), "singular");
@@ -666,6 +666,7 @@ TEST(Server, TheStreamHeaderSaysWhereTheParameterisationIsSingularAndThePrecisio
   // (about N^(1/4) = 12.5 samples here), on the hard surface as on a smooth one.
   EXPECT_LT(t.error_samples(), 12.5);
   EXPECT_EQ(smooth.header.tree().singular_leaves(), 0u);
+  EXPECT_EQ(smooth.header.tree().warped_leaves(), 0u);
   EXPECT_LT(smooth.header.tree().error_samples(), 12.5);
 }
 

@@ -99,10 +99,25 @@ void PrintTreeInfo(const ::sfcsampler::v1::TreeInfo& t, const Verbosity& verbosi
                  t.error_samples(), t.unresolved_error_samples(), t.grade());
   }
   if (verbosity.no_warnings) return;
+  if (t.warped_leaves() > 0) {
+    std::fprintf(stderr,
+                 "note: the parameterisation is singular (the area element blows up or vanishes on "
+                 "parameter lines, paper Sect. 5.3); %llu leaves beside those lines follow a fitted "
+                 "power law%s\n",
+                 static_cast<unsigned long long>(t.warped_leaves()),
+                 t.singular_leaves() > 0 ? "" : ". Finest:");
+    if (t.singular_leaves() == 0) {
+      for (const auto& w : t.singular()) {
+        std::fprintf(stderr, "  cell u in [%.9g, %.9g], v in [%.9g, %.9g]\n", w.u0(),
+                     w.u0() + w.size(), w.v0(), w.v0() + w.size());
+      }
+    }
+  }
   if (t.singular_leaves() > 0) {
     std::fprintf(stderr,
                  "warning: the parameterisation is singular (the area element blows up, paper Sect. "
-                 "5.3) in %llu leaves; their masses come from mapped sub-triangles. Finest:\n",
+                 "5.3) in %llu leaves that no edge power law fits; their masses come from mapped "
+                 "sub-triangles and samples are spread evenly inside their sub-squares. Finest:\n",
                  static_cast<unsigned long long>(t.singular_leaves()));
     for (const auto& w : t.singular()) {
       std::fprintf(stderr, "  cell u in [%.9g, %.9g], v in [%.9g, %.9g]\n", w.u0(), w.u0() + w.size(),
