@@ -93,17 +93,21 @@ class CurveTree::Builder {
     double area = 0;  // the same for delta = 1 (quadrature of the area element)
     double values[9];  // quadratic: m at the Gauss nodes; piecewise: sub-square masses
     double delta[9];   // the density at the nodes (NaN where singular)
-    float warp[2] = {1, 1};  // the quadratic's power laws (LeafModel::warp)
+    AxisWarp warp[2] = {kNoWarp, kNoWarp};  // the quadratic's power laws (LeafModel::warp)
     bool piecewise = false;
     bool singular = false;  // the area element is not finite at a node
     bool varies = false;    // ... or varies by more than 2x over them
     double area_ratio = 1;  // the largest over the smallest at the nodes
   };
 
-  // EdgeWarp probes at h 2^-kWarpProbeNear and h 2^-kWarpProbeFar from an
-  // edge, and warps for |p| >= kMinWarpPower.
+  // Power laws are read at h 2^-kWarpProbeNear and h 2^-kWarpProbeFar from
+  // the line, and warped for |p| >= kMinWarpPower. A line inside the cell is
+  // located to 1e-15 of the cell in at most kInteriorSearchSteps, and its
+  // exponents on the two sides may differ by kInteriorPowerMismatch.
   static constexpr int kWarpProbeNear = 12, kWarpProbeFar = 20;
   static constexpr double kMinWarpPower = 0.2;
+  static constexpr int kInteriorSearchSteps = 80;
+  static constexpr double kInteriorPowerMismatch = 0.1;
   // Edges are probed where the area element varies by more than this over the
   // nodes: t^(-1/3) (a superellipsoid's poles) varies by 2x, t^(+-0.2) by 1.5x.
   static constexpr double kWarpProbeRatio = 1.25;
@@ -237,20 +241,21 @@ class CurveTree::Builder {
   }
 
   // The cell's model: m at the 3 x 3 Gauss nodes. Where the area element
-  // varies by more than 2x over them, each edge is probed for a power law
-  // (EdgeWarp) and the nodes move to the warped coordinates; where it is still
-  // singular after that, the masses of the mapped g x g sub-squares instead.
+  // varies over them, each edge is probed for a power law (EdgeWarp) and the
+  // nodes move to the warped coordinates; where the quadrature is still not
+  // to be trusted, a power law about a line through the cell is looked for
+  // (InteriorWarp), and failing that the masses of the mapped g x g
+  // sub-squares are used instead.
   absl::StatusOr<CellEval> Evaluate(int depth, uint64_t x, uint64_t y) {
     RETURN_IF_ERROR(Checkpoint());
     const double h = 1.0 / curve_.PowG(depth);
     const double u0 = x * h, v0 = y * h;
-    static constexpr float kNoWarp[2] = {1, 1};
-    ASSIGN_OR_RETURN(CellEval eval, EvaluateNodes(u0, v0, h, kNoWarp));
+    AxisWarp warp[2] = {kNoWarp, kNoWarp};
+    ASSIGN_OR_RETURN(CellEval eval, EvaluateNodes(u0, v0, h, warp));
     if (eval.singular || !(eval.area_ratio <= kWarpProbeRatio)) {
-      float warp[2];
       ASSIGN_OR_RETURN(warp[0], EdgeWarp(u0, v0, h, 0));
       ASSIGN_OR_RETURN(warp[1], EdgeWarp(u0, v0, h, 1));
-      if (warp[0] != 1 || warp[1] != 1) {
+      if (warp[0].power != 1 || warp[1].power != 1) {
         ASSIGN_OR_RETURN(CellEval warped, EvaluateNodes(u0, v0, h, warp));
         if (!warped.singular) eval = warped;
       }
@@ -260,12 +265,24 @@ class CurveTree::Builder {
     if (!eval.singular && !eval.varies) return eval;
     double sub[9];
     ASSIGN_OR_RETURN(const double triangles, SubSquareMasses(u0, v0, h, eval.delta, sub));
-    if (eval.singular || triangles > kSingularExcess * eval.mass) {
-      std::copy(sub, sub + 9, eval.values);
-      eval.mass = triangles;
-      eval.piecewise = true;
-      eval.warp[0] = eval.warp[1] = 1;
+    if (!eval.singular && !(triangles > kSingularExcess * eval.mass)) return eval;
+    // The quadrature misses mass: a singular line inside the cell?
+    bool interior = false;
+    for (int axis = 0; axis < 2; ++axis) {
+      if (warp[axis].power != 1) continue;
+      ASSIGN_OR_RETURN(warp[axis], InteriorWarp(u0, v0, h, axis));
+      interior = interior || warp[axis].power != 1;
     }
+    if (interior) {
+      ASSIGN_OR_RETURN(CellEval warped, EvaluateNodes(u0, v0, h, warp));
+      if (!warped.singular && !(triangles > kSingularExcess * warped.mass && warped.varies)) {
+        return warped;
+      }
+    }
+    std::copy(sub, sub + 9, eval.values);
+    eval.mass = triangles;
+    eval.piecewise = true;
+    eval.warp[0] = eval.warp[1] = kNoWarp;
     return eval;
   }
 
@@ -273,11 +290,12 @@ class CurveTree::Builder {
   // `warp` (the values include the warp's slopes, so their Gauss sum is the
   // cell's mass), with `singular` where the area element is not finite at a
   // node and `varies` where it varies by more than 2x.
-  absl::StatusOr<CellEval> EvaluateNodes(double u0, double v0, double h, const float warp[2]) {
+  absl::StatusOr<CellEval> EvaluateNodes(double u0, double v0, double h, const AxisWarp warp[2]) {
     double us[3], vs[3], su[3], sv[3];
     for (int i = 0; i < 3; ++i) {
-      us[i] = u0 + Warp(warp[0], kGaussNode[i]) * h, su[i] = WarpSlope(warp[0], kGaussNode[i]);
-      vs[i] = v0 + Warp(warp[1], kGaussNode[i]) * h, sv[i] = WarpSlope(warp[1], kGaussNode[i]);
+      const double s = WarpNode(warp[0], kGaussNode[i]), t = WarpNode(warp[1], kGaussNode[i]);
+      us[i] = u0 + Warp(warp[0], s) * h, su[i] = WarpSlope(warp[0], s);
+      vs[i] = v0 + Warp(warp[1], t) * h, sv[i] = WarpSlope(warp[1], t);
     }
     SurfaceJet jets[9];
     surface_.JetGrid(us, 3, vs, 3, order_, jets);
@@ -315,42 +333,96 @@ class CurveTree::Builder {
     return eval;
   }
 
-  // The power law of the cell's axis `axis` (LeafModel::warp): the mass
-  // density m = delta |f_u x f_v| is probed on the axis through the cell's
-  // centre at two distances t from each edge, and its exponent p in m ~ t^p
-  // read off their ratio. An edge where m blows up (p < 0) or vanishes
-  // (p > 0) gets k = 1 / (1 + p), which makes the warped density
-  // m(W(s)) W'(s) ~ s^(k (1 + p) - 1) constant at the edge. 1 where neither
-  // edge has such a power law.
-  absl::StatusOr<float> EdgeWarp(double u0, double v0, double h, int axis) const {
+  // The mass density m = delta |f_u x f_v| at leaf coordinate x along the
+  // cell's axis `axis`, across it at the cell's middle; +infinity where the
+  // area element is not finite.
+  absl::StatusOr<double> AxisDensity(double u0, double v0, double h, int axis, double x) const {
+    const double u = axis == 0 ? u0 + x * h : u0 + h / 2, v = axis == 0 ? v0 + h / 2 : v0 + x * h;
+    const SurfaceJet jet = surface_.Jet(u, v, order_);
+    if (!IsFinite(jet.p)) return SurfaceNotFiniteError(u, v);
+    double area;
+    const SurfacePoint point = PointFromJet(jet, u, v, order_ == 2, &area);
+    if (!std::isfinite(area)) return INFINITY;
+    const double delta = density_.Value(point);
+    return std::isfinite(delta) ? delta * area : INFINITY;
+  }
+
+  // The exponent p in m ~ t^p at distance t from the singular point `centre`
+  // of the axis, on the side `side` (-1 below, +1 above), read off m at two
+  // distances; NaN where they do not tell.
+  absl::StatusOr<double> PowerBeside(double u0, double v0, double h, int axis, double centre,
+                                     int side) const {
+    double t[2], m[2];
+    for (int q = 0; q < 2; ++q) {
+      const double x = centre + side * std::ldexp(1.0, q == 0 ? -kWarpProbeNear : -kWarpProbeFar);
+      // The distance as rounded in parameter units, over the cell's side.
+      const double origin = axis == 0 ? u0 : v0;
+      t[q] = std::fabs((origin + x * h) - (origin + centre * h)) / h;
+      ASSIGN_OR_RETURN(m[q], AxisDensity(u0, v0, h, axis, x));
+      if (!(t[q] > 0) || !std::isfinite(m[q]) || !(m[q] > 0)) return NAN;
+    }
+    if (!(t[1] < t[0])) return NAN;
+    return std::log(m[1] / m[0]) / std::log(t[1] / t[0]);
+  }
+
+  // The power law of the cell's axis `axis` toward an edge (LeafModel::warp,
+  // AxisWarp with centre 0 or 1): an edge where m blows up (p < 0) or
+  // vanishes (p > 0) gets k = 1 / (1 + p), which makes the warped density
+  // m(W(s)) W'(s) ~ s^(k (1 + p) - 1) constant at the edge. kNoWarp where
+  // neither edge has such a power law.
+  absl::StatusOr<AxisWarp> EdgeWarp(double u0, double v0, double h, int axis) const {
     double best_p = 0;
     int best_side = 0;
     for (int side = 0; side < 2; ++side) {
-      double t[2], m[2];
-      bool ok = true;
-      for (int q = 0; q < 2 && ok; ++q) {
-        const double offset = std::ldexp(h, q == 0 ? -kWarpProbeNear : -kWarpProbeFar);
-        const double edge = (axis == 0 ? u0 : v0) + side * h;
-        const double along = side == 0 ? edge + offset : edge - offset;
-        t[q] = std::fabs(along - edge);  // the distance as rounded
-        const double u = axis == 0 ? along : u0 + h / 2, v = axis == 0 ? v0 + h / 2 : along;
-        const SurfaceJet jet = surface_.Jet(u, v, order_);
-        if (!IsFinite(jet.p)) return SurfaceNotFiniteError(u, v);
-        double area;
-        const SurfacePoint point = PointFromJet(jet, u, v, order_ == 2, &area);
-        const double delta = density_.Value(point);
-        m[q] = delta * area;
-        ok = t[q] > 0 && std::isfinite(m[q]) && m[q] > 0;
-      }
-      if (!ok || !(t[1] < t[0])) continue;
-      const double p = std::log(m[1] / m[0]) / std::log(t[1] / t[0]);
+      ASSIGN_OR_RETURN(const double p, PowerBeside(u0, v0, h, axis, side, side == 0 ? 1 : -1));
       if (std::fabs(p) > std::fabs(best_p)) best_p = p, best_side = side;
     }
-    // Weaker power laws are left to the quadratic; below -0.95 the mass
-    // would not be finite, and above 8 the warp's own nodes crowd the far edge.
-    if (!(std::fabs(best_p) >= kMinWarpPower) || best_p < -0.95 || best_p > 8) return 1.0f;
-    const float k = static_cast<float>(1 / (1 + best_p));
-    return best_side == 0 ? k : -k;
+    return PowerLaw(best_p, best_side);
+  }
+
+  // The power law about a line through the cell's interior where m blows
+  // up: its place found by a golden-section search for the largest m along
+  // the axis, started from the largest of 16 evenly spaced values, and its
+  // exponent the same on both sides. kNoWarp where there is none.
+  absl::StatusOr<AxisWarp> InteriorWarp(double u0, double v0, double h, int axis) const {
+    constexpr int kScan = 16;
+    int top = 0;
+    double top_m = -1;
+    for (int i = 0; i < kScan; ++i) {
+      ASSIGN_OR_RETURN(const double m, AxisDensity(u0, v0, h, axis, (i + 0.5) / kScan));
+      if (m > top_m) top_m = m, top = i;
+    }
+    double lo = std::max(0.0, (top - 0.5) / kScan), hi = std::min(1.0, (top + 1.5) / kScan);
+    const double ratio = (std::sqrt(5.0) - 1) / 2;
+    double a = hi - ratio * (hi - lo), b = lo + ratio * (hi - lo);
+    ASSIGN_OR_RETURN(double ma, AxisDensity(u0, v0, h, axis, a));
+    ASSIGN_OR_RETURN(double mb, AxisDensity(u0, v0, h, axis, b));
+    for (int it = 0; it < kInteriorSearchSteps && hi - lo > 1e-15; ++it) {
+      if (ma >= mb) {
+        hi = b, b = a, mb = ma, a = hi - ratio * (hi - lo);
+        ASSIGN_OR_RETURN(ma, AxisDensity(u0, v0, h, axis, a));
+      } else {
+        lo = a, a = b, ma = mb, b = lo + ratio * (hi - lo);
+        ASSIGN_OR_RETURN(mb, AxisDensity(u0, v0, h, axis, b));
+      }
+    }
+    const float centre = static_cast<float>((lo + hi) / 2);
+    const double margin = std::ldexp(1.0, -kWarpProbeNear + 1);
+    if (!(centre > margin && centre < 1 - margin)) return kNoWarp;
+    ASSIGN_OR_RETURN(const double below, PowerBeside(u0, v0, h, axis, centre, -1));
+    ASSIGN_OR_RETURN(const double above, PowerBeside(u0, v0, h, axis, centre, 1));
+    if (!(std::fabs(below - above) <= kInteriorPowerMismatch) || !(below + above < 0)) return kNoWarp;
+    AxisWarp warp = PowerLaw((below + above) / 2, 0);
+    if (warp.power != 1) warp.centre = centre;
+    return warp;
+  }
+
+  // The warp for m ~ t^p toward the edge `side` (0: low, 1: high): weaker
+  // power laws are left to the quadratic; below -0.95 the mass would not be
+  // finite, and above 8 the warp's own nodes crowd the far edge.
+  static AxisWarp PowerLaw(double p, int side) {
+    if (!(std::fabs(p) >= kMinWarpPower) || p < -0.95 || p > 8) return kNoWarp;
+    return {static_cast<float>(1 / (1 + p)), static_cast<float>(side)};
   }
 
   // The masses of the g x g sub-squares of the cell, each the area of its
@@ -724,7 +796,8 @@ void CurveTree::ComputeReport() {
     const double error = errors_[l] / base_mass_ * n;
     r.error_samples += error;
     const bool piecewise = leaf_model_kind(l) == LeafModel::Kind::kPiecewise;
-    const bool warped = !piecewise && (models_[l].warp[0] != 1 || models_[l].warp[1] != 1);
+    const bool warped =
+        !piecewise && (models_[l].warp[0].power != 1 || models_[l].warp[1].power != 1);
     if (piecewise) ++r.singular_leaves;
     if (warped) ++r.warped_leaves;
     const int fail = leaf_fail_grade(l);

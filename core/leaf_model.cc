@@ -29,11 +29,11 @@ double Overlap(double a0, double a1, double b0, double b1) {
 LeafModel LeafModel::Uniform() {
   LeafModel m;
   std::fill(m.c, m.c + 9, 1.0f);
-  m.warp[0] = m.warp[1] = 1;
+  m.warp[0] = m.warp[1] = kNoWarp;
   return m;
 }
 
-LeafModel LeafModel::FromQuadratic(const double values[9], const float warp[2]) {
+LeafModel LeafModel::FromQuadratic(const double values[9], const AxisWarp* warp) {
   double total = 0;
   bool ok = true;
   for (int i = 0; i < 3; ++i) {
@@ -45,8 +45,8 @@ LeafModel LeafModel::FromQuadratic(const double values[9], const float warp[2]) 
   if (!ok || !(total > 0) || !std::isfinite(total)) return Uniform();
   LeafModel m;
   for (int k = 0; k < 9; ++k) m.c[k] = static_cast<float>(values[k] / total);
-  m.warp[0] = warp == nullptr ? 1 : warp[0];
-  m.warp[1] = warp == nullptr ? 1 : warp[1];
+  m.warp[0] = warp == nullptr ? kNoWarp : warp[0];
+  m.warp[1] = warp == nullptr ? kNoWarp : warp[1];
   return m;
 }
 
@@ -100,7 +100,7 @@ void PiecewiseSubSquareIntegrals(const LeafModel& model, int grid, double x0, do
 }  // namespace leaf_model_internal
 
 double QuadraticIntegral(const double values[9], double x0, double x1, double y0, double y1,
-                         const float warp[2]) {
+                         const AxisWarp* warp) {
   if (warp != nullptr) {
     x0 = Unwarp(warp[0], x0), x1 = Unwarp(warp[0], x1);
     y0 = Unwarp(warp[1], y0), y1 = Unwarp(warp[1], y1);

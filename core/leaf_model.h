@@ -7,18 +7,17 @@
 //    Gauss-Legendre nodes of the cell. Its integral over the cell is the 3 x 3
 //    Gauss rule (exact for degree 5 per axis), and its integral over any
 //    sub-rectangle is a closed form. It never evaluates on the cell's edges.
-//    Where the area element blows up or vanishes on a cell edge (a singular
-//    parameterisation, paper Sect. 5.3), the quadratic lives in warped
-//    coordinates: each axis may carry a power law x = W(s) = s^k toward the
-//    singular edge, the paper's reparameterisation u = u'^3 fitted per cell
-//    (its future work, Sects. 5.3 and 6). With k = 1 / (1 + p) for a mass
-//    density ~ t^p at distance t from the edge, the warped density
-//    m(W(s)) W'(s) is smooth, so the quadrature converges and the model
-//    follows the mass piled against the line down to any sub-cell.
+//    Where the area element blows up or vanishes on a parameter line (a
+//    singular parameterisation, paper Sect. 5.3), the quadratic lives in
+//    warped coordinates: each axis may carry a power law toward the line
+//    (AxisWarp), the paper's reparameterisation u = u'^3 fitted per cell (its
+//    future work, Sects. 5.3 and 6). With k = 1 / (1 + p) for a mass density
+//    ~ t^p at distance t from the line, the warped density m(W(s)) W'(s) is
+//    smooth, so the quadrature converges and the model follows the mass
+//    piled against the line down to any sub-cell.
 //  - kPiecewise: constant on each of the g x g sub-squares of the cell (g the
 //    curve's grid), with the masses of the mapped sub-squares' triangles. The
-//    fallback where the area element is singular and no edge power law fits
-//    (a singular line through the cell's interior).
+//    fallback where the area element is singular and no power law fits.
 // Values are stored as floats normalised so the model integrates to 1 over the
 // cell: the leaf's mass lives in the tree's running sums, the model only shares
 // it out.
@@ -27,6 +26,7 @@
 #ifndef SFCSAMPLER_CORE_LEAF_MODEL_H_
 #define SFCSAMPLER_CORE_LEAF_MODEL_H_
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -37,42 +37,76 @@ inline constexpr double kGaussNode[3] = {0.5 - 0.38729833462074168852, 0.5,
                                          0.5 + 0.38729833462074168852};
 inline constexpr double kGaussWeight[3] = {5.0 / 18, 8.0 / 18, 5.0 / 18};
 
+// A power law along one axis of a leaf (x in the leaf's unit coordinates).
+// The line where the mass density is singular sits at x = centre (0 or 1:
+// an edge; between: a line through the cell), and x = W(s) maps [0, s_c]
+// onto [0, centre] and [s_c, 1] onto [centre, 1], each piece as
+// |x - centre| ~ |s - s_c|^power. The split s_c = c^(1/k) / (c^(1/k) +
+// (1-c)^(1/k)) makes the warped density of a power law that is the same on
+// both sides continuous. power == 1: no warp.
+struct AxisWarp {
+  float power;
+  float centre;
+};
+inline constexpr AxisWarp kNoWarp = {1, 0};
+
+inline double WarpSplit(const AxisWarp& w) {
+  if (w.centre <= 0) return 0;
+  if (w.centre >= 1) return 1;
+  const double r = 1 / static_cast<double>(w.power);
+  const double a = std::pow(static_cast<double>(w.centre), r);
+  return a / (a + std::pow(1 - static_cast<double>(w.centre), r));
+}
+// x = W(s), W'(s) and s = W^-1(x): each maps [0,1] onto itself, increasing.
+inline double Warp(const AxisWarp& w, double s) {
+  if (w.power == 1) return s;
+  const double k = w.power, c = w.centre, sc = WarpSplit(w);
+  if (s <= sc && sc > 0) return c - c * std::pow(1 - s / sc, k);
+  return c + (1 - c) * std::pow((s - sc) / (1 - sc), k);
+}
+inline double WarpSlope(const AxisWarp& w, double s) {
+  if (w.power == 1) return 1;
+  const double k = w.power, c = w.centre, sc = WarpSplit(w);
+  if (s <= sc && sc > 0) return c * k * std::pow(1 - s / sc, k - 1) / sc;
+  return (1 - c) * k * std::pow((s - sc) / (1 - sc), k - 1) / (1 - sc);
+}
+inline double Unwarp(const AxisWarp& w, double x) {
+  if (w.power == 1) return x;
+  const double r = 1 / static_cast<double>(w.power), c = w.centre, sc = WarpSplit(w);
+  if (x <= c && c > 0) return sc * (1 - std::pow((c - x) / c, r));
+  return sc + (1 - sc) * std::pow((x - c) / (1 - c), r);
+}
+
+// Where the warped density is evaluated for the node s: s itself, except at
+// the split of a line through the cell (the middle node, for a line at the
+// cell's centre), where the line itself is no point to evaluate at: the
+// warped density, nearly constant there, is taken at least 2^-20 beside the
+// line in both s and x.
+inline double WarpNode(const AxisWarp& w, double s) {
+  if (w.power == 1 || w.centre <= 0 || w.centre >= 1) return s;
+  const double split = WarpSplit(w);
+  if (!(std::fabs(s - split) < 0x1p-20)) return s;
+  return std::max(split + 0x1p-20, Unwarp(w, w.centre + 0x1p-20));
+}
+
 struct LeafModel {
   enum class Kind : uint8_t { kQuadratic = 0, kPiecewise = 1 };
   // kQuadratic: c[3 i + j] is the model at node (kGaussNode[i], kGaussNode[j]).
   // kPiecewise: c[i * grid + j] is the density on sub-square (i, j) of the
   // grid x grid split (i along x).
   float c[9];
-  // The power law of each axis (0: x, 1: y) for kQuadratic: 1 is none; k > 0
-  // is W(s) = s^k, the singular edge at 0; k < 0 is W(s) = 1 - (1 - s)^|k|,
-  // the singular edge at 1. The nodes of c are at W(kGaussNode).
-  float warp[2];
+  // The power law of each axis (0: x, 1: y) for kQuadratic; the nodes of c
+  // are at W(kGaussNode).
+  AxisWarp warp[2];
 
   // Normalised model of the given kind from raw values (densities at nodes,
   // in warped coordinates, or sub-square masses): scaled so the model
   // integrates to 1. REQUIRES: the values are finite and >= 0 with a positive
   // integral; else a uniform model.
-  static LeafModel FromQuadratic(const double values[9], const float warp[2] = nullptr);
+  static LeafModel FromQuadratic(const double values[9], const AxisWarp* warp = nullptr);
   static LeafModel FromPiecewise(const double masses[9], int grid);
   static LeafModel Uniform();
 };
-
-// One axis's power law (LeafModel::warp): x = Warp(k, s), its derivative,
-// and s = Unwarp(k, x). All map [0,1] onto itself, increasing.
-inline double Warp(float k, double s) {
-  if (k == 1) return s;
-  return k > 0 ? std::pow(s, static_cast<double>(k)) : 1 - std::pow(1 - s, -static_cast<double>(k));
-}
-inline double WarpSlope(float k, double s) {
-  if (k == 1) return 1;
-  const double a = std::fabs(static_cast<double>(k));
-  return a * std::pow(k > 0 ? s : 1 - s, a - 1);
-}
-inline double Unwarp(float k, double x) {
-  if (k == 1) return x;
-  return k > 0 ? std::pow(x, 1 / static_cast<double>(k))
-               : 1 - std::pow(1 - x, -1 / static_cast<double>(k));
-}
 
 // The integral of the model over [x0, x1] x [y0, y1] (inside [0,1]^2). For
 // kQuadratic it may be negative where the quadratic dips below zero; callers
@@ -151,7 +185,7 @@ inline void SubSquareIntegralsOnGrid(const LeafModel& model, LeafModel::Kind kin
     a[k] = y0 + k * step, b[k] = y0 + (k + 1) * step;
     a[kGrid + k] = x0 + k * step, b[kGrid + k] = x0 + (k + 1) * step;
   }
-  if (model.warp[0] != 1 || model.warp[1] != 1) {
+  if (model.warp[0].power != 1 || model.warp[1].power != 1) {
     // The model lives in warped coordinates: integrate over the images.
     for (int k = 0; k < kGrid; ++k) {
       a[k] = Unwarp(model.warp[1], a[k]), b[k] = Unwarp(model.warp[1], b[k]);
@@ -199,7 +233,7 @@ inline void SubSquareIntegrals(const LeafModel& model, LeafModel::Kind kind, int
 // The same for unnormalised quadratic node values (double precision) in the
 // coordinates warped by `warp` (null: none), used by the tree's error test.
 double QuadraticIntegral(const double values[9], double x0, double x1, double y0, double y1,
-                         const float warp[2] = nullptr);
+                         const AxisWarp* warp = nullptr);
 
 }  // namespace sfc
 

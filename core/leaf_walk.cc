@@ -51,14 +51,15 @@ void LeafWalk::Enter(size_t l) {
   leaf_span_ = static_cast<double>(tree_.leaf_end(l) - tree_.leaf_start(l));
   model_ = &tree_.leaf_model(l);
   kind_ = tree_.leaf_model_kind(l);
-  warped_ = kind_ == LeafModel::Kind::kQuadratic && (model_->warp[0] != 1 || model_->warp[1] != 1);
+  warped_ = kind_ == LeafModel::Kind::kQuadratic &&
+            (model_->warp[0].power != 1 || model_->warp[1].power != 1);
   // Samples' worth at the tree's grade, not the sequence's count: a
   // progressive set extended on the same tree keeps its prefix.
   samples_ = leaf_mass_ / total_mass_ * grade_samples_;
 }
 
-double LeafWalk::WarpedInCell(float k, double x0, double side, double fraction) {
-  if (k == 1) return x0 + fraction * side;
+double LeafWalk::WarpedInCell(const AxisWarp& k, double x0, double side, double fraction) {
+  if (k.power == 1) return x0 + fraction * side;
   const double s0 = Unwarp(k, x0), s1 = Unwarp(k, x0 + side);
   return std::clamp(Warp(k, s0 + fraction * (s1 - s0)), x0, x0 + side);
 }

@@ -8,7 +8,7 @@
 // sample (counted at the tree's grade, so every sequence on one tree places a
 // given t alike). The rest of t is followed as pure curve bits for
 // continuation_levels() more levels, and the sample sits at the centre of the
-// cell reached. In a leaf whose model is warped toward a singular edge
+// cell reached. In a leaf whose model is warped toward a singular line
 // (LeafModel::warp) the continuation is uniform in the warped coordinates of
 // its sub-cell, where the mass is: a negligible sub-cell against the line
 // still holds its mass piled against it, and there are many of them along a
@@ -71,7 +71,7 @@ class LeafWalk {
 
   // The point at `fraction` of [x0, x0 + side] (leaf units) in the
   // coordinates warped by the power law k (LeafModel::warp).
-  static double WarpedInCell(float k, double x0, double side, double fraction);
+  static double WarpedInCell(const AxisWarp& k, double x0, double side, double fraction);
   // The leaf holding m: a forward step from the current one, else a search.
   size_t LeafFor(double m) const;
   // Makes l the current leaf.

@@ -72,30 +72,32 @@ TEST(LeafModel, NormalisedModelIntegratesToOneAndKeepsShares) {
               QuadraticIntegral(values, 0, 0.5, 0.25, 0.75) / total, 1e-6);
 }
 
-// A density that is a power of the distance to one edge, t^p, is constant
-// in the coordinates warped by k = 1 / (1 + p): the warped model then shares
-// mass exactly as the density does, over any sub-rectangle, whichever edge
-// is singular and whether the density blows up (p < 0) or vanishes (p > 0).
-TEST(LeafModel, WarpedModelFollowsAPowerLawTowardAnEdge) {
+// A density that is a power of the distance to a line, |x - c|^p, is
+// constant in the coordinates warped by k = 1 / (1 + p) (AxisWarp): the
+// warped model then shares mass exactly as the density does, over any
+// sub-rectangle, whether the line is an edge (c = 0, 1) or crosses the cell,
+// and whether the density blows up (p < 0) or vanishes (p > 0).
+TEST(LeafModel, WarpedModelFollowsAPowerLawAboutALine) {
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> pos(0, 1);
   for (double p : {-2.0 / 3, -0.75, -1.0 / 3, 1.0, 3.0}) {
-    for (int side = 0; side < 2; ++side) {
+    for (double c : {0.0, 1.0, 0.25, 0.5}) {
       for (int axis = 0; axis < 2; ++axis) {
-        const float k = static_cast<float>((side == 0 ? 1 : -1) / (1 + p));
-        float warp[2] = {1, 1};
-        warp[axis] = k;
-        // The distance-to-edge CDF along the warped axis: the mass of [0, x].
+        const AxisWarp w = {static_cast<float>(1 / (1 + p)), static_cast<float>(c)};
+        AxisWarp warp[2] = {kNoWarp, kNoWarp};
+        warp[axis] = w;
+        // The normalised mass of [0, x] along the warped axis.
+        const double z = std::pow(c, 1 + p) + std::pow(1 - c, 1 + p);
         auto cdf = [&](double x) {
-          return side == 0 ? std::pow(x, 1 + p) : 1 - std::pow(1 - x, 1 + p);
+          return (x < c ? std::pow(c, 1 + p) - std::pow(c - x, 1 + p)
+                        : std::pow(c, 1 + p) + std::pow(x - c, 1 + p)) /
+                 z;
         };
         double values[9];
         for (int i = 0; i < 3; ++i) {
           for (int j = 0; j < 3; ++j) {
-            const double s = kGaussNode[axis == 0 ? i : j];
-            const double x = Warp(k, s);
-            const double t = side == 0 ? x : 1 - x;
-            values[3 * i + j] = (1 + p) * std::pow(t, p) * WarpSlope(k, s);
+            const double s = WarpNode(w, kGaussNode[axis == 0 ? i : j]);
+            values[3 * i + j] = std::pow(std::fabs(Warp(w, s) - c), p) * WarpSlope(w, s);
           }
         }
         const LeafModel m = LeafModel::FromQuadratic(values, warp);
@@ -107,27 +109,52 @@ TEST(LeafModel, WarpedModelFollowsAPowerLawTowardAnEdge) {
           const double got = axis == 0
                                  ? ModelIntegral(m, LeafModel::Kind::kQuadratic, 2, a0, a1, b0, b1)
                                  : ModelIntegral(m, LeafModel::Kind::kQuadratic, 2, b0, b1, a0, a1);
-          EXPECT_NEAR(got, exact, 2e-6) << "p " << p << " side " << side << " axis " << axis;
+          EXPECT_NEAR(got, exact, 2e-6) << "p " << p << " c " << c << " axis " << axis;
         }
-        // The sub-squares of a square touching the singular edge share its
+        // The sub-squares of a small square beside the line share its
         // integral as the density does.
         for (int grid : {2, 3}) {
-          const double side_len = 1.0 / 64, x0 = side == 0 ? 0 : 1 - side_len, y0 = 0.5;
+          const double side = 1.0 / 64, x0 = c == 1 ? 1 - side : c, y0 = 0.5;
           double out[9];
           SubSquareIntegrals(m, LeafModel::Kind::kQuadratic, grid, axis == 0 ? x0 : y0,
-                             axis == 0 ? y0 : x0, side_len, out);
-          const double step = side_len / grid;
+                             axis == 0 ? y0 : x0, side, out);
+          const double step = side / grid;
           for (int i = 0; i < grid; ++i) {
             for (int j = 0; j < grid; ++j) {
-              const int along = axis == 0 ? i : j, across = axis == 0 ? j : i;
-              const double lo = x0 + along * step;
+              const double lo = x0 + (axis == 0 ? i : j) * step;
               const double exact = (cdf(lo + step) - cdf(lo)) * step;
-              (void)across;
               EXPECT_NEAR(out[i * grid + j] / exact, 1.0, 2e-5)
-                  << "p " << p << " side " << side << " axis " << axis << " grid " << grid;
+                  << "p " << p << " c " << c << " axis " << axis << " grid " << grid;
             }
           }
         }
+      }
+    }
+  }
+}
+
+// The warp is a bijection of [0, 1] onto itself with the slope as its
+// derivative, its inverse exact to rounding, and its two pieces meet at the
+// line.
+TEST(LeafModel, AxisWarpIsAMonotoneBijection) {
+  for (float k : {3.0f, 1.5f, 0.5f, 0.25f}) {
+    for (float c : {0.0f, 1.0f, 0.25f, 0.5f, 0.7f}) {
+      const AxisWarp w = {k, c};
+      EXPECT_EQ(Warp(w, 0), 0);
+      EXPECT_EQ(Warp(w, 1), 1);
+      EXPECT_NEAR(Warp(w, WarpSplit(w)), c, 1e-15);
+      double last = 0;
+      for (int i = 1; i < 1000; ++i) {
+        const double s = i / 1000.0, x = Warp(w, s);
+        EXPECT_GT(x, last);
+        last = x;
+        // x carries 1e-16 absolute: near the line, Unwarp's root magnifies it.
+        EXPECT_NEAR(Unwarp(w, x), s, 1e-9) << k << " " << c;
+        const double d = 1e-7;
+        if (std::fabs(s - WarpSplit(w)) < 1e-3) continue;  // W' has a root or a pole there
+        EXPECT_NEAR((Warp(w, s + d) - Warp(w, s - d)) / (2 * d), WarpSlope(w, s),
+                    1e-4 * (1 + WarpSlope(w, s)))
+            << k << " " << c << " " << s;
       }
     }
   }

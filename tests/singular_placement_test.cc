@@ -105,8 +105,11 @@ struct Band {
 
 // Samples of the default superellipsoid (no reparameterisation) with
 // exponent e, N samples, seed 5, uniform density.
-SampleBatch Samples(double e, uint64_t n) {
-  const auto setup = testing::MakeSetup("superellipsoid:e=" + std::to_string(e), "uniform", n);
+SampleBatch Samples(double e, uint64_t n, CurveType curve = CurveType::kHilbert) {
+  CurveTreeOptions options;
+  options.curve = curve;
+  const auto setup =
+      testing::MakeSetup("superellipsoid:e=" + std::to_string(e), "uniform", n, options);
   return testing::Collect(testing::MakeSampler(setup, SequenceKind::kJittered, n, 5), 0, n, {}, {},
                           1 << 16);
 }
@@ -155,6 +158,18 @@ TEST(SingularPlacement, StripsBesideLinesWhereTheAreaElementBlowsUp) {
     ExpectStripsMatch(EquatorDistances(s), bands, [&](double d) { return f.Equator(d); },
                       e > 0.3 ? "e = 1/3, equator" : "e = 1/4, equator");
   }
+}
+
+TEST(SingularPlacement, StripsBesideLinesThroughTheCells) {
+  // On the 3 x 3 curves the lines u = 1/2 and v = 1/4, 1/2, 3/4 cross the
+  // cells instead of bounding them.
+  const std::vector<Band> bands = {{0, 1e-4}, {1e-4, 1e-3}, {1e-3, 2e-3}, {2e-3, 1e-2}};
+  const SampleBatch s = Samples(1.0 / 3, 200000, CurveType::kPeano);
+  const Fractions f{1.0 / 3};
+  ExpectStripsMatch(LongitudeDistances(s), bands, [&](double d) { return f.Longitude(d); },
+                    "Peano, longitude");
+  ExpectStripsMatch(EquatorDistances(s), bands, [&](double d) { return f.Equator(d); },
+                    "Peano, equator");
 }
 
 TEST(SingularPlacement, StripsBesideLinesWhereTheAreaElementVanishes) {
