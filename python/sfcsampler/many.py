@@ -46,30 +46,49 @@ def model_format(path):
     return EXTENSIONS.get(os.path.splitext(str(path))[1].lower())
 
 
+def _list_name(entry):
+    """A list entry's name: normalised, without a leading "/" or "../" (outputs stay inside
+    out_dir)."""
+    name = os.path.normpath(entry)
+    while name.startswith("/") or name.startswith("../"):
+        name = name[1:] if name.startswith("/") else name[3:]
+    return name
+
+
 def expand_paths(source):
-    """The model files a folder, a glob, a list file or a model file names, in sorted order
-    (a list file keeps its order). A list file has one path a line (relative to the list's
-    folder; blank lines and # comments skipped). FileNotFoundError when nothing matches."""
+    """[(path, name)] of the model files a folder (subfolders too), a glob, a list file or a
+    model file names; `name` is the path relative to the folder, the pattern's folder or the
+    list file's folder (as `sfcsampler sample-many` names them). Folders and patterns are
+    sorted by name, a list file keeps its order (one path a line, relative to its folder;
+    blank lines and # comments skipped). FileNotFoundError when nothing matches."""
     source = os.fspath(source)
     if os.path.isdir(source):
-        found = sorted(os.path.join(source, n) for n in os.listdir(source)
-                       if model_format(n) and os.path.isfile(os.path.join(source, n)))
+        found = []
+        for top, _, files in os.walk(source):
+            for n in files:
+                path = os.path.join(top, n)
+                if model_format(n) and os.path.isfile(path):
+                    found.append((path, os.path.relpath(path, source)))
         if not found:
             raise FileNotFoundError(f"the folder {source} has no model files "
                                     f"({', '.join(sorted(EXTENSIONS))})")
-        return found
-    if any(c in source for c in "*?["):
-        found = sorted(p for p in globlib.glob(source, recursive=True) if os.path.isfile(p))
+        return sorted(found, key=lambda item: item[1])
+    wild = min((source.find(c) for c in "*?[" if c in source), default=-1)
+    if wild >= 0:
+        slash = source.rfind("/", 0, wild)
+        root = "." if slash < 0 else source[:slash + 1]
+        found = [(p, os.path.relpath(p, root)) for p in globlib.glob(source) if os.path.isfile(p)]
         if not found:
             raise FileNotFoundError(f"the pattern {source} matches no files")
-        return found
+        return sorted(found, key=lambda item: item[1])
     if model_format(source):
-        return [source]
+        return [(source, os.path.basename(source))]
     if os.path.isfile(source):  # a list file
         base = os.path.dirname(source)
         with open(source) as f:
             lines = [line.strip() for line in f]
-        return [os.path.join(base, line) for line in lines if line and not line.startswith("#")]
+        return [(os.path.join(base, line), _list_name(line)) for line in lines
+                if line and not line.startswith("#")]
     raise FileNotFoundError(f"{source} is not a folder, a pattern, a list file or a model file")
 
 
@@ -96,15 +115,17 @@ def as_models(models):
     """A list of Model from sample_many's `models` argument: a folder, glob, list file or
     model path; a list of paths and meshes; or a dict name -> path or mesh."""
     if isinstance(models, (str, os.PathLike)):
-        return [Model(os.path.basename(p), path=p) for p in expand_paths(models)]
+        return [Model(name, path=p) for p, name in expand_paths(models)]
     if isinstance(models, dict):
         items = list(models.items())
     else:
         items = [(None, m) for m in models]
     out = []
     for k, (name, m) in enumerate(items):
-        if isinstance(m, (str, os.PathLike)):
-            out.append(Model(name or os.path.basename(os.fspath(m)), path=os.fspath(m)))
+        if isinstance(m, (str, os.PathLike)) and name is None:
+            out += [Model(n, path=p) for p, n in expand_paths(m)]  # a folder, a pattern, ...
+        elif isinstance(m, (str, os.PathLike)):
+            out.append(Model(name, path=os.fspath(m)))
         elif isinstance(m, Model):
             out.append(m)
         else:
@@ -112,10 +133,28 @@ def as_models(models):
     return out
 
 
-def output_name(name, fmt):
-    """The output file of a model: its name without the model extension, plus .FORMAT."""
+def output_name(name, fmt, keep_extension=False):
+    """The output file of a model: its name without the model extension (kept when
+    keep_extension: two models of one stem), plus .FORMAT."""
     stem, ext = os.path.splitext(name)
-    return (stem if ext.lower() in EXTENSIONS else name) + "." + fmt
+    return (stem if ext.lower() in EXTENSIONS and not keep_extension else name) + "." + fmt
+
+
+def output_names(names, fmt="npy"):
+    """output_name() of each name, keeping the extensions of names that share a stem;
+    InvalidArgumentError for a name given twice."""
+    stems = {}
+    for n in names:
+        stems[output_name(n, fmt)] = stems.get(output_name(n, fmt), 0) + 1
+    out, seen = [], {}
+    for n in names:
+        o = output_name(n, fmt, stems[output_name(n, fmt)] > 1)
+        if o in seen:
+            raise meshes.InvalidArgumentError(3, f"models {seen[o]!r} and {n!r} would both write {o}; "
+                                                 "name each model once")
+        seen[o] = n
+        out.append(o)
+    return out
 
 
 def structured(samples):
@@ -161,7 +200,7 @@ class Results(list):
         return "\n".join(lines)
 
 
-def sample_one(model, request, base_seed, sampler=None, out_dir=None, keep=True, client=None):
+def sample_one(model, request, base_seed, sampler=None, out_path=None, keep=True, client=None):
     """Samples one Model with its derived seed; never raises for the model's own errors
     (they go into Result.error). `client` samples on a server instead of `sampler`."""
     start = time.perf_counter()
@@ -170,6 +209,10 @@ def sample_one(model, request, base_seed, sampler=None, out_dir=None, keep=True,
         fmt, data = model.load()
         result.sha256 = hashlib.sha256(data).hexdigest()
         result.seed = model_seed(base_seed, result.sha256)
+        request = dict(request)
+        mesh = fmt in ("obj", "ply")  # the model columns apply to the models that have them
+        request["face"] = bool(request.get("face")) and not mesh
+        request["triangle"] = bool(request.get("triangle")) and mesh
         if client is not None:
             spec = client._upload_bytes(fmt, data, result.sha256, model.name)
             samples = client.sample(surface=spec, seed=result.seed, **request)
@@ -178,8 +221,9 @@ def sample_one(model, request, base_seed, sampler=None, out_dir=None, keep=True,
             sampler = sampler or Sampler(max_trees=0, threads=1)
             samples = sampler.sample_bytes(fmt, data, model.name, seed=result.seed, **request)
         result.count = len(samples)
-        if out_dir is not None:
-            result.path = os.path.join(out_dir, output_name(model.name, "npy"))
+        if out_path is not None:
+            result.path = out_path
+            os.makedirs(os.path.dirname(out_path) or ".", exist_ok=True)
             write_npy(result.path, samples)
         if keep:
             result.samples = samples
@@ -189,11 +233,21 @@ def sample_one(model, request, base_seed, sampler=None, out_dir=None, keep=True,
     return result
 
 
+def npy_bytes(samples):
+    """The samples as the bytes of the CLI's NPY file (client/sample_writer.cc: format 1.0,
+    the header padded to 64 bytes), so Python and the CLI write identical files."""
+    array = structured(samples)
+    descr = "[" + ", ".join(f"('{name}', '{array.dtype[name].str}')" for name in array.dtype.names) + "]"
+    header = f"{{'descr': {descr}, 'fortran_order': False, 'shape': ({len(array)},), }}"
+    header += " " * ((64 - (10 + len(header) + 1) % 64) % 64) + "\n"
+    return b"\x93NUMPY\x01\x00" + len(header).to_bytes(2, "little") + header.encode() + array.tobytes()
+
+
 def write_npy(path, samples):
     """Writes samples as the CLI's NPY (a structured array), through a temporary name."""
     tmp = path + ".part"
     with open(tmp, "wb") as f:
-        np.save(f, structured(samples))
+        f.write(npy_bytes(samples))
     os.replace(tmp, path)
 
 
@@ -228,13 +282,14 @@ def sample_many(models, *, seed=1, out_dir=None, keep=None, workers=0, progress=
 
     models: a folder, a glob ("data/**/*.obj"), a list file, or a model file; or a list of
       paths and meshes (anything sample(mesh=...) takes); or a dict name -> path or mesh.
-    out_dir: write each model's samples to OUT_DIR/<name>.npy (the CLI's NPY: numpy.load gives
-      a structured array); keep: also keep them in the results (default: only when out_dir is
+    out_dir: write each model's samples to OUT_DIR/NAME.npy, NAME the model's path relative
+      to the folder it came from, without its extension (the CLI's file, byte for byte:
+      numpy.load gives a structured array); keep: also keep them in the results (default: only when out_dir is
       None). workers: models sampled at once (0 = the CPU count, at most 8); each model then
       uses one thread. progress: a progress bar on stderr (None = when it is a terminal).
     server: "host:port" or a Client: sample on a server instead of in this process.
-    The other keywords are sample()'s (count, density, normals, triangle, ...), the same for
-    every model. Returns Results (a list of Result, in the models' order); a model that fails
+    The other keywords are sample()'s (count, density, normals, ...), the same for every model;
+    face=True applies to the CAD models and triangle=True to the meshes. Returns Results (a list of Result, in the models' order); a model that fails
     has its error in Result.error and the others go on. Results.failed, Results.summary().
     """
     from sfcsampler.client import Client
@@ -243,15 +298,10 @@ def sample_many(models, *, seed=1, out_dir=None, keep=None, workers=0, progress=
         if bad in request:
             raise TypeError(f"sample_many takes the models as its first argument, not {bad}=")
     items = as_models(models)
+    paths = [None] * len(items)
     if out_dir is not None:
         os.makedirs(out_dir, exist_ok=True)
-        names = {}
-        for m in items:
-            out = output_name(m.name, "npy")
-            if out in names:
-                raise meshes.InvalidArgumentError(
-                    3, f"models {names[out]!r} and {m.name!r} would both write {out}; rename one")
-            names[out] = m.name
+        paths = [os.path.join(out_dir, o) for o in output_names([m.name for m in items])]
     keep = out_dir is None if keep is None else keep
     workers = workers or min(8, os.cpu_count() or 1)
     own_client = isinstance(server, str)
@@ -261,7 +311,7 @@ def sample_many(models, *, seed=1, out_dir=None, keep=None, workers=0, progress=
     results = Results([None] * len(items))
     try:
         with concurrent.futures.ThreadPoolExecutor(max_workers=workers) as pool:
-            futures = {pool.submit(sample_one, m, request, seed, sampler, out_dir, keep, client): k
+            futures = {pool.submit(sample_one, m, request, seed, sampler, paths[k], keep, client): k
                        for k, m in enumerate(items)}
             for future in concurrent.futures.as_completed(futures):
                 result = future.result()
