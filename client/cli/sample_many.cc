@@ -280,6 +280,8 @@ CLI::App* AddSampleManyCommand(CLI::App* app, SampleManyFlags* f) {
   cmd->add_option("--depth-cap", r->depth_cap, "the paper's r (0 = deepest)")->capture_default_str();
   cmd->add_option("--rho", r->rho, "max samples' worth of mass per leaf")->capture_default_str();
   AddSampleFlags(cmd, r);
+  cmd->get_option("--seed")->description(
+      "base seed: each model's seed is derived from it and the model's SHA-256 (--manifest lists them)");
   return cmd;
 }
 

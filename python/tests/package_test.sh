@@ -24,15 +24,17 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 unset PYTHONPATH
 
-# A clean copy of python/ (the build leaves build/ and *.egg-info beside setup.py).
-mkdir -p "$work/src"
-cp -r "$source_dir/python" "$work/src/python"
-rm -rf "$work/src/python/build" "$work/src/python/dist" "$work/src/python"/*.egg-info
 if [ -n "$prebuilt" ]; then
+  # A clean copy of python/ (a build leaves build/ and *.egg-info beside setup.py),
+  # so that the test leaves the source tree as it was.
   export SFCSAMPLER_PREBUILT=$(cd "$prebuilt" && pwd)
+  mkdir -p "$work/src"
+  cp -r "$source_dir/python" "$work/src/python"
+  rm -rf "$work/src/python/build" "$work/src/python/dist" "$work/src/python"/*.egg-info
+  src=$work/src
 else
-  # setup.py builds the repository above python/: point it at the real one.
-  rm -rf "$work/src/python" && ln -s "$source_dir/python" "$work/src/python"
+  # setup.py builds the repository above python/ (in python/build/cmake).
+  src=$source_dir
 fi
 
 check_env() {  # VENV LABEL [TESTS]: imports from the environment, runs the tests if TESTS=1
@@ -57,15 +59,15 @@ PY
 
 echo "== pip install --no-build-isolation ./python"
 $python -m venv --system-site-packages "$work/venv-pip"
-(cd "$work/src" && "$work/venv-pip/bin/pip" install -q --no-build-isolation --no-index ./python)
+(cd "$src" && "$work/venv-pip/bin/pip" install -q --no-build-isolation --no-index ./python)
 # The ctest variant runs the tests once, on the wheel; the full run on both.
 check_env "$work/venv-pip" pip "$([ -n "$prebuilt" ] && echo 0 || echo 1)"
 
 echo "== python3 -m build --no-isolation --wheel"
 if [ -n "$prebuilt" ]; then
-  (cd "$work/src/python" && $python -m build --no-isolation --wheel --outdir "$work/dist" . >/dev/null)
+  (cd "$src" && $python -m build --no-isolation --wheel --outdir "$work/dist" python >/dev/null)
 else
-  (cd "$work/src/python" && $python -m build --no-isolation --wheel --outdir "$work/dist" .)
+  (cd "$src" && $python -m build --no-isolation --wheel --outdir "$work/dist" python)
 fi
 wheel=$(ls "$work"/dist/sfcsampler-*.whl)
 if [ -n "$prebuilt" ]; then  # the same environment, the package replaced by the wheel's
