@@ -26,6 +26,7 @@ PLY bytes).
 
 import os
 import threading
+import uuid
 
 import numpy as np
 
@@ -70,33 +71,39 @@ class _Bytes(many.Model):
         return self.fmt, self.data
 
 
-def _many_task(model, request, seed, out_path, keep, service):
+def _many_task(models, request, seed, out_paths, keep, service):
+    """A list of Result, one per model of this task's chunk."""
     if service:
-        return many.sample_one(model, request, seed, out_path=out_path, keep=keep,
-                               client=_client(service))
-    return many.sample_one(model, request, seed, sampler=_sampler(), out_path=out_path, keep=keep)
+        return [many.sample_one(m, request, seed, out_path=p, keep=keep, client=_client(service))
+                for m, p in zip(models, out_paths)]
+    return [many.sample_one(m, request, seed, sampler=_sampler(), out_path=p, keep=keep)
+            for m, p in zip(models, out_paths)]
 
 
-def _progress(futures, enabled):
+def _progress(futures, total, enabled):
     import distributed
-    bar = many._Bar(len(futures), enabled)
+    bar = many._Bar(total, enabled)
     try:
         for future in distributed.as_completed(futures):
-            bar.step(future.result())
+            for result in future.result():
+                bar.step(result)
     finally:
         bar.close()
 
 
 def sample_many(client, models, *, seed=1, out_dir=None, keep=None, service=None, send_bytes=False,
-                progress=None, **request):
+                models_per_task=0, progress=None, **request):
     """sfcsampler.sample_many() with one Dask task per model, on `client`'s cluster.
 
     client: a distributed.Client. models, seed, out_dir, keep and the request keywords are
     sfcsampler.sample_many()'s, with the same results: each model's samples depend only on it,
     the request and the base seed. service: "host:port" of an sfcsampler-server for the
     workers to sample on (default: the embedded sampler in each worker). send_bytes: ship
-    model files' bytes from here (default: workers read the paths). progress: a bar on
-    stderr (None = when it is a terminal). Returns sfcsampler.Results in the models' order.
+    model files' bytes from here (default: workers read the paths). models_per_task: models
+    in one task (0 = about a quarter of an even share per worker, at most 64: a task then
+    takes long enough for Dask's few milliseconds of overhead a task not to matter, and the
+    workers still balance); the results do not depend on it. progress: a bar on stderr (None
+    = when it is a terminal). Returns sfcsampler.Results in the models' order.
     """
     for bad in ("surface", "mesh"):
         if bad in request:
@@ -116,11 +123,20 @@ def sample_many(client, models, *, seed=1, out_dir=None, keep=None, service=None
             except (OSError, ValueError, TypeError):
                 pass  # the task reports the error by the model's name
         shipped.append(m)
-    futures = [client.submit(_many_task, m, request, seed, paths[k], keep, service, pure=False,
-                             key=f"sfcsampler-model-{k}-{os.path.basename(m.name)}")
-               for k, m in enumerate(shipped)]
-    _progress(futures, progress)
-    return many.Results(client.gather(futures))
+    if not models_per_task:
+        workers = max(1, len(client.scheduler_info().get("workers", {})))
+        models_per_task = max(1, min(64, len(shipped) // (4 * workers)))
+    futures = []
+    call = uuid.uuid4().hex[:12]  # keys unique to this call: Dask would reuse a live key's result
+    chunks = [slice(start, start + models_per_task) for start in range(0, len(shipped), models_per_task)]
+    # Each chunk's models go to the workers as data (a few MB of mesh bytes), not in the graph.
+    data = client.scatter([shipped[chunk] for chunk in chunks], hash=False)
+    for chunk, models_data in zip(chunks, data):
+        start = chunk.start
+        futures.append(client.submit(_many_task, models_data, request, seed, paths[chunk], keep,
+                                     service, pure=False, key=f"sfcsampler-models-{call}-{start}"))
+    _progress(futures, len(shipped), progress)
+    return many.Results([r for chunk in client.gather(futures) for r in chunk])
 
 
 def _shard_task(model, surface, count, index, shards, out_path, request, service):
@@ -179,10 +195,13 @@ def sample_shards(client, surface=None, count=10000, *, shards, out_dir=None, me
     if model is not None:
         import hashlib
         model = (model[0], model[1], hashlib.sha256(model[1]).hexdigest())
-        [model] = client.scatter([model], broadcast=True)  # once to each worker, not per task
+        # Once to each worker, not per task; hash=False: a fresh key (a scatter of the same bytes
+        # would share the key of an earlier call's future, which Dask may be releasing).
+        [model] = client.scatter([model], broadcast=True, hash=False)
+    call = uuid.uuid4().hex[:12]
     futures = [client.submit(_shard_task, model, surface, count, i, shards,
                              None if out_dir is None else shard_path(out_dir, i, shards), request,
-                             service, pure=False, key=f"sfcsampler-shard-{i}-of-{shards}")
+                             service, pure=False, key=f"sfcsampler-shard-{call}-{i}-of-{shards}")
                for i in range(shards)]
     return client.gather(futures)
 

@@ -35,14 +35,15 @@ def test_sample_many_equals_one_process(client, tmp_path):
     models = meshes20()
     local = sfcsampler.sample_many(models, count=4000, seed=9, normals=True, triangle=True,
                                    workers=1)
-    remote = sfcsampler.dask.sample_many(client, models, count=4000, seed=9, normals=True,
-                                         triangle=True)
-    assert len(remote) == 20 and not remote.failed
     assert len({pid for pid in client.run(os.getpid).values()}) == 2
-    for a, b in zip(local, remote):
-        assert (a.name, a.seed, a.sha256) == (b.name, b.seed, b.sha256)
-        same_samples(a.samples, b.samples)
-        assert len(b.samples) == 4000
+    for per_task in (0, 1, 7):  # one model a task, 7, and the default (2 here)
+        remote = sfcsampler.dask.sample_many(client, models, count=4000, seed=9, normals=True,
+                                             triangle=True, models_per_task=per_task)
+        assert len(remote) == 20 and not remote.failed
+        for a, b in zip(local, remote):
+            assert (a.name, a.seed, a.sha256) == (b.name, b.seed, b.sha256)
+            same_samples(a.samples, b.samples)
+            assert len(b.samples) == 4000
     # Written by the workers: the CLI's NPY of the same samples; a bad model is named.
     bad = dict(models, broken=(np.zeros((3, 3)), np.array([[0, 1, 5]])))
     written = sfcsampler.dask.sample_many(client, bad, count=4000, seed=9, out_dir=tmp_path)
@@ -92,6 +93,12 @@ def test_sample_shards_of_a_mesh_and_a_model_file(client, tmp_path):
     parts = sfcsampler.dask.sample_shards(client, f"ply:{tmp_path / 't.ply'}", 200000, shards=5,
                                           seed=3, triangle=True)
     assert np.array_equal(np.concatenate([p.x for p in parts]), whole.x)
+    # Calls in a row (the first's futures still alive) do not share tasks.
+    again = sfcsampler.dask.sample_shards(client, f"ply:{tmp_path / 't.ply'}", 200000, shards=5,
+                                          seed=4, triangle=True)
+    assert not np.array_equal(np.concatenate([p.x for p in again]), whole.x)
+    assert np.array_equal(np.concatenate([p.x for p in again]),
+                          sfcsampler.sample(mesh=(v, f), count=200000, seed=4).x)
     with pytest.raises(TypeError):
         sfcsampler.dask.sample_shards(client, "torus", 100, shards=2, begin=3)
 
