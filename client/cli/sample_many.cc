@@ -20,6 +20,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/strip.h"
 #include "client/sample_writer.h"
+#include "client/sampler_client.h"
 #include "core/status_macros.h"
 #include "engine/model_source.h"
 #include "engine/sampling_engine.h"
@@ -150,8 +151,35 @@ struct Job {
   const SampleManyFlags* flags;
   OutputFormat format;
   OutputPrecision precision;
-  const SamplingEngine* engine;
+  const SamplingEngine* engine;  // in process, or
+  SamplerClient* client;         // over the wire
 };
+
+// Every sample of `request` to `on_batch` (expected count when known), in
+// process or from the server.
+absl::Status Stream(const Job& job, const SampleRequest& request,
+                    const std::function<absl::Status(std::optional<uint64_t>, const SampleBatch&)>& on_batch) {
+  if (job.client != nullptr) {
+    return job.client
+        ->Sample(request,
+                 [&](const ::sfcsampler::v1::StreamHeader& header, const SampleBatch& batch) {
+                   std::optional<uint64_t> expected;
+                   if (header.expected_samples() >= 0) expected = header.expected_samples();
+                   return on_batch(expected, batch);
+                 })
+        .status();
+  }
+  ASSIGN_OR_RETURN(SamplingJob sampling, job.engine->Start(request));
+  std::optional<uint64_t> expected;
+  if (request.region.kind == Region::Kind::kAll) expected = sampling.end - sampling.begin;
+  SampleBatch batch;
+  while (true) {
+    batch.Clear();
+    ASSIGN_OR_RETURN(const size_t n, sampling.cursor->Next(65536, &batch));
+    if (n == 0) return absl::OkStatus();
+    RETURN_IF_ERROR(on_batch(expected, batch));
+  }
+}
 
 // Samples one model into its output file (written under a temporary name,
 // renamed when complete). Fills `o` and returns the model's error, if any.
@@ -169,24 +197,26 @@ absl::Status SampleOne(const Job& job, Outcome* o) {
   flags.face = flags.face && !mesh;
   flags.triangle = flags.triangle && mesh;
   ASSIGN_OR_RETURN(const SampleRequest request, ToSampleRequest(flags));
-  ASSIGN_OR_RETURN(SamplingJob sampling, job.engine->Start(request));
-  std::optional<uint64_t> expected;
-  if (request.region.kind == Region::Kind::kAll) expected = sampling.end - sampling.begin;
   std::error_code error;
   fs::create_directories(fs::path(o->output).parent_path(), error);
   const std::string part = o->output + ".part";
-  ASSIGN_OR_RETURN(std::unique_ptr<SampleWriter> writer,
-                   SampleWriter::Open(part, job.format, request.fields, expected, job.precision));
-  SampleBatch batch;
-  absl::Status status;
-  while (status.ok()) {
-    batch.Clear();
-    auto n = sampling.cursor->Next(65536, &batch);
-    if (!n.ok()) status = n.status();
-    if (!n.ok() || *n == 0) break;
-    status = writer->Write(batch);
+  std::unique_ptr<SampleWriter> writer;
+  absl::Status status = Stream(job, request, [&](std::optional<uint64_t> expected, const SampleBatch& batch) {
+    if (!writer) {
+      ASSIGN_OR_RETURN(writer, SampleWriter::Open(part, job.format, request.fields, expected, job.precision));
+    }
+    return writer->Write(batch);
+  });
+  if (status.ok() && !writer) {  // a region with no samples: still a valid, empty file
+    auto opened = SampleWriter::Open(part, job.format, request.fields, std::nullopt, job.precision);
+    if (opened.ok()) writer = *std::move(opened);
+    status = opened.status();
   }
   if (status.ok()) status = writer->Finish();
+  if (!writer) {
+    fs::remove(part, error);
+    return status;
+  }
   o->samples = writer->written();
   writer.reset();
   if (status.ok()) {
@@ -269,6 +299,12 @@ CLI::App* AddSampleManyCommand(CLI::App* app, SampleManyFlags* f) {
   cmd->add_option("--manifest", f->manifest,
                   "also write a TSV: name, sha256, seed, samples, output, error (one row per model)");
   cmd->add_flag("--quiet,-q", f->quiet, "no progress bar and no summary (failures still print)");
+  cmd->add_option("--server", f->server,
+                  "HOST:PORT of an sfcsampler-server (default: in-process); each model is uploaded "
+                  "once, only if the server lacks its bytes");
+  cmd->add_option("--token-file", f->token_file, "file with the server's bearer token");
+  cmd->add_flag("--tls", f->tls, "connect with TLS (system roots)");
+  cmd->add_option("--tls-roots", f->tls_roots, "PEM roots to trust for TLS (implies --tls)");
   // The tree and set flags of `sample`, the same for every model (not --surface).
   RequestFlags* r = &f->request;
   cmd->add_option("--density", r->density, "density spec (uniform, gaussian:floor=F, mean:floor=F, expr:...)")
@@ -344,6 +380,25 @@ int RunSampleMany(const SampleManyFlags& flags) {
   limits.generation_threads = jobs > 1 ? 1 : static_cast<int>(std::min(4u, hardware));
   SamplingEngine engine(limits, &source, &files);
   job.engine = &engine;
+  job.client = nullptr;
+  std::unique_ptr<SamplerClient> client;
+  if (!flags.server.empty()) {
+    ClientOptions options;
+    options.target = flags.server;
+    options.tls = flags.tls || !flags.tls_roots.empty();
+    options.tls_root_certs_file = flags.tls_roots;
+    options.precision = job.precision == OutputPrecision::kFloat32 ? ::sfcsampler::v1::PRECISION_FLOAT32
+                                                                    : ::sfcsampler::v1::PRECISION_FLOAT64;
+    if (!flags.token_file.empty()) {
+      auto token = ReadFile(flags.token_file);
+      if (!token.ok()) return Usage("cannot read --token-file " + flags.token_file);
+      options.token = std::string(absl::StripTrailingAsciiWhitespace(*token));
+    }
+    auto connected = SamplerClient::Connect(options);
+    if (!connected.ok()) return Usage(std::string(connected.status().message()));
+    client = *std::move(connected);
+    job.client = client.get();
+  }
 
   const auto start = std::chrono::steady_clock::now();
   Bar bar(outcomes.size(), !flags.quiet);

@@ -15,7 +15,9 @@
 // (--face applies to the CAD models and --triangle to the meshes). A
 // model that fails is reported by name with its error, the others go on; the
 // summary comes at the end and the exit status is 1 if any failed (2 for
-// bad flags or inputs that name no models).
+// bad flags or inputs that name no models). With --server every model goes
+// to the server (uploaded only if it lacks the bytes) and the outputs are the
+// same bytes.
 //
 // Thread-safety: RunSampleMany runs its own worker threads.
 #ifndef SFCSAMPLER_CLIENT_CLI_SAMPLE_MANY_H_
@@ -39,6 +41,10 @@ struct SampleManyFlags {
   int jobs = 0;                 // 0: the hardware threads, at most 8
   std::string manifest;         // a TSV of every model's outcome, or ""
   bool quiet = false;
+  std::string server;           // host:port; "" = in-process
+  std::string token_file;       // bearer token for the server
+  bool tls = false;
+  std::string tls_roots;
   RequestFlags request;         // every model's request but the surface and seed
 };
 

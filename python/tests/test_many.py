@@ -198,3 +198,21 @@ def test_python_sample_many_over_the_wire(server, folder):
     assert "broken.ply" in remote[2].error
     for a, b in zip(local[:2], remote[:2]):
         same_samples(a.samples, b.samples)
+
+
+def test_cli_over_the_wire_same_files(server, folder, tmp_path):
+    local = run("sample-many", folder, "-O", tmp_path / "local", *FLAGS, "--face", "--triangle", "-q")
+    remote = run("sample-many", folder, "-O", tmp_path / "remote", *FLAGS, "--face", "--triangle",
+                 "--server", server, "-j", "3", "-q")
+    assert local.returncode == remote.returncode == 1, remote.stderr
+    for name in BROKEN:
+        assert f"FAILED {name}: INVALID_ARGUMENT" in remote.stderr, remote.stderr
+    assert listing(tmp_path / "remote") == listing(tmp_path / "local") != []
+    for name in listing(tmp_path / "local"):
+        assert filecmp.cmp(tmp_path / "local" / name, tmp_path / "remote" / name, shallow=False), name
+    f32 = run("sample-many", folder / "torus.ply", "-O", tmp_path / "f32", *FLAGS, "--precision",
+              "float32", "--server", server, "-q")
+    f32_local = run("sample-many", folder / "torus.ply", "-O", tmp_path / "f32l", *FLAGS, "--precision",
+                    "float32", "-q")
+    assert f32.returncode == f32_local.returncode == 0
+    assert filecmp.cmp(tmp_path / "f32" / "torus.npy", tmp_path / "f32l" / "torus.npy", shallow=False)
