@@ -26,6 +26,13 @@ packages=(
   python3-grpcio python3-protobuf                # sfcsampler.Client: gRPC and the generated *_pb2.py
   python3-pytest                                 # the Python tests in the suite
   python3-matplotlib                             # the examples' plots (Monte Carlo error, torus picture)
+  python3-distributed                            # sfcsampler.dask: tasks on a Dask cluster (its tests start a
+                                                 # LocalCluster); the issue asks for Dask, not a scheduler of ours
+  python3-build python3-wheel python3-setuptools # pip install ./python and python -m build --wheel
+  python3-pip python3-venv python3-pybind11      # without PyPI: the packaging test's virtual environment,
+                                                 # pybind11's Python side for the setuptools build
+  python3-open3d                                 # mesh objects from Open3D in the tests; the peer of
+                                                 # bench/many_meshes.py and bench/mesh_vs_open3d.py
   libocct-foundation-dev libocct-modeling-data-dev  # OpenCASCADE: STEP/IGES faces, exact derivatives,
   libocct-modeling-algorithms-dev libocct-data-exchange-dev  # trims, areas, test models (cad/)
   libtbb-dev                                     # OpenCASCADE's CMake targets link libtbb.so

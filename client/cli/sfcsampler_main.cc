@@ -14,6 +14,7 @@
 #include "catalog/catalog.h"
 #include "client/cli/progress.h"
 #include "client/cli/request_flags.h"
+#include "client/cli/sample_many.h"
 #include "client/sample_writer.h"
 #include "client/sampler_client.h"
 #include "core/area_estimator.h"
@@ -645,6 +646,9 @@ int main(int argc, char** argv) {
   sample->add_flag("--no-warnings", verbosity.no_warnings, "do not print the depth-cap warnings");
   add_connection(sample);
 
+  sfc::SampleManyFlags many_flags;
+  CLI::App* sample_many = sfc::AddSampleManyCommand(&app, &many_flags);
+
   CLI::App* prepare = app.add_subcommand("prepare", "build (warm) a curve tree and print its key and statistics");
   sfc::AddTreeFlags(prepare, &flags);
   prepare->add_option("--count,-n", flags.count, "size the tree for this many samples")->capture_default_str();
@@ -698,6 +702,7 @@ int main(int argc, char** argv) {
 
   CLI11_PARSE(app, argc, argv);
   if (sample->parsed()) return sfc::RunSample(flags, out, verbosity, conn);
+  if (sample_many->parsed()) return sfc::RunSampleMany(many_flags);
   if (prepare->parsed()) return sfc::RunPrepare(flags, conn);
   if (cache->parsed()) return sfc::RunCache(conn);
   if (health->parsed()) return sfc::RunHealth(conn);

@@ -16,6 +16,7 @@
 #include "engine/sampling_engine.h"
 #include "python/bindings/arrays.h"
 #include "python/bindings/errors.h"
+#include "python/bindings/memory_models.h"
 #include "python/bindings/recent_tree_source.h"
 #include "python/bindings/register.h"
 #include "python/bindings/request.h"
@@ -155,7 +156,20 @@ class PyJob {
 class PyEngine {
  public:
   PyEngine(size_t max_trees, int threads)
-      : source_(max_trees), engine_(Limits(threads), &source_, &files_) {}
+      : source_(max_trees), engine_(Limits(threads), &source_, &models_) {}
+
+  std::string HoldModel(const std::string& format, const py::bytes& data, const std::string& name) {
+    const auto parsed = ModelFormatFromName(format);
+    if (!parsed) {
+      throw StatusException(absl::InvalidArgumentError(
+          "model format must be one of step, iges, nurbs, obj, ply, not \"" + format + "\""));
+    }
+    std::string bytes = data;  // one copy, owned by the held model
+    py::gil_scoped_release release;
+    return models_.Hold(*parsed, std::move(bytes), name);
+  }
+
+  void ReleaseModel(const std::string& spec) { models_.Release(spec); }
 
   std::unique_ptr<PyJob> Start(const PyRequest& r, const std::string& precision) {
     if (precision != "float64" && precision != "float32") {
@@ -194,7 +208,7 @@ class PyEngine {
   }
 
   RecentTreeSource source_;
-  FileModelSource files_;  // model specs name local files in process
+  MemoryModelSource models_;  // local files, and meshes handed over as arrays
   SamplingEngine engine_;
 };
 
@@ -229,6 +243,13 @@ threads: threads filling one request's samples (0 = as the CLI: up to 4). The
            py::arg("precision") = "float64",
            "Validates the request, builds (or reuses) its tree and opens its job. Raises "
            "sfcsampler.InvalidArgumentError or ResourceExhaustedError with the engine's message.")
+      .def("hold_model", &PyEngine::HoldModel, py::arg("format"), py::arg("data"),
+           py::arg("name") = "",
+           "Holds a model's file bytes (FORMAT step, iges, nurbs, obj or ply) in memory, hashes "
+           "them (SHA-256, GIL released) and returns the spec \"FORMAT:sha256=<hex>\" that "
+           "requests name it by until release_model(spec). Holds are counted.")
+      .def("release_model", &PyEngine::ReleaseModel, py::arg("spec"),
+           "Ends one hold_model() of `spec`; the bytes go when the last hold ends.")
       .def("prepare", &PyEngine::Prepare, py::arg("request"),
            "Builds (or reuses) the request's tree, sized for tree_count (or count), and returns "
            "its summary.");

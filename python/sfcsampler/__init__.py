@@ -20,13 +20,15 @@ subclasses carrying the status code and message.
 from sfcsampler._core import ALGORITHM_VERSION, densities, surfaces
 from sfcsampler.client import Client
 from sfcsampler.embedded import Sampler, batches, prepare, sample
+from sfcsampler.many import Result, Results, model_seed, sample_many
+from sfcsampler.meshes import write_ply
 from sfcsampler.errors import (DataLossError, DeadlineExceededError, DepthCapWarning, Error,
                                InvalidArgumentError, ResourceExhaustedError, UnauthenticatedError,
                                UnavailableError)
 from sfcsampler.samples import Samples
 
 __all__ = [
-    "ALGORITHM_VERSION", "Client", "DataLossError", "DeadlineExceededError", "DepthCapWarning",
+    "ALGORITHM_VERSION", "Client", "Result", "Results", "model_seed", "sample_many", "write_ply", "DataLossError", "DeadlineExceededError", "DepthCapWarning",
     "Error", "InvalidArgumentError", "ResourceExhaustedError", "Samples", "Sampler",
     "UnauthenticatedError", "UnavailableError", "batches", "densities", "prepare", "sample",
     "surfaces",

@@ -19,7 +19,7 @@ import time
 import grpc
 import numpy as np
 
-from sfcsampler import _core, _wire
+from sfcsampler import _core, _wire, meshes
 from sfcsampler._request import make_request
 from sfcsampler.errors import DataLossError, InvalidArgumentError, from_status
 from sfcsampler.samples import Samples, concatenate, warn_depth_cap
@@ -141,6 +141,17 @@ class Client:
             except OSError as e:
                 raise InvalidArgumentError(3, f'cannot read the model "{reference}": {e}') from e
             digest = hashlib.sha256(local).hexdigest()
+        return self._upload_bytes(fmt, local, digest, os.path.basename(reference))
+
+    def upload_mesh(self, mesh, weights=None):
+        """Makes sure the server holds a mesh given as arrays (see sfcsampler.sample's mesh=);
+        uploads its canonical PLY bytes only if the server lacks them, and returns
+        "ply:sha256=<hex>"."""
+        data = meshes.mesh_ply(mesh, weights)
+        return self._upload_bytes("ply", data, hashlib.sha256(data).hexdigest(), "mesh (arrays)")
+
+    def _upload_bytes(self, fmt, local, digest, name):
+        """FindModel, then UploadModel of `local` (None: only look) when the server lacks it."""
         metadata = self._metadata("")
         try:
             return self._stub.FindModel(pb.FindModelRequest(sha256=digest, format=fmt),
@@ -148,7 +159,6 @@ class Client:
         except grpc.RpcError as e:
             if e.code() != grpc.StatusCode.NOT_FOUND or local is None:
                 raise _error(e) from None
-        name = os.path.basename(reference)
 
         def chunks():
             for offset in range(0, max(len(local), 1), _UPLOAD_CHUNK):
@@ -161,7 +171,12 @@ class Client:
             raise _error(e) from None
 
     def _with_model(self, request):
-        """`request` with a model file's surface replaced by the spec the server knows it by."""
+        """`request` with a model file's surface, or a mesh=... in memory, replaced by the spec
+        the server knows it by."""
+        request, ply = meshes.resolve(request)
+        if ply is not None:
+            spec = self._upload_bytes("ply", ply, hashlib.sha256(ply).hexdigest(), "mesh (arrays)")
+            return dict(request, surface=spec)
         surface = request.get("surface")
         if isinstance(surface, str):
             uploaded = self.upload(surface)

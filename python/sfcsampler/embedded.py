@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from sfcsampler import _core
+from sfcsampler import _core, meshes
 from sfcsampler._request import make_request
 from sfcsampler.samples import Samples, warn_depth_cap
 
@@ -27,8 +27,19 @@ class Sampler:
     def __init__(self, max_trees=4, threads=0):
         self._engine = _core.Engine(max_trees=max_trees, threads=threads)
 
+    def _held(self, request, call):
+        """call(parsed request) with a mesh=... argument held in memory as its PLY bytes."""
+        request, ply = meshes.resolve(request)
+        if ply is None:
+            return call(make_request(request))
+        spec = self._engine.hold_model("ply", ply, "mesh (arrays)")
+        try:
+            return call(make_request(dict(request, surface=spec)))
+        finally:
+            self._engine.release_model(spec)
+
     def _start(self, precision, request):
-        job = self._engine.start(make_request(request), precision=precision)
+        job = self._held(request, lambda r: self._engine.start(r, precision=precision))
         warn_depth_cap(job.tree, stacklevel=4)
         return job
 
@@ -38,6 +49,17 @@ class Sampler:
         columns = job.next(_ALL) or {}
         return Samples(columns, job.tree, job.begin, job.end, job.seed, _core.ALGORITHM_VERSION,
                        _dtype(precision))
+
+    def sample_bytes(self, fmt, data, name="", *, precision="float64", **request):
+        """sample() of a model given as its file's bytes (fmt: step, iges, nurbs, obj, ply):
+        the same samples as surface="FORMAT:FILE" on a file holding them, with no file."""
+        if "surface" in request or "mesh" in request:
+            raise TypeError("sample_bytes takes the model as fmt and data, not surface= or mesh=")
+        spec = self._engine.hold_model(fmt, data, name)
+        try:
+            return self.sample(precision=precision, surface=spec, **request)
+        finally:
+            self._engine.release_model(spec)
 
     def batches(self, *, batch_size=65536, precision="float64", **request):
         """Yields the requested samples as Samples of at most batch_size each, in curve order."""
@@ -51,7 +73,7 @@ class Sampler:
 
     def prepare(self, **request):
         """Builds (or finds) the request's tree, sized for tree_count or count; returns its summary."""
-        tree = self._engine.prepare(make_request(request))
+        tree = self._held(request, self._engine.prepare)
         warn_depth_cap(tree, stacklevel=3)
         return tree
 
@@ -64,7 +86,15 @@ def sample(*, precision="float64", threads=0, **request):
     numbers as the CLI, the server and Client.sample():
 
       surface="sphere", density="uniform"   catalogue specs ("torus:R=2;r=0.5",
-                                            "gaussian:floor=0.05", "expr:u+v")
+                                            "gaussian:floor=0.05", "expr:u+v"),
+                                            or a model file ("ply:scan.ply")
+      mesh=(vertices, faces)                instead of surface: a triangle mesh in
+                                            memory (float32/float64 (n, 3) and
+                                            int32/int64 (m, 3) arrays; or a trimesh
+                                            or Open3D mesh), sampled as the same
+                                            mesh in a PLY file would be; then
+                                            density may be per-vertex weights
+                                            (an array of n values >= 0)
       count=10000, seed=1                   N, the size of the whole set
       curve="hilbert"                       hilbert | hilbert2 | peano
       sequence="jittered"                   jittered | equal | random |

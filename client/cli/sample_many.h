@@ -1,0 +1,65 @@
+// `sfcsampler sample-many`: samples many model files (STEP, IGES, NURBS, OBJ,
+// PLY) in one run, one output file per model, several models at a time.
+//
+// Inputs are folders (their model files by extension, subfolders too), glob
+// patterns (glob(3): no "**"), list files (one path a line, relative to the
+// list's folder; blank lines and # comments skipped) or model files. A model's
+// name is its path relative to the folder, the pattern's folder or the list's
+// folder, and its output is OUT_DIR/NAME with the model extension replaced by
+// the format's (kept when two models share a stem, as part.step and part.iges),
+// so a dataset's tree (ShapeNet's <synset>/<id>/models/model_normalized.obj) is
+// mirrored. Each model's seed comes from
+// the base --seed and the model's content hash (ModelSeed), so a model's
+// output does not depend on the order of the inputs or on --jobs, and equals
+// `sfcsampler sample --surface FORMAT:FILE --seed <its seed>` on it alone
+// (--face applies to the CAD models and --triangle to the meshes). A
+// model that fails is reported by name with its error, the others go on; the
+// summary comes at the end and the exit status is 1 if any failed (2 for
+// bad flags or inputs that name no models). With --server every model goes
+// to the server (uploaded only if it lacks the bytes) and the outputs are the
+// same bytes.
+//
+// Thread-safety: RunSampleMany runs its own worker threads.
+#ifndef SFCSAMPLER_CLIENT_CLI_SAMPLE_MANY_H_
+#define SFCSAMPLER_CLIENT_CLI_SAMPLE_MANY_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "CLI/CLI.hpp"
+#include "client/cli/request_flags.h"
+
+namespace sfc {
+
+struct SampleManyFlags {
+  std::vector<std::string> inputs;
+  std::string out_dir = "samples";
+  std::string format = "npy";  // npy | csv | ply
+  bool ascii = false;
+  std::string precision = "float64";
+  int jobs = 0;                 // 0: the hardware threads, at most 8
+  std::string manifest;         // a TSV of every model's outcome, or ""
+  bool quiet = false;
+  std::string server;           // host:port; "" = in-process
+  std::string token_file;       // bearer token for the server
+  bool tls = false;
+  std::string tls_roots;
+  RequestFlags request;         // every model's request but the surface and seed
+};
+
+// Adds the subcommand and its flags to `app`; `flags` must outlive parsing.
+CLI::App* AddSampleManyCommand(CLI::App* app, SampleManyFlags* flags);
+
+// Runs it; returns the exit status.
+int RunSampleMany(const SampleManyFlags& flags);
+
+// The seed of a model with content hash `sha256_hex` (64 hex digits) under
+// `base_seed`: the first 8 bytes, big-endian, of SHA-256("sfcsampler.model-seed\0"
+// + base_seed as 8 bytes little-endian + the hash's 32 bytes), top bit cleared.
+// python/sfcsampler/many.py computes the same.
+uint64_t ModelSeed(uint64_t base_seed, const std::string& sha256_hex);
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_CLIENT_CLI_SAMPLE_MANY_H_

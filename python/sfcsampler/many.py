@@ -1,0 +1,324 @@
+"""Many models in one call: sfcsampler.sample_many() and what `sfcsampler
+sample-many` and sfcsampler.dask share with it.
+
+Each model's seed is derived from the base seed and the model's content hash
+(the SHA-256 of its file bytes, or of the canonical PLY of a mesh given as
+arrays), so a model's samples do not depend on the order of the models, on
+which worker sampled it or on how many workers there were:
+
+    seed = first 8 bytes, big-endian, of
+           SHA-256("sfcsampler.model-seed\\0" + base seed as 8 bytes little-endian
+                   + the 32 bytes of the model's SHA-256), top bit cleared
+
+(model_seed(); the CLI computes the same, client/cli/sample_many.cc). A
+model's result is then exactly sfcsampler.sample(surface="FORMAT:FILE",
+seed=model_seed(base, sha256), ...) on it alone.
+"""
+
+import concurrent.futures
+import glob as globlib
+import hashlib
+import os
+import sys
+import threading
+import time
+
+import numpy as np
+
+from sfcsampler import meshes
+from sfcsampler.errors import Error
+
+# File extensions of the model formats (lower case), as the CLI reads them.
+EXTENSIONS = {".step": "step", ".stp": "step", ".iges": "iges", ".igs": "iges", ".nurbs": "nurbs",
+              ".obj": "obj", ".ply": "ply"}
+_SEED_TAG = b"sfcsampler.model-seed\0"
+
+
+def model_seed(base_seed, sha256_hex):
+    """The seed a model gets from the base seed and its content hash (64 hex digits)."""
+    digest = hashlib.sha256(_SEED_TAG + int(base_seed).to_bytes(8, "little") +
+                            bytes.fromhex(sha256_hex)).digest()
+    return int.from_bytes(digest[:8], "big") & ((1 << 63) - 1)
+
+
+def model_format(path):
+    """"step", "obj", ... from a file name's extension, or None."""
+    return EXTENSIONS.get(os.path.splitext(str(path))[1].lower())
+
+
+def _list_name(entry):
+    """A list entry's name: normalised, without a leading "/" or "../" (outputs stay inside
+    out_dir)."""
+    name = os.path.normpath(entry)
+    while name.startswith("/") or name.startswith("../"):
+        name = name[1:] if name.startswith("/") else name[3:]
+    return name
+
+
+def expand_paths(source):
+    """[(path, name)] of the model files a folder (subfolders too), a glob, a list file or a
+    model file names; `name` is the path relative to the folder, the pattern's folder or the
+    list file's folder (as `sfcsampler sample-many` names them). Folders and patterns are
+    sorted by name, a list file keeps its order (one path a line, relative to its folder;
+    blank lines and # comments skipped). FileNotFoundError when nothing matches."""
+    source = os.fspath(source)
+    if os.path.isdir(source):
+        found = []
+        for top, _, files in os.walk(source):
+            for n in files:
+                path = os.path.join(top, n)
+                if model_format(n) and os.path.isfile(path):
+                    found.append((path, os.path.relpath(path, source)))
+        if not found:
+            raise FileNotFoundError(f"the folder {source} has no model files "
+                                    f"({', '.join(sorted(EXTENSIONS))})")
+        return sorted(found, key=lambda item: item[1])
+    wild = min((source.find(c) for c in "*?[" if c in source), default=-1)
+    if wild >= 0:
+        slash = source.rfind("/", 0, wild)
+        root = "." if slash < 0 else source[:slash + 1]
+        found = [(p, os.path.relpath(p, root)) for p in globlib.glob(source) if os.path.isfile(p)]
+        if not found:
+            raise FileNotFoundError(f"the pattern {source} matches no files")
+        return sorted(found, key=lambda item: item[1])
+    if model_format(source):
+        return [(source, os.path.basename(source))]
+    if os.path.isfile(source):  # a list file
+        base = os.path.dirname(source)
+        with open(source) as f:
+            lines = [line.strip() for line in f]
+        return [(os.path.join(base, line), _list_name(line)) for line in lines
+                if line and not line.startswith("#")]
+    raise FileNotFoundError(f"{source} is not a folder, a pattern, a list file or a model file")
+
+
+class Model:
+    """One model to sample: its name (for messages and the output file's stem) and either a
+    file (path) or a mesh in memory (mesh arrays or object, optional per-vertex weights)."""
+
+    def __init__(self, name, path=None, mesh=None, weights=None):
+        self.name, self.path, self.mesh, self.weights = name, path, mesh, weights
+
+    def load(self):
+        """(format, bytes) of the model: the file's bytes, or a mesh's canonical PLY."""
+        if self.path is not None:
+            fmt = model_format(self.path)
+            if fmt is None:
+                raise meshes.InvalidArgumentError(
+                    3, f"unknown model format (extension); use one of {', '.join(sorted(EXTENSIONS))}")
+            with open(self.path, "rb") as f:
+                return fmt, f.read()
+        return "ply", meshes.mesh_ply(self.mesh, self.weights)
+
+
+def as_models(models):
+    """A list of Model from sample_many's `models` argument: a folder, glob, list file or
+    model path; a list of paths and meshes; or a dict name -> path or mesh."""
+    if isinstance(models, (str, os.PathLike)):
+        return [Model(name, path=p) for p, name in expand_paths(models)]
+    if isinstance(models, dict):
+        items = list(models.items())
+    else:
+        items = [(None, m) for m in models]
+    out = []
+    for k, (name, m) in enumerate(items):
+        if isinstance(m, (str, os.PathLike)) and name is None:
+            out += [Model(n, path=p) for p, n in expand_paths(m)]  # a folder, a pattern, ...
+        elif isinstance(m, (str, os.PathLike)):
+            out.append(Model(name, path=os.fspath(m)))
+        elif isinstance(m, Model):
+            out.append(m)
+        else:
+            out.append(Model(name or f"mesh{k}", mesh=m))
+    return out
+
+
+def output_name(name, fmt, keep_extension=False):
+    """The output file of a model: its name without the model extension (kept when
+    keep_extension: two models of one stem), plus .FORMAT."""
+    stem, ext = os.path.splitext(name)
+    return (stem if ext.lower() in EXTENSIONS and not keep_extension else name) + "." + fmt
+
+
+def output_names(names, fmt="npy"):
+    """output_name() of each name, keeping the extensions of names that share a stem;
+    InvalidArgumentError for a name given twice."""
+    stems = {}
+    for n in names:
+        stems[output_name(n, fmt)] = stems.get(output_name(n, fmt), 0) + 1
+    out, seen = [], {}
+    for n in names:
+        o = output_name(n, fmt, stems[output_name(n, fmt)] > 1)
+        if o in seen:
+            raise meshes.InvalidArgumentError(3, f"models {seen[o]!r} and {n!r} would both write {o}; "
+                                                 "name each model once")
+        seen[o] = n
+        out.append(o)
+    return out
+
+
+def structured(samples):
+    """Samples as one structured array with the CLI's NPY fields (numpy.load of its .npy)."""
+    cols = samples.columns()
+    dtype = [(k, v.dtype.newbyteorder("<")) for k, v in cols.items()]
+    out = np.empty(len(samples), dtype=dtype)
+    for k, v in cols.items():
+        out[k] = v
+    return out
+
+
+class Result:
+    """One model's outcome: name, sha256, seed, samples (when kept), path (when written),
+    count, seconds, error (None when it worked)."""
+
+    def __init__(self, name, sha256=None, seed=None, samples=None, path=None, count=0,
+                 seconds=0.0, error=None):
+        self.name, self.sha256, self.seed, self.samples, self.path = name, sha256, seed, samples, path
+        self.count, self.seconds, self.error = count, seconds, error
+
+    @property
+    def ok(self):
+        return self.error is None
+
+    def __repr__(self):
+        state = "ok" if self.ok else f"failed: {self.error}"
+        return f"Result({self.name!r}, {self.count} samples, seed {self.seed}, {state})"
+
+
+class Results(list):
+    """sample_many()'s results, in the order of the models."""
+
+    @property
+    def failed(self):
+        return [r for r in self if not r.ok]
+
+    def summary(self):
+        ok = len(self) - len(self.failed)
+        lines = [f"{len(self)} models: {ok} sampled, {len(self.failed)} failed, "
+                 f"{sum(r.count for r in self)} samples"]
+        lines += [f"  FAILED {r.name}: {r.error}" for r in self.failed]
+        return "\n".join(lines)
+
+
+def sample_one(model, request, base_seed, sampler=None, out_path=None, keep=True, client=None):
+    """Samples one Model with its derived seed; never raises for the model's own errors
+    (they go into Result.error). `client` samples on a server instead of `sampler`."""
+    start = time.perf_counter()
+    result = Result(model.name)
+    try:
+        fmt, data = model.load()
+        result.sha256 = hashlib.sha256(data).hexdigest()
+        result.seed = model_seed(base_seed, result.sha256)
+        request = dict(request)
+        mesh = fmt in ("obj", "ply")  # the model columns apply to the models that have them
+        request["face"] = bool(request.get("face")) and not mesh
+        request["triangle"] = bool(request.get("triangle")) and mesh
+        if client is not None:
+            spec = client._upload_bytes(fmt, data, result.sha256, model.name)
+            samples = client.sample(surface=spec, seed=result.seed, **request)
+        else:
+            from sfcsampler.embedded import Sampler
+            sampler = sampler or Sampler(max_trees=0, threads=1)
+            samples = sampler.sample_bytes(fmt, data, model.name, seed=result.seed, **request)
+        result.count = len(samples)
+        if out_path is not None:
+            result.path = out_path
+            os.makedirs(os.path.dirname(out_path) or ".", exist_ok=True)
+            write_npy(result.path, samples)
+        if keep:
+            result.samples = samples
+    except (Error, OSError, ValueError, TypeError, MemoryError) as e:
+        result.error = str(e)
+    result.seconds = time.perf_counter() - start
+    return result
+
+
+def npy_bytes(samples):
+    """The samples as the bytes of the CLI's NPY file (client/sample_writer.cc: format 1.0,
+    the header padded to 64 bytes), so Python and the CLI write identical files."""
+    array = structured(samples)
+    descr = "[" + ", ".join(f"('{name}', '{array.dtype[name].str}')" for name in array.dtype.names) + "]"
+    header = f"{{'descr': {descr}, 'fortran_order': False, 'shape': ({len(array)},), }}"
+    header += " " * ((64 - (10 + len(header) + 1) % 64) % 64) + "\n"
+    return b"\x93NUMPY\x01\x00" + len(header).to_bytes(2, "little") + header.encode() + array.tobytes()
+
+
+def write_npy(path, samples):
+    """Writes samples as the CLI's NPY (a structured array), through a temporary name."""
+    tmp = path + ".part"
+    with open(tmp, "wb") as f:
+        f.write(npy_bytes(samples))
+    os.replace(tmp, path)
+
+
+class _Bar:
+    """"k/N models (f failed)" redrawn on stderr when it is a terminal."""
+
+    def __init__(self, total, enabled):
+        self.total, self.done, self.failed = total, 0, 0
+        self.enabled = sys.stderr.isatty() if enabled is None else enabled
+        self.lock = threading.Lock()
+
+    def step(self, result):
+        with self.lock:
+            self.done += 1
+            self.failed += not result.ok
+            if self.enabled:
+                width = 30
+                filled = width * self.done // max(self.total, 1)
+                sys.stderr.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {self.done}/{self.total} "
+                                 f"models, {self.failed} failed ")
+                sys.stderr.flush()
+
+    def close(self):
+        if self.enabled:
+            sys.stderr.write("\r\033[K")
+            sys.stderr.flush()
+
+
+def sample_many(models, *, seed=1, out_dir=None, keep=None, workers=0, progress=None,
+                server=None, **request):
+    """Samples many models, each with its own seed derived from `seed` and its content hash.
+
+    models: a folder, a glob ("data/**/*.obj"), a list file, or a model file; or a list of
+      paths and meshes (anything sample(mesh=...) takes); or a dict name -> path or mesh.
+    out_dir: write each model's samples to OUT_DIR/NAME.npy, NAME the model's path relative
+      to the folder it came from, without its extension (the CLI's file, byte for byte:
+      numpy.load gives a structured array); keep: also keep them in the results (default: only when out_dir is
+      None). workers: models sampled at once (0 = the CPU count, at most 8); each model then
+      uses one thread. progress: a progress bar on stderr (None = when it is a terminal).
+    server: "host:port" or a Client: sample on a server instead of in this process.
+    The other keywords are sample()'s (count, density, normals, ...), the same for every model;
+    face=True applies to the CAD models and triangle=True to the meshes. Returns Results (a list of Result, in the models' order); a model that fails
+    has its error in Result.error and the others go on. Results.failed, Results.summary().
+    """
+    from sfcsampler.client import Client
+    from sfcsampler.embedded import Sampler
+    for bad in ("surface", "mesh"):
+        if bad in request:
+            raise TypeError(f"sample_many takes the models as its first argument, not {bad}=")
+    items = as_models(models)
+    paths = [None] * len(items)
+    if out_dir is not None:
+        os.makedirs(out_dir, exist_ok=True)
+        paths = [os.path.join(out_dir, o) for o in output_names([m.name for m in items])]
+    keep = out_dir is None if keep is None else keep
+    workers = workers or min(8, os.cpu_count() or 1)
+    own_client = isinstance(server, str)
+    client = Client(server) if own_client else server
+    sampler = None if client is not None else Sampler(max_trees=0, threads=1 if workers > 1 else 0)
+    bar = _Bar(len(items), progress)
+    results = Results([None] * len(items))
+    try:
+        with concurrent.futures.ThreadPoolExecutor(max_workers=workers) as pool:
+            futures = {pool.submit(sample_one, m, request, seed, sampler, paths[k], keep, client): k
+                       for k, m in enumerate(items)}
+            for future in concurrent.futures.as_completed(futures):
+                result = future.result()
+                results[futures[future]] = result
+                bar.step(result)
+    finally:
+        bar.close()
+        if own_client:
+            client.close()
+    return results
