@@ -9,7 +9,7 @@
 //    random spherical triangles, points pushed radially to the unit sphere)
 //    for N = 2^l and 2^l + 2^(l-1), N = 64 .. 24576, ours against i.i.d.
 //    points on the same mesh, averaged over 4 seeds, with the least-squares
-//    slope of log D against log N (the paper's protocol, ALGORITHM.md).
+//    slope of log D against log N (the paper's protocol, docs/ALGORITHM.md).
 #include <unistd.h>
 
 #include <algorithm>

@@ -3,7 +3,7 @@
 //
 // Every face is wrapped as our own sfc::Surface (core/surface.h), evaluated by
 // OpenCASCADE with exact first and second derivatives; the kernel's types
-// never appear in this header (STYLE.md: like Gmsh's OCCFace). The face's
+// never appear in this header (as Gmsh wraps each TopoDS_Face in its OCCFace). The face's
 // parameter box [u0,u1]x[v0,v1] is mapped linearly onto the unit square, with
 // u reversed for a face whose orientation is reversed, so that fu x fv points
 // out of the solid.

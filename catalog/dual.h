@@ -1,7 +1,7 @@
 // Forward-mode dual numbers in the two surface parameters (u, v): a value
 // with its gradient and, for order 2, its Hessian, carried through every
 // operation of a user expression in one pass (automatic differentiation;
-// ALGORITHM.md needs f_u, f_v for the area element and f_uu, f_uv, f_vv for
+// docs/ALGORITHM.md needs f_u, f_v for the area element and f_uu, f_uv, f_vv for
 // curvature densities).
 //
 // The value part of every operation is computed exactly as the plain-double

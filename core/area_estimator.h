@@ -1,5 +1,5 @@
 // Estimators of a curve vertex's share of int delta dS (paper Sect. 3,
-// estimators (a), (b), (c); ALGORITHM.md step 2), plus a cell quadrature.
+// estimators (a), (b), (c); docs/ALGORITHM.md step 2), plus a cell quadrature.
 //
 // All functions are pure and thread-safe. Errors: InvalidArgument when the
 // surface is not finite or the density is negative or not finite at a point

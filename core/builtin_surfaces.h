@@ -1,4 +1,4 @@
-// The built-in surface catalogue (ALGORITHM.md "Evaluation protocol",
+// The built-in surface catalogue (docs/ALGORITHM.md "Evaluation protocol",
 // paper Sects. 5.2-5.3). Each factory documents its formula over its native
 // parameter box; the box is mapped linearly onto the unit square.
 //

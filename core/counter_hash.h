@@ -1,6 +1,6 @@
 // Counter-based random numbers: a pure function of (seed, stream, counter).
 //
-// ALGORITHM.md "Random access": jitter U_k is a hash of (seed, k), so any
+// docs/ALGORITHM.md "Random access": jitter U_k is a hash of (seed, k), so any
 // sample can be computed alone. The mixer is SplitMix64's finaliser (Steele,
 // Lea and Flood 2014), applied twice. Stateless and thread-safe.
 #ifndef SFCSAMPLER_CORE_COUNTER_HASH_H_

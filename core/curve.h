@@ -1,5 +1,5 @@
 // Space-filling curves on the unit square, behind one table-driven
-// abstraction (paper Sect. 3 and Fig. 3; ALGORITHM.md "Curves").
+// abstraction (paper Sect. 3 and Fig. 3; docs/ALGORITHM.md "Curves").
 //
 // A curve of grid g subdivides a cell into w = g*g children visited in a fixed
 // order. Each cell carries an orientation ("state"), one of the 8 symmetries of

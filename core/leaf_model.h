@@ -1,5 +1,5 @@
 // The local model of the mass density m = delta |f_u x f_v| that each curve
-// tree leaf carries (ALGORITHM.md, "A tree sized by the surface" and "Inside a
+// tree leaf carries (docs/ALGORITHM.md, "A tree sized by the surface" and "Inside a
 // leaf, follow the model").
 //
 // Two kinds, both in the leaf's own unit coordinates (x, y) in [0,1]^2:

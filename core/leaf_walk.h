@@ -1,5 +1,5 @@
 // Placement of samples by their mass coordinates (paper Fig. 1 line 8;
-// ALGORITHM.md step 4 and "Inside a leaf, follow the model"), as a walk.
+// docs/ALGORITHM.md step 4 and "Inside a leaf, follow the model"), as a walk.
 //
 // Mass coordinate m = q_k S_M lands in the leaf l with S_{l-1} <= m < S_l.
 // Inside it, t = (m - S_{l-1}) / s_l descends the leaf's own curve, at each

@@ -1,4 +1,4 @@
-// Equalisation (paper Fig. 1 line 8; ALGORITHM.md step 4) and the samples it
+// Equalisation (paper Fig. 1 line 8; docs/ALGORITHM.md step 4) and the samples it
 // yields, by index range or region, in curve order.
 //
 // Sample k has mass coordinate q_k S_M; core/leaf_walk.h places it in its

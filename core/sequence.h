@@ -1,5 +1,5 @@
 // One-dimensional sequences q_k in [0,1) that are placed along the curve
-// (paper Sect. 3, "Create1DPoints"; ALGORITHM.md step 3).
+// (paper Sect. 3, "Create1DPoints"; docs/ALGORITHM.md step 3).
 //
 // Every q_k is a pure function of (kind, count, seed, k), so any index can be
 // computed alone. Thread-safety: immutable value type.

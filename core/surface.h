@@ -1,7 +1,7 @@
 // Parametric surfaces f : [0,1]^2 -> R^3 and their differential geometry.
 //
 // Every surface maps the unit square; a surface with another native
-// parameter box maps it linearly (ALGORITHM.md, "Inputs and output"), so all
+// parameter box maps it linearly (docs/ALGORITHM.md, "Inputs and output"), so all
 // derivatives here are taken with respect to the unit-square parameters.
 //
 // Thread-safety: Surface implementations are immutable after construction and

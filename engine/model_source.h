@@ -1,5 +1,5 @@
 // Model files (CAD and meshes) that surfaces are made from, and where their
-// bytes come from (SERVICE.md: "A CAD or mesh user sends a STEP, IGES, OBJ or
+// bytes come from (docs/SERVICE.md: "A CAD or mesh user sends a STEP, IGES, OBJ or
 // PLY model once; the server keys it by a content hash").
 //
 // A model spec is FORMAT:REFERENCE. The reference is a file path, which only

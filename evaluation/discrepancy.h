@@ -1,5 +1,5 @@
 // Discrepancy estimators for the evaluation protocol (paper Sects. 4-5;
-// ALGORITHM.md "Evaluation protocol"): D = sup over a family of test shapes
+// docs/ALGORITHM.md "Evaluation protocol"): D = sup over a family of test shapes
 // of |points inside / N - measure of the shape|.
 //
 // Each estimator takes the sup over a finite family, so it is a lower bound of

@@ -1,4 +1,4 @@
-// The evaluation protocol of paper Sects. 4-5 (ALGORITHM.md): discrepancy of
+// The evaluation protocol of paper Sects. 4-5 (docs/ALGORITHM.md): discrepancy of
 // point sets of N = 2^l and 2^l + 2^(l-1) points for our sampler and the
 // reference sets, on the unit square (anchored boxes, quarter discs,
 // triangles) and the unit sphere (spherical triangles), with least-squares

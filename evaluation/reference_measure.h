@@ -1,5 +1,5 @@
 // A reference measure for density discrepancy that shares nothing with the
-// curve tree (ALGORITHM.md, "Evaluation protocol"): the mass of delta dA on
+// curve tree (docs/ALGORITHM.md, "Evaluation protocol"): the mass of delta dA on
 // each cell of a uniform parameter grid by a graded tensor Gauss-Legendre
 // rule. Each cell's axis is mapped by the polynomial q(s) = 10 s^3 - 15 s^4 +
 // 6 s^5, whose derivative 30 s^2 (1-s)^2 vanishes to second order at both

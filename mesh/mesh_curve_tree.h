@@ -1,4 +1,4 @@
-// The curve through a triangle mesh and the mass along it (ALGORITHM.md
+// The curve through a triangle mesh and the mass along it (docs/ALGORITHM.md
 // steps 1-2, carried from the parameter square to a mesh).
 //
 // The curve. Triangles are visited in the 3D Hilbert order of their
@@ -30,7 +30,7 @@
 // midpoint rule's O(h^3) error, so a run of whole leaves hides no model
 // error; the model's error shows only inside leaves a region cuts, at most
 // `tolerance` samples each, below the jittered set's own discrepancy (about
-// N^(1/4) samples; ALGORITHM.md "A tree sized by the surface"). The model
+// N^(1/4) samples; docs/ALGORITHM.md "A tree sized by the surface"). The model
 // error of a cell of size h holding n samples is ~ n h^2 ~ N h^4, so for a
 // smooth density the leaf count grows like N^(1/2), not N. Uniform density
 // never splits (masses are exact areas): a mesh of T triangles is a tree of
@@ -128,7 +128,7 @@ class MeshCurveTree {
                        std::vector<std::pair<size_t, size_t>>* runs) const;
 
   // Follows the fraction t in [0, 1) of a leaf's mass down the leaf's own
-  // curve for 52 more levels (ALGORITHM.md "Inside a leaf, follow the
+  // curve for 52 more levels (docs/ALGORITHM.md "Inside a leaf, follow the
   // model"): at each level the two children share the mass by the exact
   // integrals of the cell's linear model, and t moves into the child that
   // holds it. Gives the barycentric coordinates of the final cell's centroid

@@ -1,4 +1,4 @@
-// Equalisation along the mesh curve (ALGORITHM.md step 4) and a cursor with
+// Equalisation along the mesh curve (docs/ALGORITHM.md step 4) and a cursor with
 // the contract of core's SampleCursor (core/sampler.h).
 //
 // Sample k lands in the leaf l with S_{l-1} <= q_k S_M < S_l; its fraction

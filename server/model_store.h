@@ -1,6 +1,6 @@
 // The server's store of uploaded models (CAD files and meshes), keyed by the
 // SHA-256 of their bytes, so a model travels once and every job shares it
-// and its trees (SERVICE.md). The server never opens a path a client sends:
+// and its trees (docs/SERVICE.md). The server never opens a path a client sends:
 // models reach it only through UploadModel.
 //
 // Bounded: one model may hold at most max_model_bytes (larger uploads are

@@ -1,4 +1,4 @@
-// Bearer-token authentication of the sampler RPCs (SERVICE.md, security).
+// Bearer-token authentication of the sampler RPCs (docs/SERVICE.md, security).
 //
 // TokenAuthenticator compares a presented "authorization" value with
 // "Bearer <token>" in constant time: both are hashed with SHA-256 and the

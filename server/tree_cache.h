@@ -1,4 +1,4 @@
-// The server's shared cache of curve trees (SERVICE.md, "Many jobs share one
+// The server's shared cache of curve trees (docs/SERVICE.md, "Many jobs share one
 // server").
 //
 // Keyed by the canonical text of everything that shapes a tree plus its grade.

@@ -92,7 +92,7 @@ double SphereCellMass(double u0, double h) {
 }
 
 TEST(CurveTree, LeafMassErrorsSumToWellBelowTheJitteredDiscrepancy) {
-  // ALGORITHM.md: the error summed over any run of leaves stays well below
+  // docs/ALGORITHM.md: the error summed over any run of leaves stays well below
   // N^(1/4) samples; the sum over all leaves of |error| bounds every run.
   for (uint64_t n : {uint64_t{1} << 12, uint64_t{1} << 20, uint64_t{1} << 26}) {
     const auto s = MakeSetup("sphere", "expr:1+10*u", n);

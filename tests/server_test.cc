@@ -1,6 +1,6 @@
 // The service end to end: a real sfcsampler server on a loopback port and the
 // real client library, no mocks. Checks the behaviour users rely on
-// (SERVICE.md): slices and shards, resume, the shared cache, eviction,
+// (docs/SERVICE.md): slices and shards, resume, the shared cache, eviction,
 // flow control, cancellation, and every bad input's status code.
 #include <atomic>
 #include <chrono>
