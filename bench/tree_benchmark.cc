@@ -1,4 +1,4 @@
-// Prints the README's tree table: leaves, bytes and build time of the default
+// Prints docs/MEASURED.md's tree table: leaves, bytes and build time of the default
 // tree (jittered Hilbert, default options and budget) for the sphere, the
 // torus, the eight surface with |K| density and the superellipsoid with
 // exponent 1/3 (no reparameterisation), at N = 10^4, 10^6 and 10^8, with the

@@ -566,7 +566,7 @@ class CurveTree::Builder {
 
   // Room for one more leaf, within the budget. Capacity grows by half and
   // never past the budget; PodArray grows without copying and its unwritten
-  // tail takes no memory, so the peak is about the leaves' own bytes (README).
+  // tail takes no memory, so the peak is about the leaves' own bytes (docs/MEASURED.md).
   absl::Status Grow() {
     if (starts_.size() >= options_.max_leaves) return BudgetError();
     if (starts_.size() == starts_.capacity()) {
