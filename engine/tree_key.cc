@@ -3,6 +3,7 @@
 #include "absl/strings/str_format.h"
 #include "core/area_estimator.h"
 #include "core/curve.h"
+#include "engine/sample_request.h"
 
 namespace sfc {
 
@@ -22,9 +23,11 @@ std::string TreeKey::HexWithGrade(int grade) const { return absl::StrFormat("%01
 TreeKey MakeTreeKey(const std::string& canonical_surface, const std::string& canonical_density,
                     const CurveTreeOptions& options) {
   TreeKey key;
+  // The algorithm version is part of the key: a tree of another version is
+  // another tree, in every cache and behind the proxy's hash.
   key.canonical = absl::StrFormat(
-      "surface=%s|density=%s|curve=%s|estimator=%s|tolerance=%.17g|depth_cap=%d|rho=%.17g",
-      canonical_surface, canonical_density, CurveName(options.curve),
+      "version=%s|surface=%s|density=%s|curve=%s|estimator=%s|tolerance=%.17g|depth_cap=%d|rho=%.17g",
+      kAlgorithmVersion, canonical_surface, canonical_density, CurveName(options.curve),
       AreaEstimatorName(options.estimator), options.tolerance, options.depth_cap, options.rho);
   key.hash = Fnv1a64(key.canonical);
   return key;

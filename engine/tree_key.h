@@ -12,7 +12,7 @@
 namespace sfc {
 
 struct TreeKey {
-  std::string canonical;  // "surface=...|density=...|curve=...|..."
+  std::string canonical;  // "version=...|surface=...|density=...|curve=...|..."
   uint64_t hash = 0;      // FNV-1a 64 of canonical
 
   // 16 lowercase hex digits of `hash`.
