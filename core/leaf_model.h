@@ -164,10 +164,12 @@ void PiecewiseSubSquareIntegrals(const LeafModel& model, int grid, double x0, do
 }  // namespace leaf_model_internal
 
 // The integrals over the grid x grid sub-squares of the square
-// [x0, x0 + side] x [y0, y0 + side]: out[i * grid + j] for the sub-square i
-// along x, j along y. Shares the 1D integrals, and each y row of the
-// quadratic, between sub-squares. Inline: the sampler's descent calls it once
-// per model level. REQUIRES: grid is 2 or 3 (the curves' grids).
+// [x0, x0 + side] x [y0, y0 + side] in the model's own coordinates (warped,
+// for a kQuadratic model with a power law: LeafWalk descends the leaf's curve
+// there): out[i * grid + j] for the sub-square i along x, j along y. Shares
+// the 1D integrals, and each y row of the quadratic, between sub-squares.
+// Inline: the sampler's descent calls it once per model level. REQUIRES:
+// grid is 2 or 3 (the curves' grids).
 template <int kGrid>
 inline void SubSquareIntegralsOnGrid(const LeafModel& model, LeafModel::Kind kind, double x0,
                                      double y0, double side, double out[9]) {
@@ -184,14 +186,6 @@ inline void SubSquareIntegralsOnGrid(const LeafModel& model, LeafModel::Kind kin
   for (int k = 0; k < kGrid; ++k) {
     a[k] = y0 + k * step, b[k] = y0 + (k + 1) * step;
     a[kGrid + k] = x0 + k * step, b[kGrid + k] = x0 + (k + 1) * step;
-  }
-  if (model.warp[0].power != 1 || model.warp[1].power != 1) {
-    // The model lives in warped coordinates: integrate over the images.
-    for (int k = 0; k < kGrid; ++k) {
-      a[k] = Unwarp(model.warp[1], a[k]), b[k] = Unwarp(model.warp[1], b[k]);
-      a[kGrid + k] = Unwarp(model.warp[0], a[kGrid + k]);
-      b[kGrid + k] = Unwarp(model.warp[0], b[kGrid + k]);
-    }
   }
   for (int k = 0; k < kCells; ++k) {
     d[k] = b[k] - a[k];

@@ -58,12 +58,6 @@ void LeafWalk::Enter(size_t l) {
   samples_ = leaf_mass_ / total_mass_ * grade_samples_;
 }
 
-double LeafWalk::WarpedInCell(const AxisWarp& k, double x0, double side, double fraction) {
-  if (k.power == 1) return x0 + fraction * side;
-  const double s0 = Unwarp(k, x0), s1 = Unwarp(k, x0 + side);
-  return std::clamp(Warp(k, s0 + fraction * (s1 - s0)), x0, x0 + side);
-}
-
 template <int kGrid>
 bool LeafWalk::Split(Node& node) const {
   // The children's t bounds from the model's exact integrals.
@@ -206,9 +200,8 @@ void LeafWalk::PlaceInLeaf(const double* m, size_t n, double* u, double* v,
     const double x = static_cast<double>(static_cast<int64_t>(cx));
     const double y = static_cast<double>(static_cast<int64_t>(cy));
     double px = at.x0 + (x + 0.5) * cell, py = at.y0 + (y + 0.5) * cell;
-    if (warped_) {
-      px = WarpedInCell(model_->warp[0], at.x0, at.side, (x + 0.5) * inverse_cells_);
-      py = WarpedInCell(model_->warp[1], at.y0, at.side, (y + 0.5) * inverse_cells_);
+    if (warped_) {  // the leaf's curve ran in warped coordinates
+      px = Warp(model_->warp[0], px), py = Warp(model_->warp[1], py);
     }
     u[i] = cell_.u0 + px * cell_.size;
     v[i] = cell_.v0 + py * cell_.size;

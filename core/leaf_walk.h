@@ -9,10 +9,11 @@
 // given t alike). The rest of t is followed as pure curve bits for
 // continuation_levels() more levels, and the sample sits at the centre of the
 // cell reached. In a leaf whose model is warped toward a singular line
-// (LeafModel::warp) the continuation is uniform in the warped coordinates of
-// its sub-cell, where the mass is: a negligible sub-cell against the line
-// still holds its mass piled against it, and there are many of them along a
-// line.
+// (LeafModel::warp) the leaf's curve runs in the warped coordinates, where
+// the model is smooth, and the point reached is mapped back through the warp:
+// the paper's reparameterisation (Sect. 5.3) inside one leaf. Its cells are
+// then thin strips along the line, as the mass piled against the line needs,
+// and a sub-cell too light to split holds its mass evenly.
 //
 // Coordinates handed over in non-decreasing order make this a merge: the
 // leaf advances by a forward step, and the samples of one leaf descend
@@ -69,9 +70,6 @@ class LeafWalk {
     double bounds[9];        // upper t of each child, in curve order
   };
 
-  // The point at `fraction` of [x0, x0 + side] (leaf units) in the
-  // coordinates warped by the power law k (LeafModel::warp).
-  static double WarpedInCell(const AxisWarp& k, double x0, double side, double fraction);
   // The leaf holding m: a forward step from the current one, else a search.
   size_t LeafFor(double m) const;
   // Makes l the current leaf.

@@ -111,10 +111,12 @@ TEST(LeafModel, WarpedModelFollowsAPowerLawAboutALine) {
                                  : ModelIntegral(m, LeafModel::Kind::kQuadratic, 2, b0, b1, a0, a1);
           EXPECT_NEAR(got, exact, 2e-6) << "p " << p << " c " << c << " axis " << axis;
         }
-        // The sub-squares of a small square beside the line share its
-        // integral as the density does.
+        // The sub-squares of a small square beside the line, in the warped
+        // coordinates the walk descends in, share its integral as the
+        // density does over their images.
         for (int grid : {2, 3}) {
-          const double side = 1.0 / 64, x0 = c == 1 ? 1 - side : c, y0 = 0.5;
+          const double side = 1.0 / 64, y0 = 0.5;
+          const double x0 = c == 1 ? 1 - side : WarpSplit(w);
           double out[9];
           SubSquareIntegrals(m, LeafModel::Kind::kQuadratic, grid, axis == 0 ? x0 : y0,
                              axis == 0 ? y0 : x0, side, out);
@@ -122,7 +124,7 @@ TEST(LeafModel, WarpedModelFollowsAPowerLawAboutALine) {
           for (int i = 0; i < grid; ++i) {
             for (int j = 0; j < grid; ++j) {
               const double lo = x0 + (axis == 0 ? i : j) * step;
-              const double exact = (cdf(lo + step) - cdf(lo)) * step;
+              const double exact = (cdf(Warp(w, lo + step)) - cdf(Warp(w, lo))) * step;
               EXPECT_NEAR(out[i * grid + j] / exact, 1.0, 2e-5)
                   << "p " << p << " c " << c << " axis " << axis << " grid " << grid;
             }
