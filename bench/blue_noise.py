@@ -78,6 +78,7 @@ def main():
     cli = sys.argv[1] if len(sys.argv) > 1 else "build/client/sfcsampler"
     seeds = [int(s) for s in (sys.argv[2] if len(sys.argv) > 2 else "1,2,3").split(",")]
     rows = {}
+    counts = {}
 
     def add(name, plane, sphere):
         rows.setdefault(name, []).append(plane + sphere)
@@ -94,10 +95,9 @@ def main():
         for r in (0.80, 0.70):
             p = qmc.PoissonDisk(d=2, radius=r * spacing(N, False), seed=seed).random(N)
             ds = dart_sphere(r * spacing(N, True), rng)
-            add(f"PoissonDisk r = {r:.2f} (plane {len(p)} points, sphere {len(ds)}), by N = 4096",
-                nn(p, False, N), nn(ds, True, N))
-            add(f"PoissonDisk r = {r:.2f} (plane {len(p)} points, sphere {len(ds)}), by its own count",
-                nn(p, False), nn(ds, True))
+            counts.setdefault(r, []).append(f"{len(p)}/{len(ds)}")
+            add(f"PoissonDisk r = {r:.2f}, by N = 4096", nn(p, False, N), nn(ds, True, N))
+            add(f"PoissonDisk r = {r:.2f}, by its own count", nn(p, False), nn(ds, True))
         print(f"seed {seed} done", file=sys.stderr)
     print(f"Blue noise, N = {N}, nearest-neighbour distance / hexagonal spacing, mean +- SE over seeds "
           f"{','.join(map(str, seeds))}\n")
@@ -107,6 +107,8 @@ def main():
         m = a.mean(axis=0)
         se = a.std(axis=0, ddof=1) / np.sqrt(len(a)) if len(a) > 1 else np.zeros(4)
         print(f"| {name} | " + " | ".join(f"{x:.3f} +- {e:.3f}" for x, e in zip(m, se)) + " |")
+    for r, c in counts.items():
+        print(f"\nPoissonDisk r = {r:.2f}: points reached (plane / sphere dart throwing) per seed: {', '.join(c)}")
 
 
 if __name__ == "__main__":
