@@ -124,6 +124,12 @@ class Runner {
         "| surface | density | lines u / v | slope | grid-256 slope | D at N = %d | D grid-256 | worst box (last seed) |\n"
         "|---|---|---|---:|---:|---:|---:|---|\n",
         box.sample_corners, box.random_corners, sizes.front(), sizes.back(), SeedList(o_.seeds), sizes.back()));
+    // D by N, mean of the seeds, with the grid-256 measure's in brackets.
+    std::string by_n = "\nD by N, mean of the seeds (grid-256 in brackets):\n\n| surface | density |";
+    for (uint64_t n : sizes) absl::StrAppend(&by_n, " ", n, " |");
+    absl::StrAppend(&by_n, "\n|---|---|");
+    for (size_t i = 0; i < sizes.size(); ++i) absl::StrAppend(&by_n, "---:|");
+    by_n += "\n";
     // The fast setting: the default and the reparameterised surface only.
     for (const Case& c : o_.full ? absl::MakeConstSpan(cases) : absl::MakeConstSpan(cases, 2)) {
       ASSIGN_OR_RETURN(const SurfaceFromSpec surface, MakeSurface(c.surface));
@@ -134,6 +140,7 @@ class Runner {
         return cells[std::lround(u0 * 256) * 256 + std::lround(v0 * 256)];
       };
       std::vector<double> slopes, grid_slopes, last, last_grid;
+      std::vector<double> d_sum(sizes.size(), 0), g_sum(sizes.size(), 0);
       BoxDiscrepancy worst;
       for (uint64_t seed : o_.seeds) {
         std::vector<double> ns, ds, gs;
@@ -147,14 +154,18 @@ class Runner {
           ns.push_back(static_cast<double>(n));
           ds.push_back(d.d);
           gs.push_back(ParameterRectDiscrepancy(uv, cell_mass, 256));
+          d_sum[ns.size() - 1] += d.d / o_.seeds.size();
+          g_sum[ns.size() - 1] += gs.back() / o_.seeds.size();
           worst = d;
         }
         slopes.push_back(LogLogSlope(ns, ds));
         grid_slopes.push_back(LogLogSlope(ns, gs));
         last.push_back(ds.back());
         last_grid.push_back(gs.back());
-        Log(absl::StrFormat("boxes %s with %s, seed %d: slope %.3f (grid-256 %.3f)", c.surface, c.density, seed,
-                            slopes.back(), grid_slopes.back()));
+        Log(absl::StrFormat("boxes %s with %s, seed %d: slope %.3f (grid-256 %.3f); worst box at N = %d: "
+                            "[%.6g, %.6g] x [%.6g, %.6g], %.5f of the points, %.5f of the mass",
+                            c.surface, c.density, seed, slopes.back(), grid_slopes.back(), sizes.back(), worst.u0,
+                            worst.u1, worst.v0, worst.v1, worst.point_fraction, worst.mass_fraction));
       }
       auto list = [](const std::vector<double>& x) {
         return absl::StrJoin(x, " ", [](std::string* out, double v) { absl::StrAppend(out, absl::StrFormat("%g", v)); });
@@ -163,11 +174,15 @@ class Runner {
                           c.surface, c.density, list(lines.u), list(lines.v), PlusMinus(slopes),
                           PlusMinus(grid_slopes), PlusMinus(last, "%.2e"), PlusMinus(last_grid, "%.2e"),
                           worst.u0, worst.u1, worst.v0, worst.v1, worst.point_fraction, worst.mass_fraction));
+      by_n += absl::StrFormat("| %s | %s |", c.surface, c.density);
+      for (size_t i = 0; i < sizes.size(); ++i) absl::StrAppend(&by_n, absl::StrFormat(" %.2e (%.2e) |", d_sum[i], g_sum[i]));
+      by_n += "\n";
       double mean, se;
       MeanAndStandardError(slopes, &mean, &se);
       Check(absl::StrFormat("box slope, %s with %s, N = %d..%d", c.surface, c.density, sizes.front(), sizes.back()),
             PlusMinus(slopes), c.judged ? "<= -0.70" : "", mean <= -0.70, c.judged && o_.full);
     }
+    Out(by_n);
     Out("\n");
     return absl::OkStatus();
   }
