@@ -67,6 +67,7 @@ class Runner {
   absl::Status Run() {
     if (Wants("boxes")) RETURN_IF_ERROR(Boxes());
     if (Wants("strips")) RETURN_IF_ERROR(Strips());
+    if (Wants("bands")) RETURN_IF_ERROR(Bands());
     if (Wants("mc")) RETURN_IF_ERROR(MonteCarlo());
     if (Wants("plane")) RETURN_IF_ERROR(Plane());
     if (Wants("sphere") || Wants("models")) RETURN_IF_ERROR(Spheres());
@@ -308,6 +309,68 @@ class Runner {
     return absl::OkStatus();
   }
 
+  // Section 2b: stratification beside the lines. The count in a thin band
+  // beside a line, over many seeds: its mean says whether the mass is right,
+  // its spread across seeds whether the set is still stratified there (a
+  // jittered set along the curve spreads far less than i.i.d. points).
+  absl::Status Bands() {
+    const uint64_t n = o_.full ? 24576 : 4096;
+    const int seeds = o_.full ? 8 : 4;
+    struct Band {
+      const char* name;
+      double u0, u1, v0, v1;  // in the natural angles' unit parameters
+    };
+    const Band bands[] = {
+        {"u within 3e-4 of 1/2, v in [0.1, 0.6]", 0.4997, 0.5003, 0.1, 0.6},
+        {"v within 1e-4 of 1/4, u in [0.1, 0.45]", 0.1, 0.45, 0.2499, 0.2501},
+        {"control: u in [0.30, 0.31], v in [0.1, 0.6]", 0.30, 0.31, 0.1, 0.6},
+    };
+    Out(absl::StrFormat(
+        "## Stratification beside the lines: samples in thin bands, N = %d, seeds 1..%d\n\n"
+        "Mean and standard deviation across seeds (angles from the points' coordinates). The mean checks "
+        "the mass; the spread checks that the set is still stratified there (i.i.d. points spread by "
+        "sqrt(mean)).\n\n| surface | band | mean | SD across seeds | i.i.d. SD |\n|---|---|---:|---:|---:|\n",
+        n, seeds));
+    for (const char* e_text : {"1/3", "1/4"}) {
+      double sd_of[2][3] = {};
+      int k = 0;
+      for (const std::string spec : {absl::StrCat("superellipsoid:e=", e_text),
+                                     absl::StrCat("superellipsoid:e=", e_text, ";reparam=1")}) {
+        bool plain;
+        const double e = SuperellipsoidExponent(spec, &plain);
+        std::vector<double> counts[3];
+        for (int seed = 1; seed <= seeds; ++seed) {
+          ASSIGN_OR_RETURN(const SampleBatch b, Sample(spec, "uniform", n, seed));
+          int64_t c[3] = {};
+          for (size_t i = 0; i < b.size(); ++i) {
+            const double u = SuperellipsoidLatitude(e, b.x[i], b.y[i], b.z[i]) / kPi + 0.5;
+            const double v = SuperellipsoidLongitude(e, b.x[i], b.y[i]) / (2 * kPi) + 0.5;
+            for (int j = 0; j < 3; ++j) {
+              c[j] += u >= bands[j].u0 && u < bands[j].u1 && v >= bands[j].v0 && v < bands[j].v1;
+            }
+          }
+          for (int j = 0; j < 3; ++j) counts[j].push_back(static_cast<double>(c[j]));
+        }
+        for (int j = 0; j < 3; ++j) {
+          double mean, se;
+          MeanAndStandardError(counts[j], &mean, &se);
+          sd_of[k][j] = se * std::sqrt(static_cast<double>(seeds));
+          Out(absl::StrFormat("| %s | %s | %.1f | %.1f | %.1f |\n", spec, bands[j].name, mean, sd_of[k][j],
+                              std::sqrt(mean)));
+        }
+        ++k;
+      }
+      Check(absl::StrFormat("stratification beside the lines, e = %s, N = %d: SD across %d seeds over reparam=1's "
+                            "(equator band, longitude band, control)", e_text, n, seeds),
+            absl::StrFormat("%.1f, %.1f, %.1f", sd_of[0][0] / sd_of[1][0], sd_of[0][1] / sd_of[1][1],
+                            sd_of[0][2] / sd_of[1][2]),
+            "", true, false);
+      Log(absl::StrFormat("bands e = %s done", e_text));
+    }
+    Out("\n");
+    return absl::OkStatus();
+  }
+
   // Section 3: Monte Carlo mean of x^2.
   absl::Status MonteCarlo() {
     const std::vector<uint64_t> sizes = o_.full ? std::vector<uint64_t>{10000, 100000, 1000000}
@@ -530,10 +593,10 @@ void MeanAndStandardError(const std::vector<double>& x, double* mean, double* se
 absl::StatusOr<QualityReport> RunQuality(const QualityOptions& options, const QualitySource& source) {
   if (options.seeds.empty() || options.strip_seeds.empty()) return absl::InvalidArgumentError("no seeds");
   for (const std::string& s : options.sections) {
-    static const char* const kKnown[] = {"boxes", "strips", "mc", "plane", "sphere", "models", "blue"};
+    static const char* const kKnown[] = {"boxes", "strips", "bands", "mc", "plane", "sphere", "models", "blue"};
     if (std::find(std::begin(kKnown), std::end(kKnown), s) == std::end(kKnown)) {
       return absl::InvalidArgumentError(absl::StrCat(
-          "unknown quality section \"", s, "\" (boxes strips mc plane sphere models blue)"));
+          "unknown quality section \"", s, "\" (boxes strips bands mc plane sphere models blue)"));
     }
   }
   Runner runner(options, source);

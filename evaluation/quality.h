@@ -7,6 +7,8 @@
 //    measure on the same sets next to it;
 //  - strip counts beside every singular line at N = 200 000 against the
 //    closed-form fractions (evaluation/superellipsoid_exact.h);
+//  - the spread across seeds of the counts in thin bands beside the lines
+//    (stratification), against the reparameterised surface's;
 //  - the Monte Carlo mean of x^2 against its exact value;
 //  - plane (star discrepancy, ours against 2D jittered), sphere (spherical
 //    triangles), a sphere-shaped CAD model and mesh against the built-in;
@@ -40,7 +42,7 @@ struct QualityOptions {
   bool full = false;
   std::vector<uint64_t> seeds = {1, 2, 3};             // slopes and Monte Carlo
   std::vector<uint64_t> strip_seeds = {5, 6, 7};       // strips (the seed 5 first)
-  std::vector<std::string> sections;  // empty: all of boxes strips mc plane sphere models blue
+  std::vector<std::string> sections;  // empty: all of boxes strips bands mc plane sphere models blue
   std::string step_sphere;  // model spec of a sphere (step:/tmp/fx/sphere.step); empty: skipped
   std::string mesh_sphere;  // model spec of a sphere mesh (ply:/tmp/ico.ply); empty: skipped
   std::function<void(const std::string&)> progress;  // one line per finished item

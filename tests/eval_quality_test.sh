@@ -12,7 +12,7 @@ fail() { echo "FAIL: $*"; exit 1; }
 "$cli" eval --sections quality --out-dir "$tmp/q" > "$tmp/out.md" 2> "$tmp/err.txt" || { cat "$tmp/err.txt"; fail "eval quality"; }
 [ -s "$tmp/q/quality.md" ] || fail "no quality.md"
 cmp -s "$tmp/q/quality.md" "$tmp/out.md" || [ "$(wc -c < "$tmp/q/quality.md")" -gt 1000 ] || fail "quality.md differs from stdout"
-for section in "sample-anchored boxes" "strips beside the singular lines" "Monte Carlo" "Plane, star" \
+for section in "sample-anchored boxes" "strips beside the singular lines" "Stratification beside" "Monte Carlo" "Plane, star" \
                "Sphere, spherical-triangle" "Blue noise" "## Summary"; do
   grep -q "$section" "$tmp/out.md" || fail "missing section: $section"
 done

@@ -17,7 +17,7 @@ void AddEvalQualityFlags(CLI::App* eval, EvalQualityFlags* f) {
       ->delimiter(',')
       ->capture_default_str();
   eval->add_option("--quality-sections", f->quality_sections,
-                   "subset of: boxes strips mc plane sphere models blue (default all)")
+                   "subset of: boxes strips bands mc plane sphere models blue (default all)")
       ->delimiter(',');
   eval->add_option("--quality-seeds", f->seeds, "seeds of the quality report's slopes and Monte Carlo (>= 3)")
       ->delimiter(',')
