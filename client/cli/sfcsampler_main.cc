@@ -12,6 +12,7 @@
 #include "CLI/CLI.hpp"
 #include "absl/strings/str_format.h"
 #include "catalog/catalog.h"
+#include "client/cli/eval_quality.h"
 #include "client/cli/progress.h"
 #include "client/cli/request_flags.h"
 #include "client/cli/sample_many.h"
@@ -378,6 +379,7 @@ struct EvalFlags {
   uint64_t seed = 1;
   std::string model;  // model mode: a sphere-shaped model spec against the built-in sphere
   int seeds = 2;
+  EvalQualityFlags quality;
 };
 
 // Model mode (issue 11): the spherical-triangle discrepancy of a model that is
@@ -441,6 +443,32 @@ int RunEvalModel(const EvalFlags& f, const Connection& conn) {
 
 int RunEval(const EvalFlags& f, const Connection& conn) {
   if (!f.model.empty()) return RunEvalModel(f, conn);
+  if (f.setting != "fast" && f.setting != "full") {
+    return Fail(absl::InvalidArgumentError("--setting must be fast or full"));
+  }
+  if (WantsSection(f.quality, "quality")) {
+    // Every set of the report in full, from the server or in process.
+    auto source = [&conn](const std::string& surface, const std::string& density, uint64_t count,
+                          uint64_t seed) -> absl::StatusOr<SampleBatch> {
+      SampleRequest request;
+      request.tree.surface = surface;
+      request.tree.density = density;
+      request.count = count;
+      request.seed = seed;
+      SampleBatch all;
+      Progress quiet(false);
+      std::string provenance;
+      RETURN_IF_ERROR(StreamSamples(request, conn, 0, v1::PRECISION_FLOAT64, Verbosity{true, true}, &quiet,
+                                    [&](std::optional<uint64_t>, const SampleBatch& batch) {
+                                      all.Append(batch);
+                                      return absl::OkStatus();
+                                    },
+                                    &provenance));
+      return all;
+    };
+    if (const int rc = RunEvalQuality(f.quality, f.setting == "full", f.out_dir, source); rc != 0) return rc;
+  }
+  if (!WantsSection(f.quality, "protocol")) return 0;
   ProtocolOptions options;
   std::unique_ptr<SamplerClient> client;
   if (!conn.server.empty()) {
@@ -687,6 +715,7 @@ int main(int argc, char** argv) {
                    "model mode: a sphere-shaped model (step:sphere.step, ply:icosphere.ply, ...) "
                    "against the built-in sphere, spherical-triangle discrepancy, N = 64..24576");
   eval->add_option("--seeds", eval_flags.seeds, "model mode: seeds averaged per N")->capture_default_str();
+  sfc::AddEvalQualityFlags(eval, &eval_flags.quality);
   add_connection(eval);
 
   sfc::RenderFlags render_flags;

@@ -1,0 +1,616 @@
+#include "evaluation/quality.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "absl/types/span.h"
+#include "catalog/catalog.h"
+#include "core/status_macros.h"
+#include "evaluation/blue_noise.h"
+#include "evaluation/box_discrepancy.h"
+#include "evaluation/discrepancy.h"
+#include "evaluation/reference_measure.h"
+#include "evaluation/reference_sets.h"
+#include "evaluation/superellipsoid_exact.h"
+
+namespace sfc {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+std::vector<uint64_t> Sizes(uint64_t lo, uint64_t hi) {
+  std::vector<uint64_t> out;
+  for (int l = 1; l < 40; ++l) {
+    for (uint64_t n : {uint64_t{1} << l, (uint64_t{3} << l) / 2}) {
+      if (n >= lo && n <= hi) out.push_back(n);
+    }
+  }
+  return out;
+}
+
+std::string PlusMinus(const std::vector<double>& x, const char* format = "%.3f") {
+  double m, se;
+  MeanAndStandardError(x, &m, &se);
+  return absl::StrFormat(absl::StrCat(format, " +- ", format).c_str(), m, se);
+}
+
+std::string SeedList(const std::vector<uint64_t>& seeds) { return absl::StrJoin(seeds, ","); }
+
+// The superellipsoid's exponent and whether its parameters are the default
+// ones (linear in the angles), from a catalogue spec; e = 0 if it is not one.
+double SuperellipsoidExponent(const std::string& spec, bool* plain) {
+  *plain = false;
+  if (spec.rfind("superellipsoid", 0) != 0) return 0;
+  *plain = spec.find("reparam=1") == std::string::npos;
+  const size_t at = spec.find("e=");
+  if (at == std::string::npos) return 1.0 / 3;
+  const std::string value = spec.substr(at + 2, spec.find(';', at) - at - 2);
+  const size_t slash = value.find('/');
+  return slash == std::string::npos ? std::stod(value)
+                                    : std::stod(value.substr(0, slash)) / std::stod(value.substr(slash + 1));
+}
+
+class Runner {
+ public:
+  Runner(const QualityOptions& o, const QualitySource& source) : o_(o), source_(source) {}
+
+  bool Wants(const std::string& section) const {
+    return o_.sections.empty() ||
+           std::find(o_.sections.begin(), o_.sections.end(), section) != o_.sections.end();
+  }
+
+  absl::Status Run() {
+    if (Wants("boxes")) RETURN_IF_ERROR(Boxes());
+    if (Wants("strips")) RETURN_IF_ERROR(Strips());
+    if (Wants("bands")) RETURN_IF_ERROR(Bands());
+    if (Wants("mc")) RETURN_IF_ERROR(MonteCarlo());
+    if (Wants("plane")) RETURN_IF_ERROR(Plane());
+    if (Wants("sphere") || Wants("models")) RETURN_IF_ERROR(Spheres());
+    if (Wants("blue")) RETURN_IF_ERROR(BlueNoise());
+    return absl::OkStatus();
+  }
+
+  QualityReport report;
+
+ private:
+  void Log(const std::string& line) {
+    if (o_.progress) o_.progress(line);
+  }
+  void Check(std::string name, std::string measured, std::string target, bool pass, bool judged = true) {
+    report.checks.push_back({std::move(name), std::move(measured), std::move(target),
+                             !judged ? "INFO" : pass ? "PASS" : "FAIL"});
+  }
+  void Out(const std::string& text) { absl::StrAppend(&report.tables, text); }
+
+  absl::StatusOr<SampleBatch> Sample(const std::string& surface, const std::string& density, uint64_t n,
+                                     uint64_t seed) {
+    ASSIGN_OR_RETURN(SampleBatch b, source_(surface, density, n, seed));
+    if (b.size() != n) {
+      return absl::InternalError(absl::StrFormat("%s: asked for %d samples, got %d", surface, n, b.size()));
+    }
+    return b;
+  }
+
+  // Section 1: density discrepancy on sample-anchored boxes.
+  absl::Status Boxes() {
+    struct Case {
+      const char* surface;
+      const char* density;
+      bool judged;
+    };
+    const Case cases[] = {
+        {"superellipsoid", "uniform", true},
+        {"superellipsoid:reparam=1", "uniform", false},
+        {"superellipsoid:e=1/4", "uniform", true},
+        {"superellipsoid:e=2", "uniform", true},
+        {"superellipsoid:e=3", "uniform", true},
+        {"superellipsoid", "gaussian:floor=0.1", true},
+        {"superellipsoid", "expr:u+v", true},
+    };
+    const std::vector<uint64_t> sizes = o_.full ? Sizes(64, 24576) : Sizes(64, 384);
+    BoxDiscrepancyOptions box;
+    if (!o_.full) box.sample_corners = 32, box.random_corners = 16, box.background = 16, box.random_boxes = 5000;
+    Out(absl::StrFormat(
+        "## Density discrepancy on sample-anchored boxes (graded reference)\n\n"
+        "Boxes with corners at %d sample coordinates per axis (open and closed), %d random points and a grid "
+        "graded toward the singular lines (detected: the area element blows up or vanishes); every box's mass "
+        "integrated on the box by graded Gauss-Legendre. N = %d..%d (2^l and 3 2^(l-1)), seeds %s; slope = "
+        "least squares of log D on log N per seed, then mean +- standard error. `grid-256` is the old measure "
+        "(a fixed 256 x 256 grid) on the same sets.\n\n"
+        "| surface | density | lines u / v | slope | grid-256 slope | D at N = %d | D grid-256 | worst box (last seed) |\n"
+        "|---|---|---|---:|---:|---:|---:|---|\n",
+        box.sample_corners, box.random_corners, sizes.front(), sizes.back(), SeedList(o_.seeds), sizes.back()));
+    // D by N, mean of the seeds, with the grid-256 measure's in brackets.
+    std::string by_n = "\nD by N, mean of the seeds (grid-256 in brackets):\n\n| surface | density |";
+    for (uint64_t n : sizes) absl::StrAppend(&by_n, " ", n, " |");
+    absl::StrAppend(&by_n, "\n|---|---|");
+    for (size_t i = 0; i < sizes.size(); ++i) absl::StrAppend(&by_n, "---:|");
+    by_n += "\n";
+    // The fast setting: the default and the reparameterised surface only.
+    for (const Case& c : o_.full ? absl::MakeConstSpan(cases) : absl::MakeConstSpan(cases, 2)) {
+      ASSIGN_OR_RETURN(const SurfaceFromSpec surface, MakeSurface(c.surface));
+      ASSIGN_OR_RETURN(const DensityFromSpec density, MakeDensity(c.density));
+      ASSIGN_OR_RETURN(const SingularLines lines, DetectSingularLines(*surface.surface, *density.density));
+      ASSIGN_OR_RETURN(const std::vector<double> cells, GradedCellMasses(*surface.surface, *density.density, 256, 8));
+      auto cell_mass = [&](double u0, double v0, double) {
+        return cells[std::lround(u0 * 256) * 256 + std::lround(v0 * 256)];
+      };
+      std::vector<double> slopes, grid_slopes, last, last_grid;
+      std::vector<double> d_sum(sizes.size(), 0), g_sum(sizes.size(), 0);
+      BoxDiscrepancy worst;
+      for (uint64_t seed : o_.seeds) {
+        std::vector<double> ns, ds, gs;
+        for (uint64_t n : sizes) {
+          ASSIGN_OR_RETURN(const SampleBatch b, Sample(c.surface, c.density, n, seed));
+          std::vector<Point2> uv(b.size());
+          for (size_t i = 0; i < b.size(); ++i) uv[i] = {b.u[i], b.v[i]};
+          box.seed = seed * 1000003 + n;
+          ASSIGN_OR_RETURN(const BoxDiscrepancy d,
+                           SampleAnchoredBoxDiscrepancy(*surface.surface, *density.density, lines, uv, box));
+          ns.push_back(static_cast<double>(n));
+          ds.push_back(d.d);
+          gs.push_back(ParameterRectDiscrepancy(uv, cell_mass, 256));
+          d_sum[ns.size() - 1] += d.d / o_.seeds.size();
+          g_sum[ns.size() - 1] += gs.back() / o_.seeds.size();
+          worst = d;
+        }
+        slopes.push_back(LogLogSlope(ns, ds));
+        grid_slopes.push_back(LogLogSlope(ns, gs));
+        last.push_back(ds.back());
+        last_grid.push_back(gs.back());
+        Log(absl::StrFormat("boxes %s with %s, seed %d: slope %.3f (grid-256 %.3f); worst box at N = %d: "
+                            "[%.6g, %.6g] x [%.6g, %.6g], %.5f of the points, %.5f of the mass",
+                            c.surface, c.density, seed, slopes.back(), grid_slopes.back(), sizes.back(), worst.u0,
+                            worst.u1, worst.v0, worst.v1, worst.point_fraction, worst.mass_fraction));
+      }
+      auto list = [](const std::vector<double>& x) {
+        return absl::StrJoin(x, " ", [](std::string* out, double v) { absl::StrAppend(out, absl::StrFormat("%g", v)); });
+      };
+      Out(absl::StrFormat("| %s | %s | %s / %s | %s | %s | %s | %s | [%.6g, %.6g] x [%.6g, %.6g]: %.5f of the points, %.5f of the mass |\n",
+                          c.surface, c.density, list(lines.u), list(lines.v), PlusMinus(slopes),
+                          PlusMinus(grid_slopes), PlusMinus(last, "%.2e"), PlusMinus(last_grid, "%.2e"),
+                          worst.u0, worst.u1, worst.v0, worst.v1, worst.point_fraction, worst.mass_fraction));
+      by_n += absl::StrFormat("| %s | %s |", c.surface, c.density);
+      for (size_t i = 0; i < sizes.size(); ++i) absl::StrAppend(&by_n, absl::StrFormat(" %.2e (%.2e) |", d_sum[i], g_sum[i]));
+      by_n += "\n";
+      double mean, se;
+      MeanAndStandardError(slopes, &mean, &se);
+      Check(absl::StrFormat("box slope, %s with %s, N = %d..%d", c.surface, c.density, sizes.front(), sizes.back()),
+            PlusMinus(slopes), c.judged ? "<= -0.70" : "", mean <= -0.70, c.judged && o_.full);
+    }
+    Out(by_n);
+    Out("\n");
+    return absl::OkStatus();
+  }
+
+  // Section 2: strips beside singular lines.
+  absl::Status Strips() {
+    const uint64_t n = o_.full ? 200000 : 20000;
+    const std::vector<uint64_t> seeds = o_.full ? o_.strip_seeds : std::vector<uint64_t>{o_.strip_seeds.front()};
+    const double bands[] = {0, 1e-4, 1e-3, 2e-3, 1e-2};
+    struct Case {
+      const char* surface;
+      const char* density;
+    };
+    const Case cases[] = {
+        {"superellipsoid", "uniform"},       {"superellipsoid:reparam=1", "uniform"},
+        {"superellipsoid:e=1/4", "uniform"}, {"superellipsoid:e=2", "uniform"},
+        {"superellipsoid:e=3", "uniform"},   {"superellipsoid", "gaussian:floor=0.1"},
+        {"superellipsoid", "expr:u+v"},
+    };
+    Out(absl::StrFormat(
+        "## Samples in strips beside the singular lines, N = %d, seeds %s\n\n"
+        "Distance in unit parameter of the natural angles: longitude / 2 pi to the nearest of -pi, -pi/2, 0, "
+        "pi/2 (all four lines together), |latitude| / pi for the equator, (pi/2 - |latitude|) / pi for the two "
+        "poles together. Uniform density: angles from the points' coordinates (so any parameterisation), exact "
+        "counts from the closed-form quadrature in the angles (t = w^12). Other densities: distances in (u, v), "
+        "exact from the graded box reference. Pass: every count within max(2 %% of exact, 2 sqrt(max(exact, 1))).\n\n"
+        "| surface | density | line | band | exact | counts | worst deviation / tolerance |\n"
+        "|---|---|---|---|---:|---|---:|\n",
+        n, SeedList(seeds)));
+    for (const Case& c : o_.full ? absl::MakeConstSpan(cases) : absl::MakeConstSpan(cases, 2)) {
+      bool plain;
+      const double e = SuperellipsoidExponent(c.surface, &plain);
+      const bool uniform = std::string(c.density) == "uniform";
+      // exact[family][band] as fractions.
+      double exact[3][4];
+      if (uniform) {
+        for (int b = 0; b < 4; ++b) {
+          exact[0][b] = SuperellipsoidLongitudeStripFraction(e, bands[b + 1]) -
+                        (b ? SuperellipsoidLongitudeStripFraction(e, bands[b]) : 0);
+          exact[1][b] = SuperellipsoidEquatorStripFraction(e, bands[b + 1]) -
+                        (b ? SuperellipsoidEquatorStripFraction(e, bands[b]) : 0);
+          exact[2][b] = SuperellipsoidPoleStripFraction(e, bands[b + 1]) -
+                        (b ? SuperellipsoidPoleStripFraction(e, bands[b]) : 0);
+        }
+      } else {
+        ASSIGN_OR_RETURN(const SurfaceFromSpec surface, MakeSurface(c.surface));
+        ASSIGN_OR_RETURN(const DensityFromSpec density, MakeDensity(c.density));
+        ASSIGN_OR_RETURN(const SingularLines lines, DetectSingularLines(*surface.surface, *density.density));
+        std::vector<double> ub, vb;
+        for (double d : bands) {
+          for (double l : {0.0, 0.25, 0.5, 0.75, 1.0}) vb.push_back(std::clamp(l - d, 0.0, 1.0)), vb.push_back(std::clamp(l + d, 0.0, 1.0));
+          for (double l : {0.0, 0.5, 1.0}) ub.push_back(std::clamp(l - d, 0.0, 1.0)), ub.push_back(std::clamp(l + d, 0.0, 1.0));
+        }
+        ASSIGN_OR_RETURN(const GradedBoxMeasure m,
+                         GradedBoxMeasure::Build(*surface.surface, *density.density, lines, ub, vb));
+        const size_t nu = m.u().size() - 1, nv = m.v().size() - 1;
+        auto within = [&](int family, double d) {
+          double s = 0;
+          if (family == 0) {
+            s = m.Mass(0, nu, 0, m.VIndex(d)) + m.Mass(0, nu, m.VIndex(1 - d), nv);
+            for (double l : {0.25, 0.5, 0.75}) s += m.Mass(0, nu, m.VIndex(l - d), m.VIndex(l + d));
+          } else if (family == 1) {
+            s = m.Mass(m.UIndex(0.5 - d), m.UIndex(0.5 + d), 0, nv);
+          } else {
+            s = m.Mass(0, m.UIndex(d), 0, nv) + m.Mass(m.UIndex(1 - d), nu, 0, nv);
+          }
+          return s / m.total();
+        };
+        for (int f = 0; f < 3; ++f) {
+          for (int b = 0; b < 4; ++b) exact[f][b] = within(f, bands[b + 1]) - (b ? within(f, bands[b]) : 0);
+        }
+      }
+      int64_t counts[3][4][8] = {};
+      for (size_t s = 0; s < seeds.size() && s < 8; ++s) {
+        ASSIGN_OR_RETURN(const SampleBatch batch, Sample(c.surface, c.density, n, seeds[s]));
+        for (size_t i = 0; i < batch.size(); ++i) {
+          double dist[3];
+          if (uniform) {
+            const double lon = SuperellipsoidLongitude(e, batch.x[i], batch.y[i]);
+            const double lat = SuperellipsoidLatitude(e, batch.x[i], batch.y[i], batch.z[i]);
+            const double q = std::fabs(lon) / (kPi / 2);  // quarter turns from 0
+            dist[0] = std::fabs(q - std::round(q)) / 4;
+            dist[1] = std::fabs(lat) / kPi;
+            dist[2] = (kPi / 2 - std::fabs(lat)) / kPi;
+          } else {
+            dist[0] = std::fabs(batch.v[i] * 4 - std::round(batch.v[i] * 4)) / 4;
+            dist[1] = std::fabs(batch.u[i] - 0.5);
+            dist[2] = std::min(batch.u[i], 1 - batch.u[i]);
+          }
+          for (int f = 0; f < 3; ++f) {
+            for (int b = 0; b < 4; ++b) {
+              if (dist[f] >= bands[b] && dist[f] < bands[b + 1]) ++counts[f][b][s];
+            }
+          }
+        }
+      }
+      const char* family_names[] = {"longitude", "equator", "poles"};
+      const char* band_names[] = {"< 1e-4", "1e-4..1e-3", "1e-3..2e-3", "2e-3..1e-2"};
+      for (int f = 0; f < 3; ++f) {
+        double worst_ratio = 0;
+        for (int b = 0; b < 4; ++b) {
+          const double ex = exact[f][b] * n;
+          // 2 sqrt(exact) for small counts, and never below 2 samples
+          // (beside the vanishing lines of e = 2, 3 the exact count is < 1).
+          const double tol = std::max(0.02 * ex, 2 * std::sqrt(std::max(ex, 1.0)));
+          std::string list;
+          double band_worst = 0;
+          for (size_t s = 0; s < seeds.size() && s < 8; ++s) {
+            absl::StrAppend(&list, s ? " " : "", counts[f][b][s]);
+            band_worst = std::max(band_worst, std::fabs(counts[f][b][s] - ex) / tol);
+          }
+          worst_ratio = std::max(worst_ratio, band_worst);
+          Out(absl::StrFormat("| %s | %s | %s | %s | %.0f | %s | %.2f |\n", c.surface, c.density,
+                              family_names[f], band_names[b], ex, list, band_worst));
+        }
+        Check(absl::StrFormat("strips, %s with %s, %s lines, N = %d", c.surface, c.density, family_names[f], n),
+              absl::StrFormat("worst |count - exact| / tolerance = %.2f", worst_ratio), "<= 1 (every band, seed)",
+              worst_ratio <= 1, o_.full);
+      }
+      Log(absl::StrFormat("strips %s with %s done", c.surface, c.density));
+    }
+    Out("\n");
+    return absl::OkStatus();
+  }
+
+  // Section 2b: stratification beside the lines. The count in a thin band
+  // beside a line, over many seeds: its mean says whether the mass is right,
+  // its spread across seeds whether the set is still stratified there (a
+  // jittered set along the curve spreads far less than i.i.d. points).
+  absl::Status Bands() {
+    const uint64_t n = o_.full ? 24576 : 4096;
+    const int seeds = o_.full ? 8 : 4;
+    struct Band {
+      const char* name;
+      double u0, u1, v0, v1;  // in the natural angles' unit parameters
+    };
+    const Band bands[] = {
+        {"u within 3e-4 of 1/2, v in [0.1, 0.6]", 0.4997, 0.5003, 0.1, 0.6},
+        {"v within 1e-4 of 1/4, u in [0.1, 0.45]", 0.1, 0.45, 0.2499, 0.2501},
+        {"control: u in [0.30, 0.31], v in [0.1, 0.6]", 0.30, 0.31, 0.1, 0.6},
+    };
+    Out(absl::StrFormat(
+        "## Stratification beside the lines: samples in thin bands, N = %d, seeds 1..%d\n\n"
+        "Mean and standard deviation across seeds (angles from the points' coordinates). The mean checks "
+        "the mass; the spread checks that the set is still stratified there (i.i.d. points spread by "
+        "sqrt(mean)).\n\n| surface | band | mean | SD across seeds | i.i.d. SD |\n|---|---|---:|---:|---:|\n",
+        n, seeds));
+    for (const char* e_text : {"1/3", "1/4"}) {
+      double sd_of[2][3] = {};
+      int k = 0;
+      for (const std::string spec : {absl::StrCat("superellipsoid:e=", e_text),
+                                     absl::StrCat("superellipsoid:e=", e_text, ";reparam=1")}) {
+        bool plain;
+        const double e = SuperellipsoidExponent(spec, &plain);
+        std::vector<double> counts[3];
+        for (int seed = 1; seed <= seeds; ++seed) {
+          ASSIGN_OR_RETURN(const SampleBatch b, Sample(spec, "uniform", n, seed));
+          int64_t c[3] = {};
+          for (size_t i = 0; i < b.size(); ++i) {
+            const double u = SuperellipsoidLatitude(e, b.x[i], b.y[i], b.z[i]) / kPi + 0.5;
+            const double v = SuperellipsoidLongitude(e, b.x[i], b.y[i]) / (2 * kPi) + 0.5;
+            for (int j = 0; j < 3; ++j) {
+              c[j] += u >= bands[j].u0 && u < bands[j].u1 && v >= bands[j].v0 && v < bands[j].v1;
+            }
+          }
+          for (int j = 0; j < 3; ++j) counts[j].push_back(static_cast<double>(c[j]));
+        }
+        for (int j = 0; j < 3; ++j) {
+          double mean, se;
+          MeanAndStandardError(counts[j], &mean, &se);
+          sd_of[k][j] = se * std::sqrt(static_cast<double>(seeds));
+          Out(absl::StrFormat("| %s | %s | %.1f | %.1f | %.1f |\n", spec, bands[j].name, mean, sd_of[k][j],
+                              std::sqrt(mean)));
+        }
+        ++k;
+      }
+      Check(absl::StrFormat("stratification beside the lines, e = %s, N = %d: SD across %d seeds over reparam=1's "
+                            "(equator band, longitude band, control)", e_text, n, seeds),
+            absl::StrFormat("%.1f, %.1f, %.1f", sd_of[0][0] / sd_of[1][0], sd_of[0][1] / sd_of[1][1],
+                            sd_of[0][2] / sd_of[1][2]),
+            "", true, false);
+      Log(absl::StrFormat("bands e = %s done", e_text));
+    }
+    Out("\n");
+    return absl::OkStatus();
+  }
+
+  // Section 3: Monte Carlo mean of x^2.
+  absl::Status MonteCarlo() {
+    const std::vector<uint64_t> sizes = o_.full ? std::vector<uint64_t>{10000, 100000, 1000000}
+                                                : std::vector<uint64_t>{10000};
+    const char* surfaces[] = {"superellipsoid", "superellipsoid:reparam=1", "superellipsoid:e=1/4"};
+    const size_t count = o_.full ? 3 : 2;
+    Out(absl::StrFormat(
+        "## Monte Carlo: the mean of x^2 over the surface (uniform density), error per seed (seeds %s)\n\n"
+        "| surface | exact | N | errors |\n|---|---:|---:|---|\n",
+        SeedList(o_.seeds)));
+    for (const char* spec : absl::MakeConstSpan(surfaces, count)) {
+      bool plain;
+      const double e = SuperellipsoidExponent(spec, &plain);
+      const double exact = SuperellipsoidMeanX2(e);
+      double worst_last = 0;
+      for (uint64_t n : sizes) {
+        std::string list;
+        for (uint64_t seed : o_.seeds) {
+          ASSIGN_OR_RETURN(const SampleBatch b, Sample(spec, "uniform", n, seed));
+          double sum = 0;
+          for (size_t i = 0; i < b.size(); ++i) sum += b.x[i] * b.x[i];
+          const double err = sum / n - exact;
+          absl::StrAppend(&list, list.empty() ? "" : " ", absl::StrFormat("%+.2e", err));
+          if (n == sizes.back()) worst_last = std::max(worst_last, std::fabs(err));
+        }
+        Out(absl::StrFormat("| %s | %.7f | %d | %s |\n", spec, exact, n, list));
+      }
+      Check(absl::StrFormat("Monte Carlo x^2, %s, N = %d", spec, sizes.back()),
+            absl::StrFormat("worst |error| %.2e", worst_last), "< 1e-5 in every seed", worst_last < 1e-5,
+            o_.full && std::string(spec) != "superellipsoid:reparam=1");
+      Log(absl::StrFormat("Monte Carlo %s done", spec));
+    }
+    Out("\n");
+    return absl::OkStatus();
+  }
+
+  // Section 4: the plane, ours against 2D jittered (star discrepancy).
+  absl::Status Plane() {
+    const std::vector<uint64_t> sizes = o_.full ? Sizes(64, 24576) : Sizes(64, 768);
+    std::vector<double> ours, jit, ours_last, jit_last;
+    for (uint64_t seed : o_.seeds) {
+      std::vector<double> ns, d1, d2;
+      for (uint64_t n : sizes) {
+        ASSIGN_OR_RETURN(const SampleBatch b, Sample("plane", "uniform", n, seed));
+        std::vector<Point2> pts(b.size());
+        for (size_t i = 0; i < b.size(); ++i) pts[i] = {b.u[i], b.v[i]};
+        ns.push_back(static_cast<double>(n));
+        d1.push_back(StarDiscrepancy(pts, 2048));
+        d2.push_back(StarDiscrepancy(JitteredSquare(n, seed), 2048));
+      }
+      ours.push_back(LogLogSlope(ns, d1));
+      jit.push_back(LogLogSlope(ns, d2));
+      ours_last.push_back(d1.back());
+      jit_last.push_back(d2.back());
+    }
+    Out(absl::StrFormat(
+        "## Plane, star discrepancy (anchored boxes, corners at 2048 point coordinates), N = %d..%d, seeds %s\n\n"
+        "| set | slope | D at N = %d |\n|---|---:|---:|\n| ours (hilbert-jittered) | %s | %s |\n"
+        "| 2D jittered | %s | %s |\n\n",
+        sizes.front(), sizes.back(), SeedList(o_.seeds), sizes.back(), PlusMinus(ours),
+        PlusMinus(ours_last, "%.2e"), PlusMinus(jit), PlusMinus(jit_last, "%.2e")));
+    double m1, s1, m2, s2;
+    MeanAndStandardError(ours, &m1, &s1);
+    MeanAndStandardError(jit, &m2, &s2);
+    Check(absl::StrFormat("plane star-discrepancy slope, ours vs 2D jittered (%s), N = %d..%d", PlusMinus(jit),
+                          sizes.front(), sizes.back()),
+          PlusMinus(ours), "<= jittered + 2 SE", m1 <= m2 + 2 * std::hypot(s1, s2), o_.full);
+    Log("plane done");
+    return absl::OkStatus();
+  }
+
+  // Spherical-triangle slopes of one sphere-shaped set source, per seed.
+  absl::StatusOr<std::vector<double>> SphereSlopes(const std::string& spec, const std::vector<uint64_t>& sizes,
+                                                   std::vector<double>* last) {
+    std::vector<double> slopes;
+    for (uint64_t seed : o_.seeds) {
+      std::vector<double> ns, ds;
+      for (uint64_t n : sizes) {
+        ASSIGN_OR_RETURN(const SampleBatch b, Sample(spec, "uniform", n, seed));
+        // Projected onto the unit sphere about the centre of the bounding
+        // box (a model's sphere may be anywhere, of any radius).
+        Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+        for (size_t i = 0; i < b.size(); ++i) {
+          lo = {std::min(lo.x, b.x[i]), std::min(lo.y, b.y[i]), std::min(lo.z, b.z[i])};
+          hi = {std::max(hi.x, b.x[i]), std::max(hi.y, b.y[i]), std::max(hi.z, b.z[i])};
+        }
+        const Vec3 centre = spec == "sphere" ? Vec3{0, 0, 0} : (lo + hi) * 0.5;
+        std::vector<Vec3> pts(b.size());
+        for (size_t i = 0; i < b.size(); ++i) {
+          const Vec3 d = Vec3{b.x[i], b.y[i], b.z[i]} - centre;
+          pts[i] = d * (1 / Norm(d));
+        }
+        ns.push_back(static_cast<double>(n));
+        ds.push_back(SphericalTriangleDiscrepancy(pts, 128, seed));
+      }
+      slopes.push_back(LogLogSlope(ns, ds));
+      if (last) last->push_back(ds.back());
+    }
+    return slopes;
+  }
+
+  // Section 5: the sphere, and sphere-shaped models against it.
+  absl::Status Spheres() {
+    const uint64_t top = o_.full ? 24576 : 768, mesh_top = o_.full ? 6144 : 768;
+    const std::vector<uint64_t> sizes = Sizes(64, top), mesh_sizes = Sizes(64, mesh_top);
+    Out(absl::StrFormat(
+        "## Sphere, spherical-triangle discrepancy (128 random triangles per seed), seeds %s\n\n"
+        "| set | N | slope | D at the largest N |\n|---|---|---:|---:|\n",
+        SeedList(o_.seeds)));
+    std::vector<double> last;
+    ASSIGN_OR_RETURN(const std::vector<double> sphere, SphereSlopes("sphere", sizes, &last));
+    Out(absl::StrFormat("| built-in sphere | %d..%d | %s | %s |\n", sizes.front(), sizes.back(), PlusMinus(sphere),
+                        PlusMinus(last, "%.2e")));
+    double ms, ss;
+    MeanAndStandardError(sphere, &ms, &ss);
+    if (Wants("sphere")) {
+      Check(absl::StrFormat("sphere spherical-triangle slope, N = %d..%d", sizes.front(), sizes.back()),
+            PlusMinus(sphere), "<= -0.73", ms <= -0.73, o_.full);
+    }
+    if (Wants("models") && !o_.step_sphere.empty()) {
+      last.clear();
+      ASSIGN_OR_RETURN(const std::vector<double> step, SphereSlopes(o_.step_sphere, sizes, &last));
+      Out(absl::StrFormat("| %s | %d..%d | %s | %s |\n", o_.step_sphere, sizes.front(), sizes.back(),
+                          PlusMinus(step), PlusMinus(last, "%.2e")));
+      double m, s;
+      MeanAndStandardError(step, &m, &s);
+      Check(absl::StrFormat("CAD sphere (%s) slope against the built-in (%s), N = %d..%d", o_.step_sphere,
+                            PlusMinus(sphere), sizes.front(), sizes.back()),
+            PlusMinus(step), "within 0.01 of the built-in", std::fabs(m - ms) <= 0.01, o_.full);
+    }
+    if (Wants("models") && !o_.mesh_sphere.empty()) {
+      last.clear();
+      ASSIGN_OR_RETURN(const std::vector<double> builtin, SphereSlopes("sphere", mesh_sizes, &last));
+      Out(absl::StrFormat("| built-in sphere | %d..%d | %s | %s |\n", mesh_sizes.front(), mesh_sizes.back(),
+                          PlusMinus(builtin), PlusMinus(last, "%.2e")));
+      last.clear();
+      ASSIGN_OR_RETURN(const std::vector<double> mesh, SphereSlopes(o_.mesh_sphere, mesh_sizes, &last));
+      Out(absl::StrFormat("| %s | %d..%d | %s | %s |\n", o_.mesh_sphere, mesh_sizes.front(), mesh_sizes.back(),
+                          PlusMinus(mesh), PlusMinus(last, "%.2e")));
+      double mb, sb, mm, sm;
+      MeanAndStandardError(builtin, &mb, &sb);
+      MeanAndStandardError(mesh, &mm, &sm);
+      Check(absl::StrFormat("mesh sphere (%s) slope against the built-in (%s), N = %d..%d", o_.mesh_sphere,
+                            PlusMinus(builtin), mesh_sizes.front(), mesh_sizes.back()),
+            PlusMinus(mesh), "within 0.01 of the built-in", std::fabs(mm - mb) <= 0.01, o_.full);
+    }
+    Out("\n");
+    Log("sphere done");
+    return absl::OkStatus();
+  }
+
+  // Section 6: blue-noise figures at N = 4096 (a measurement, no target).
+  absl::Status BlueNoise() {
+    const uint64_t n = 4096;
+    const std::vector<uint64_t> seeds = o_.full ? o_.seeds : std::vector<uint64_t>{o_.seeds.front()};
+    Out(absl::StrFormat(
+        "## Blue noise, N = %d: nearest-neighbour distance relative to hexagonal packing (min / mean), seeds %s\n\n"
+        "Plane: Euclidean in the unit square. Sphere: chord on the unit sphere; the square's sets mapped by "
+        "z = 1 - 2x, phi = 2 pi y. Dart throwing with radius 0.75 of the hexagonal spacing (0.80 jams near 3 860 points) is the Poisson-disk "
+        "reference here; bench/blue_noise.py gives scipy's qmc.PoissonDisk.\n\n"
+        "| set | plane min | plane mean | sphere min | sphere mean |\n|---|---:|---:|---:|---:|\n",
+        n, SeedList(seeds)));
+    std::map<std::string, std::vector<double>> f[4];
+    const char* names[] = {"ours (hilbert-jittered)", "2D jittered", "scrambled Sobol (Owen)", "dart throwing r = 0.75"};
+    for (uint64_t seed : seeds) {
+      ASSIGN_OR_RETURN(const SampleBatch plane, Sample("plane", "uniform", n, seed));
+      ASSIGN_OR_RETURN(const SampleBatch sphere, Sample("sphere", "uniform", n, seed));
+      std::vector<Point2> ours(n);
+      std::vector<Vec3> ours_s(n);
+      for (size_t i = 0; i < n; ++i) ours[i] = {plane.u[i], plane.v[i]}, ours_s[i] = {sphere.x[i], sphere.y[i], sphere.z[i]};
+      const std::vector<Point2> jit = JitteredSquare(n, seed), sob = ScrambledSobolSquare(n, seed);
+      const std::vector<Point2> dart = DartThrowingSquare(n, 0.75, seed);
+      const std::vector<Vec3> dart_s = DartThrowingSphere(n, 0.75, seed);
+      const NearestNeighbour p[] = {PlaneNearestNeighbour(ours), PlaneNearestNeighbour(jit),
+                                    PlaneNearestNeighbour(sob), PlaneNearestNeighbour(dart)};
+      const NearestNeighbour s[] = {SphereNearestNeighbour(ours_s), SphereNearestNeighbour(SquareToSphere(jit)),
+                                    SphereNearestNeighbour(SquareToSphere(sob)), SphereNearestNeighbour(dart_s)};
+      for (int k = 0; k < 4; ++k) {
+        f[0][names[k]].push_back(p[k].min);
+        f[1][names[k]].push_back(p[k].mean);
+        f[2][names[k]].push_back(s[k].min);
+        f[3][names[k]].push_back(s[k].mean);
+      }
+    }
+    for (const char* name : names) {
+      Out(absl::StrFormat("| %s | %s | %s | %s | %s |\n", name, PlusMinus(f[0][name]), PlusMinus(f[1][name]),
+                          PlusMinus(f[2][name]), PlusMinus(f[3][name])));
+      Check(absl::StrFormat("blue noise N = 4096, %s: plane min / mean, sphere min / mean", name),
+            absl::StrFormat("%.2f / %.2f, %.2f / %.2f", Mean(f[0][name]), Mean(f[1][name]), Mean(f[2][name]),
+                            Mean(f[3][name])),
+            "", true, false);
+    }
+    Out("\n");
+    Log("blue noise done");
+    return absl::OkStatus();
+  }
+
+  static double Mean(const std::vector<double>& x) {
+    double m, se;
+    MeanAndStandardError(x, &m, &se);
+    return m;
+  }
+
+  const QualityOptions& o_;
+  const QualitySource& source_;
+};
+
+}  // namespace
+
+void MeanAndStandardError(const std::vector<double>& x, double* mean, double* se) {
+  const size_t n = x.size();
+  double s = 0;
+  for (double v : x) s += v;
+  *mean = n ? s / n : 0;
+  double ss = 0;
+  for (double v : x) ss += (v - *mean) * (v - *mean);
+  *se = n > 1 ? std::sqrt(ss / (n - 1) / n) : 0;
+}
+
+absl::StatusOr<QualityReport> RunQuality(const QualityOptions& options, const QualitySource& source) {
+  if (options.seeds.empty() || options.strip_seeds.empty()) return absl::InvalidArgumentError("no seeds");
+  for (const std::string& s : options.sections) {
+    static const char* const kKnown[] = {"boxes", "strips", "bands", "mc", "plane", "sphere", "models", "blue"};
+    if (std::find(std::begin(kKnown), std::end(kKnown), s) == std::end(kKnown)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "unknown quality section \"", s, "\" (boxes strips bands mc plane sphere models blue)"));
+    }
+  }
+  Runner runner(options, source);
+  RETURN_IF_ERROR(runner.Run());
+  return std::move(runner.report);
+}
+
+std::string QualitySummary(const std::vector<QualityCheck>& checks) {
+  std::string out = "| check | measured | target | verdict |\n|---|---|---|---|\n";
+  for (const QualityCheck& c : checks) {
+    absl::StrAppend(&out, "| ", c.name, " | ", c.measured, " | ", c.target, " | ",
+                    c.verdict == "FAIL" ? "**FAIL**" : c.verdict, " |\n");
+  }
+  return out;
+}
+
+}  // namespace sfc

@@ -1,0 +1,58 @@
+// Blue-noise figures and their reference sets (evaluation/blue_noise.h).
+#include "evaluation/blue_noise.h"
+
+#include <cmath>
+
+#include "evaluation/reference_sets.h"
+#include "gtest/gtest.h"
+
+namespace sfc {
+namespace {
+
+TEST(BlueNoise, HexagonalLatticeScoresOne) {
+  // A hexagonal lattice of spacing d fills the square with ~2 / (sqrt 3 d^2)
+  // points; its nearest neighbours are all at d.
+  const double d = 0.02;
+  std::vector<Point2> pts;
+  for (int row = 0; row * d * std::sqrt(3.0) / 2 < 1; ++row) {
+    for (double x = (row % 2) * d / 2; x < 1; x += d) pts.push_back({x, row * d * std::sqrt(3.0) / 2});
+  }
+  const NearestNeighbour nn = PlaneNearestNeighbour(pts);
+  // The spacing for this many points differs from d only by the lattice's
+  // boundary rows and columns.
+  EXPECT_NEAR(nn.min, nn.mean, 1e-9);
+  EXPECT_NEAR(nn.min, 1, 0.03);
+}
+
+TEST(BlueNoise, DartThrowingKeepsItsRadius) {
+  const std::vector<Point2> p = DartThrowingSquare(2000, 0.7, 3);
+  ASSERT_EQ(p.size(), 2000u);
+  EXPECT_GE(PlaneNearestNeighbour(p).min, 0.7);
+  const std::vector<Vec3> s = DartThrowingSphere(2000, 0.7, 3);
+  ASSERT_EQ(s.size(), 2000u);
+  EXPECT_GE(SphereNearestNeighbour(s).min, 0.7);
+  // Jittered points come much closer.
+  EXPECT_LT(PlaneNearestNeighbour(JitteredSquare(2000, 3)).min, 0.4);
+}
+
+TEST(BlueNoise, ScrambledSobolIsStillANet) {
+  // Owen scrambling keeps the (0, m, 2)-net property: every elementary box
+  // of area 2^-m holds exactly one of the first 2^m points.
+  const int m = 8;
+  for (uint64_t seed : {1, 2}) {
+    const std::vector<Point2> p = ScrambledSobolSquare(1 << m, seed);
+    for (int i = 0; i <= m; ++i) {
+      std::vector<int> count(1 << m, 0);
+      for (const Point2& q : p) {
+        const int a = static_cast<int>(q.x * (1 << i)), b = static_cast<int>(q.y * (1 << (m - i)));
+        ++count[(a << (m - i)) + b];
+      }
+      for (int c : count) ASSERT_EQ(c, 1) << "seed " << seed << ", " << i << " x-bits";
+    }
+    // And it is not the unscrambled set.
+    EXPECT_NE(p[1].x, SobolSquare(2)[1].x);
+  }
+}
+
+}  // namespace
+}  // namespace sfc
