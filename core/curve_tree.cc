@@ -493,6 +493,13 @@ class CurveTree::Builder {
       fail = FailGrade(error, eval.mass, base_, options_.rho);
       // The paper's flatness test, for leaves that carry a whole sample.
       int flat = SamplesGrade(eval.mass, base_, kFlatnessFloor, 0.5);
+      // Beside a line where the area element blows up (a warp with power
+      // above 1) the mapped probes spread like h^(1 + p), p < 0, and the test
+      // would split down to the sample floors: many small leaves, each a
+      // separate square the line's thin bands cut across, which loses the
+      // stratification the warped curve gives (docs/ALGORITHM.md, "Singular
+      // parameterisations"). The model error test governs those leaves.
+      if (eval.warp[0].power > 1 || eval.warp[1].power > 1) flat = kNeverFails;
       if (flat <= grade_) {
         ASSIGN_OR_RETURN(const double spread, CellSpread(x * h, y * h, h));
         if (!(spread > options_.tolerance)) {

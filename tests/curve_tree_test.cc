@@ -144,29 +144,38 @@ TEST(CurveTree, LeafBudgetIsResourceExhausted) {
 }
 
 TEST(CurveTree, DepthCapHitsAreReportedWithPlaceAndExcess) {
-  // The superellipsoid with e = 1/3 is the paper's precision-limit example.
+  // A torus asked for a tolerance that depth 5 cannot reach.
   CurveTreeOptions options;
-  options.depth_cap = 8;
-  options.tolerance = 0.05;
-  const auto s = MakeSetup("superellipsoid", "uniform", 1000, options);
+  options.depth_cap = 5;
+  options.tolerance = 0.01;
+  const auto s = MakeSetup("torus", "uniform", 1000, options);
   const PrecisionReport& report = s.tree->precision();
   EXPECT_GT(report.geometry_capped_leaves, 0u);
   ASSERT_FALSE(report.worst.empty());
   const DepthCapHit& worst = report.worst.front();
   EXPECT_GT(worst.measured, worst.limit);
-  EXPECT_DOUBLE_EQ(worst.size, std::ldexp(1.0, -8));
+  EXPECT_DOUBLE_EQ(worst.size, std::ldexp(1.0, -5));
   for (size_t i = 1; i < report.worst.size(); ++i) {
     EXPECT_GE(report.worst[i - 1].measured / report.worst[i - 1].limit,
               report.worst[i].measured / report.worst[i].limit);
   }
-  // With the power-law reparameterisation the same cap leaves fewer cells
-  // short, and none by as much.
-  const auto r = MakeSetup("superellipsoid:reparam=1", "uniform", 1000, options);
-  const PrecisionReport& rr = r.tree->precision();
-  EXPECT_LT(rr.geometry_capped_leaves, report.geometry_capped_leaves);
-  if (!rr.worst.empty()) {
-    EXPECT_LT(rr.worst.front().measured, worst.measured);
-  }
+}
+
+TEST(CurveTree, LeavesBesideALineWhereTheAreaBlowsUpAreLeftToTheErrorTest) {
+  // The paper's precision-limit example: beside the superellipsoid's lines
+  // the mapped probes spread like h^(1/3), so the flatness test alone would
+  // split to the cap. The warped leaves there are judged by their model's
+  // error instead, and the tree is at most two levels deeper than with the
+  // paper's manual reparameterisation u = u'^3 (the flatness test took it to
+  // depth 13 at this N).
+  CurveTreeOptions options;
+  options.depth_cap = 8;
+  options.tolerance = 0.05;
+  const auto s = MakeSetup("superellipsoid", "uniform", 1000, options);
+  EXPECT_EQ(s.tree->precision().geometry_capped_leaves, 0u);
+  const auto plain = MakeSetup("superellipsoid", "uniform", 24576);
+  const auto reparam = MakeSetup("superellipsoid:reparam=1", "uniform", 24576);
+  EXPECT_LE(plain.tree->max_depth(), reparam.tree->max_depth() + 2);
 }
 
 TEST(CurveTree, BadInputIsInvalidArgument) {
