@@ -1,9 +1,8 @@
 // The curve through a triangle mesh and the mass along it (docs/ALGORITHM.md
 // steps 1-2, carried from the parameter square to a mesh).
 //
-// The curve. Triangles are visited in the 3D Hilbert order of their
-// centroids (Skilling 2004; core/hilbert3d.h; 2^21 cells per
-// axis), so consecutive
+// The curve. Triangles are visited in the order of recursive bisection by
+// area (mesh/triangle_order.h), so consecutive
 // triangles are close in space, and each triangle carries its own
 // Sierpinski-type curve: its first split is at the midpoint of its longest
 // edge, whose two ends are the curve's entry and exit (the exit is the end
@@ -15,7 +14,7 @@
 // so cells shrink evenly (diameter ~ 2^(-depth/2)). Each split is an affine
 // map of barycentric coordinates: no lengths are compared below the root, and
 // a sample's descent costs a few flops per level. We chose this over a walk
-// across neighbouring triangles because the Hilbert order needs no
+// across neighbouring triangles because the bisection order needs no
 // connectivity (non-manifold and disconnected meshes work alike), and over
 // the mesh's UV atlas (Quinn, Langbein, Martin 2007) because most files have
 // none and atlases have seams.
