@@ -18,6 +18,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "cad/model.h"
+#include "cad/preflight.h"
 
 namespace sfc::cad {
 
@@ -35,12 +36,19 @@ struct LoadOptions {
   // box's larger side (points this close to a trim curve count as inside).
   // Default 1e-9.
   double trim_tolerance = 1e-9;
+  // What the kernel's readers are spared (cad/preflight.h).
+  PreflightLimits preflight;
 };
 
 // Reads a model from `bytes`. `name` names the input in every error message
-// (e.g. the file name the user gave). Errors:
+// (e.g. the file name the user gave); it is escaped and clipped there
+// (util/echo.h), as is every piece of the input a message quotes. Errors:
 //   RESOURCE_EXHAUSTED  bytes.size() > options.max_bytes;
-//   INVALID_ARGUMENT    unreadable or truncated STEP/IGES, a model without
+//   INVALID_ARGUMENT    a STEP/IGES past a PreflightLimits limit (nesting,
+//                       entities, record or line length); face entities of
+//                       the file that did not become faces, or errors the
+//                       reader reported while loading it (nothing is dropped
+//                       silently); unreadable or truncated STEP/IGES, a model without
 //                       faces, an unbounded face, non-finite geometry, a
 //                       malformed NURBS patch (knots, multiplicities,
 //                       weights, counts, NaN);
