@@ -1,6 +1,7 @@
 #include "server/model_store.h"
 
 #include "absl/strings/str_format.h"
+#include "util/echo.h"
 
 namespace sfc {
 
@@ -14,12 +15,14 @@ absl::StatusOr<StoredModel> ModelStore::Put(ModelFormat format, std::string byte
     return absl::ResourceExhaustedError(absl::StrFormat(
         "the model \"%s\" is %d bytes, more than this server takes (max_model_bytes %d, model "
         "budget %d); simplify or split it, or ask the operator to raise the limit",
-        name, bytes.size(), std::min(max_model_bytes_, budget_bytes_), budget_bytes_));
+        Echo(name, kMaxNameEcho), bytes.size(), std::min(max_model_bytes_, budget_bytes_),
+        budget_bytes_));
   }
   StoredModel model;
   model.format = format;
   model.sha256 = Sha256Hex(bytes);
-  model.name = name;
+  // No name is kept: the model is shared by every client that sends these
+  // bytes, and one client's file name must not show in another's errors.
   absl::MutexLock lock(&mu_);
   if (auto it = entries_.find(model.sha256); it != entries_.end()) {
     lru_.splice(lru_.begin(), lru_, it->second.lru);

@@ -38,7 +38,8 @@ class ModelStore final : public ModelSource {
 
   // Stores `bytes` as a model of `format` (or finds it stored). `already`
   // says whether it was. RESOURCE_EXHAUSTED past max_model_bytes or the
-  // budget.
+  // budget. `name` (this upload's) appears only in this call's error: stored
+  // models have no name, so errors about them name format and hash.
   absl::StatusOr<StoredModel> Put(ModelFormat format, std::string bytes, const std::string& name,
                                   bool* already = nullptr) ABSL_LOCKS_EXCLUDED(mu_);
 

@@ -7,6 +7,7 @@
 #include "core/status_macros.h"
 #include "proto/convert.h"
 #include "server/message_pipeline.h"
+#include "util/echo.h"
 #include "spdlog/spdlog.h"
 
 namespace sfc {
@@ -120,8 +121,9 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
   }
   metrics_->CountRequest("Sample", status.error_code());
   spdlog::info("rpc=Sample peer={} surface=\"{}\" count={} sent={} seconds={:.3f} code={} msg=\"{}\"",
-               context->peer(), request->tree().surface(), request->count(), sent,
-               SecondsSince(start), static_cast<int>(status.error_code()), status.error_message());
+               Echo(context->peer()), Echo(request->tree().surface(), kMaxNameEcho),
+               request->count(), sent, SecondsSince(start), static_cast<int>(status.error_code()),
+               Echo(status.error_message(), kMaxStatusMessageBytes));
   return status;
 }
 
@@ -234,8 +236,8 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
     if (!item->response) {
       const absl::Status& s = item->status;
       if (s.ok()) break;
-      return grpc::Status(static_cast<grpc::StatusCode>(s.code()),
-                          absl::StrFormat("%s (after %d samples were sent)", s.message(), *sent));
+      return ToGrpcStatus(absl::Status(
+          s.code(), absl::StrFormat("%s (after %d samples were sent)", s.message(), *sent)));
     }
     if (first) {
       *item->response->mutable_header() = std::move(header);
@@ -276,9 +278,10 @@ grpc::Status SamplerService::Prepare(grpc::ServerContext* context, const v1::Pre
   }
   metrics_->CountRequest("Prepare", status.error_code());
   spdlog::info("rpc=Prepare peer={} surface=\"{}\" count={} hit={} seconds={:.3f} code={} msg=\"{}\"",
-               context->peer(), request->tree().surface(), request->count(),
-               response->tree().cache_hit(), SecondsSince(start),
-               static_cast<int>(status.error_code()), status.error_message());
+               Echo(context->peer()), Echo(request->tree().surface(), kMaxNameEcho),
+               request->count(), response->tree().cache_hit(), SecondsSince(start),
+               static_cast<int>(status.error_code()),
+               Echo(status.error_message(), kMaxStatusMessageBytes));
   return status;
 }
 
@@ -370,13 +373,15 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
     bool first = true;
     while (status.ok() && reader->Read(&chunk)) {
       if (first) {
-        name = chunk.name();
+        // The name is the client's: escaped and clipped before any message
+        // or log line shows it, and never stored (the model is shared).
+        name = Echo(chunk.name(), kMaxNameEcho);
         format = ModelFormatFromName(chunk.format());
         if (!format) {
           status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
                                 absl::StrFormat("unknown model format \"%s\"; use step, iges, nurbs, "
                                                 "obj or ply",
-                                                chunk.format()));
+                                                Echo(chunk.format())));
         }
         first = false;
       }
@@ -407,8 +412,10 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
   }
   metrics_->CountRequest("UploadModel", status.error_code());
   spdlog::info("rpc=UploadModel peer={} name=\"{}\" bytes={} sha256={} already={} seconds={:.3f} code={} msg=\"{}\"",
-               context->peer(), name, response->bytes(), response->sha256(), response->already_stored(),
-               SecondsSince(start), static_cast<int>(status.error_code()), status.error_message());
+               Echo(context->peer()), name, response->bytes(), response->sha256(),
+               response->already_stored(), SecondsSince(start),
+               static_cast<int>(status.error_code()),
+               Echo(status.error_message(), kMaxStatusMessageBytes));
   return status;
 }
 
@@ -422,7 +429,7 @@ grpc::Status SamplerService::FindModel(grpc::ServerContext* context, const v1::F
       status = ToGrpcStatus(spec.status());
     } else if (!spec->has_value()) {
       status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                            absl::StrFormat("unknown model format \"%s\"", format));
+                            absl::StrFormat("unknown model format \"%s\"", Echo(format)));
     } else {
       auto found = models_->Resolve(**spec);
       if (found.ok()) {
