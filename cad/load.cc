@@ -16,6 +16,8 @@
 #include <Geom_BSplineSurface.hxx>
 #include <IGESControl_Reader.hxx>
 #include <IGESData_IGESEntity.hxx>
+#include <Message_ProgressIndicator.hxx>
+#include <Message_ProgressScope.hxx>
 #include <Interface_Check.hxx>
 #include <Interface_CheckIterator.hxx>
 #include <Interface_InterfaceModel.hxx>
@@ -140,6 +142,37 @@ class TempFile {
   std::error_code ignored_;
 };
 
+// OpenCASCADE's progress indicator as our stop check: the kernel's
+// algorithms poll UserBreak() through their Message_ProgressScope and return
+// early when it says so. The status that stopped it is kept.
+class StopIndicator final : public Message_ProgressIndicator {
+ public:
+  explicit StopIndicator(std::function<absl::Status()> check) : check_(std::move(check)) {}
+  Standard_Boolean UserBreak() override {
+    if (!check_) return Standard_False;
+    absl::Status s = check_();
+    if (s.ok()) return Standard_False;
+    absl::MutexLock lock(&mu_);
+    if (status_.ok()) status_ = std::move(s);
+    return Standard_True;
+  }
+  void Show(const Message_ProgressScope&, const Standard_Boolean) override {}
+  absl::Status status() {
+    absl::MutexLock lock(&mu_);
+    return status_;
+  }
+
+ private:
+  const std::function<absl::Status()> check_;
+  absl::Mutex mu_;
+  absl::Status status_ ABSL_GUARDED_BY(mu_);
+};
+
+// options.check's status now (OK when there is none).
+absl::Status Checked(const LoadOptions& options) {
+  return options.check ? options.check() : absl::OkStatus();
+}
+
 // The first fail the reader reported while loading the file (`load`) or
 // transferring it, as "LABEL: message", clipped; "" when none.
 std::string FirstFail(const Handle(Interface_InterfaceModel) & model,
@@ -215,7 +248,7 @@ absl::Status CheckTransfer(XSControl_Reader& reader, const ModelCensus& census, 
 
 // REQUIRES: PreflightStep passed and gave `census`.
 absl::StatusOr<TopoDS_Shape> ReadStep(absl::string_view bytes, const ModelCensus& census,
-                                      absl::string_view name) {
+                                      absl::string_view name, const LoadOptions& options) {
   STEPControl_Reader reader;
   std::istringstream stream{std::string(bytes)};
   const IFSelect_ReturnStatus status = reader.ReadStream("upload.step", stream);
@@ -225,7 +258,10 @@ absl::StatusOr<TopoDS_Shape> ReadStep(absl::string_view bytes, const ModelCensus
     return Invalid(ModelFormat::kStep, name,
                    "the STEP reader rejected it (syntax or structure errors)");
   }
-  reader.TransferRoots();
+  RETURN_IF_ERROR(Checked(options));
+  Handle(StopIndicator) progress = new StopIndicator(options.check);
+  reader.TransferRoots(progress->Start());
+  RETURN_IF_ERROR(progress->status());
   RETURN_IF_ERROR(CheckTransfer(reader, census, ModelFormat::kStep, name));
   return reader.OneShape();
 }
@@ -233,7 +269,7 @@ absl::StatusOr<TopoDS_Shape> ReadStep(absl::string_view bytes, const ModelCensus
 // Reads the IGES file at `path`, the private copy Load made of the bytes.
 // REQUIRES: PreflightIges passed and gave `census`.
 absl::StatusOr<TopoDS_Shape> ReadIges(const std::string& path, const ModelCensus& census,
-                                      absl::string_view name) {
+                                      absl::string_view name, const LoadOptions& options) {
   IGESControl_Reader reader;
   const IFSelect_ReturnStatus status = reader.ReadFile(path.c_str());
   if (status == IFSelect_RetVoid)
@@ -242,7 +278,10 @@ absl::StatusOr<TopoDS_Shape> ReadIges(const std::string& path, const ModelCensus
     return Invalid(ModelFormat::kIges, name,
                    "the IGES reader rejected it (syntax or structure errors)");
   }
-  reader.TransferRoots();
+  RETURN_IF_ERROR(Checked(options));
+  Handle(StopIndicator) progress = new StopIndicator(options.check);
+  reader.TransferRoots(progress->Start());
+  RETURN_IF_ERROR(progress->status());
   RETURN_IF_ERROR(CheckTransfer(reader, census, ModelFormat::kIges, name));
   return reader.OneShape();
 }
@@ -366,11 +405,11 @@ absl::StatusOr<std::shared_ptr<const Model>> LoadUnguarded(ModelFormat format,
   TopoDS_Shape shape;
   switch (format) {
     case ModelFormat::kStep: {
-      ASSIGN_OR_RETURN(shape, ReadStep(bytes, census, name));
+      ASSIGN_OR_RETURN(shape, ReadStep(bytes, census, name, options));
       break;
     }
     case ModelFormat::kIges: {
-      ASSIGN_OR_RETURN(shape, ReadIges(iges_path, census, name));
+      ASSIGN_OR_RETURN(shape, ReadIges(iges_path, census, name, options));
       break;
     }
     case ModelFormat::kNurbs: {
@@ -384,6 +423,7 @@ absl::StatusOr<std::shared_ptr<const Model>> LoadUnguarded(ModelFormat format,
   std::vector<Face> faces;
   faces.reserve(map.Extent());
   for (int i = 1; i <= map.Extent(); ++i) {
+    RETURN_IF_ERROR(Checked(options));
     ASSIGN_OR_RETURN(Face face, MakeFace(TopoDS::Face(map(i)), i - 1, format, name, options));
     faces.push_back(std::move(face));
   }

@@ -13,6 +13,7 @@
 #define SFCSAMPLER_CAD_LOAD_H_
 
 #include <cstddef>
+#include <functional>
 #include <memory>
 
 #include "absl/status/statusor.h"
@@ -38,6 +39,10 @@ struct LoadOptions {
   double trim_tolerance = 1e-9;
   // What the kernel's readers are spared (cad/preflight.h).
   PreflightLimits preflight;
+  // Asked while the kernel works (OpenCASCADE's user break, polled by the
+  // transfer and shape healing) and between faces; a non-OK status stops the
+  // load, which returns it. Empty: never stop.
+  std::function<absl::Status()> check;
 };
 
 // Reads a model from `bytes`. `name` names the input in every error message
@@ -53,7 +58,8 @@ struct LoadOptions {
 //                       malformed NURBS patch (knots, multiplicities,
 //                       weights, counts, NaN);
 //   INTERNAL            the kernel failed in an unexpected way (its
-//                       exception's message is passed on).
+//                       exception's message is passed on);
+//   options.check's status, when it stopped the load.
 // Never throws: the kernel's Standard_Failure is caught here, and so is a
 // fault inside the kernel on malformed input (a null dereference in the IGES
 // reader), which the kernel's signal handlers turn into a Standard_Failure;

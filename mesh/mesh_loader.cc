@@ -151,7 +151,9 @@ absl::StatusOr<TriangleMesh> LoadObj(absl::string_view bytes, absl::string_view 
   tinyobj::ObjReaderConfig config;
   config.triangulate = false;  // we fan-triangulate and count the polygons
   config.vertex_color = false;
-  if (!reader.ParseFromString(std::string(bytes), "", config)) {
+  const bool parsed = reader.ParseFromString(std::string(bytes), "", config);
+  if (options.check) RETURN_IF_ERROR(options.check());
+  if (!parsed) {
     return Malformed(name, absl::StrFormat("not a valid OBJ file: %s",
                                            Echo(absl::StripAsciiWhitespace(reader.Error()), 200)));
   }
@@ -364,6 +366,7 @@ absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view 
     const ScalarGetter gx = getter(ix), gy = getter(iy), gz = getter(iz), gnx = getter(inx),
                        gny = getter(iny), gnz = getter(inz), gw = getter(iw);
     for (size_t j = 0; j < items; ++j) {
+      if (options.check && (j & 0xffff) == 0) RETURN_IF_ERROR(options.check());
       for (size_t k = 0; k < props; ++k) element.property(k)->get(in);
       if (!in) {
         return Malformed(name, absl::StrFormat("the file ends or breaks inside %s %d of %d (a "

@@ -1,5 +1,7 @@
 #include "server/model_store.h"
 
+#include <vector>
+
 #include "absl/strings/str_format.h"
 #include "util/echo.h"
 
@@ -23,6 +25,8 @@ absl::StatusOr<StoredModel> ModelStore::Put(ModelFormat format, std::string byte
   model.sha256 = Sha256Hex(bytes);
   // No name is kept: the model is shared by every client that sends these
   // bytes, and one client's file name must not show in another's errors.
+  std::vector<std::string> evicted;
+  {
   absl::MutexLock lock(&mu_);
   if (auto it = entries_.find(model.sha256); it != entries_.end()) {
     lru_.splice(lru_.begin(), lru_, it->second.lru);
@@ -41,9 +45,14 @@ absl::StatusOr<StoredModel> ModelStore::Put(ModelFormat format, std::string byte
   while (stats_.bytes > budget_bytes_ && lru_.size() > 1) {
     auto victim = entries_.find(lru_.back());
     stats_.bytes -= victim->second.model.bytes->size();
+    evicted.push_back(victim->first);
     entries_.erase(victim);
     lru_.pop_back();
     ++stats_.evictions;
+  }
+  }
+  if (on_evict_) {
+    for (const std::string& sha256 : evicted) on_evict_(sha256);
   }
   return model;
 }

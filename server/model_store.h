@@ -13,6 +13,7 @@
 #ifndef SFCSAMPLER_SERVER_MODEL_STORE_H_
 #define SFCSAMPLER_SERVER_MODEL_STORE_H_
 
+#include <functional>
 #include <list>
 #include <string>
 #include <unordered_map>
@@ -47,6 +48,12 @@ class ModelStore final : public ModelSource {
   // client paths), an unknown hash NOT_FOUND.
   absl::StatusOr<StoredModel> Resolve(const ModelSpec& spec) const override ABSL_LOCKS_EXCLUDED(mu_);
 
+  // Called with the hash of every model evicted for the budget, outside the
+  // store's lock. Set once, before the store is shared.
+  void SetEvictionListener(std::function<void(const std::string& sha256)> listener) {
+    on_evict_ = std::move(listener);
+  }
+
   // Counts an upload turned away for its size (the service stops reading it
   // before Put).
   void CountRejected() ABSL_LOCKS_EXCLUDED(mu_);
@@ -64,6 +71,7 @@ class ModelStore final : public ModelSource {
   // Constant after construction.
   const uint64_t budget_bytes_;
   const uint64_t max_model_bytes_;
+  std::function<void(const std::string&)> on_evict_;  // set before use
 
   mutable absl::Mutex mu_;
   // sha256 -> model; a model stored under two formats keeps the first.

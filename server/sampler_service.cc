@@ -77,12 +77,22 @@ SamplerService::SamplerService(const ServerOptions& options, TreeCache* cache, M
       cache_(cache),
       models_(models),
       metrics_(metrics),
-      engine_(options.limits, cache, models),
+      engine_(
+          [&options] {
+            EngineLimits limits = options.limits;
+            limits.parse_failure_ttl_seconds = options.failure_ttl_seconds;
+            return limits;
+          }(),
+          cache, models),
       authenticator_(options.token.empty() || token_checked_by_transport
                          ? nullptr
                          : std::make_unique<const TokenAuthenticator>(options.token)),
       watchdog_(options.write_timeout_seconds),
-      stream_memory_(options.stream_memory_bytes) {}
+      stream_memory_(options.stream_memory_bytes) {
+  // An evicted upload's parses go with it (their requests hold what they use).
+  models_->SetEvictionListener(
+      [this](const std::string& sha256) { engine_.loaded_models().ForgetModel(sha256); });
+}
 
 grpc::Status SamplerService::Admit(const grpc::ServerContext& context) const {
   if (draining_.load()) {
@@ -103,6 +113,7 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
   const auto start = Clock::now();
   uint64_t sent = 0;
   grpc::Status status = Admit(*context);
+  if (status.ok()) status = PrepareModelOutsideSlot(context, *request);
   if (status.ok()) {
     // Claim a stream slot; give it back on every path out.
     if (active_streams_.fetch_add(1) >= options_.max_concurrent_streams) {
@@ -125,6 +136,20 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
                request->count(), sent, SecondsSince(start), static_cast<int>(status.error_code()),
                Echo(status.error_message(), kMaxStatusMessageBytes));
   return status;
+}
+
+grpc::Status SamplerService::PrepareModelOutsideSlot(grpc::ServerContext* context,
+                                                     const v1::SampleRequest& request) {
+  auto model = ParseModelSpec(request.tree().surface());
+  if (!model.ok() || !model->has_value()) return grpc::Status::OK;  // RunSample says why
+  auto parsed = FromProto(request);
+  if (!parsed.ok()) return ToGrpcStatus(parsed.status());
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(options_.request_deadline_seconds));
+  auto prepared = engine_.Prepare(parsed->tree, parsed->tree_count ? parsed->tree_count : parsed->count,
+                                  RequestControl(context, deadline, options_.request_deadline_seconds));
+  if (!prepared.ok()) return ToGrpcStatus(prepared.status());
+  return grpc::Status::OK;
 }
 
 grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::SampleRequest& request,
@@ -348,6 +373,19 @@ grpc::Status SamplerService::GetCacheStats(grpc::ServerContext* context,
     response->set_max_model_bytes(models_->max_model_bytes());
     response->set_model_uploads(m.uploads);
     response->set_model_evictions(m.evictions);
+    const LoadedModelsStats p = engine_.loaded_models().stats();
+    const LoadedModelsOptions& po = engine_.loaded_models().options();
+    response->set_parsed_models(p.models);
+    response->set_parsed_model_bytes(p.bytes);
+    response->set_parsed_model_budget_bytes(po.budget_bytes);
+    response->set_model_parse_threads(po.parse_threads);
+    response->set_model_parse_seconds(po.parse_seconds);
+    response->set_model_parses(p.parses);
+    response->set_model_parse_failures(p.parse_failures);
+    response->set_model_parses_stopped(p.parses_stopped);
+    response->set_model_parses_running(p.parsing);
+    response->set_model_parses_queued(p.queued);
+    response->set_max_queued_parses(po.max_queued_parses);
   }
   metrics_->CountRequest("GetCacheStats", status.error_code());
   return status;
