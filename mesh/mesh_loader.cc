@@ -293,8 +293,40 @@ bool HasNarrowListCount(const CgalPlyNumber* p) {
          narrow(int8_t{}) || narrow(uint8_t{}) || narrow(float{}) || narrow(double{});
 }
 
+// CGAL's header parser appends a "property" line to the last element
+// without checking that there is one: a property before any element writes
+// through a null pointer (found by fuzz/ply_fuzzer). The header is checked
+// here first: it ends with end_header, and every property follows an element.
+absl::Status CheckPlyHeader(absl::string_view bytes, absl::string_view name) {
+  constexpr size_t kMaxHeader = size_t{1} << 20;
+  bool element = false;
+  size_t line_number = 0, start = 0;
+  // Lines and keywords as CGAL reads them: std::getline, then >> keyword.
+  while (start < bytes.size() && start < kMaxHeader) {
+    size_t end = bytes.find('\n', start);
+    if (end == absl::string_view::npos) end = bytes.size();
+    const absl::string_view line = bytes.substr(start, end - start);
+    start = end + 1;
+    ++line_number;
+    std::vector<absl::string_view> tokens =
+        absl::StrSplit(line, absl::ByAnyChar(" \t\r\v\f"), absl::SkipEmpty());
+    // CGAL takes line 1 as the signature and line 2 as the format line,
+    // whatever they hold; keywords count from line 3.
+    if (tokens.empty() || line_number <= 2) continue;
+    if (tokens[0] == "end_header") return absl::OkStatus();
+    if (tokens[0] == "element") element = true;
+    if (tokens[0] == "property" && !element) {
+      return Malformed(name, absl::StrFormat("header line %d: a property before any element "
+                                             "('%s'); properties follow their 'element' line",
+                                             line_number, Echo(line)));
+    }
+  }
+  return Malformed(name, "the PLY header has no 'end_header' line in its first 1 MiB");
+}
+
 absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view name,
                                      const MeshLoadOptions& options) {
+  RETURN_IF_ERROR(CheckPlyHeader(bytes, name));
   std::istringstream in(std::string(bytes), std::ios::in | std::ios::binary);
   CgalPlyReader reader(/*verbose=*/false);
   if (!reader.init(in)) {

@@ -144,6 +144,26 @@ TEST(CadHostile, DanglingReferenceInAFaceIsNamed) {
   ExpectRefused(Load(ModelFormat::kIges, iges, "dangling.iges"), " type 510");
 }
 
+// An ORIENTED_EDGE whose edge is itself: OpenCASCADE's EdgeStart/EdgeEnd
+// recurse until the stack overflows (found by fuzz/step_fuzzer). The fault is
+// turned into an error on the load's thread, and the process lives on.
+TEST(CadHostile, AnEdgeThatIsItselfOverflowsNoStack) {
+  std::string step = Bytes(Solid::kBoxWithHole, ModelFormat::kStep);
+  const size_t edge = step.find("= ORIENTED_EDGE('',*,*,#");
+  ASSERT_NE(edge, std::string::npos);
+  const size_t id_start = step.rfind('#', edge);
+  const std::string id = step.substr(id_start, step.find(' ', id_start) - id_start);
+  const size_t ref = step.find('#', edge);
+  step.replace(ref, step.find(',', ref) - ref, id);
+  for (int i = 0; i < 2; ++i) {  // twice: the thread's handler set-up survives a fault
+    absl::StatusOr<std::shared_ptr<const Model>> model;
+    std::thread([&] { model = Load(ModelFormat::kStep, step, "cycle.step"); }).join();
+    ASSERT_FALSE(model.ok());
+    EXPECT_EQ(model.status().code(), absl::StatusCode::kInvalidArgument) << model.status();
+  }
+  EXPECT_TRUE(Load(ModelFormat::kStep, Bytes(Solid::kSphere, ModelFormat::kStep), "after").ok());
+}
+
 // 64 random bytes inserted into a part, 40 times: each copy is refused or
 // gives the part's 8 faces, every one with an area.
 TEST(CadHostile, RandomInsertionsAreRefusedOrHarmless) {

@@ -87,5 +87,21 @@ TEST(MeshHostile, PlyIndicesPastTheVerticesAreRefusedWithTheIndex) {
   }
 }
 
+// A property line before any element line made CGAL's header parser write
+// through a null pointer (fuzz/ply_fuzzer).
+TEST(MeshHostile, PlyPropertyBeforeAnyElementIsRefused) {
+  MeshLoadOptions options;
+  options.format = MeshFormat::kPly;
+  auto mesh = LoadMesh("ply\nformat ascii 1.0\nproperty double x\nelement vertex 1\nend_header\n0\n",
+                       "hostile.ply", options);
+  ExpectRefused(mesh, "a property before any element");
+  // Line 2 is the format line for CGAL, whatever it says.
+  ExpectRefused(LoadMesh("ply\nelement ascii 1.0\nproperty double x\nend_header\n0\n",
+                         "hostile.ply", options),
+                "a property before any element");
+  ExpectRefused(LoadMesh("ply\nformat ascii 1.0\nelement vertex 1\n", "hostile.ply", options),
+                "end_header");
+}
+
 }  // namespace
 }  // namespace sfc
