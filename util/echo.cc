@@ -1,5 +1,7 @@
 #include "util/echo.h"
 
+#include <algorithm>
+
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 
@@ -7,32 +9,31 @@ namespace sfc {
 
 std::string Echo(absl::string_view text, size_t max) {
   std::string out;
-  const absl::string_view shown = text.substr(0, max);
-  out.reserve(shown.size() + 16);
-  for (const char ch : shown) {
-    const unsigned char c = static_cast<unsigned char>(ch);
+  out.reserve(std::min(text.size(), max) + 24);
+  size_t shown = 0;
+  for (; shown < text.size(); ++shown) {
+    const unsigned char c = static_cast<unsigned char>(text[shown]);
+    std::string piece;
     switch (c) {
       case '\n':
-        out += "\\n";
+        piece = "\\n";
         break;
       case '\r':
-        out += "\\r";
+        piece = "\\r";
         break;
       case '\t':
-        out += "\\t";
+        piece = "\\t";
         break;
       case '\\':
-        out += "\\\\";
+        piece = "\\\\";
         break;
       default:
-        if (c < 0x20 || c >= 0x7f) {
-          absl::StrAppendFormat(&out, "\\x%02x", c);
-        } else {
-          out += ch;
-        }
+        piece = c < 0x20 || c >= 0x7f ? absl::StrFormat("\\x%02x", c) : std::string(1, c);
     }
+    if (out.size() + piece.size() > max) break;
+    out += piece;
   }
-  if (shown.size() < text.size()) absl::StrAppend(&out, "... (", text.size(), " bytes)");
+  if (shown < text.size()) absl::StrAppend(&out, "... (", text.size(), " bytes)");
   return out;
 }
 

@@ -14,14 +14,14 @@
 
 namespace sfc {
 
-// Longest echo of a token or line of input in a message, in input bytes.
+// Longest echo of a token or line of input in a message, in characters.
 inline constexpr size_t kMaxEcho = 80;
-// Longest echo of an upload's name (ModelChunk.name), in input bytes.
+// Longest echo of an upload's name (ModelChunk.name), in characters.
 inline constexpr size_t kMaxNameEcho = 128;
 
-// `text` escaped, its first `max` bytes only; a clipped echo ends with
-// "... (N bytes)", N the length of `text`. The result has at most
-// 4 * max + 32 bytes and only printable ASCII.
+// `text` escaped, cut after at most `max` characters of the escaped form; a
+// clipped echo ends with "... (N bytes)", N the length of `text`. The result
+// has at most max + 32 bytes, all printable ASCII.
 std::string Echo(absl::string_view text, size_t max = kMaxEcho);
 
 // `message` cut to at most `max` bytes (>= 32) at a character boundary, ending
