@@ -15,6 +15,18 @@
 #include <GProp_GProps.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <IGESControl_Reader.hxx>
+#include <IGESData_IGESEntity.hxx>
+#include <Message_ProgressIndicator.hxx>
+#include <Message_ProgressScope.hxx>
+#include <Interface_Check.hxx>
+#include <Interface_CheckIterator.hxx>
+#include <Interface_InterfaceModel.hxx>
+#include <StepShape_Face.hxx>
+#include <TCollection_HAsciiString.hxx>
+#include <TransferBRep.hxx>
+#include <Transfer_TransientProcess.hxx>
+#include <XSControl_TransferReader.hxx>
+#include <XSControl_WorkSession.hxx>
 #include <Precision.hxx>
 #include <STEPControl_Reader.hxx>
 #include <Standard_ErrorHandler.hxx>
@@ -34,6 +46,7 @@
 #include <new>
 #include <sstream>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -45,7 +58,9 @@
 #include "cad/internal/kernel_setup.h"
 #include "cad/internal/occ_face.h"
 #include "cad/nurbs_patch.h"
+#include "cad/preflight.h"
 #include "core/status_macros.h"
+#include "util/echo.h"
 
 namespace sfc::cad {
 namespace {
@@ -127,24 +142,134 @@ class TempFile {
   std::error_code ignored_;
 };
 
-// REQUIRES: CheckStepFraming passed.
-absl::StatusOr<TopoDS_Shape> ReadStep(absl::string_view bytes, absl::string_view name) {
+// OpenCASCADE's progress indicator as our stop check: the kernel's
+// algorithms poll UserBreak() through their Message_ProgressScope and return
+// early when it says so. The status that stopped it is kept.
+class StopIndicator final : public Message_ProgressIndicator {
+ public:
+  explicit StopIndicator(std::function<absl::Status()> check) : check_(std::move(check)) {}
+  Standard_Boolean UserBreak() override {
+    if (!check_) return Standard_False;
+    absl::Status s = check_();
+    if (s.ok()) return Standard_False;
+    absl::MutexLock lock(&mu_);
+    if (status_.ok()) status_ = std::move(s);
+    return Standard_True;
+  }
+  void Show(const Message_ProgressScope&, const Standard_Boolean) override {}
+  absl::Status status() {
+    absl::MutexLock lock(&mu_);
+    return status_;
+  }
+
+ private:
+  const std::function<absl::Status()> check_;
+  absl::Mutex mu_;
+  absl::Status status_ ABSL_GUARDED_BY(mu_);
+};
+
+// options.check's status now (OK when there is none).
+absl::Status Checked(const LoadOptions& options) {
+  return options.check ? options.check() : absl::OkStatus();
+}
+
+// The first fail the reader reported while loading the file (`load`) or
+// transferring it, as "LABEL: message", clipped; "" when none.
+std::string FirstFail(const Handle(Interface_InterfaceModel) & model,
+                      const Interface_CheckIterator& checks) {
+  for (checks.Start(); checks.More(); checks.Next()) {
+    const Handle(Interface_Check)& check = checks.Value();
+    if (check.IsNull() || !check->HasFailed()) continue;
+    std::string where = "the file";
+    if (check->HasEntity() && !model.IsNull() && model->Number(check->Entity()) > 0) {
+      where = model->StringLabel(check->Entity())->ToCString();
+    }
+    return absl::StrCat(Echo(where, 24), ": ", Echo(check->CFail(1), kMaxEcho));
+  }
+  return "";
+}
+
+// Nothing lost silently: every face entity the preflight found in the file
+// (census) must have become a face, and the reader must report no fail while
+// loading the file. Missing faces are named (the first few).
+absl::Status CheckTransfer(XSControl_Reader& reader, const ModelCensus& census, ModelFormat format,
+                           absl::string_view name) {
+  const Handle(XSControl_WorkSession) ws = reader.WS();
+  const Handle(Interface_InterfaceModel) model = ws->Model();
+  const Handle(Transfer_TransientProcess) process = ws->TransferReader()->TransientProcess();
+  if (model.IsNull() || model->NbEntities() == 0) {
+    return Invalid(format, name, "empty model: it has no entities");
+  }
+  // Labels of the face entities that became faces: "#12" (STEP), "D37" (IGES).
+  std::unordered_set<std::string> transferred;
+  const bool step = format == ModelFormat::kStep;
+  for (int i = 1; !model.IsNull() && i <= model->NbEntities(); ++i) {
+    const Handle(Standard_Transient) entity = model->Value(i);
+    bool face = false;
+    if (step) {
+      face = entity->IsKind(STANDARD_TYPE(StepShape_Face));
+    } else if (auto iges = Handle(IGESData_IGESEntity)::DownCast(entity); !iges.IsNull()) {
+      face = true;  // any kind: surfaces too become faces
+    }
+    if (!face || process.IsNull()) continue;
+    const TopoDS_Shape shape = TransferBRep::ShapeResult(process, entity);
+    if (!shape.IsNull() && shape.ShapeType() == TopAbs_FACE) {
+      transferred.insert(model->StringLabel(entity)->ToCString());
+    }
+  }
+  std::vector<std::string> missing;
+  for (size_t i = 0; i < census.faces.size(); ++i) {
+    const std::string label = absl::StrCat(step ? "#" : "D", census.face_ids[i]);
+    if (transferred.count(label) == 0) missing.push_back(census.faces[i]);
+  }
+  const std::string load_fail = FirstFail(model, ws->ModelCheckList());
+  if (missing.empty()) {
+    if (load_fail.empty()) return absl::OkStatus();
+    return Invalid(format, name,
+                   absl::StrCat("the reader found errors in it (first: ", load_fail,
+                                "); fix or re-export the file"));
+  }
+  constexpr size_t kNamed = 5;
+  std::string named;
+  for (size_t i = 0; i < std::min(missing.size(), kNamed); ++i) {
+    absl::StrAppend(&named, i ? ", " : "", Echo(missing[i], 40));
+  }
+  if (missing.size() > kNamed) absl::StrAppend(&named, ", ...");
+  const std::string fail = !load_fail.empty() ? load_fail
+                           : process.IsNull() ? ""
+                                              : FirstFail(model, process->CheckList(Standard_False));
+  return Invalid(
+      format, name,
+      absl::StrCat(missing.size(), " of its ", census.faces.size(),
+                   " face entities did not become faces (", named, ")",
+                   fail.empty() ? "" : absl::StrCat("; the reader said ", fail),
+                   "; a dangling #reference or a damaged entity? fix or re-export the file"));
+}
+
+// REQUIRES: PreflightStep passed and gave `census`.
+absl::StatusOr<TopoDS_Shape> ReadStep(absl::string_view bytes, const ModelCensus& census,
+                                      absl::string_view name, const LoadOptions& options) {
   STEPControl_Reader reader;
   std::istringstream stream{std::string(bytes)};
-  const std::string stream_name(name);
-  const IFSelect_ReturnStatus status = reader.ReadStream(stream_name.c_str(), stream);
+  const IFSelect_ReturnStatus status = reader.ReadStream("upload.step", stream);
   if (status == IFSelect_RetVoid)
     return Invalid(ModelFormat::kStep, name, "empty model: it has no entities");
   if (status != IFSelect_RetDone) {
     return Invalid(ModelFormat::kStep, name,
                    "the STEP reader rejected it (syntax or structure errors)");
   }
-  reader.TransferRoots();
+  RETURN_IF_ERROR(Checked(options));
+  Handle(StopIndicator) progress = new StopIndicator(options.check);
+  reader.TransferRoots(progress->Start());
+  RETURN_IF_ERROR(progress->status());
+  RETURN_IF_ERROR(CheckTransfer(reader, census, ModelFormat::kStep, name));
   return reader.OneShape();
 }
 
 // Reads the IGES file at `path`, the private copy Load made of the bytes.
-absl::StatusOr<TopoDS_Shape> ReadIges(const std::string& path, absl::string_view name) {
+// REQUIRES: PreflightIges passed and gave `census`.
+absl::StatusOr<TopoDS_Shape> ReadIges(const std::string& path, const ModelCensus& census,
+                                      absl::string_view name, const LoadOptions& options) {
   IGESControl_Reader reader;
   const IFSelect_ReturnStatus status = reader.ReadFile(path.c_str());
   if (status == IFSelect_RetVoid)
@@ -153,7 +278,11 @@ absl::StatusOr<TopoDS_Shape> ReadIges(const std::string& path, absl::string_view
     return Invalid(ModelFormat::kIges, name,
                    "the IGES reader rejected it (syntax or structure errors)");
   }
-  reader.TransferRoots();
+  RETURN_IF_ERROR(Checked(options));
+  Handle(StopIndicator) progress = new StopIndicator(options.check);
+  reader.TransferRoots(progress->Start());
+  RETURN_IF_ERROR(progress->status());
+  RETURN_IF_ERROR(CheckTransfer(reader, census, ModelFormat::kIges, name));
   return reader.OneShape();
 }
 
@@ -269,17 +398,18 @@ absl::StatusOr<Face> MakeFace(const TopoDS_Face& face, int index, ModelFormat fo
 // `iges_path` holds the bytes.
 absl::StatusOr<std::shared_ptr<const Model>> LoadUnguarded(ModelFormat format,
                                                            absl::string_view bytes,
+                                                           const ModelCensus& census,
                                                            const std::string& iges_path,
                                                            absl::string_view name,
                                                            const LoadOptions& options) {
   TopoDS_Shape shape;
   switch (format) {
     case ModelFormat::kStep: {
-      ASSIGN_OR_RETURN(shape, ReadStep(bytes, name));
+      ASSIGN_OR_RETURN(shape, ReadStep(bytes, census, name, options));
       break;
     }
     case ModelFormat::kIges: {
-      ASSIGN_OR_RETURN(shape, ReadIges(iges_path, name));
+      ASSIGN_OR_RETURN(shape, ReadIges(iges_path, census, name, options));
       break;
     }
     case ModelFormat::kNurbs: {
@@ -293,6 +423,7 @@ absl::StatusOr<std::shared_ptr<const Model>> LoadUnguarded(ModelFormat format,
   std::vector<Face> faces;
   faces.reserve(map.Extent());
   for (int i = 1; i <= map.Extent(); ++i) {
+    RETURN_IF_ERROR(Checked(options));
     ASSIGN_OR_RETURN(Face face, MakeFace(TopoDS::Face(map(i)), i - 1, format, name, options));
     faces.push_back(std::move(face));
   }
@@ -305,22 +436,23 @@ absl::StatusOr<std::shared_ptr<const Model>> LoadUnguarded(ModelFormat format,
 // of this load, nothing else (no lock or file of ours lives below here).
 absl::StatusOr<std::shared_ptr<const Model>> GuardedLoad(ModelFormat format,
                                                          absl::string_view bytes,
+                                                         const ModelCensus& census,
                                                          const std::string& iges_path,
                                                          absl::string_view name,
                                                          const LoadOptions& options) {
   try {
     OCC_CATCH_SIGNALS
-    return LoadUnguarded(format, bytes, iges_path, name, options);
+    return LoadUnguarded(format, bytes, census, iges_path, name, options);
   } catch (const Standard_Failure& e) {
     return Invalid(format, name,
-                   absl::StrCat("the kernel failed on it: ", e.GetMessageString(), " (",
-                                e.DynamicType()->Name(), ")"));
+                   absl::StrCat("the kernel failed on it: ", Echo(e.GetMessageString()), " (",
+                                Echo(e.DynamicType()->Name()), ")"));
   } catch (const std::bad_alloc&) {
     return absl::ResourceExhaustedError(
         absl::StrCat(ModelFormatName(format), " file ", name, ": out of memory while reading it"));
   } catch (const std::exception& e) {
     return absl::InternalError(
-        absl::StrCat(ModelFormatName(format), " file ", name, ": ", e.what()));
+        absl::StrCat(ModelFormatName(format), " file ", name, ": ", Echo(e.what())));
   }
 }
 
@@ -348,8 +480,9 @@ absl::string_view ModelFormatName(ModelFormat format) {
 }
 
 absl::StatusOr<std::shared_ptr<const Model>> Load(ModelFormat format, absl::string_view bytes,
-                                                  absl::string_view name,
+                                                  absl::string_view untrusted_name,
                                                   const LoadOptions& options) {
+  const std::string name = Echo(untrusted_name, kMaxNameEcho);
   if (bytes.size() > options.max_bytes) {
     return absl::ResourceExhaustedError(
         absl::StrCat(absl::AsciiStrToUpper(ModelFormatName(format)), " file ", name, " has ",
@@ -360,16 +493,25 @@ absl::StatusOr<std::shared_ptr<const Model>> Load(ModelFormat format, absl::stri
   // destructors of the frames between the fault and itself.
   std::string iges_path;
   TempFile file;
-  if (format == ModelFormat::kStep) RETURN_IF_ERROR(CheckStepFraming(bytes, name));
+  ModelCensus census;
+  if (format == ModelFormat::kStep) {
+    RETURN_IF_ERROR(CheckStepFraming(bytes, name));
+    auto step = PreflightStep(bytes, options.preflight);
+    if (!step.ok()) return Invalid(format, name, step.status().message());
+    census = *std::move(step);
+  }
   if (format == ModelFormat::kIges) {
     RETURN_IF_ERROR(CheckIgesFraming(bytes, name));
+    auto iges = PreflightIges(bytes, options.preflight);
+    if (!iges.ok()) return Invalid(format, name, iges.status().message());
+    census = *std::move(iges);
     RETURN_IF_ERROR(file.Write(bytes));  // IGESControl_Reader reads only files
     iges_path = file.path();
   }
   SilenceKernelMessages();
   ConvertKernelSignals();
   absl::MutexLock lock(&g_reader_mutex);
-  return GuardedLoad(format, bytes, iges_path, name, options);
+  return GuardedLoad(format, bytes, census, iges_path, name, options);
 }
 
 }  // namespace sfc::cad

@@ -13,11 +13,13 @@
 #define SFCSAMPLER_CAD_LOAD_H_
 
 #include <cstddef>
+#include <functional>
 #include <memory>
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "cad/model.h"
+#include "cad/preflight.h"
 
 namespace sfc::cad {
 
@@ -35,17 +37,29 @@ struct LoadOptions {
   // box's larger side (points this close to a trim curve count as inside).
   // Default 1e-9.
   double trim_tolerance = 1e-9;
+  // What the kernel's readers are spared (cad/preflight.h).
+  PreflightLimits preflight;
+  // Asked while the kernel works (OpenCASCADE's user break, polled by the
+  // transfer and shape healing) and between faces; a non-OK status stops the
+  // load, which returns it. Empty: never stop.
+  std::function<absl::Status()> check;
 };
 
 // Reads a model from `bytes`. `name` names the input in every error message
-// (e.g. the file name the user gave). Errors:
+// (e.g. the file name the user gave); it is escaped and clipped there
+// (util/echo.h), as is every piece of the input a message quotes. Errors:
 //   RESOURCE_EXHAUSTED  bytes.size() > options.max_bytes;
-//   INVALID_ARGUMENT    unreadable or truncated STEP/IGES, a model without
+//   INVALID_ARGUMENT    a STEP/IGES past a PreflightLimits limit (nesting,
+//                       entities, record or line length); face entities of
+//                       the file that did not become faces, or errors the
+//                       reader reported while loading it (nothing is dropped
+//                       silently); unreadable or truncated STEP/IGES, a model without
 //                       faces, an unbounded face, non-finite geometry, a
 //                       malformed NURBS patch (knots, multiplicities,
 //                       weights, counts, NaN);
 //   INTERNAL            the kernel failed in an unexpected way (its
-//                       exception's message is passed on).
+//                       exception's message is passed on);
+//   options.check's status, when it stopped the load.
 // Never throws: the kernel's Standard_Failure is caught here, and so is a
 // fault inside the kernel on malformed input (a null dereference in the IGES
 // reader), which the kernel's signal handlers turn into a Standard_Failure;

@@ -10,13 +10,14 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 #include "core/status_macros.h"
+#include "util/echo.h"
 
 namespace sfc::cad {
 namespace {
 
 class Parser {
  public:
-  explicit Parser(absl::string_view name) : name_(name) {}
+  explicit Parser(absl::string_view name) : name_(Echo(name, kMaxNameEcho)) {}
 
   absl::Status Error(int line, absl::string_view what) const {
     if (line > 0) {
@@ -29,11 +30,11 @@ class Parser {
   absl::StatusOr<double> Number(int line, absl::string_view token, absl::string_view what) const {
     double value;
     if (!absl::SimpleAtod(token, &value)) {
-      return Error(line, absl::StrCat(what, ": '", token, "' is not a number"));
+      return Error(line, absl::StrCat(what, ": '", Echo(token), "' is not a number"));
     }
     if (!std::isfinite(value)) {
       return Error(line,
-                   absl::StrCat(what, " is ", token, " (NaN or infinite); give finite numbers"));
+                   absl::StrCat(what, " is ", Echo(token), " (NaN or infinite); give finite numbers"));
     }
     return value;
   }
@@ -41,7 +42,7 @@ class Parser {
   absl::StatusOr<int> Integer(int line, absl::string_view token, absl::string_view what) const {
     int value;
     if (!absl::SimpleAtoi(token, &value)) {
-      return Error(line, absl::StrCat(what, ": '", token, "' is not an integer"));
+      return Error(line, absl::StrCat(what, ": '", Echo(token), "' is not an integer"));
     }
     return value;
   }
@@ -116,7 +117,7 @@ absl::StatusOr<NurbsPatch> ParseNurbsPatch(absl::string_view text, absl::string_
     }
     if (key == "degree" || key == "count") {
       if (tokens.size() != 3)
-        return parser.Error(line_number, absl::StrCat("'", key, "' takes two integers (u, v)"));
+        return parser.Error(line_number, absl::StrCat("'", Echo(key), "' takes two integers (u, v)"));
       ASSIGN_OR_RETURN(int a, parser.Integer(line_number, tokens[1], key));
       ASSIGN_OR_RETURN(int b, parser.Integer(line_number, tokens[2], key));
       if (key == "degree") {
@@ -168,7 +169,7 @@ absl::StatusOr<NurbsPatch> ParseNurbsPatch(absl::string_view text, absl::string_
       patch.poles.push_back(pole);
     } else {
       return parser.Error(line_number,
-                          absl::StrCat("unknown keyword '", key,
+                          absl::StrCat("unknown keyword '", Echo(key),
                                        "' (expected degree, count, knots_u, knots_v or pole)"));
     }
   }

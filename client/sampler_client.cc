@@ -94,6 +94,12 @@ absl::StatusOr<std::unique_ptr<SamplerClient>> SamplerClient::Connect(const Clie
 }
 
 std::string SamplerClient::SurfaceKey(const TreeSpec& spec) {
+  // A model routes by itself, not by its tree: its bytes are stored on the
+  // replica that its FindModel and UploadModel reached.
+  if (auto model = ParseModelSpec(spec.surface); model.ok() && model->has_value() &&
+                                                 !(*model)->sha256.empty()) {
+    return ModelRoutingKey((*model)->format, (*model)->sha256);
+  }
   auto surface = MakeSurface(spec.surface);
   auto density = MakeDensity(spec.density);
   if (surface.ok() && density.ok()) {
@@ -135,6 +141,9 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
   if (!surface.ok()) return surface.status();
   request.tree.surface = *std::move(surface);
   const std::string key = SurfaceKey(request.tree);
+  const auto asked_model = ParseModelSpec(asked.tree.surface);
+  const bool from_file =
+      asked_model.ok() && asked_model->has_value() && (*asked_model)->sha256.empty();
   const bool monotone = Sequence(request.sequence, 1, 0).monotone();
   StreamSummary summary;
   bool have_header = false;
@@ -220,7 +229,13 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
     // so asking again is safe.
     const bool transport_reset = status.error_code() == grpc::StatusCode::INTERNAL &&
                                  status.error_message().find("RST_STREAM") != std::string::npos;
-    const bool resumable = status.error_code() == grpc::StatusCode::UNAVAILABLE || transport_reset;
+    // Behind a proxy, a resume after the model's replica died reaches the
+    // next replica on the ring, which lacks the model: upload it there
+    // again (when the request named a local file) and resume.
+    const bool model_moved = status.error_code() == grpc::StatusCode::NOT_FOUND &&
+                             summary.resumes > 0 && from_file;
+    const bool resumable =
+        status.error_code() == grpc::StatusCode::UNAVAILABLE || transport_reset || model_moved;
     if (!resumable || attempt >= options_.max_resumes) {
       absl::Status s = FromGrpcStatus(status);
       return absl::Status(s.code(), absl::StrFormat("%s (received %d samples%s)", s.message(),
@@ -235,6 +250,10 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
     // to connect, so this attempt is not spent on a refused connection.
     channel_->WaitForConnected(std::chrono::system_clock::now() + pause);
     backoff *= 2;
+    if (model_moved) {
+      auto again = EnsureModel(asked.tree.surface);
+      if (!again.ok()) return again.status();
+    }
     if (monotone && summary.received > 0) {
       const auto range = SamplingEngine::ResolveRange(request);
       if (!range.ok()) return range.status();
@@ -284,7 +303,8 @@ absl::StatusOr<v1::ModelInfo> SamplerClient::UploadModel(const std::string& form
                                                          const std::string& bytes) {
   constexpr size_t kChunk = size_t{1} << 20;  // well under every message limit
   grpc::ClientContext context;
-  Decorate(&context, "");
+  const std::optional<ModelFormat> known = ModelFormatFromName(format);
+  Decorate(&context, known ? ModelRoutingKey(*known, Sha256Hex(bytes)) : "");
   v1::ModelInfo info;
   auto writer = stub_->UploadModel(&context, &info);
   v1::ModelChunk chunk;
@@ -324,7 +344,7 @@ absl::StatusOr<std::string> SamplerClient::EnsureModel(const std::string& spec) 
   find.set_sha256(sha256);
   find.set_format(std::string(ModelFormatName(model_spec.format)));
   grpc::ClientContext context;
-  Decorate(&context, "");
+  Decorate(&context, ModelRoutingKey(model_spec.format, sha256));
   v1::ModelInfo info;
   const grpc::Status found = stub_->FindModel(&context, find, &info);
   if (found.ok()) return info.spec();

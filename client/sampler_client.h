@@ -9,7 +9,11 @@
 // from the same tree key, algorithm version and seed as the first, or the
 // call fails with FAILED_PRECONDITION (a rolling upgrade would otherwise mix
 // two sets). Every call carries the
-// x-surface-key header (the tree key) for consistent-hash proxies.
+// x-surface-key header for consistent-hash proxies: the tree key, or for a
+// model (FindModel, UploadModel, a Sample naming it) the model's
+// ModelRoutingKey, so all of them reach the replica that stores it. A resume
+// that meets NOT_FOUND because the model's replica died uploads the model
+// again (when the request named a local file) and goes on.
 //
 // Thread-safety: a SamplerClient may be used from several threads at once.
 #ifndef SFCSAMPLER_CLIENT_SAMPLER_CLIENT_H_
@@ -85,7 +89,9 @@ class SamplerClient {
   static SampleRequest Range(SampleRequest request, uint64_t begin, uint64_t end);
   static SampleRequest Shard(SampleRequest request, uint64_t i, uint64_t k);
 
-  // The tree key the server will use for `spec`, as sent in x-surface-key.
+  // The routing key sent in x-surface-key: the tree key the server will use
+  // for `spec`, or for a model named by hash (FORMAT:sha256=HEX) the model's
+  // ModelRoutingKey, which FindModel and UploadModel of that model send too.
   static std::string SurfaceKey(const TreeSpec& spec);
 
  private:

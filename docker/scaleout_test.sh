@@ -6,7 +6,12 @@
 #     completes through the client's resume;
 #  3. the samples are byte-identical to a single in-process run;
 #  4. a replica killed while it builds a tree: the retry lands on another
-#     replica and the samples are still byte-identical.
+#     replica and the samples are still byte-identical;
+#  5. models (a STEP part and an OBJ mesh) on a fresh set of 3 replicas:
+#     FindModel, UploadModel and the Sample carry the model's key, so each
+#     model is stored on one replica and samples byte-identical to in-process;
+#     the mesh's replica killed mid-stream, the client uploads the model to
+#     the next replica and resumes, byte-identical.
 #   bash docker/scaleout_test.sh BUILD_DIR
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -126,4 +131,78 @@ wait "$client" || fail "the request did not complete after the replica building 
 grep -q "[1-9][0-9]* resumes" "$dir/slow-client.log" || fail "the client should have retried: $(cat "$dir/slow-client.log")"
 cmp -s "$dir/slow-embedded.csv" "$dir/slow-proxy.csv" || fail "samples after a mid-build kill differ from the in-process run"
 echo "mid-build kill: replica $((builder + 1)) killed while building; $(grep -o '[0-9]* resumes' "$dir/slow-client.log"); samples byte-identical to the in-process run"
+
+# 5. Models through the proxy, on a fresh set of replicas.
+kill "$scaleout" 2>/dev/null || true; wait "$scaleout" 2>/dev/null || true
+mdir="$dir/models"; mkdir -p "$mdir/cluster"
+[ -x "$build/cad/make_cad_fixtures" ] || { echo "scaleout_test: all checks passed (no CAD build: models skipped)"; exit 0; }
+"$build/cad/make_cad_fixtures" "$mdir" > /dev/null
+# A torus of 128 x 64 quads as OBJ.
+awk 'BEGIN { n = 128; m = 64; pi = atan2(0, -1)
+  for (i = 0; i < n; i++) for (j = 0; j < m; j++) {
+    a = 2 * pi * i / n; b = 2 * pi * j / m
+    printf "v %.9f %.9f %.9f\n", (1 + 0.3 * cos(b)) * cos(a), (1 + 0.3 * cos(b)) * sin(a), 0.3 * sin(b) }
+  for (i = 0; i < n; i++) for (j = 0; j < m; j++) {
+    p = i * m + j + 1; q = ((i + 1) % n) * m + j + 1; r = ((i + 1) % n) * m + (j + 1) % m + 1; t = i * m + (j + 1) % m + 1
+    printf "f %d %d %d %d\n", p, q, r, t } }' > "$mdir/torus.obj"
+proxy_port=$((20000 + RANDOM % 20000))
+SFC_SCALEOUT_DIR="$mdir/cluster" PATH="$PATH" bash "$root/docker/scaleout.sh" 3 "$proxy_port" > "$mdir/scaleout.log" 2>&1 &
+scaleout=$!
+for _ in $(seq 200); do [ -f "$mdir/cluster/ready" ] && break; sleep 0.05; done
+[ -f "$mdir/cluster/ready" ] || fail "the second set of replicas did not start"
+proxy="127.0.0.1:$proxy_port"
+mapfile -t replicas < "$mdir/cluster/replicas"
+ports=(); rpids=()
+for r in "${replicas[@]}"; do rpids+=("${r%% *}"); ports+=("${r##* }"); done
+models=("step:$mdir/box_with_hole.step" "obj:$mdir/torus.obj")
+for m in "${models[@]}"; do
+  for density in uniform "expr:1+z*z"; do
+    "$cli" sample -q --surface "$m" --density "$density" --count 20000 --seed 5 -o "$mdir/embedded.csv"
+    timeout 60 "$cli" sample -q --server "$proxy" --surface "$m" --density "$density" --count 20000 \
+      --seed 5 -o "$mdir/proxy.csv" 2> "$mdir/client.log" || fail "model $m through the proxy: $(cat "$mdir/client.log")"
+    cmp -s "$mdir/embedded.csv" "$mdir/proxy.csv" || fail "model $m ($density) through the proxy differs from in-process"
+  done
+done
+stored=$(sum_stat models)
+[ "$stored" -eq 2 ] || fail "each model should be stored on exactly one replica ($stored copies of 2 models)"
+[ "$(sum_stat model_uploads)" -eq 2 ] || fail "each model should travel once ($(sum_stat model_uploads) uploads)"
+echo "models: a STEP part and an OBJ mesh, 2 densities each, through the proxy on 3 replicas; each stored once; byte-identical to in-process"
+# The Python client routes models by the same key (python/sfcsampler/client.py).
+# Debian's python3 has python3-grpcio (tools/setup-debian.sh).
+py=/usr/bin/python3; [ -x "$py" ] || py=python3
+if PYTHONPATH="$build/python" "$py" -c "import sfcsampler" 2> /dev/null; then
+  PYTHONPATH="$build/python" timeout 120 "$py" - "$proxy" "$mdir/torus.obj" "$mdir/box_with_hole.step" <<'PY' || fail "the Python client's models through the proxy"
+import sys, numpy as np, sfcsampler
+proxy, obj, step = sys.argv[1:]
+with sfcsampler.Client(proxy) as client:
+    for surface in ("obj:" + obj, "step:" + step):
+        for density in ("uniform", "expr:2+x"):
+            wire = client.sample(surface=surface, density=density, count=5000, seed=11)
+            local = sfcsampler.sample(surface=surface, density=density, count=5000, seed=11)
+            for column in ("index", "u", "v", "x", "y", "z"):
+                assert np.array_equal(getattr(wire, column), getattr(local, column)), (surface, column)
+PY
+  [ "$(sum_stat models)" -eq 2 ] || fail "the Python client stored a model on a second replica"
+  echo "models: the Python client reaches the same replicas; samples equal to in-process"
+fi
+mesh_owner=""
+for j in 0 1 2; do
+  before=$(cache_stat "${ports[$j]}" models)
+  [ "$before" -gt 0 ] && timeout 10 "$cli" sample -q --server "127.0.0.1:${ports[$j]}" \
+    --surface "obj:sha256=$(sha256sum "$mdir/torus.obj" | cut -c1-64)" --count 10 -o /dev/null 2> /dev/null && mesh_owner=$j
+done
+[ -n "$mesh_owner" ] || fail "no replica holds the mesh"
+"$cli" sample -q --surface "obj:$mdir/torus.obj" --count 1500000 --seed 9 -o "$mdir/embedded.csv"
+timeout 120 "$cli" sample --server "$proxy" --surface "obj:$mdir/torus.obj" --count 1500000 --seed 9 \
+  --batch-size 2000 -o "$mdir/through-proxy.csv" 2> "$mdir/client.log" &
+client=$!
+for _ in $(seq 400); do
+  [ "$(stat -c %s "$mdir/through-proxy.csv" 2>/dev/null || echo 0)" -gt 10000000 ] && break
+  sleep 0.02
+done
+kill -9 "${rpids[$mesh_owner]}"
+wait "$client" || fail "the mesh stream did not complete after its replica died: $(cat "$mdir/client.log")"
+grep -q "[1-9][0-9]* resumes" "$mdir/client.log" || fail "the client should have resumed: $(cat "$mdir/client.log")"
+cmp -s "$mdir/embedded.csv" "$mdir/through-proxy.csv" || fail "mesh samples after the kill differ from in-process"
+echo "model kill: the mesh's replica killed mid-stream; $(grep -o '[0-9]* resumes' "$mdir/client.log") (the model uploaded again to the next replica); 1.5 M samples byte-identical"
 echo "scaleout_test: all checks passed"

@@ -1,5 +1,8 @@
 #include "engine/cad_jobs.h"
 
+#include <malloc.h>
+
+#include <algorithm>
 #include <utility>
 
 #include "absl/strings/str_format.h"
@@ -11,17 +14,38 @@
 namespace sfc {
 namespace {
 
+// Heap bytes in use now (glibc), for what a parse keeps: OpenCASCADE's
+// objects have no size of their own to ask.
+uint64_t HeapInUse() {
+  const struct mallinfo2 info = mallinfo2();
+  return info.uordblks + info.hblkhd;
+}
+
 absl::StatusOr<std::shared_ptr<const cad::Model>> LoadCad(const StoredModel& model,
-                                                          LoadedModels* loaded) {
+                                                          LoadedModels* loaded,
+                                                          const std::function<absl::Status()>& caller) {
+  // The parse owns its inputs: it runs on a parse thread and may outlive the
+  // request that started it.
   return loaded->Get<cad::Model>(
-      model.Spec(), [&]() -> absl::StatusOr<std::shared_ptr<const cad::Model>> {
+      model.Spec(),
+      [model](const ParseCheck& check) -> absl::StatusOr<LoadedModels::Parsed> {
         ASSIGN_OR_RETURN(const cad::ModelFormat format,
                          cad::ParseModelFormat(std::string(ModelFormatName(model.format))));
         cad::LoadOptions options;
         options.max_bytes = std::max<size_t>(options.max_bytes, model.bytes->size());
-        return cad::Load(format, *model.bytes, model.name.empty() ? model.Spec() : model.name,
-                         options);
-      });
+        options.check = check;
+        const uint64_t before = HeapInUse();
+        ASSIGN_OR_RETURN(std::shared_ptr<const cad::Model> parsed,
+                         cad::Load(format, *model.bytes, model.name.empty() ? model.Spec() : model.name,
+                                   options));
+        const uint64_t after = HeapInUse();
+        // What the model holds: the heap's growth across the load (other
+        // threads' allocations make this approximate), at least 4 KiB a face.
+        const uint64_t bytes =
+            std::max<uint64_t>(after > before ? after - before : 0, 4096 * parsed->faces().size());
+        return LoadedModels::Parsed{std::move(parsed), bytes};
+      },
+      caller);
 }
 
 class CadBatchCursor final : public BatchCursor {
@@ -39,9 +63,10 @@ class CadBatchCursor final : public BatchCursor {
 }  // namespace
 
 absl::StatusOr<CadTreeRecipe> CadTreeFor(const StoredModel& model, const std::string& density,
-                                         const CurveTreeOptions& options, LoadedModels* loaded) {
+                                         const CurveTreeOptions& options, LoadedModels* loaded,
+                                         const std::function<absl::Status()>& caller) {
   ASSIGN_OR_RETURN(DensityFromSpec d, MakeDensity(density));
-  ASSIGN_OR_RETURN(std::shared_ptr<const cad::Model> cad_model, LoadCad(model, loaded));
+  ASSIGN_OR_RETURN(std::shared_ptr<const cad::Model> cad_model, LoadCad(model, loaded, caller));
   CadTreeRecipe recipe;
   recipe.canonical_density = d.canonical;
   recipe.factory.build = [cad_model, density = d.density, options](
@@ -66,7 +91,7 @@ absl::StatusOr<std::unique_ptr<BatchCursor>> CadCursor(const AnyTree& tree, Sequ
 }
 
 absl::StatusOr<std::string> DescribeCadModel(const StoredModel& model, LoadedModels* loaded) {
-  ASSIGN_OR_RETURN(std::shared_ptr<const cad::Model> cad_model, LoadCad(model, loaded));
+  ASSIGN_OR_RETURN(std::shared_ptr<const cad::Model> cad_model, LoadCad(model, loaded, nullptr));
   return cad::DescribeModel(*cad_model);
 }
 

@@ -12,6 +12,7 @@
 #ifndef SFCSAMPLER_ENGINE_CAD_JOBS_H_
 #define SFCSAMPLER_ENGINE_CAD_JOBS_H_
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -32,11 +33,14 @@ struct CadTreeRecipe {
   TreeFactory factory;
 };
 
-// Loads `model` (through `loaded`) and returns how to build its trees.
-// Errors: INVALID_ARGUMENT for a malformed or empty model (the message names
-// the file) or a bad density spec.
+// Loads `model` (through `loaded`: on its parse threads, `caller` asked while
+// the request waits) and returns how to build its trees. Errors:
+// INVALID_ARGUMENT for a malformed or empty model (the message names the
+// file, or FORMAT:sha256=HEX for an upload) or a bad density spec;
+// RESOURCE_EXHAUSTED when the parse ran out of its CPU budget; caller's.
 absl::StatusOr<CadTreeRecipe> CadTreeFor(const StoredModel& model, const std::string& density,
-                                         const CurveTreeOptions& options, LoadedModels* loaded);
+                                         const CurveTreeOptions& options, LoadedModels* loaded,
+                                         const std::function<absl::Status()>& caller);
 
 // A cursor over samples [begin, end) of `sequence` on the model trees held by
 // `tree`. Errors as cad::ModelSampleCursor::Create.

@@ -1,26 +1,239 @@
 #include "engine/loaded_models.h"
 
-namespace sfc {
+#include <pthread.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#include <time.h>
 
-std::shared_ptr<const void> LoadedModels::Find(const std::string& key) {
-  absl::MutexLock lock(&mu_);
-  auto it = entries_.find(key);
-  if (it == entries_.end()) return nullptr;
-  lru_.splice(lru_.begin(), lru_, it->second.lru);
-  return it->second.model;
+#include <atomic>
+
+#include <exception>
+#include <new>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_format.h"
+#include "absl/time/time.h"
+
+namespace sfc {
+namespace {
+
+// The parse threads' nice value (Linux: per thread), below the RPC threads'.
+constexpr int kParseNice = 10;
+
+// CPU seconds of the thread whose CPU clock is `clock`.
+double CpuSeconds(clockid_t clock) {
+  timespec t{};
+  clock_gettime(clock, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
-std::shared_ptr<const void> LoadedModels::Keep(const std::string& key,
-                                               std::shared_ptr<const void> model) {
-  absl::MutexLock lock(&mu_);
-  if (auto it = entries_.find(key); it != entries_.end()) return it->second.model;
-  lru_.push_front(key);
-  entries_[key] = Entry{model, lru_.begin()};
-  while (entries_.size() > capacity_) {
-    entries_.erase(lru_.back());
-    lru_.pop_back();
+}  // namespace
+
+LoadedModels::LoadedModels(const LoadedModelsOptions& options) : options_(options) {
+  const int threads = std::max(1, options_.parse_threads);
+  for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { ParserLoop(); });
+}
+
+LoadedModels::~LoadedModels() {
+  {
+    absl::MutexLock lock(&mu_);
+    stopping_ = true;
   }
-  return model;
+  for (std::thread& t : threads_) t.join();
+}
+
+absl::StatusOr<std::shared_ptr<const void>> LoadedModels::GetAny(
+    const std::string& key, ParseFn parse, const std::function<absl::Status()>& caller) {
+  std::shared_ptr<Job> job;
+  {
+    absl::MutexLock lock(&mu_);
+    if (auto it = entries_.find(key); it != entries_.end()) {
+      lru_.splice(lru_.begin(), lru_, it->second.lru);
+      ++stats_.hits;
+      return it->second.parsed.model;
+    }
+    if (auto it = failures_.find(key); it != failures_.end()) {
+      const double age = std::chrono::duration<double>(Clock::now() - it->second.when).count();
+      if (age <= options_.failure_ttl_seconds) {
+        ++stats_.failure_hits;
+        return it->second.status;
+      }
+      failures_.erase(it);
+    }
+    if (stopping_) return absl::UnavailableError("the server is shutting down");
+    if (auto it = pending_.find(key); it != pending_.end()) {
+      job = it->second;
+    } else {
+      if (queue_.size() >= static_cast<size_t>(std::max(0, options_.max_queued_parses))) {
+        ++stats_.parses_rejected;
+        return absl::ResourceExhaustedError(absl::StrFormat(
+            "%d model parses are already waiting for a parser (max_queued_parses); retry later",
+            queue_.size()));
+      }
+      job = std::make_shared<Job>();
+      job->key = key;
+      job->parse = std::move(parse);
+      pending_.emplace(key, job);
+      queue_.push_back(job);
+    }
+    ++job->waiters;
+  }
+  // Wait in short steps, asking the caller between them.
+  while (true) {
+    absl::Status wanted = caller ? caller() : absl::OkStatus();
+    absl::MutexLock lock(&mu_);
+    if (job->done) {
+      --job->waiters;
+      if (!job->result.ok()) return job->result.status();
+      return job->result->model;
+    }
+    if (!wanted.ok()) {
+      --job->waiters;
+      return wanted;
+    }
+    mu_.AwaitWithTimeout(absl::Condition(&job->done), absl::Milliseconds(50));
+  }
+}
+
+void LoadedModels::ParserLoop() {
+  // Parses yield the CPU to the threads that serve requests: one hostile
+  // model on every parse thread must not slow other clients' samples.
+  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), kParseNice);
+  while (true) {
+    std::shared_ptr<Job> job;
+    {
+      absl::MutexLock lock(&mu_);
+      auto ready = [this]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
+        return stopping_ || !queue_.empty();
+      };
+      mu_.Await(absl::Condition(&ready));
+      if (stopping_) {
+        // Nobody is parsed any more: queued requests get UNAVAILABLE.
+        for (auto& queued : queue_) {
+          queued->result = absl::UnavailableError("the server is shutting down");
+          queued->done = true;
+          pending_.erase(queued->key);
+        }
+        queue_.clear();
+        return;
+      }
+      job = queue_.front();
+      queue_.pop_front();
+      if (job->waiters == 0) {  // every request left while it was queued
+        job->result = absl::CancelledError("no request waits for this model any more");
+        job->done = true;
+        pending_.erase(job->key);
+        ++stats_.parses_stopped;
+        continue;
+      }
+      ++stats_.parsing;
+    }
+    // The parse thread's CPU clock: a parser may call the check from its own
+    // helper threads, so it is thread-safe and reads this thread's clock.
+    clockid_t cpu_clock = CLOCK_THREAD_CPUTIME_ID;
+    if (pthread_getcpuclockid(pthread_self(), &cpu_clock) != 0) cpu_clock = CLOCK_THREAD_CPUTIME_ID;
+    const double cpu_start = CpuSeconds(cpu_clock);
+    std::atomic<uint64_t> calls{0};
+    absl::Mutex stop_mu;
+    absl::Status stop;  // sticky once set; guarded by stop_mu
+    const ParseCheck check = [&]() -> absl::Status {
+      // Called often by the parsers: the locks and the clock every 64th time.
+      if ((calls.fetch_add(1, std::memory_order_relaxed) & 63) != 0) {
+        absl::MutexLock l(&stop_mu);
+        return stop;
+      }
+      absl::Status now;
+      {
+        absl::MutexLock lock(&mu_);
+        if (stopping_) {
+          now = absl::UnavailableError("the server is shutting down");
+        } else if (job->waiters == 0) {
+          now = absl::CancelledError("no request waits for this model any more");
+        }
+      }
+      const double spent = CpuSeconds(cpu_clock) - cpu_start;
+      if (now.ok() && options_.parse_seconds > 0 && spent > options_.parse_seconds) {
+        now = absl::ResourceExhaustedError(absl::StrFormat(
+            "parsing the model took more than %g s of CPU (the server's model_parse_seconds) and "
+            "was stopped: simplify the model (fewer or simpler faces), or ask the operator to "
+            "raise the limit",
+            options_.parse_seconds));
+      }
+      absl::MutexLock l(&stop_mu);
+      if (stop.ok()) stop = now;
+      return stop;
+    };
+    absl::StatusOr<Parsed> result;
+    try {
+      result = job->parse(check);
+    } catch (const std::bad_alloc&) {
+      result = absl::ResourceExhaustedError("out of memory while parsing the model");
+    } catch (const std::exception& e) {
+      result = absl::InternalError(absl::StrFormat("parsing the model failed: %s", e.what()));
+    }
+    {
+      absl::MutexLock l(&stop_mu);
+      if (result.ok() && !stop.ok()) result = stop;  // a parser that ignored the stop
+    }
+    absl::MutexLock lock(&mu_);
+    --stats_.parsing;
+    ++stats_.parses;
+    pending_.erase(job->key);
+    if (result.ok()) {
+      Keep(job->key, *result);
+    } else if (result.status().code() == absl::StatusCode::kCancelled ||
+               result.status().code() == absl::StatusCode::kUnavailable) {
+      ++stats_.parses_stopped;  // not the model's fault: the next request parses again
+    } else {
+      if (result.status().code() == absl::StatusCode::kResourceExhausted) ++stats_.parses_stopped;
+      failures_[job->key] = Failure{result.status(), Clock::now()};
+      ++stats_.parse_failures;
+    }
+    job->result = std::move(result);
+    job->done = true;
+  }
+}
+
+void LoadedModels::Keep(const std::string& key, const Parsed& parsed) {
+  if (parsed.bytes > options_.budget_bytes) return;  // returned to its requests, not kept
+  if (entries_.count(key)) return;
+  lru_.push_front(key);
+  entries_.emplace(key, Entry{parsed, lru_.begin()});
+  stats_.bytes += parsed.bytes;
+  while (stats_.bytes > options_.budget_bytes && !lru_.empty()) {
+    auto victim = entries_.find(lru_.back());
+    stats_.bytes -= victim->second.parsed.bytes;
+    entries_.erase(victim);
+    lru_.pop_back();
+    ++stats_.evictions;
+  }
+}
+
+void LoadedModels::ForgetModel(const std::string& sha256) {
+  const std::string needle = "sha256=" + sha256;
+  absl::MutexLock lock(&mu_);
+  for (auto it = lru_.begin(); it != lru_.end();) {
+    if (absl::StrContains(*it, needle)) {
+      auto entry = entries_.find(*it);
+      stats_.bytes -= entry->second.parsed.bytes;
+      entries_.erase(entry);
+      it = lru_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  for (auto it = failures_.begin(); it != failures_.end();) {
+    it = absl::StrContains(it->first, needle) ? failures_.erase(it) : std::next(it);
+  }
+}
+
+LoadedModelsStats LoadedModels::stats() const {
+  absl::MutexLock lock(&mu_);
+  LoadedModelsStats s = stats_;
+  s.models = entries_.size();
+  s.queued = queue_.size();
+  return s;
 }
 
 }  // namespace sfc

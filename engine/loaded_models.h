@@ -1,21 +1,35 @@
-// Parsed models (meshes, CAD models), kept so that requests for one model do
-// not parse its file again: a tree found in the cache still needs its model
-// to place samples on. Keyed by the model's canonical spec plus whatever
-// changes the parse (a weight property, say); bounded by a count, least
-// recently used first out. A model in use stays alive through its
-// shared_ptr after it leaves this cache.
+// Parsed models (meshes, CAD models): parsing a model is a build. Parses run
+// on this object's own threads, never on an RPC thread, so a request that
+// waits for one holds no stream slot and no lock; the request waits with its
+// own check (client gone, deadline) and leaves when it says so.
 //
-// Two requests that miss at once may both parse; the first to finish is kept.
+//  - Bounded: at most parse_threads parses at once, at most max_queued_parses
+//    waiting for a thread (past that a miss is RESOURCE_EXHAUSTED), each with
+//    a CPU budget (thread CPU time, parse_seconds) that its ParseControl
+//    check reports when spent; a parse nobody waits for any more is told to
+//    stop too. The parsers poll the check (CAD: OpenCASCADE's user break).
+//  - One parse per key: requests for a key being parsed wait for that parse.
+//  - A failed parse is remembered per key (a model's format + content hash
+//    + whatever changes the parse) for failure_ttl_seconds: the same hostile
+//    file is not parsed again on every request.
+//  - Kept parses are counted in bytes (Parsed::bytes) against budget_bytes,
+//    least recently used first out; a parse larger than the budget alone is
+//    returned to its requests but not kept. ForgetModel() drops a model's parses
+//    (an evicted upload). A model in use stays alive through its shared_ptr.
 //
 // Thread-safety: thread-safe.
 #ifndef SFCSAMPLER_ENGINE_LOADED_MODELS_H_
 #define SFCSAMPLER_ENGINE_LOADED_MODELS_H_
 
+#include <chrono>
+#include <deque>
 #include <functional>
 #include <list>
 #include <memory>
 #include <string>
+#include <thread>
 #include <unordered_map>
+#include <vector>
 
 #include "absl/base/thread_annotations.h"
 #include "absl/status/statusor.h"
@@ -23,35 +37,103 @@
 
 namespace sfc {
 
+struct LoadedModelsOptions {
+  uint64_t budget_bytes = uint64_t{256} << 20;  // parsed models kept; default 256 MiB
+  int parse_threads = 1;                        // parses at once, >= 1
+  int max_queued_parses = 8;                    // parses waiting for a thread, >= 0
+  // CPU seconds one parse may take (its thread's CPU time); 0 = no budget.
+  double parse_seconds = 0;
+  double failure_ttl_seconds = 60;  // how long a failed parse is remembered, >= 0
+};
+
+struct LoadedModelsStats {
+  uint64_t models = 0;           // kept now
+  uint64_t bytes = 0;            // of kept models, now
+  uint64_t hits = 0;
+  uint64_t parses = 0;           // finished, ok or not
+  uint64_t parse_failures = 0;   // remembered failures made
+  uint64_t failure_hits = 0;     // requests answered from a remembered failure
+  uint64_t parses_stopped = 0;   // abandoned by every request, or out of CPU budget
+  uint64_t parses_rejected = 0;  // misses turned away: queue full
+  uint64_t evictions = 0;
+  uint64_t parsing = 0;          // running now
+  uint64_t queued = 0;           // waiting for a thread now
+};
+
+// What a parse may ask while it runs: OK to go on, or why to stop
+// (CANCELLED: nobody waits; RESOURCE_EXHAUSTED: CPU budget spent;
+// UNAVAILABLE: shutdown). Cheap enough to call often.
+using ParseCheck = std::function<absl::Status()>;
+
 class LoadedModels {
  public:
-  explicit LoadedModels(size_t capacity = 8) : capacity_(capacity) {}
+  struct Parsed {
+    std::shared_ptr<const void> model;
+    uint64_t bytes = 0;  // what keeping it costs
+  };
+  using ParseFn = std::function<absl::StatusOr<Parsed>(const ParseCheck& check)>;
 
-  // The model under `key`, parsed by `load` if not kept. Errors are load's,
-  // and are not kept (the next request parses again).
+  explicit LoadedModels(const LoadedModelsOptions& options = {});
+  ~LoadedModels();  // stops the parses and joins the threads
+  LoadedModels(const LoadedModels&) = delete;
+  LoadedModels& operator=(const LoadedModels&) = delete;
+
+  // The model under `key`, parsed by `parse` on a parse thread if not kept.
+  // `caller` (may be empty) is asked while the request waits; its non-OK
+  // status ends the wait with that status (the parse goes on while another
+  // request waits for it). `parse` must own what it uses.
   template <typename Model>
-  absl::StatusOr<std::shared_ptr<const Model>> Get(
-      const std::string& key, const std::function<absl::StatusOr<std::shared_ptr<const Model>>()>& load) {
-    if (auto kept = Find(key)) return std::static_pointer_cast<const Model>(kept);
-    auto loaded = load();
-    if (!loaded.ok()) return loaded.status();
-    return std::static_pointer_cast<const Model>(Keep(key, *loaded));
+  absl::StatusOr<std::shared_ptr<const Model>> Get(const std::string& key, ParseFn parse,
+                                                   const std::function<absl::Status()>& caller) {
+    auto any = GetAny(key, std::move(parse), caller);
+    if (!any.ok()) return any.status();
+    return std::static_pointer_cast<const Model>(*std::move(any));
   }
 
- private:
-  std::shared_ptr<const void> Find(const std::string& key) ABSL_LOCKS_EXCLUDED(mu_);
-  // Keeps `model` under `key` unless another is kept there already; returns the kept one.
-  std::shared_ptr<const void> Keep(const std::string& key, std::shared_ptr<const void> model)
-      ABSL_LOCKS_EXCLUDED(mu_);
+  // Drops the kept parses and remembered failures of the model whose bytes
+  // have SHA-256 `sha256` (keys holding "sha256=<hex>"): an evicted upload,
+  // or a model whose request failed.
+  void ForgetModel(const std::string& sha256) ABSL_LOCKS_EXCLUDED(mu_);
 
+  LoadedModelsStats stats() const ABSL_LOCKS_EXCLUDED(mu_);
+  const LoadedModelsOptions& options() const { return options_; }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  struct Job {
+    std::string key;
+    ParseFn parse;
+    int waiters = 0;  // guarded by mu_
+    bool done = false;
+    absl::StatusOr<Parsed> result;
+  };
   struct Entry {
-    std::shared_ptr<const void> model;
+    Parsed parsed;
     std::list<std::string>::iterator lru;
   };
-  const size_t capacity_;
-  absl::Mutex mu_;
+  struct Failure {
+    absl::Status status;
+    Clock::time_point when;
+  };
+
+  absl::StatusOr<std::shared_ptr<const void>> GetAny(const std::string& key, ParseFn parse,
+                                                     const std::function<absl::Status()>& caller)
+      ABSL_LOCKS_EXCLUDED(mu_);
+  void ParserLoop() ABSL_LOCKS_EXCLUDED(mu_);
+  void Keep(const std::string& key, const Parsed& parsed) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+
+  // Constant after construction.
+  const LoadedModelsOptions options_;
+
+  mutable absl::Mutex mu_;
   std::unordered_map<std::string, Entry> entries_ ABSL_GUARDED_BY(mu_);
   std::list<std::string> lru_ ABSL_GUARDED_BY(mu_);  // front: most recently used
+  std::unordered_map<std::string, std::shared_ptr<Job>> pending_ ABSL_GUARDED_BY(mu_);
+  std::deque<std::shared_ptr<Job>> queue_ ABSL_GUARDED_BY(mu_);
+  std::unordered_map<std::string, Failure> failures_ ABSL_GUARDED_BY(mu_);
+  bool stopping_ ABSL_GUARDED_BY(mu_) = false;
+  LoadedModelsStats stats_ ABSL_GUARDED_BY(mu_);
+  std::vector<std::thread> threads_;  // started in the constructor, joined in the destructor
 };
 
 }  // namespace sfc

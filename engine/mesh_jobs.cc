@@ -90,11 +90,23 @@ class MeshBatchCursor final : public BatchCursor {
   MeshSampleColumns columns_;
 };
 
+// What a kept mesh surface costs: its arrays (positions, triangles,
+// normals, weights, face normals, curvature).
+uint64_t MeshSurfaceBytes(const MeshSurface& surface) {
+  const TriangleMesh& m = surface.mesh();
+  const VertexCurvature& k = surface.curvature();
+  return sizeof(MeshSurface) + m.positions.capacity() * sizeof(Vec3) +
+         m.triangles.capacity() * sizeof(m.triangles[0]) + m.normals.capacity() * sizeof(Vec3) +
+         m.weights.capacity() * sizeof(double) + surface.triangle_count() * sizeof(Vec3) +
+         (k.gaussian.capacity() + k.mean.capacity() + k.mixed_area.capacity()) * sizeof(double);
+}
+
 }  // namespace
 
 absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::string& density,
                                            double tolerance, uint64_t max_leaves,
-                                           LoadedModels* loaded) {
+                                           LoadedModels* loaded,
+                                           const std::function<absl::Status()>& caller) {
   ASSIGN_OR_RETURN(MeshDensityChoice choice, ParseMeshDensity(density));
   const bool curvature = choice.density->needs_curvature();
   const std::string key = absl::StrCat(model.Spec(), "|curvature=", curvature,
@@ -103,12 +115,23 @@ absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::
   options.format = model.format == ModelFormat::kPly ? MeshFormat::kPly : MeshFormat::kObj;
   options.weight_property = choice.weight_property;
   options.max_bytes = model.bytes->size();
-  ASSIGN_OR_RETURN(std::shared_ptr<const MeshSurface> surface,
-                   loaded->Get<MeshSurface>(key, [&]() -> absl::StatusOr<std::shared_ptr<const MeshSurface>> {
-                     const std::string name = model.name.empty() ? model.Spec() : model.name;
-                     ASSIGN_OR_RETURN(TriangleMesh mesh, LoadMesh(*model.bytes, name, options));
-                     return MeshSurface::Create(std::move(mesh), curvature);
-                   }));
+  // The parse owns its inputs: it runs on a parse thread and may outlive the
+  // request that started it.
+  ASSIGN_OR_RETURN(
+      std::shared_ptr<const MeshSurface> surface,
+      loaded->Get<MeshSurface>(
+          key,
+          [model, options, curvature](const ParseCheck& check) mutable
+          -> absl::StatusOr<LoadedModels::Parsed> {
+            options.check = check;
+            const std::string name = model.name.empty() ? model.Spec() : model.name;
+            ASSIGN_OR_RETURN(TriangleMesh mesh, LoadMesh(*model.bytes, name, options));
+            RETURN_IF_ERROR(check());
+            std::shared_ptr<const MeshSurface> parsed = MeshSurface::Create(std::move(mesh), curvature);
+            const uint64_t bytes = MeshSurfaceBytes(*parsed);
+            return LoadedModels::Parsed{std::move(parsed), bytes};
+          },
+          caller));
   MeshTreeRecipe recipe;
   recipe.canonical_density = choice.canonical;
   recipe.factory.build = [surface, density = choice.density, tolerance, max_leaves](

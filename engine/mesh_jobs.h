@@ -11,6 +11,7 @@
 #ifndef SFCSAMPLER_ENGINE_MESH_JOBS_H_
 #define SFCSAMPLER_ENGINE_MESH_JOBS_H_
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -30,14 +31,16 @@ struct MeshTreeRecipe {
   TreeFactory factory;
 };
 
-// Parses `density` for a mesh, loads `model` (through `loaded`) as that
+// Parses `density` for a mesh, loads `model` (through `loaded`, on its parse
+// threads; `caller` is asked while the request waits) as that
 // density needs it, and returns how to build its tree. `tolerance` 0 takes
 // the mesh tree's default. Errors: INVALID_ARGUMENT for a density meshes do
 // not support, a malformed mesh (the message names the file), a missing
 // weight property.
 absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::string& density,
                                            double tolerance, uint64_t max_leaves,
-                                           LoadedModels* loaded);
+                                           LoadedModels* loaded,
+                                           const std::function<absl::Status()>& caller);
 
 // A cursor over samples [begin, end) of `sequence` on the mesh tree held by
 // `tree`, inside `region`, with `fields` (u, v are the barycentric

@@ -10,6 +10,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/strip.h"
+#include "util/echo.h"
 
 namespace sfc {
 namespace {
@@ -47,7 +48,9 @@ std::string Sha256Hex(std::string_view bytes) {
   return hex;
 }
 
-std::string StoredModel::Spec() const {
+std::string StoredModel::Spec() const { return ModelRoutingKey(format, sha256); }
+
+std::string ModelRoutingKey(ModelFormat format, std::string_view sha256) {
   return absl::StrFormat("%s:sha256=%s", ModelFormatName(format), sha256);
 }
 
@@ -63,7 +66,7 @@ absl::StatusOr<std::optional<ModelSpec>> ParseModelSpec(std::string_view text) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "the model spec \"%s\" names no file; write %s:FILE (or %s:sha256=HASH for a model "
         "uploaded to a server)",
-        spec, ModelFormatName(*format), ModelFormatName(*format)));
+        Echo(spec), ModelFormatName(*format), ModelFormatName(*format)));
   }
   if (absl::StartsWith(out.reference, "sha256=")) {
     const std::string hash = absl::AsciiStrToLower(out.reference.substr(7));
@@ -71,7 +74,7 @@ absl::StatusOr<std::optional<ModelSpec>> ParseModelSpec(std::string_view text) {
                      hash.find_first_not_of("0123456789abcdef") == std::string::npos;
     if (!hex) {
       return absl::InvalidArgumentError(absl::StrFormat(
-          "\"%s\" is not a SHA-256: it needs 64 hex digits after sha256=", out.reference));
+          "\"%s\" is not a SHA-256: it needs 64 hex digits after sha256=", Echo(out.reference)));
     }
     out.sha256 = hash;
     out.reference = "sha256=" + hash;
@@ -84,22 +87,22 @@ absl::StatusOr<StoredModel> FileModelSource::Resolve(const ModelSpec& spec) cons
     return absl::NotFoundError(absl::StrFormat(
         "%s names an uploaded model, which only a server stores; give the file's path instead, "
         "or add --server",
-        spec.reference));
+        Echo(spec.reference)));
   }
   std::error_code error;
   const auto size = std::filesystem::file_size(spec.reference, error);
   if (error) {
     return absl::InvalidArgumentError(
-        absl::StrFormat("cannot read the model \"%s\": %s", spec.reference, error.message()));
+        absl::StrFormat("cannot read the model \"%s\": %s", Echo(spec.reference, kMaxNameEcho), error.message()));
   }
   if (size > max_bytes_) {
     return absl::ResourceExhaustedError(absl::StrFormat(
-        "the model \"%s\" is %d bytes, more than the limit of %d", spec.reference, size, max_bytes_));
+        "the model \"%s\" is %d bytes, more than the limit of %d", Echo(spec.reference, kMaxNameEcho), size, max_bytes_));
   }
   std::ifstream in(spec.reference, std::ios::binary);
   auto bytes = std::make_shared<std::string>(size, '\0');
   if (!in || !in.read(bytes->data(), static_cast<std::streamsize>(size))) {
-    return absl::InvalidArgumentError(absl::StrFormat("cannot read the model \"%s\"", spec.reference));
+    return absl::InvalidArgumentError(absl::StrFormat("cannot read the model \"%s\"", Echo(spec.reference, kMaxNameEcho)));
   }
   StoredModel model;
   model.format = spec.format;

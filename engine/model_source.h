@@ -41,6 +41,15 @@ struct StoredModel {
   std::string Spec() const;
 };
 
+// The x-surface-key (the consistent-hash proxy's routing key, docker/) of
+// every request about one model: FindModel, UploadModel, and the Sample and
+// Prepare that name it, so all of them reach the replica that stores it.
+// "FORMAT:sha256=<hex>", the canonical spec, whatever the density or
+// options (one model's trees then share a replica too). `sha256`: 64
+// lowercase hex digits. The Python client (python/sfcsampler/client.py)
+// makes the same string.
+std::string ModelRoutingKey(ModelFormat format, std::string_view sha256);
+
 // A parsed model spec: the format and the reference after the colon.
 struct ModelSpec {
   ModelFormat format;

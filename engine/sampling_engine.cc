@@ -14,7 +14,18 @@
 namespace sfc {
 
 SamplingEngine::SamplingEngine(EngineLimits limits, TreeSource* source, const ModelSource* models)
-    : limits_(limits), source_(source), models_(models) {}
+    : limits_(limits),
+      source_(source),
+      models_(models),
+      loaded_(std::make_unique<LoadedModels>([&limits] {
+        LoadedModelsOptions o;
+        o.budget_bytes = limits.parsed_model_bytes;
+        o.parse_threads = limits.model_parse_threads;
+        o.max_queued_parses = limits.max_queued_parses;
+        o.parse_seconds = limits.model_parse_seconds;
+        o.failure_ttl_seconds = limits.parse_failure_ttl_seconds;
+        return o;
+      }())) {}
 
 const char* TreeKindName(TreeKind kind) {
   switch (kind) {
@@ -54,7 +65,7 @@ absl::StatusOr<PreparedTree> SamplingEngine::PrepareModel(const ModelSpec& model
 #ifdef SFC_HAVE_MESH
     ASSIGN_OR_RETURN(MeshTreeRecipe recipe,
                      MeshTreeFor(stored, spec.density, spec.options.tolerance,
-                                 limits_.max_tree_leaves, loaded_.get()));
+                                 limits_.max_tree_leaves, loaded_.get(), caller.check));
     CurveTreeOptions options;  // a mesh's curve has no options but the tolerance
     options.tolerance = spec.options.tolerance;
     prepared.kind = TreeKind::kMesh;
@@ -66,13 +77,24 @@ absl::StatusOr<PreparedTree> SamplingEngine::PrepareModel(const ModelSpec& model
     CurveTreeOptions options = spec.options;
     options.max_leaves = limits_.max_tree_leaves;
     ASSIGN_OR_RETURN(CadTreeRecipe recipe,
-                     CadTreeFor(stored, spec.density, options, loaded_.get()));
+                     CadTreeFor(stored, spec.density, options, loaded_.get(), caller.check));
     prepared.kind = TreeKind::kCadModel;
     prepared.key = MakeTreeKey(stored.Spec(), recipe.canonical_density, options);
     factory = std::move(recipe.factory);
 #endif
   }
-  ASSIGN_OR_RETURN(prepared.lookup, source_->Get(prepared.key, prepared.grade, factory, caller));
+  auto lookup = source_->Get(prepared.key, prepared.grade, factory, caller);
+  if (!lookup.ok()) {
+    // A model whose tree failed is not kept for a next request (its memory
+    // goes once no request holds it); a request that left keeps it.
+    const absl::StatusCode code = lookup.status().code();
+    if (code != absl::StatusCode::kCancelled && code != absl::StatusCode::kDeadlineExceeded &&
+        code != absl::StatusCode::kUnavailable) {
+      loaded_->ForgetModel(stored.sha256);
+    }
+    return lookup.status();
+  }
+  prepared.lookup = *std::move(lookup);
   return prepared;
 }
 

@@ -71,6 +71,9 @@ class SamplingEngine {
   // The index range [begin, end) a request selects (before its region).
   static absl::StatusOr<std::pair<uint64_t, uint64_t>> ResolveRange(const SampleRequest& request);
 
+  // The parsed models (for statistics, and to forget an evicted upload's).
+  LoadedModels& loaded_models() const { return *loaded_; }
+
  private:
   absl::StatusOr<PreparedTree> PrepareModel(const ModelSpec& model, const TreeSpec& spec,
                                             uint64_t count, const BuildControl& caller) const;
@@ -85,7 +88,7 @@ class SamplingEngine {
   const EngineLimits limits_;
   TreeSource* const source_;
   const ModelSource* const models_;
-  const std::unique_ptr<LoadedModels> loaded_ = std::make_unique<LoadedModels>();
+  const std::unique_ptr<LoadedModels> loaded_;
 };
 
 }  // namespace sfc

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "absl/algorithm/container.h"
 #include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
@@ -17,6 +18,7 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 #include "core/status_macros.h"
+#include "util/echo.h"
 
 namespace sfc {
 namespace {
@@ -40,17 +42,85 @@ void AddPolygon(const std::vector<uint32_t>& corners, TriangleMesh* mesh) {
 
 // ---------------------------------------------------------------- OBJ
 
+// What the line scan of an OBJ file found: its face lines, which the mesh
+// must all hold afterwards (nothing dropped silently).
+struct ObjCensus {
+  uint64_t face_lines = 0;
+};
+
+// One corner's index of kind `what` ("vertex", "texture coordinate",
+// "normal"): OBJ counts from 1, or backwards from -1 over the `defined`
+// elements of that kind above the line. tinyobjloader parses indices into an
+// int without checking for overflow, so 4294967299 would wrap to 3; here
+// every index is read exactly (64-bit, overflow refused) and range-checked.
+absl::Status CheckObjIndex(absl::string_view token, uint64_t defined, absl::string_view what,
+                           absl::string_view plural, size_t line_number, absl::string_view name) {
+  int64_t index = 0;
+  const absl::string_view digits = absl::StartsWith(token, "-") ? token.substr(1) : token;
+  const bool integer = !digits.empty() && absl::c_all_of(digits, absl::ascii_isdigit);
+  if (integer && !absl::SimpleAtoi(token, &index)) index = 0;  // past 64 bits: out of range
+  const bool in_range = integer && index != 0 &&
+                        (index > 0 ? static_cast<uint64_t>(index) <= defined
+                                   : static_cast<uint64_t>(-(index + 1)) < defined);
+  if (in_range) return absl::OkStatus();
+  return Malformed(
+      name, absl::StrFormat("line %d: face %s index '%s' is %s; the file defines %d %s above "
+                            "this line (indices 1..%d, or -1..-%d counting back)",
+                            line_number, what, Echo(token),
+                            integer ? "out of range" : "not an integer", defined, plural, defined,
+                            defined));
+}
+
 // tinyobjloader reads a coordinate it cannot parse ("nan", a cut-off line) as
-// 0 without a word, so the vertex lines are checked here first: at least three
-// numbers, each finite.
-absl::Status CheckObjVertexLines(absl::string_view text, absl::string_view name) {
+// 0 without a word, and wraps face indices past 32 bits, so the vertex and
+// face lines are checked here first: a vertex has at least three numbers,
+// each finite; a face has at least three corners, each index in range.
+absl::StatusOr<ObjCensus> CheckObjLines(absl::string_view text, absl::string_view name) {
+  ObjCensus census;
+  uint64_t vertices = 0, texcoords = 0, normals = 0;
   size_t line_number = 0;
   for (absl::string_view line : absl::StrSplit(text, '\n')) {
     ++line_number;
     line = absl::StripAsciiWhitespace(line);
-    if (!absl::StartsWith(line, "v ") && !absl::StartsWith(line, "v\t")) continue;
+    const bool v = absl::StartsWith(line, "v ") || absl::StartsWith(line, "v\t");
+    const bool f = absl::StartsWith(line, "f ") || absl::StartsWith(line, "f\t");
+    if (absl::StartsWith(line, "vt ") || absl::StartsWith(line, "vt\t")) ++texcoords;
+    if (absl::StartsWith(line, "vn ") || absl::StartsWith(line, "vn\t")) ++normals;
+    if (!v && !f) continue;
+    // A comment ends the line's data.
+    if (const size_t hash = line.find('#'); hash != absl::string_view::npos) {
+      line = line.substr(0, hash);
+    }
     std::vector<absl::string_view> tokens =
-        absl::StrSplit(line.substr(2), absl::ByAnyChar(" \t"), absl::SkipEmpty());
+        absl::StrSplit(line.substr(2), absl::ByAnyChar(" \t\r"), absl::SkipEmpty());
+    if (f) {
+      ++census.face_lines;
+      if (tokens.size() < 3) {
+        return Malformed(name, absl::StrFormat("line %d: a face needs three corners, found %d "
+                                               "(a truncated file?)",
+                                               line_number, tokens.size()));
+      }
+      for (absl::string_view corner : tokens) {
+        // v, v/vt, v/vt/vn or v//vn.
+        std::vector<absl::string_view> parts = absl::StrSplit(corner, '/');
+        if (parts.size() > 3) {
+          return Malformed(name, absl::StrFormat("line %d: face corner '%s' has more than three "
+                                                 "indices (v/vt/vn)",
+                                                 line_number, Echo(corner)));
+        }
+        RETURN_IF_ERROR(CheckObjIndex(parts[0], vertices, "vertex", "vertices", line_number, name));
+        if (parts.size() > 1 && !parts[1].empty()) {
+          RETURN_IF_ERROR(
+              CheckObjIndex(parts[1], texcoords, "texture coordinate", "texture coordinates",
+                            line_number, name));
+        }
+        if (parts.size() > 2) {
+          RETURN_IF_ERROR(CheckObjIndex(parts[2], normals, "normal", "normals", line_number, name));
+        }
+      }
+      continue;
+    }
+    ++vertices;
     if (tokens.size() < 3) {
       return Malformed(name, absl::StrFormat("line %d: a vertex needs three coordinates, found %d "
                                              "(a truncated file?)",
@@ -61,11 +131,11 @@ absl::Status CheckObjVertexLines(absl::string_view text, absl::string_view name)
       if (!absl::SimpleAtod(tokens[c], &value) || !std::isfinite(value)) {
         return Malformed(name, absl::StrFormat("line %d: vertex coordinate '%s' is not a finite "
                                                "number",
-                                               line_number, tokens[c]));
+                                               line_number, Echo(tokens[c])));
       }
     }
   }
-  return absl::OkStatus();
+  return census;
 }
 
 absl::StatusOr<TriangleMesh> LoadObj(absl::string_view bytes, absl::string_view name,
@@ -74,16 +144,18 @@ absl::StatusOr<TriangleMesh> LoadObj(absl::string_view bytes, absl::string_view 
     return absl::InvalidArgumentError(absl::StrFormat(
         "mesh '%s': OBJ files have no named vertex properties, so weight property '%s' cannot "
         "be read; give the mesh as PLY with a vertex property of that name",
-        name, options.weight_property));
+        name, Echo(options.weight_property)));
   }
-  RETURN_IF_ERROR(CheckObjVertexLines(bytes, name));
+  ASSIGN_OR_RETURN(const ObjCensus census, CheckObjLines(bytes, name));
   tinyobj::ObjReader reader;
   tinyobj::ObjReaderConfig config;
   config.triangulate = false;  // we fan-triangulate and count the polygons
   config.vertex_color = false;
-  if (!reader.ParseFromString(std::string(bytes), "", config)) {
+  const bool parsed = reader.ParseFromString(std::string(bytes), "", config);
+  if (options.check) RETURN_IF_ERROR(options.check());
+  if (!parsed) {
     return Malformed(name, absl::StrFormat("not a valid OBJ file: %s",
-                                           absl::StripAsciiWhitespace(reader.Error())));
+                                           Echo(absl::StripAsciiWhitespace(reader.Error()), 200)));
   }
   const std::string& warning = reader.Warning();
   if (absl::StrContains(warning, "out of bounds")) {
@@ -93,6 +165,16 @@ absl::StatusOr<TriangleMesh> LoadObj(absl::string_view bytes, absl::string_view 
     return Malformed(name, "a face has fewer than three corners (a truncated file?)");
   }
   const tinyobj::attrib_t& attrib = reader.GetAttrib();
+  uint64_t faces_read = 0;
+  for (const tinyobj::shape_t& shape : reader.GetShapes()) {
+    faces_read += shape.mesh.num_face_vertices.size();
+  }
+  if (faces_read != census.face_lines) {
+    return Malformed(name, absl::StrFormat("the file has %d face lines but the OBJ reader kept %d; "
+                                           "a damaged face line? (reader: %s)",
+                                           census.face_lines, faces_read,
+                                           Echo(absl::StripAsciiWhitespace(reader.Warning()), 200)));
+  }
   TriangleMesh mesh;
   mesh.name = std::string(name);
   const size_t nv = attrib.vertices.size() / 3;
@@ -211,8 +293,40 @@ bool HasNarrowListCount(const CgalPlyNumber* p) {
          narrow(int8_t{}) || narrow(uint8_t{}) || narrow(float{}) || narrow(double{});
 }
 
+// CGAL's header parser appends a "property" line to the last element
+// without checking that there is one: a property before any element writes
+// through a null pointer (found by fuzz/ply_fuzzer). The header is checked
+// here first: it ends with end_header, and every property follows an element.
+absl::Status CheckPlyHeader(absl::string_view bytes, absl::string_view name) {
+  constexpr size_t kMaxHeader = size_t{1} << 20;
+  bool element = false;
+  size_t line_number = 0, start = 0;
+  // Lines and keywords as CGAL reads them: std::getline, then >> keyword.
+  while (start < bytes.size() && start < kMaxHeader) {
+    size_t end = bytes.find('\n', start);
+    if (end == absl::string_view::npos) end = bytes.size();
+    const absl::string_view line = bytes.substr(start, end - start);
+    start = end + 1;
+    ++line_number;
+    std::vector<absl::string_view> tokens =
+        absl::StrSplit(line, absl::ByAnyChar(" \t\r\v\f"), absl::SkipEmpty());
+    // CGAL takes line 1 as the signature and line 2 as the format line,
+    // whatever they hold; keywords count from line 3.
+    if (tokens.empty() || line_number <= 2) continue;
+    if (tokens[0] == "end_header") return absl::OkStatus();
+    if (tokens[0] == "element") element = true;
+    if (tokens[0] == "property" && !element) {
+      return Malformed(name, absl::StrFormat("header line %d: a property before any element "
+                                             "('%s'); properties follow their 'element' line",
+                                             line_number, Echo(line)));
+    }
+  }
+  return Malformed(name, "the PLY header has no 'end_header' line in its first 1 MiB");
+}
+
 absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view name,
                                      const MeshLoadOptions& options) {
+  RETURN_IF_ERROR(CheckPlyHeader(bytes, name));
   std::istringstream in(std::string(bytes), std::ios::in | std::ios::binary);
   CgalPlyReader reader(/*verbose=*/false);
   if (!reader.init(in)) {
@@ -231,14 +345,15 @@ absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view 
     if (items > bytes.size()) {
       return Malformed(name, absl::StrFormat("element '%s' declares %d items, more than the %d "
                                              "bytes of the file can hold (a truncated file?)",
-                                             element.name(), items, bytes.size()));
+                                             Echo(element.name()), items, bytes.size()));
     }
     for (size_t k = 0; k < props; ++k) {
       CgalPlyNumber* p = element.property(k);
       if (Resolve(p) == nullptr && !HasNarrowListCount(p)) {
         return Malformed(name, absl::StrFormat("property '%s' of element '%s' is a list with a "
                                                "32-bit count; write 'property list uchar int %s'",
-                                               p->name(), element.name(), p->name()));
+                                               Echo(p->name()), Echo(element.name()),
+                                               Echo(p->name())));
       }
     }
     const bool is_vertex = element.name() == "vertex";
@@ -265,7 +380,7 @@ absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view 
       if (!options.weight_property.empty() && iw < 0) {
         return Malformed(name, absl::StrFormat("the vertex element has no scalar property '%s' "
                                                "to read weights from",
-                                               options.weight_property));
+                                               Echo(options.weight_property)));
       }
       have_vertices = true;
       mesh.positions.reserve(items);
@@ -283,11 +398,12 @@ absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view 
     const ScalarGetter gx = getter(ix), gy = getter(iy), gz = getter(iz), gnx = getter(inx),
                        gny = getter(iny), gnz = getter(inz), gw = getter(iw);
     for (size_t j = 0; j < items; ++j) {
+      if (options.check && (j & 0xffff) == 0) RETURN_IF_ERROR(options.check());
       for (size_t k = 0; k < props; ++k) element.property(k)->get(in);
       if (!in) {
         return Malformed(name, absl::StrFormat("the file ends or breaks inside %s %d of %d (a "
                                                "truncated or malformed file?)",
-                                               element.name(), j, items));
+                                               Echo(element.name()), j, items));
       }
       if (is_vertex) {
         mesh.positions.push_back({gx(element.property(ix)), gy(element.property(iy)),
@@ -306,8 +422,14 @@ absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view 
         }
         corners.clear();
         for (int64_t c : list) {
-          if (c < 0 || c > UINT32_MAX) {
-            return Malformed(name, absl::StrFormat("face %d uses vertex index %d", j, c));
+          // Vertices come before faces in every writer's files; a face that
+          // names a vertex past them is refused here, with the index.
+          if (c < 0 || static_cast<uint64_t>(c) >= mesh.positions.size()) {
+            return Malformed(name, absl::StrFormat("face %d uses vertex index %d, but the file "
+                                                   "has %d vertices before its faces (indices "
+                                                   "0..%d)",
+                                                   j, c, mesh.positions.size(),
+                                                   static_cast<int64_t>(mesh.positions.size()) - 1));
           }
           corners.push_back(static_cast<uint32_t>(c));
         }
@@ -330,8 +452,9 @@ std::optional<MeshFormat> MeshFormatFromFileName(absl::string_view file_name) {
   return std::nullopt;
 }
 
-absl::StatusOr<TriangleMesh> LoadMesh(absl::string_view bytes, absl::string_view name,
+absl::StatusOr<TriangleMesh> LoadMesh(absl::string_view bytes, absl::string_view untrusted_name,
                                       const MeshLoadOptions& options) {
+  const std::string name = Echo(untrusted_name, kMaxNameEcho);
   if (bytes.size() > options.max_bytes) {
     return absl::ResourceExhaustedError(absl::StrFormat(
         "mesh '%s' is %d bytes, past the limit of %d bytes", name, bytes.size(),
@@ -352,7 +475,7 @@ absl::StatusOr<TriangleMesh> LoadMesh(absl::string_view bytes, absl::string_view
     return absl::ResourceExhaustedError(
         absl::StrFormat("mesh '%s' needs more memory than is available", name));
   } catch (const std::exception& e) {
-    return Malformed(name, absl::StrFormat("the reader failed: %s", e.what()));
+    return Malformed(name, absl::StrFormat("the reader failed: %s", Echo(e.what())));
   }
   if (!mesh.ok()) return mesh.status();
   RETURN_IF_ERROR(FinalizeMesh(&*mesh));

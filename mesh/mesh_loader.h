@@ -13,6 +13,7 @@
 #define SFCSAMPLER_MESH_MESH_LOADER_H_
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include "absl/strings/string_view.h"
@@ -40,6 +41,9 @@ struct MeshLoadOptions {
   // weights (MeshDensityKind::kVertexWeight); empty = none. OBJ has no named
   // vertex properties: naming one for an OBJ file is INVALID_ARGUMENT.
   std::string weight_property;
+  // Asked between parts of the work (every 65536 PLY items, after the OBJ
+  // reader); a non-OK status stops the load, which returns it. Empty: never.
+  std::function<absl::Status()> check;
 };
 
 // Parses `bytes` as a mesh called `name` (used in messages only), then

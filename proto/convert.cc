@@ -1,5 +1,7 @@
 #include "proto/convert.h"
 
+#include "util/echo.h"
+
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
@@ -441,8 +443,11 @@ void ToProto(const CatalogEntry& e, v1::CatalogEntry* out) {
 }
 
 grpc::Status ToGrpcStatus(const absl::Status& status) {
-  // absl and gRPC share the canonical code numbering.
-  return grpc::Status(static_cast<grpc::StatusCode>(status.code()), std::string(status.message()));
+  // absl and gRPC share the canonical code numbering. The message travels in
+  // a header (grpc-message): a long one would turn the real code into the
+  // client's RESOURCE_EXHAUSTED about metadata size.
+  return grpc::Status(static_cast<grpc::StatusCode>(status.code()),
+                      ClipMessage(status.message(), kMaxStatusMessageBytes));
 }
 
 absl::Status FromGrpcStatus(const grpc::Status& status) {

@@ -47,6 +47,12 @@ absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fiel
 void ToProto(const PreparedTree& tree, v1::TreeInfo* out);
 void ToProto(const CatalogEntry& entry, v1::CatalogEntry* out);
 
+// The longest status message the server sends, in bytes; longer ones are
+// clipped by ToGrpcStatus (util/echo.h ClipMessage).
+inline constexpr size_t kMaxStatusMessageBytes = 1024;
+
+// The one conversion of the server's statuses for the wire: same code, the
+// message clipped to kMaxStatusMessageBytes.
 grpc::Status ToGrpcStatus(const absl::Status& status);
 absl::Status FromGrpcStatus(const grpc::Status& status);
 

@@ -1,6 +1,9 @@
 #include "server/model_store.h"
 
+#include <vector>
+
 #include "absl/strings/str_format.h"
+#include "util/echo.h"
 
 namespace sfc {
 
@@ -14,12 +17,16 @@ absl::StatusOr<StoredModel> ModelStore::Put(ModelFormat format, std::string byte
     return absl::ResourceExhaustedError(absl::StrFormat(
         "the model \"%s\" is %d bytes, more than this server takes (max_model_bytes %d, model "
         "budget %d); simplify or split it, or ask the operator to raise the limit",
-        name, bytes.size(), std::min(max_model_bytes_, budget_bytes_), budget_bytes_));
+        Echo(name, kMaxNameEcho), bytes.size(), std::min(max_model_bytes_, budget_bytes_),
+        budget_bytes_));
   }
   StoredModel model;
   model.format = format;
   model.sha256 = Sha256Hex(bytes);
-  model.name = name;
+  // No name is kept: the model is shared by every client that sends these
+  // bytes, and one client's file name must not show in another's errors.
+  std::vector<std::string> evicted;
+  {
   absl::MutexLock lock(&mu_);
   if (auto it = entries_.find(model.sha256); it != entries_.end()) {
     lru_.splice(lru_.begin(), lru_, it->second.lru);
@@ -38,9 +45,14 @@ absl::StatusOr<StoredModel> ModelStore::Put(ModelFormat format, std::string byte
   while (stats_.bytes > budget_bytes_ && lru_.size() > 1) {
     auto victim = entries_.find(lru_.back());
     stats_.bytes -= victim->second.model.bytes->size();
+    evicted.push_back(victim->first);
     entries_.erase(victim);
     lru_.pop_back();
     ++stats_.evictions;
+  }
+  }
+  if (on_evict_) {
+    for (const std::string& sha256 : evicted) on_evict_(sha256);
   }
   return model;
 }

@@ -13,6 +13,7 @@
 #ifndef SFCSAMPLER_SERVER_MODEL_STORE_H_
 #define SFCSAMPLER_SERVER_MODEL_STORE_H_
 
+#include <functional>
 #include <list>
 #include <string>
 #include <unordered_map>
@@ -38,13 +39,20 @@ class ModelStore final : public ModelSource {
 
   // Stores `bytes` as a model of `format` (or finds it stored). `already`
   // says whether it was. RESOURCE_EXHAUSTED past max_model_bytes or the
-  // budget.
+  // budget. `name` (this upload's) appears only in this call's error: stored
+  // models have no name, so errors about them name format and hash.
   absl::StatusOr<StoredModel> Put(ModelFormat format, std::string bytes, const std::string& name,
                                   bool* already = nullptr) ABSL_LOCKS_EXCLUDED(mu_);
 
   // sha256 references only; a path is INVALID_ARGUMENT (the server opens no
   // client paths), an unknown hash NOT_FOUND.
   absl::StatusOr<StoredModel> Resolve(const ModelSpec& spec) const override ABSL_LOCKS_EXCLUDED(mu_);
+
+  // Called with the hash of every model evicted for the budget, outside the
+  // store's lock. Set once, before the store is shared.
+  void SetEvictionListener(std::function<void(const std::string& sha256)> listener) {
+    on_evict_ = std::move(listener);
+  }
 
   // Counts an upload turned away for its size (the service stops reading it
   // before Put).
@@ -63,6 +71,7 @@ class ModelStore final : public ModelSource {
   // Constant after construction.
   const uint64_t budget_bytes_;
   const uint64_t max_model_bytes_;
+  std::function<void(const std::string&)> on_evict_;  // set before use
 
   mutable absl::Mutex mu_;
   // sha256 -> model; a model stored under two formats keeps the first.

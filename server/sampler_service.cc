@@ -7,6 +7,7 @@
 #include "core/status_macros.h"
 #include "proto/convert.h"
 #include "server/message_pipeline.h"
+#include "util/echo.h"
 #include "spdlog/spdlog.h"
 
 namespace sfc {
@@ -76,12 +77,22 @@ SamplerService::SamplerService(const ServerOptions& options, TreeCache* cache, M
       cache_(cache),
       models_(models),
       metrics_(metrics),
-      engine_(options.limits, cache, models),
+      engine_(
+          [&options] {
+            EngineLimits limits = options.limits;
+            limits.parse_failure_ttl_seconds = options.failure_ttl_seconds;
+            return limits;
+          }(),
+          cache, models),
       authenticator_(options.token.empty() || token_checked_by_transport
                          ? nullptr
                          : std::make_unique<const TokenAuthenticator>(options.token)),
       watchdog_(options.write_timeout_seconds),
-      stream_memory_(options.stream_memory_bytes) {}
+      stream_memory_(options.stream_memory_bytes) {
+  // An evicted upload's parses go with it (their requests hold what they use).
+  models_->SetEvictionListener(
+      [this](const std::string& sha256) { engine_.loaded_models().ForgetModel(sha256); });
+}
 
 grpc::Status SamplerService::Admit(const grpc::ServerContext& context) const {
   if (draining_.load()) {
@@ -102,6 +113,7 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
   const auto start = Clock::now();
   uint64_t sent = 0;
   grpc::Status status = Admit(*context);
+  if (status.ok()) status = PrepareModelOutsideSlot(context, *request);
   if (status.ok()) {
     // Claim a stream slot; give it back on every path out.
     if (active_streams_.fetch_add(1) >= options_.max_concurrent_streams) {
@@ -120,9 +132,24 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
   }
   metrics_->CountRequest("Sample", status.error_code());
   spdlog::info("rpc=Sample peer={} surface=\"{}\" count={} sent={} seconds={:.3f} code={} msg=\"{}\"",
-               context->peer(), request->tree().surface(), request->count(), sent,
-               SecondsSince(start), static_cast<int>(status.error_code()), status.error_message());
+               Echo(context->peer()), Echo(request->tree().surface(), kMaxNameEcho),
+               request->count(), sent, SecondsSince(start), static_cast<int>(status.error_code()),
+               Echo(status.error_message(), kMaxStatusMessageBytes));
   return status;
+}
+
+grpc::Status SamplerService::PrepareModelOutsideSlot(grpc::ServerContext* context,
+                                                     const v1::SampleRequest& request) {
+  auto model = ParseModelSpec(request.tree().surface());
+  if (!model.ok() || !model->has_value()) return grpc::Status::OK;  // RunSample says why
+  auto parsed = FromProto(request);
+  if (!parsed.ok()) return ToGrpcStatus(parsed.status());
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(options_.request_deadline_seconds));
+  auto prepared = engine_.Prepare(parsed->tree, parsed->tree_count ? parsed->tree_count : parsed->count,
+                                  RequestControl(context, deadline, options_.request_deadline_seconds));
+  if (!prepared.ok()) return ToGrpcStatus(prepared.status());
+  return grpc::Status::OK;
 }
 
 grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::SampleRequest& request,
@@ -234,8 +261,8 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
     if (!item->response) {
       const absl::Status& s = item->status;
       if (s.ok()) break;
-      return grpc::Status(static_cast<grpc::StatusCode>(s.code()),
-                          absl::StrFormat("%s (after %d samples were sent)", s.message(), *sent));
+      return ToGrpcStatus(absl::Status(
+          s.code(), absl::StrFormat("%s (after %d samples were sent)", s.message(), *sent)));
     }
     if (first) {
       *item->response->mutable_header() = std::move(header);
@@ -276,9 +303,10 @@ grpc::Status SamplerService::Prepare(grpc::ServerContext* context, const v1::Pre
   }
   metrics_->CountRequest("Prepare", status.error_code());
   spdlog::info("rpc=Prepare peer={} surface=\"{}\" count={} hit={} seconds={:.3f} code={} msg=\"{}\"",
-               context->peer(), request->tree().surface(), request->count(),
-               response->tree().cache_hit(), SecondsSince(start),
-               static_cast<int>(status.error_code()), status.error_message());
+               Echo(context->peer()), Echo(request->tree().surface(), kMaxNameEcho),
+               request->count(), response->tree().cache_hit(), SecondsSince(start),
+               static_cast<int>(status.error_code()),
+               Echo(status.error_message(), kMaxStatusMessageBytes));
   return status;
 }
 
@@ -345,6 +373,19 @@ grpc::Status SamplerService::GetCacheStats(grpc::ServerContext* context,
     response->set_max_model_bytes(models_->max_model_bytes());
     response->set_model_uploads(m.uploads);
     response->set_model_evictions(m.evictions);
+    const LoadedModelsStats p = engine_.loaded_models().stats();
+    const LoadedModelsOptions& po = engine_.loaded_models().options();
+    response->set_parsed_models(p.models);
+    response->set_parsed_model_bytes(p.bytes);
+    response->set_parsed_model_budget_bytes(po.budget_bytes);
+    response->set_model_parse_threads(po.parse_threads);
+    response->set_model_parse_seconds(po.parse_seconds);
+    response->set_model_parses(p.parses);
+    response->set_model_parse_failures(p.parse_failures);
+    response->set_model_parses_stopped(p.parses_stopped);
+    response->set_model_parses_running(p.parsing);
+    response->set_model_parses_queued(p.queued);
+    response->set_max_queued_parses(po.max_queued_parses);
   }
   metrics_->CountRequest("GetCacheStats", status.error_code());
   return status;
@@ -370,13 +411,15 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
     bool first = true;
     while (status.ok() && reader->Read(&chunk)) {
       if (first) {
-        name = chunk.name();
+        // The name is the client's: escaped and clipped before any message
+        // or log line shows it, and never stored (the model is shared).
+        name = Echo(chunk.name(), kMaxNameEcho);
         format = ModelFormatFromName(chunk.format());
         if (!format) {
           status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
                                 absl::StrFormat("unknown model format \"%s\"; use step, iges, nurbs, "
                                                 "obj or ply",
-                                                chunk.format()));
+                                                Echo(chunk.format())));
         }
         first = false;
       }
@@ -407,8 +450,10 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
   }
   metrics_->CountRequest("UploadModel", status.error_code());
   spdlog::info("rpc=UploadModel peer={} name=\"{}\" bytes={} sha256={} already={} seconds={:.3f} code={} msg=\"{}\"",
-               context->peer(), name, response->bytes(), response->sha256(), response->already_stored(),
-               SecondsSince(start), static_cast<int>(status.error_code()), status.error_message());
+               Echo(context->peer()), name, response->bytes(), response->sha256(),
+               response->already_stored(), SecondsSince(start),
+               static_cast<int>(status.error_code()),
+               Echo(status.error_message(), kMaxStatusMessageBytes));
   return status;
 }
 
@@ -422,7 +467,7 @@ grpc::Status SamplerService::FindModel(grpc::ServerContext* context, const v1::F
       status = ToGrpcStatus(spec.status());
     } else if (!spec->has_value()) {
       status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                            absl::StrFormat("unknown model format \"%s\"", format));
+                            absl::StrFormat("unknown model format \"%s\"", Echo(format)));
     } else {
       auto found = models_->Resolve(**spec);
       if (found.ok()) {

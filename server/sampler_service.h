@@ -62,6 +62,11 @@ class SamplerService final : public ::sfcsampler::v1::Sampler::Service {
  private:
   // UNAVAILABLE while draining; UNAUTHENTICATED without the token.
   grpc::Status Admit(const grpc::ServerContext& context) const;
+  // A Sample naming a model: its parse and tree, made (or waited for) before
+  // the stream takes a slot, so a slow or hostile parse holds none. OK for
+  // other requests (and for errors RunSample reports itself).
+  grpc::Status PrepareModelOutsideSlot(grpc::ServerContext* context,
+                                       const ::sfcsampler::v1::SampleRequest& request);
   grpc::Status RunSample(grpc::ServerContext* context, const ::sfcsampler::v1::SampleRequest& request,
                          grpc::ServerWriter<::sfcsampler::v1::SampleResponse>* writer,
                          uint64_t* sent);

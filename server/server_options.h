@@ -21,6 +21,8 @@ struct ServerOptions {
   EngineLimits limits = [] {
     EngineLimits l;
     l.generation_threads = 2;
+    // A server parses other people's files: each parse gets a CPU budget.
+    l.model_parse_seconds = 120;
     return l;
   }();
   uint64_t cache_bytes = uint64_t{1} << 30;    // tree cache budget, 1 GiB

@@ -52,6 +52,22 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--max-model-bytes", o.max_model_bytes, "largest model one upload may carry, bytes")
       ->capture_default_str();
+  app.add_option("--parsed-model-bytes", o.limits.parsed_model_bytes,
+                 "parsed models kept (meshes, CAD models), bytes (LRU eviction)")
+      ->capture_default_str();
+  app.add_option("--model-parse-threads", o.limits.model_parse_threads,
+                 "model files parsed at once (on threads of their own, not the RPC threads)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 64));
+  app.add_option("--max-queued-parses", o.limits.max_queued_parses,
+                 "model parses that may wait for a parse thread; more are RESOURCE_EXHAUSTED")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--model-parse-seconds", o.limits.model_parse_seconds,
+                 "CPU seconds one model parse may take before it is stopped (0: no limit); a "
+                 "failed parse is remembered for --failure-ttl seconds")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--max-concurrent-streams", o.max_concurrent_streams, "Sample streams at once")
       ->capture_default_str();
   app.add_option("--max-batch-size", o.max_batch_size, "most samples per message")->capture_default_str();

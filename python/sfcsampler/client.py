@@ -38,6 +38,22 @@ _MODEL_FORMATS = ("step", "iges", "nurbs", "obj", "ply")
 _UPLOAD_CHUNK = 1 << 20  # the server takes chunks of up to 1 MiB
 
 
+def _model_key(fmt, digest):
+    """x-surface-key of every request about a model (FindModel, UploadModel,
+    and the Sample/Prepare naming it): "FORMAT:sha256=<hex>", as the C++
+    client's ModelRoutingKey (engine/model_source.h), so that behind a
+    consistent-hash proxy all of them reach the replica storing the model."""
+    return f"{fmt}:sha256={digest.lower()}"
+
+
+def _routing_key(request):
+    """The key for a request: its model's, or its tree key."""
+    fmt, colon, reference = request.surface.strip().partition(":")
+    if colon and fmt in _MODEL_FORMATS and reference.strip().startswith("sha256="):
+        return _model_key(fmt, reference.strip()[len("sha256="):])
+    return request.surface_key
+
+
 def _tree_spec(request, spec):
     spec.surface = request.surface
     spec.density = request.density
@@ -152,7 +168,7 @@ class Client:
 
     def _upload_bytes(self, fmt, local, digest, name):
         """FindModel, then UploadModel of `local` (None: only look) when the server lacks it."""
-        metadata = self._metadata("")
+        metadata = self._metadata(_model_key(fmt, digest))
         try:
             return self._stub.FindModel(pb.FindModelRequest(sha256=digest, format=fmt),
                                         timeout=self._timeout, metadata=metadata).spec
@@ -237,7 +253,7 @@ class Client:
                                            ("curve_position", req.curve_position),
                                            ("face", req.face), ("triangle", req.triangle)) if on]
         range_end = req.index_range[1]
-        metadata = self._metadata(req.surface_key)
+        metadata = self._metadata(_routing_key(req))
         first = None          # the first stream's header
         tree = None
         received = 0
@@ -281,7 +297,12 @@ class Client:
                                   np.float32 if precision == "float32" else np.float64)
             except grpc.RpcError as e:
                 details = e.details() or ""
-                resumable = (e.code() == grpc.StatusCode.UNAVAILABLE or
+                # Behind a proxy, the replica after a dead one lacks the model:
+                # upload it there again (a local file) and resume.
+                model_moved = (e.code() == grpc.StatusCode.NOT_FOUND and attempt > 0 and
+                               isinstance(request.get("surface"), str) and
+                               request["surface"] != req.surface)
+                resumable = (e.code() == grpc.StatusCode.UNAVAILABLE or model_moved or
                              (e.code() == grpc.StatusCode.INTERNAL and "RST_STREAM" in details))
                 if not resumable or attempt == self._max_resumes:
                     where = f", last index {last_index}" if received else ""
@@ -289,6 +310,8 @@ class Client:
                 self.resumes += 1
                 time.sleep(backoff)
                 backoff *= 2
+                if model_moved:
+                    self.upload(request["surface"])
                 if req.monotone and received:
                     resume_range = (last_index + 1, range_end)
                 elif not req.monotone:
@@ -323,7 +346,7 @@ class Client:
         w = pb.PrepareRequest(count=req.tree_count or req.count)
         _tree_spec(req, w.tree)
         try:
-            response = self._stub.Prepare(w, timeout=self._timeout, metadata=self._metadata(req.surface_key))
+            response = self._stub.Prepare(w, timeout=self._timeout, metadata=self._metadata(_routing_key(req)))
         except grpc.RpcError as e:
             raise _error(e) from None
         tree = _wire.message_dict(response.tree)

@@ -1,0 +1,157 @@
+#include "cad/preflight.h"
+
+#include <algorithm>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "util/echo.h"
+
+namespace sfc::cad {
+namespace {
+
+// 1-based line number of byte `at`.
+uint64_t LineOf(absl::string_view bytes, size_t at) {
+  return 1 + static_cast<uint64_t>(std::count(bytes.begin(), bytes.begin() + at, '\n'));
+}
+
+// The record's "#N = KEYWORD(" head, when it has one: its number and keyword.
+bool ParseHead(absl::string_view record, uint64_t* id, absl::string_view* keyword) {
+  record = absl::StripLeadingAsciiWhitespace(record);
+  if (record.empty() || record[0] != '#') return false;
+  size_t i = 1;
+  while (i < record.size() && absl::ascii_isdigit(record[i])) ++i;
+  if (!absl::SimpleAtoi(record.substr(1, i - 1), id)) return false;
+  record = absl::StripLeadingAsciiWhitespace(record.substr(i));
+  if (record.empty() || record[0] != '=') return false;
+  record = absl::StripLeadingAsciiWhitespace(record.substr(1));
+  size_t j = 0;
+  while (j < record.size() && (absl::ascii_isalnum(record[j]) || record[j] == '_')) ++j;
+  *keyword = record.substr(0, j);
+  return j > 0;
+}
+
+}  // namespace
+
+absl::StatusOr<ModelCensus> PreflightStep(absl::string_view bytes, const PreflightLimits& limits) {
+  ModelCensus census;
+  int depth = 0;
+  size_t record_start = 0;
+  bool in_data = false;
+  for (size_t i = 0; i < bytes.size(); ++i) {
+    const char c = bytes[i];
+    if (c == '\'') {  // a string: '' is a quote inside it
+      for (++i; i < bytes.size(); ++i) {
+        if (bytes[i] != '\'') continue;
+        if (i + 1 < bytes.size() && bytes[i + 1] == '\'') {
+          ++i;
+        } else {
+          break;
+        }
+      }
+    } else if (c == '/' && i + 1 < bytes.size() && bytes[i + 1] == '*') {
+      const size_t end = bytes.find("*/", i + 2);
+      i = end == absl::string_view::npos ? bytes.size() : end + 1;
+    } else if (c == '(') {
+      if (++depth > limits.max_nesting) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "parentheses nest deeper than %d at line %d (max_nesting; real models nest at most "
+            "5 deep): the record starting '%s' is malformed, fix or re-export the file",
+            limits.max_nesting, LineOf(bytes, i),
+            Echo(absl::StripLeadingAsciiWhitespace(bytes.substr(record_start, 40)))));
+      }
+      census.max_nesting = std::max(census.max_nesting, depth);
+    } else if (c == ')') {
+      depth = std::max(depth - 1, 0);
+    }
+    const size_t length = i + 1 - record_start;
+    if (length > limits.max_record_bytes) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "the record at line %d, starting '%s', is longer than %d bytes (max_record_bytes): a "
+          "missing ';' or a broken file; fix or re-export it",
+          LineOf(bytes, record_start),
+          Echo(absl::StripLeadingAsciiWhitespace(bytes.substr(record_start, 40))),
+          limits.max_record_bytes));
+    }
+    if (i < bytes.size() && bytes[i] == ';') {
+      const absl::string_view record =
+          absl::StripAsciiWhitespace(bytes.substr(record_start, i - record_start));
+      census.longest_record = std::max<uint64_t>(census.longest_record, record.size());
+      if (record == "DATA") in_data = true;
+      if (record == "ENDSEC") in_data = false;
+      uint64_t id = 0;
+      absl::string_view keyword;
+      if (in_data && ParseHead(record, &id, &keyword)) {
+        if (++census.entities > limits.max_entities) {
+          return absl::InvalidArgumentError(absl::StrFormat(
+              "the file has more than %d entity instances (max_entities); split the model",
+              limits.max_entities));
+        }
+        const std::string upper = absl::AsciiStrToUpper(keyword);
+        if (upper == "ADVANCED_FACE" || upper == "FACE_SURFACE") {
+          census.faces.push_back(absl::StrCat("#", id, " ", upper));
+          census.face_ids.push_back(id);
+        }
+      }
+      depth = 0;
+      record_start = i + 1;
+    }
+  }
+  return census;
+}
+
+absl::StatusOr<ModelCensus> PreflightIges(absl::string_view bytes, const PreflightLimits& limits) {
+  ModelCensus census;
+  uint64_t line_number = 0;
+  bool first_of_entry = true;
+  size_t start = 0;
+  while (start < bytes.size()) {
+    size_t end = bytes.find('\n', start);
+    if (end == absl::string_view::npos) end = bytes.size();
+    absl::string_view line = bytes.substr(start, end - start);
+    start = end + 1;
+    ++line_number;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    // Writers may pad past column 80 with blanks; anything else is too long.
+    const absl::string_view text = line.size() > limits.max_iges_line
+                                       ? absl::StripTrailingAsciiWhitespace(line)
+                                       : line;
+    census.longest_record = std::max<uint64_t>(census.longest_record, text.size());
+    if (text.size() > limits.max_iges_line) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "line %d has %d characters; IGES records have %d columns (max_iges_line), so the file "
+          "is broken or not IGES: '%s'",
+          line_number, text.size(), limits.max_iges_line, Echo(text, 40)));
+    }
+    if (line.size() < 73 || line[72] != 'D') continue;
+    // Directory entries take two lines; the first holds the type (columns
+    // 1-8), the status (65-72) and the sequence number (74-80).
+    if (!first_of_entry) {
+      first_of_entry = true;
+      continue;
+    }
+    first_of_entry = false;
+    if (++census.entities > limits.max_entities) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "the file has more than %d directory entries (max_entities); split the model",
+          limits.max_entities));
+    }
+    int type = 0;
+    uint64_t sequence = 0;
+    if (!absl::SimpleAtoi(absl::StripAsciiWhitespace(line.substr(0, 8)), &type)) continue;
+    if (!absl::SimpleAtoi(absl::StripAsciiWhitespace(line.substr(73, 7)), &sequence)) continue;
+    const absl::string_view status = line.substr(64, 8);
+    const bool independent = status.size() == 8 && status.substr(2, 2) == "00";
+    const bool face = type == 510 || type == 144 || type == 143;
+    const bool surface = type == 128 || type == 114 || type == 118 || type == 120 ||
+                         type == 122 || type == 140 || (type >= 190 && type <= 198 && type % 2 == 0);
+    if (face || (surface && independent)) {
+      census.faces.push_back(absl::StrCat("DE ", sequence, " type ", type));
+      census.face_ids.push_back(sequence);
+    }
+  }
+  return census;
+}
+
+}  // namespace sfc::cad

@@ -1,0 +1,48 @@
+// util/echo.h: escaped, bounded echoes of untrusted text.
+#include "util/echo.h"
+
+#include <string>
+
+#include "gtest/gtest.h"
+
+namespace sfc {
+namespace {
+
+bool Printable(const std::string& s) {
+  for (char c : s) {
+    if (c < 0x20 || c > 0x7e) return false;
+  }
+  return true;
+}
+
+TEST(Echo, EscapesControlAndNonAsciiBytesAndBoundsTheResult) {
+  EXPECT_EQ(Echo("part.step"), "part.step");
+  EXPECT_EQ(Echo("a\nb\tc\\d\x01\xff"), "a\\nb\\tc\\\\d\\x01\\xff");
+  for (const std::string& input : {std::string(1 << 20, '\x85'), std::string(1 << 20, 'x'),
+                                   std::string(1 << 20, '\n')}) {
+    const std::string echo = Echo(input);
+    EXPECT_LE(echo.size(), kMaxEcho + 32) << echo;
+    EXPECT_TRUE(Printable(echo)) << echo;
+    EXPECT_NE(echo.find("(1048576 bytes)"), std::string::npos) << echo;
+  }
+  // An escape is never cut in half.
+  const std::string cut = Echo(std::string(100, '\x85'), 10);
+  EXPECT_EQ(cut.substr(0, 8), "\\x85\\x85");
+  EXPECT_EQ(cut.substr(8, 3), "...");
+}
+
+TEST(Echo, ClipMessageKeepsShortMessagesAndCutsLongOnesAtACharacter) {
+  EXPECT_EQ(ClipMessage("short", 1024), "short");
+  const std::string clipped = ClipMessage(std::string(5000, 'y'), 1024);
+  EXPECT_LE(clipped.size(), 1024u);
+  EXPECT_NE(clipped.find("(message clipped)"), std::string::npos);
+  std::string utf8;
+  for (int i = 0; i < 1000; ++i) utf8 += "\xc3\xa9";  // é
+  const std::string cut = ClipMessage(utf8, 101);
+  EXPECT_LE(cut.size(), 101u);
+  const size_t body = cut.find(" ... ");
+  EXPECT_EQ(body % 2, 0u) << "a UTF-8 sequence was split";
+}
+
+}  // namespace
+}  // namespace sfc

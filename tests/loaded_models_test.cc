@@ -1,0 +1,143 @@
+// LoadedModels (engine/loaded_models.h): parses on threads of their own,
+// one parse per key, failures remembered, a byte budget, stops when nobody
+// waits or the CPU budget is spent, and a caller that leaves at once.
+#include "engine/loaded_models.h"
+
+#include <atomic>
+#include <chrono>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "gtest/gtest.h"
+
+namespace sfc {
+namespace {
+
+using Parsed = LoadedModels::Parsed;
+
+LoadedModels::ParseFn Returning(uint64_t bytes, std::atomic<int>* parses) {
+  return [bytes, parses](const ParseCheck&) -> absl::StatusOr<Parsed> {
+    ++*parses;
+    return Parsed{std::make_shared<const int>(7), bytes};
+  };
+}
+
+// Spins (checking) until told to stop; returns the check's status.
+LoadedModels::ParseFn Spinning(std::atomic<bool>* started) {
+  return [started](const ParseCheck& check) -> absl::StatusOr<Parsed> {
+    *started = true;
+    while (true) {
+      if (absl::Status s = check(); !s.ok()) return s;
+    }
+  };
+}
+
+TEST(LoadedModels, KeepsWithinItsByteBudgetLeastRecentlyUsedFirstOut) {
+  LoadedModelsOptions o;
+  o.budget_bytes = 250;
+  LoadedModels loaded(o);
+  std::atomic<int> parses{0};
+  for (const char* key : {"a", "b", "c"}) {
+    ASSERT_TRUE(loaded.Get<int>(key, Returning(100, &parses), nullptr).ok());
+  }
+  EXPECT_EQ(loaded.stats().bytes, 200u);
+  EXPECT_EQ(loaded.stats().models, 2u);
+  EXPECT_EQ(loaded.stats().evictions, 1u);
+  ASSERT_TRUE(loaded.Get<int>("c", Returning(100, &parses), nullptr).ok());
+  EXPECT_EQ(parses.load(), 3);  // c was kept
+  ASSERT_TRUE(loaded.Get<int>("a", Returning(100, &parses), nullptr).ok());
+  EXPECT_EQ(parses.load(), 4);  // a was evicted
+  // Larger than the whole budget: returned, not kept.
+  auto big = loaded.Get<int>("big", Returning(1000, &parses), nullptr);
+  ASSERT_TRUE(big.ok());
+  EXPECT_EQ(**big, 7);
+  EXPECT_LE(loaded.stats().bytes, 250u);
+}
+
+TEST(LoadedModels, ConcurrentRequestsShareOneParseAndFailuresAreRemembered) {
+  LoadedModels loaded;
+  std::atomic<int> parses{0};
+  auto slow = [&parses](const ParseCheck&) -> absl::StatusOr<Parsed> {
+    ++parses;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    return Parsed{std::make_shared<const int>(1), 8};
+  };
+  std::vector<std::thread> threads;
+  for (int i = 0; i < 8; ++i) {
+    threads.emplace_back([&] { EXPECT_TRUE(loaded.Get<int>("k", slow, nullptr).ok()); });
+  }
+  for (auto& t : threads) t.join();
+  EXPECT_EQ(parses.load(), 1);
+
+  std::atomic<int> failures{0};
+  auto failing = [&failures](const ParseCheck&) -> absl::StatusOr<Parsed> {
+    ++failures;
+    return absl::InvalidArgumentError("bad face");
+  };
+  EXPECT_EQ(loaded.Get<int>("sha256=ab|x", failing, nullptr).status().message(), "bad face");
+  EXPECT_EQ(loaded.Get<int>("sha256=ab|x", failing, nullptr).status().message(), "bad face");
+  EXPECT_EQ(failures.load(), 1);
+  EXPECT_EQ(loaded.stats().failure_hits, 1u);
+  loaded.ForgetModel("ab");  // forgets failures too
+  EXPECT_FALSE(loaded.Get<int>("sha256=ab|x", failing, nullptr).ok());
+  EXPECT_EQ(failures.load(), 2);
+}
+
+TEST(LoadedModels, TheCpuBudgetStopsAParse) {
+  LoadedModelsOptions o;
+  o.parse_seconds = 0.2;
+  LoadedModels loaded(o);
+  std::atomic<bool> started{false};
+  auto s = loaded.Get<int>("spin", Spinning(&started), nullptr);
+  EXPECT_EQ(s.status().code(), absl::StatusCode::kResourceExhausted) << s.status();
+  EXPECT_NE(s.status().message().find("model_parse_seconds"), std::string::npos);
+  EXPECT_EQ(loaded.stats().parses_stopped, 1u);
+}
+
+TEST(LoadedModels, ACallerLeavesAtOnceAndAParseNobodyWantsStops) {
+  LoadedModels loaded;  // no CPU budget: only the callers stop it
+  std::atomic<bool> started{false};
+  std::atomic<bool> leave{false};
+  const auto start = std::chrono::steady_clock::now();
+  std::thread t([&] {
+    auto s = loaded.Get<int>("spin", Spinning(&started), [&]() -> absl::Status {
+      return leave ? absl::CancelledError("client gone") : absl::OkStatus();
+    });
+    EXPECT_EQ(s.status().message(), "client gone");
+  });
+  while (!started) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  leave = true;
+  t.join();
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2.0);
+  for (int i = 0; i < 200 && loaded.stats().parsing > 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_EQ(loaded.stats().parsing, 0u) << "the abandoned parse did not stop";
+  EXPECT_EQ(loaded.stats().parses_stopped, 1u);
+  EXPECT_EQ(loaded.stats().parse_failures, 0u);  // not the model's fault: not remembered
+}
+
+TEST(LoadedModels, AFullQueueIsResourceExhausted) {
+  LoadedModelsOptions o;
+  o.max_queued_parses = 1;
+  LoadedModels loaded(o);
+  std::atomic<bool> started{false}, other{false};
+  std::atomic<bool> leave{false};
+  auto until_leave = [&]() -> absl::Status {
+    return leave ? absl::CancelledError("done") : absl::OkStatus();
+  };
+  std::thread running([&] { loaded.Get<int>("a", Spinning(&started), until_leave).IgnoreError(); });
+  while (!started) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  std::thread queued([&] { loaded.Get<int>("b", Spinning(&other), until_leave).IgnoreError(); });
+  while (loaded.stats().queued < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  auto refused = loaded.Get<int>("c", Spinning(&other), nullptr);
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_NE(refused.status().message().find("max_queued_parses"), std::string::npos);
+  leave = true;
+  running.join();
+  queued.join();
+}
+
+}  // namespace
+}  // namespace sfc

@@ -1,0 +1,293 @@
+// Models over the wire (issue 21): hostile uploads get bounded, escaped
+// errors with the right code, names are the sender's own, and the routing
+// key of every request about a model is the model's. A real server on a
+// loopback port and the real client; every file is made here.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <functional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "cad/fixtures.h"
+#include "client/sampler_client.h"
+#include "engine/model_source.h"
+#include "gtest/gtest.h"
+#include "proto/convert.h"
+#include "server/sampler_server.h"
+
+namespace sfc {
+namespace {
+
+namespace v1 = ::sfcsampler::v1;
+
+ServerOptions LoopbackOptions() {
+  ServerOptions o;
+  o.address = "127.0.0.1:0";
+  o.health_address = "";
+  o.metrics_address = "";
+  return o;
+}
+
+struct Running {
+  std::unique_ptr<SamplerServer> server;
+  std::unique_ptr<SamplerClient> client;
+};
+
+Running StartServer(const ServerOptions& options) {
+  Running r;
+  auto server = SamplerServer::Start(options);
+  EXPECT_TRUE(server.ok()) << server.status();
+  r.server = *std::move(server);
+  ClientOptions client;
+  client.target = "127.0.0.1:" + std::to_string(r.server->port());
+  r.client = *SamplerClient::Connect(client);
+  return r;
+}
+
+SampleRequest Request(const std::string& surface, uint64_t count) {
+  SampleRequest r;
+  r.tree.surface = surface;
+  r.count = count;
+  r.seed = 1;
+  return r;
+}
+
+absl::Status SampleStatus(SamplerClient& client, const SampleRequest& request) {
+  auto s = client.Sample(request, [](const v1::StreamHeader&, const SampleBatch&) {
+    return absl::OkStatus();
+  });
+  return s.status();
+}
+
+constexpr char kSquareObj[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
+
+// A 100 000-digit index: the real INVALID_ARGUMENT arrives (not the
+// client's RESOURCE_EXHAUSTED about header size), under 1 KB, the token
+// clipped.
+TEST(ServerModels, AGiantTokenGivesABoundedInvalidArgument) {
+  Running r = StartServer(LoopbackOptions());
+  const std::string obj = absl::StrCat(kSquareObj, "f 1 2 ", std::string(100000, '9'), "\n");
+  auto info = r.client->UploadModel("obj", "giant.obj", obj);
+  ASSERT_TRUE(info.ok()) << info.status();
+  const absl::Status s = SampleStatus(*r.client, Request(info->spec(), 100));
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument) << s;
+  EXPECT_LE(s.message().size(), kMaxStatusMessageBytes);
+  EXPECT_NE(s.message().find("(100000 bytes)"), std::string::npos) << s.message();
+  // The server still serves.
+  EXPECT_TRUE(SampleStatus(*r.client, Request("sphere", 100)).ok());
+}
+
+// Any status, however long, leaves the server clipped to 1 KB.
+TEST(ServerModels, ToGrpcStatusClipsMessages) {
+  const grpc::Status s = ToGrpcStatus(absl::InvalidArgumentError(std::string(1 << 20, 'x')));
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_LE(s.error_message().size(), kMaxStatusMessageBytes);
+  EXPECT_NE(s.error_message().find("clipped"), std::string::npos);
+  EXPECT_EQ(ToGrpcStatus(absl::NotFoundError("short")).error_message(), "short");
+}
+
+// A newline and a megabyte in the upload name forge no log line and make
+// no long message; a second client sending the same bytes under another
+// name never sees the first one's name.
+TEST(ServerModels, UploadNamesAreEscapedCappedAndNeverShownToAnotherClient) {
+  ServerOptions options = LoopbackOptions();
+  options.max_model_bytes = 1 << 10;
+  Running r = StartServer(options);
+  const std::string forged = absl::StrCat("part.step\nrpc=Forged", std::string(1 << 20, 'n'));
+  const absl::Status big =
+      r.client->UploadModel("obj", forged, std::string(2 << 10, 'x')).status();
+  EXPECT_EQ(big.code(), absl::StatusCode::kResourceExhausted) << big;
+  EXPECT_EQ(big.message().find('\n'), std::string::npos) << big.message();
+  EXPECT_NE(big.message().find("part.step\\nrpc=Forged"), std::string::npos) << big.message();
+  EXPECT_LE(big.message().size(), kMaxStatusMessageBytes);
+
+  const std::string bad = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n";
+  auto first = r.client->UploadModel("obj", "secret_part_name.obj", bad);
+  ASSERT_TRUE(first.ok()) << first.status();
+  auto second = r.client->UploadModel("obj", "mine.obj", bad);
+  ASSERT_TRUE(second.ok()) << second.status();
+  EXPECT_TRUE(second->already_stored());
+  const absl::Status s = SampleStatus(*r.client, Request(second->spec(), 100));
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument) << s;
+  EXPECT_EQ(s.message().find("secret_part_name"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find(second->spec()), std::string::npos) << s.message();
+}
+
+// Behind a consistent-hash proxy, FindModel, UploadModel and the Sample of
+// one model must carry one key: the model's, whatever the density.
+TEST(ServerModels, EveryRequestAboutAModelCarriesTheModelsRoutingKey) {
+  const std::string sha = Sha256Hex(kSquareObj);
+  const std::string key = ModelRoutingKey(ModelFormat::kObj, sha);
+  EXPECT_EQ(key, "obj:sha256=" + sha);
+  TreeSpec spec;
+  spec.surface = "obj:sha256=" + sha;
+  EXPECT_EQ(SamplerClient::SurfaceKey(spec), key);
+  spec.density = "expr:1+x*x";
+  EXPECT_EQ(SamplerClient::SurfaceKey(spec), key);
+  spec.surface = "sphere";
+  EXPECT_NE(SamplerClient::SurfaceKey(spec), key);
+}
+
+
+// A sphere whose shell lists its one face `copies` times: small, valid, and
+// quadratic in OpenCASCADE's shell healing (20 000 copies: 2.3 s of CPU).
+std::string HostileShellStep(int copies) {
+  auto step = cad::fixtures::SolidBytes(cad::fixtures::Solid::kSphere, cad::ModelFormat::kStep);
+  EXPECT_TRUE(step.ok()) << step.status();
+  std::string text = *step;
+  const size_t shell = text.find("CLOSED_SHELL('',(");
+  const size_t open = text.find('(', text.find(',', shell));
+  const size_t close = text.find(')', open);
+  const std::string face = text.substr(open + 1, close - open - 1);
+  text.replace(open + 1, close - open - 1,
+               absl::StrJoin(std::vector<std::string>(copies, face), ","));
+  return text;
+}
+
+double Seconds(const std::function<void()>& f) {
+  const auto start = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The parse's CPU budget stops it (OpenCASCADE's user break), the failure
+// is remembered per content hash, and no stream slot is held meanwhile.
+TEST(ServerModels, AHostileParseIsStoppedAtItsBudgetAndRemembered) {
+  ServerOptions options = LoopbackOptions();
+  options.limits.model_parse_seconds = 0.5;
+  Running r = StartServer(options);
+  auto info = r.client->UploadModel("step", "shell.step", HostileShellStep(60000));
+  ASSERT_TRUE(info.ok()) << info.status();
+  absl::Status first;
+  const double cpu0 = static_cast<double>(std::clock()) / CLOCKS_PER_SEC;
+  const double t1 = Seconds([&] { first = SampleStatus(*r.client, Request(info->spec(), 1000)); });
+  const double cpu = static_cast<double>(std::clock()) / CLOCKS_PER_SEC - cpu0;
+  EXPECT_EQ(first.code(), absl::StatusCode::kResourceExhausted) << first;
+  EXPECT_NE(first.message().find("model_parse_seconds"), std::string::npos) << first;
+  std::printf("hostile parse refused after %.2f s (%.2f s of process CPU)\n", t1, cpu);
+  EXPECT_LT(t1, 10.0) << "the budget of 0.5 s CPU did not stop the parse";
+  absl::Status again;
+  const double t2 = Seconds([&] { again = SampleStatus(*r.client, Request(info->spec(), 1000)); });
+  EXPECT_EQ(again.code(), absl::StatusCode::kResourceExhausted) << again;
+  EXPECT_LT(t2, 0.5) << "the failed parse was not remembered";
+  auto stats = r.client->GetCacheStats();
+  ASSERT_TRUE(stats.ok());
+  EXPECT_EQ(stats->model_parses(), 1u);
+  EXPECT_EQ(stats->model_parse_failures(), 1u);
+  EXPECT_EQ(stats->model_parse_seconds(), 0.5);
+}
+
+// 4 hostile uploads parsing (one parse thread, 2 stream slots): another
+// client's request completes within 2x its usual time (plus 50 ms of
+// scheduling slack on a shared machine), and is not refused for slots.
+TEST(ServerModels, AGoodRequestWhileFourHostileUploadsParseTakesAtMostTwiceItsTime) {
+  ServerOptions options = LoopbackOptions();
+  options.limits.model_parse_seconds = 30;
+  options.limits.model_parse_threads = 1;
+  options.limits.generation_threads = 1;
+  options.max_concurrent_streams = 2;
+  Running r = StartServer(options);
+  const SampleRequest good = Request("torus", 200000);
+  ASSERT_TRUE(SampleStatus(*r.client, good).ok());  // its tree is cached from here on
+  auto median_seconds = [&] {
+    std::vector<double> t;
+    for (int i = 0; i < 5; ++i) {
+      t.push_back(Seconds([&] { EXPECT_TRUE(SampleStatus(*r.client, good).ok()); }));
+    }
+    std::sort(t.begin(), t.end());
+    return t[2];
+  };
+  const double usual = median_seconds();
+  std::vector<std::string> specs;
+  for (int i = 0; i < 4; ++i) {
+    auto info = r.client->UploadModel("step", absl::StrCat("hostile", i, ".step"),
+                                      HostileShellStep(40000 + i));
+    ASSERT_TRUE(info.ok()) << info.status();
+    specs.push_back(info->spec());
+  }
+  std::vector<std::thread> hostile;
+  std::vector<std::unique_ptr<SamplerClient>> clients;
+  for (const std::string& spec : specs) {
+    ClientOptions o;
+    o.target = "127.0.0.1:" + std::to_string(r.server->port());
+    o.deadline_seconds = 20;
+    clients.push_back(*SamplerClient::Connect(o));
+    hostile.emplace_back([client = clients.back().get(), spec] {
+      SampleStatus(*client, Request(spec, 1000)).IgnoreError();
+    });
+  }
+  // Until the parses run (one) and wait (three).
+  for (int i = 0; i < 200; ++i) {
+    auto s = r.client->GetCacheStats();
+    if (s.ok() && s->model_parses_running() == 1 && s->model_parses_queued() == 3) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  auto during = r.client->GetCacheStats();
+  ASSERT_TRUE(during.ok());
+  EXPECT_EQ(during->model_parses_running(), 1u);
+  const double busy = median_seconds();
+  auto after = r.client->GetCacheStats();
+  ASSERT_TRUE(after.ok());
+  EXPECT_EQ(after->model_parses_running(), 1u) << "the hostile parses ended before the measurement";
+  std::printf("good request: usual %.3f s, with 4 hostile parses %.3f s (%.2fx)\n", usual, busy,
+              busy / usual);
+  EXPECT_LE(busy, 2 * usual + 0.05);
+  r.server->Shutdown(0, 0);  // stops the parses; the hostile clients get their errors
+  for (std::thread& t : hostile) t.join();
+}
+
+// A grid of n x n quads as OBJ (distinct n: distinct bytes).
+std::string GridObj(int n) {
+  std::string obj;
+  for (int i = 0; i <= n; ++i) {
+    for (int j = 0; j <= n; ++j) absl::StrAppend(&obj, "v ", i, " ", j, " 0\n");
+  }
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const int a = i * (n + 1) + j + 1;
+      absl::StrAppend(&obj, "f ", a, " ", a + n + 1, " ", a + n + 2, " ", a + 1, "\n");
+    }
+  }
+  return obj;
+}
+
+// Parsed models are counted in bytes and reported; the parse of a request
+// whose tree failed, and the parses of an evicted upload, are dropped.
+TEST(ServerModels, ParsedModelsAreCountedAndDroppedWithFailedRequestsAndEvictedUploads) {
+  ServerOptions options = LoopbackOptions();
+  const std::string a = GridObj(40), b = GridObj(41);
+  options.model_bytes = a.size() + b.size() / 2;  // room for one of them
+  options.limits.parsed_model_bytes = 32 << 20;
+  Running r = StartServer(options);
+  auto info_a = r.client->UploadModel("obj", "a.obj", a);
+  ASSERT_TRUE(info_a.ok()) << info_a.status();
+  ASSERT_TRUE(SampleStatus(*r.client, Request(info_a->spec(), 1000)).ok());
+  auto stats = *r.client->GetCacheStats();
+  EXPECT_EQ(stats.parsed_models(), 1u);
+  // 41 x 41 vertices, 3200 triangles: positions, triangles, face normals at least.
+  EXPECT_GE(stats.parsed_model_bytes(), 41u * 41 * 24 + 3200 * (12 + 24));
+  EXPECT_EQ(stats.parsed_model_budget_bytes(), 32u << 20);
+  // A density that is zero everywhere: the tree fails, the parse is not kept.
+  SampleRequest zero = Request(info_a->spec(), 1000);
+  zero.tree.density = "expr:0*x";
+  EXPECT_EQ(SampleStatus(*r.client, zero).code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_EQ(r.client->GetCacheStats()->parsed_models(), 0u);
+  ASSERT_TRUE(SampleStatus(*r.client, Request(info_a->spec(), 1000)).ok());
+  EXPECT_EQ(r.client->GetCacheStats()->parsed_models(), 1u);
+  // Uploading b evicts a from the store, and a's parse goes with it.
+  auto info_b = r.client->UploadModel("obj", "b.obj", b);
+  ASSERT_TRUE(info_b.ok()) << info_b.status();
+  stats = *r.client->GetCacheStats();
+  EXPECT_EQ(stats.models(), 1u);
+  EXPECT_EQ(stats.model_evictions(), 1u);
+  EXPECT_EQ(stats.parsed_models(), 0u);
+  EXPECT_EQ(stats.parsed_model_bytes(), 0u);
+}
+
+}  // namespace
+}  // namespace sfc
