@@ -195,7 +195,11 @@ def test_python_sample_many_over_the_wire(server, folder):
     local = sfcsampler.sample_many(names, count=2000, seed=5)
     remote = sfcsampler.sample_many(names, count=2000, seed=5, server=server)
     assert [r.ok for r in remote] == [True, True, False]
-    assert "broken.ply" in remote[2].error
+    # The result is named by its file; the server names a stored model by its
+    # format and hash, never by an upload name (issue 21).
+    assert remote[2].name.endswith("broken.ply")
+    assert "INVALID_ARGUMENT" in remote[2].error and remote[2].sha256 in remote[2].error
+    assert "broken.ply" in remote.summary()
     for a, b in zip(local[:2], remote[:2]):
         same_samples(a.samples, b.samples)
 
