@@ -77,6 +77,14 @@ inline double Unwarp(const AxisWarp& w, double x) {
   return sc + (1 - sc) * std::pow((x - c) / (1 - c), r);
 }
 
+// Whether the walk descends a leaf's curve in the warped coordinate of this
+// axis: where its power law blows up (power > 1) the mass piled against the
+// line is even there, and the curve's cells become thin strips along the line,
+// as the line's thin bands need. Where it vanishes (power < 1) the warp would
+// widen the cells beside the line instead; the curve stays in leaf
+// coordinates and only the model is warped.
+inline bool DescendsWarped(const AxisWarp& w) { return w.power > 1; }
+
 // Where the warped density is evaluated for the node s: s itself, except at
 // the split of a line through the cell (the middle node, for a line at the
 // cell's centre), where the line itself is no point to evaluate at: the
@@ -164,9 +172,10 @@ void PiecewiseSubSquareIntegrals(const LeafModel& model, int grid, double x0, do
 }  // namespace leaf_model_internal
 
 // The integrals over the grid x grid sub-squares of the square
-// [x0, x0 + side] x [y0, y0 + side] in the model's own coordinates (warped,
-// for a kQuadratic model with a power law: LeafWalk descends the leaf's curve
-// there): out[i * grid + j] for the sub-square i along x, j along y. Shares
+// [x0, x0 + side] x [y0, y0 + side] in the coordinates the walk descends in
+// (DescendsWarped): warped along an axis whose power law blows up, the leaf's
+// own along the others. out[i * grid + j] for the sub-square i along x, j
+// along y. Shares
 // the 1D integrals, and each y row of the quadratic, between sub-squares.
 // Inline: the sampler's descent calls it once per model level. REQUIRES:
 // grid is 2 or 3 (the curves' grids).
@@ -186,6 +195,16 @@ inline void SubSquareIntegralsOnGrid(const LeafModel& model, LeafModel::Kind kin
   for (int k = 0; k < kGrid; ++k) {
     a[k] = y0 + k * step, b[k] = y0 + (k + 1) * step;
     a[kGrid + k] = x0 + k * step, b[kGrid + k] = x0 + (k + 1) * step;
+  }
+  // An axis whose power law vanishes (power < 1) is descended in leaf
+  // coordinates: integrate over the sub-cells' images in warped ones.
+  if (model.warp[1].power < 1) {
+    for (int k = 0; k < kGrid; ++k) a[k] = Unwarp(model.warp[1], a[k]), b[k] = Unwarp(model.warp[1], b[k]);
+  }
+  if (model.warp[0].power < 1) {
+    for (int k = kGrid; k < kCells; ++k) {
+      a[k] = Unwarp(model.warp[0], a[k]), b[k] = Unwarp(model.warp[0], b[k]);
+    }
   }
   for (int k = 0; k < kCells; ++k) {
     d[k] = b[k] - a[k];

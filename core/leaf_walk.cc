@@ -58,6 +58,14 @@ void LeafWalk::Enter(size_t l) {
   samples_ = leaf_mass_ / total_mass_ * grade_samples_;
 }
 
+double LeafWalk::PlaceOnAxis(const AxisWarp& w, double x0, double side, double x) {
+  if (w.power == 1) return x;
+  if (DescendsWarped(w)) return Warp(w, x);  // the curve ran in warped coordinates
+  // Uniform in warped coordinates inside the sub-cell [x0, x0 + side].
+  const double s0 = Unwarp(w, x0), s1 = Unwarp(w, x0 + side);
+  return std::clamp(Warp(w, s0 + (x - x0) / side * (s1 - s0)), x0, x0 + side);
+}
+
 template <int kGrid>
 bool LeafWalk::Split(Node& node) const {
   // The children's t bounds from the model's exact integrals.
@@ -200,8 +208,9 @@ void LeafWalk::PlaceInLeaf(const double* m, size_t n, double* u, double* v,
     const double x = static_cast<double>(static_cast<int64_t>(cx));
     const double y = static_cast<double>(static_cast<int64_t>(cy));
     double px = at.x0 + (x + 0.5) * cell, py = at.y0 + (y + 0.5) * cell;
-    if (warped_) {  // the leaf's curve ran in warped coordinates
-      px = Warp(model_->warp[0], px), py = Warp(model_->warp[1], py);
+    if (warped_) {
+      px = PlaceOnAxis(model_->warp[0], at.x0, at.side, px);
+      py = PlaceOnAxis(model_->warp[1], at.y0, at.side, py);
     }
     u[i] = cell_.u0 + px * cell_.size;
     v[i] = cell_.v0 + py * cell_.size;

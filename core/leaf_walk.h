@@ -9,11 +9,12 @@
 // given t alike). The rest of t is followed as pure curve bits for
 // continuation_levels() more levels, and the sample sits at the centre of the
 // cell reached. In a leaf whose model is warped toward a singular line
-// (LeafModel::warp) the leaf's curve runs in the warped coordinates, where
-// the model is smooth, and the point reached is mapped back through the warp:
-// the paper's reparameterisation (Sect. 5.3) inside one leaf. Its cells are
-// then thin strips along the line, as the mass piled against the line needs,
-// and a sub-cell too light to split holds its mass evenly.
+// (LeafModel::warp) where the area element blows up, the leaf's curve runs in
+// the warped coordinates, where the model is smooth, and the point reached is
+// mapped back through the warp: the paper's reparameterisation (Sect. 5.3)
+// inside one leaf, whose cells are then thin strips along the line. Where it
+// vanishes, the curve stays in leaf coordinates and the continuation inside
+// the last sub-cell is uniform in warped ones (DescendsWarped).
 //
 // Coordinates handed over in non-decreasing order make this a merge: the
 // leaf advances by a forward step, and the samples of one leaf descend
@@ -70,6 +71,9 @@ class LeafWalk {
     double bounds[9];        // upper t of each child, in curve order
   };
 
+  // Leaf coordinate along one axis of the point at x in the sub-cell
+  // [x0, x0 + side] the descent reached (DescendsWarped: x is warped).
+  static double PlaceOnAxis(const AxisWarp& w, double x0, double side, double x);
   // The leaf holding m: a forward step from the current one, else a search.
   size_t LeafFor(double m) const;
   // Makes l the current leaf.

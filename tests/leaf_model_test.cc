@@ -111,12 +111,14 @@ TEST(LeafModel, WarpedModelFollowsAPowerLawAboutALine) {
                                  : ModelIntegral(m, LeafModel::Kind::kQuadratic, 2, b0, b1, a0, a1);
           EXPECT_NEAR(got, exact, 2e-6) << "p " << p << " c " << c << " axis " << axis;
         }
-        // The sub-squares of a small square beside the line, in the warped
-        // coordinates the walk descends in, share its integral as the
-        // density does over their images.
+        // The sub-squares of a small square beside the line, in the
+        // coordinates the walk descends in (DescendsWarped), share its
+        // integral as the density does over them.
+        const bool warped = DescendsWarped(w);
+        auto leaf = [&](double x) { return warped ? Warp(w, x) : x; };
         for (int grid : {2, 3}) {
           const double side = 1.0 / 64, y0 = 0.5;
-          const double x0 = c == 1 ? 1 - side : WarpSplit(w);
+          const double x0 = c == 1 ? 1 - side : warped ? WarpSplit(w) : c;
           double out[9];
           SubSquareIntegrals(m, LeafModel::Kind::kQuadratic, grid, axis == 0 ? x0 : y0,
                              axis == 0 ? y0 : x0, side, out);
@@ -124,7 +126,7 @@ TEST(LeafModel, WarpedModelFollowsAPowerLawAboutALine) {
           for (int i = 0; i < grid; ++i) {
             for (int j = 0; j < grid; ++j) {
               const double lo = x0 + (axis == 0 ? i : j) * step;
-              const double exact = (cdf(Warp(w, lo + step)) - cdf(Warp(w, lo))) * step;
+              const double exact = (cdf(leaf(lo + step)) - cdf(leaf(lo))) * step;
               EXPECT_NEAR(out[i * grid + j] / exact, 1.0, 2e-5)
                   << "p " << p << " c " << c << " axis " << axis << " grid " << grid;
             }
