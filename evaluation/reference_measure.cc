@@ -4,45 +4,18 @@
 
 #include "absl/strings/str_format.h"
 #include "core/area_estimator.h"
+#include "evaluation/gauss_legendre.h"
 
 namespace sfc {
-namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-// Gauss-Legendre nodes and weights on [0,1] by Newton's method on P_n.
-void GaussLegendre(int n, std::vector<double>* x, std::vector<double>* w) {
-  x->resize(n);
-  w->resize(n);
-  for (int i = 0; i < n; ++i) {
-    double z = std::cos(kPi * (i + 0.75) / (n + 0.5)), dp = 0;
-    for (int it = 0; it < 100; ++it) {
-      double p0 = 1, p1 = z;
-      for (int k = 2; k <= n; ++k) {
-        const double p2 = ((2 * k - 1) * z * p1 - (k - 1) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      if (n == 1) p1 = z, p0 = 1;
-      dp = n * (z * p1 - p0) / (z * z - 1);
-      const double step = p1 / dp;
-      z -= step;
-      if (std::fabs(step) < 1e-16) break;
-    }
-    (*x)[i] = (1 - z) / 2;
-    (*w)[i] = 1 / ((1 - z * z) * dp * dp);  // 2 / ((1-z^2) P'^2), halved for [0,1]
-  }
-}
-
-}  // namespace
 
 absl::StatusOr<std::vector<double>> GradedCellMasses(const Surface& surface, const Density& density,
                                                      int grid, int nodes) {
   if (grid < 1 || nodes < 1 || nodes > 16) {
     return absl::InvalidArgumentError("GradedCellMasses needs grid >= 1 and 1 <= nodes <= 16");
   }
-  std::vector<double> s, ws;
-  GaussLegendre(nodes, &s, &ws);
+  const GaussRule& rule = GaussLegendreRule(nodes);
+  const std::vector<double>& s = rule.x;
+  const std::vector<double>& ws = rule.w;
   // The graded nodes inside a unit cell: q(s) and weight w q'(s).
   std::vector<double> q(nodes), wq(nodes);
   for (int k = 0; k < nodes; ++k) {

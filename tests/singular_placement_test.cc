@@ -4,13 +4,14 @@
 // fractions, for an area element that blows up (e = 1/3, 1/4) and one that
 // vanishes (e = 2) on the lines. The exact fractions come from this file's
 // own quadrature of a closed-form area element (the substitution t = w^3
-// removes the singularity), sharing nothing with the sampler but the
-// surface's definition. Coarse histograms cannot see this error: every
-// leaf's total is right, only the thin strips show it.
+// removes the singularity; the evaluation's Gauss rule), sharing nothing
+// with the sampler but the surface's definition. Coarse histograms cannot
+// see this error: every leaf's total is right, only the thin strips show it.
 #include <cmath>
 #include <functional>
 #include <vector>
 
+#include "evaluation/gauss_legendre.h"
 #include "gtest/gtest.h"
 #include "tests/test_util.h"
 
@@ -19,39 +20,15 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// 16-point Gauss-Legendre on [-1, 1], by Newton's method on P_16.
-struct GaussRule {
-  double x[16], w[16];
-  GaussRule() {
-    const int n = 16;
-    for (int i = 0; i < n; ++i) {
-      double z = std::cos(kPi * (i + 0.75) / (n + 0.5)), dp = 0;
-      for (int it = 0; it < 100; ++it) {
-        double p0 = 1, p1 = z;
-        for (int k = 2; k <= n; ++k) {
-          const double p2 = ((2 * k - 1) * z * p1 - (k - 1) * p0) / k;
-          p0 = p1, p1 = p2;
-        }
-        dp = n * (z * p1 - p0) / (z * z - 1);
-        const double dz = p1 / dp;
-        z -= dz;
-        if (std::fabs(dz) < 1e-16) break;
-      }
-      x[i] = z, w[i] = 2 / ((1 - z * z) * dp * dp);
-    }
-  }
-};
-
-// Composite 16-point rule with `panels` panels on [a, b].
+// Composite 16-point Gauss-Legendre rule with `panels` panels on [a, b].
 double Integrate(const std::function<double(double)>& f, double a, double b, int panels) {
-  static const GaussRule rule;
+  const GaussRule& rule = GaussLegendreRule(16);
   double sum = 0;
   const double h = (b - a) / panels;
   for (int p = 0; p < panels; ++p) {
-    const double mid = a + (p + 0.5) * h;
-    for (int i = 0; i < 16; ++i) sum += rule.w[i] * f(mid + rule.x[i] * h / 2);
+    for (int i = 0; i < 16; ++i) sum += rule.w[i] * f(a + (p + rule.x[i]) * h);
   }
-  return sum * h / 2;
+  return sum * h;
 }
 
 // |f_a x f_b| of the superellipsoid (cos^e a cos^e b, cos^e a sin^e b,
