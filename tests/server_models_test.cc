@@ -19,43 +19,17 @@
 #include "gtest/gtest.h"
 #include "proto/convert.h"
 #include "server/sampler_server.h"
+#include "tests/server_test_util.h"
 
 namespace sfc {
 namespace {
 
 namespace v1 = ::sfcsampler::v1;
 
-ServerOptions LoopbackOptions() {
-  ServerOptions o;
-  o.address = "127.0.0.1:0";
-  o.health_address = "";
-  o.metrics_address = "";
-  return o;
-}
-
-struct Running {
-  std::unique_ptr<SamplerServer> server;
-  std::unique_ptr<SamplerClient> client;
-};
-
-Running StartServer(const ServerOptions& options) {
-  Running r;
-  auto server = SamplerServer::Start(options);
-  EXPECT_TRUE(server.ok()) << server.status();
-  r.server = *std::move(server);
-  ClientOptions client;
-  client.target = "127.0.0.1:" + std::to_string(r.server->port());
-  r.client = *SamplerClient::Connect(client);
-  return r;
-}
-
-SampleRequest Request(const std::string& surface, uint64_t count) {
-  SampleRequest r;
-  r.tree.surface = surface;
-  r.count = count;
-  r.seed = 1;
-  return r;
-}
+using testing::LoopbackOptions;
+using testing::Request;
+using testing::Running;
+using testing::StartServer;
 
 absl::Status SampleStatus(SamplerClient& client, const SampleRequest& request) {
   auto s = client.Sample(request, [](const v1::StreamHeader&, const SampleBatch&) {

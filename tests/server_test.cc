@@ -13,6 +13,7 @@
 #include "grpcpp/create_channel.h"
 #include "gtest/gtest.h"
 #include "server/sampler_server.h"
+#include "tests/server_test_util.h"
 
 namespace sfc {
 namespace {
@@ -20,36 +21,10 @@ namespace {
 namespace v1 = ::sfcsampler::v1;
 using std::chrono::milliseconds;
 
-ServerOptions LoopbackOptions() {
-  ServerOptions o;
-  o.address = "127.0.0.1:0";
-  o.health_address = "";
-  o.metrics_address = "";
-  return o;
-}
-
-struct Running {
-  std::unique_ptr<SamplerServer> server;
-  std::unique_ptr<SamplerClient> client;
-};
-
-Running StartServer(const ServerOptions& options, ClientOptions client = {}) {
-  Running r;
-  auto server = SamplerServer::Start(options);
-  EXPECT_TRUE(server.ok()) << server.status();
-  r.server = *std::move(server);
-  client.target = "127.0.0.1:" + std::to_string(r.server->port());
-  r.client = *SamplerClient::Connect(client);
-  return r;
-}
-
-SampleRequest Request(const std::string& surface, uint64_t count, uint64_t seed = 1) {
-  SampleRequest r;
-  r.tree.surface = surface;
-  r.count = count;
-  r.seed = seed;
-  return r;
-}
+using testing::LoopbackOptions;
+using testing::Request;
+using testing::Running;
+using testing::StartServer;
 
 // A stream far larger than flow-control buffers, so the server is still
 // writing it when something happens, on a tree that builds at once (the
