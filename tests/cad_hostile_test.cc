@@ -12,22 +12,14 @@
 #include "cad/load.h"
 #include "cad/preflight.h"
 #include "gtest/gtest.h"
+#include "tests/cad_test_util.h"
 
 namespace sfc::cad {
 namespace {
 
 using fixtures::Solid;
 
-const std::string& Bytes(Solid solid, ModelFormat format) {
-  static auto* cache = new std::map<std::pair<Solid, ModelFormat>, std::string>;
-  auto it = cache->find({solid, format});
-  if (it == cache->end()) {
-    auto bytes = fixtures::SolidBytes(solid, format);
-    EXPECT_TRUE(bytes.ok()) << bytes.status();
-    it = cache->emplace(std::make_pair(solid, format), bytes.ok() ? *bytes : "").first;
-  }
-  return it->second;
-}
+using testing::Bytes;
 
 std::string StepWithData(const std::string& data) {
   return absl::StrCat(

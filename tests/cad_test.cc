@@ -21,6 +21,7 @@
 #include "cad/model.h"
 #include "cad/nurbs_patch.h"
 #include "gtest/gtest.h"
+#include "tests/cad_test_util.h"
 
 namespace sfc::cad {
 namespace {
@@ -28,17 +29,7 @@ namespace {
 using fixtures::Solid;
 constexpr double kPi = 3.14159265358979323846;
 
-// Fixture bytes, made once per process (the kernel's writers are slow-ish).
-const std::string& Bytes(Solid solid, ModelFormat format) {
-  static auto* cache = new std::map<std::pair<Solid, ModelFormat>, std::string>;
-  auto it = cache->find({solid, format});
-  if (it == cache->end()) {
-    auto bytes = fixtures::SolidBytes(solid, format);
-    EXPECT_TRUE(bytes.ok()) << bytes.status();
-    it = cache->emplace(std::make_pair(solid, format), bytes.ok() ? *bytes : "").first;
-  }
-  return it->second;
-}
+using testing::Bytes;
 
 std::shared_ptr<const Model> LoadOk(Solid solid, ModelFormat format) {
   auto model = Load(format, Bytes(solid, format), fixtures::SolidName(solid));
