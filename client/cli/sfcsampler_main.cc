@@ -382,6 +382,28 @@ struct EvalFlags {
   EvalQualityFlags quality;
 };
 
+// The whole jittered set of `count` samples (seed `seed`) of the surface and
+// density, in curve order, from the server or in process.
+absl::StatusOr<SampleBatch> WholeSet(const Connection& conn, const std::string& surface,
+                                     const std::string& density, uint64_t count, uint64_t seed) {
+  SampleRequest request;
+  request.tree.surface = surface;
+  request.tree.density = density;
+  request.count = count;
+  request.seed = seed;
+  SampleBatch all;
+  Progress quiet(false);
+  std::string provenance;
+  RETURN_IF_ERROR(StreamSamples(
+      request, conn, 0, v1::PRECISION_FLOAT64, Verbosity{true, true}, &quiet,
+      [&](std::optional<uint64_t>, const SampleBatch& batch) {
+        all.Append(batch);
+        return absl::OkStatus();
+      },
+      &provenance));
+  return all;
+}
+
 // Model mode (issue 11): the spherical-triangle discrepancy of a model that is
 // a sphere (a STEP, IGES or NURBS sphere, or a mesh of one) against the
 // built-in sphere, N = 64 .. 24576, the mean over `seeds` seeds, and both
@@ -391,20 +413,7 @@ struct EvalFlags {
 int RunEvalModel(const EvalFlags& f, const Connection& conn) {
   auto discrepancy = [&](const std::string& surface, uint64_t n,
                          uint64_t seed) -> absl::StatusOr<double> {
-    SampleRequest request;
-    request.tree.surface = surface;
-    request.count = n;
-    request.seed = seed;
-    SampleBatch all;
-    Progress quiet(false);
-    std::string provenance;
-    RETURN_IF_ERROR(StreamSamples(
-        request, conn, 0, v1::PRECISION_FLOAT64, Verbosity{true, true}, &quiet,
-        [&](std::optional<uint64_t>, const SampleBatch& batch) {
-          all.Append(batch);
-          return absl::OkStatus();
-        },
-        &provenance));
+    ASSIGN_OR_RETURN(const SampleBatch all, WholeSet(conn, surface, "uniform", n, seed));
     Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
     for (size_t i = 0; i < all.size(); ++i) {
       lo = {std::min(lo.x, all.x[i]), std::min(lo.y, all.y[i]), std::min(lo.z, all.z[i])};
@@ -449,23 +458,7 @@ int RunEval(const EvalFlags& f, const Connection& conn) {
   if (WantsSection(f.quality, "quality")) {
     // Every set of the report in full, from the server or in process.
     auto source = [&conn](const std::string& surface, const std::string& density, uint64_t count,
-                          uint64_t seed) -> absl::StatusOr<SampleBatch> {
-      SampleRequest request;
-      request.tree.surface = surface;
-      request.tree.density = density;
-      request.count = count;
-      request.seed = seed;
-      SampleBatch all;
-      Progress quiet(false);
-      std::string provenance;
-      RETURN_IF_ERROR(StreamSamples(request, conn, 0, v1::PRECISION_FLOAT64, Verbosity{true, true}, &quiet,
-                                    [&](std::optional<uint64_t>, const SampleBatch& batch) {
-                                      all.Append(batch);
-                                      return absl::OkStatus();
-                                    },
-                                    &provenance));
-      return all;
-    };
+                          uint64_t seed) { return WholeSet(conn, surface, density, count, seed); };
     if (const int rc = RunEvalQuality(f.quality, f.setting == "full", f.out_dir, source); rc != 0) return rc;
   }
   if (!WantsSection(f.quality, "protocol")) return 0;
