@@ -37,6 +37,24 @@ cache_stat() {  # cache_stat PORT FIELD
   timeout 10 "$cli" cache --server "127.0.0.1:$1" | awk -v f="$2:" '$1 == f {v = $2} END {print v + 0}'
 }
 sum_stat() { local s=0; for p in "${ports[@]}"; do s=$((s + $(cache_stat "$p" "$1"))); done; echo "$s"; }
+# kill_mid_stream SURFACE PID OUT: streams 1.5 M samples of SURFACE through the
+# proxy into OUT, kills the replica PID once ~100 000 rows are written, and
+# checks that the client resumed and that the samples equal an in-process run.
+kill_mid_stream() {
+  local surface=$1 pid=$2 out=$3
+  "$cli" sample -q --surface "$surface" --count 1500000 --seed 9 -o "$out/embedded.csv"
+  timeout 120 "$cli" sample --server "$proxy" --surface "$surface" --count 1500000 --seed 9 \
+    --batch-size 2000 -o "$out/through-proxy.csv" 2> "$out/client.log" &
+  local client=$!
+  for _ in $(seq 400); do
+    [ "$(stat -c %s "$out/through-proxy.csv" 2>/dev/null || echo 0)" -gt 10000000 ] && break
+    sleep 0.02
+  done
+  kill -9 "$pid"
+  wait "$client" || fail "the stream of $surface did not complete after its replica died: $(cat "$out/client.log")"
+  grep -q "[1-9][0-9]* resumes" "$out/client.log" || fail "the client should have resumed: $(cat "$out/client.log")"
+  cmp -s "$out/embedded.csv" "$out/through-proxy.csv" || fail "samples of $surface through the proxy differ from an in-process run"
+}
 sample() { timeout 60 "$cli" sample -q --server "$proxy" "$@"; }
 
 # 1. Warm-up: 12 surfaces, each asked once; record which replica built it.
@@ -64,19 +82,7 @@ echo "warm-up: 12 surfaces over $used replicas; cache hit ratio after warm-up $r
 # 2 and 3. A long stream whose replica is killed mid-way.
 victim_surface="${surfaces[0]}"
 victim=${owner[$victim_surface]}
-"$cli" sample -q --surface "$victim_surface" --count 1500000 --seed 9 -o "$dir/embedded.csv"
-timeout 120 "$cli" sample --server "$proxy" --surface "$victim_surface" --count 1500000 --seed 9 \
-  --batch-size 2000 -o "$dir/through-proxy.csv" 2> "$dir/client.log" &
-client=$!
-# Kill the replica once the stream is well under way (~100 000 rows written).
-for _ in $(seq 400); do
-  [ "$(stat -c %s "$dir/through-proxy.csv" 2>/dev/null || echo 0)" -gt 10000000 ] && break
-  sleep 0.02
-done
-kill -9 "${rpids[$victim]}"
-wait "$client" || fail "the stream did not complete after its replica died: $(cat "$dir/client.log")"
-grep -q "[1-9][0-9]* resumes" "$dir/client.log" || fail "the client should have resumed: $(cat "$dir/client.log")"
-cmp -s "$dir/embedded.csv" "$dir/through-proxy.csv" || fail "samples through the proxy differ from a single in-process run"
+kill_mid_stream "$victim_surface" "${rpids[$victim]}" "$dir"
 echo "kill: $(grep -o '[0-9]* resumes' "$dir/client.log"); 1.5 M samples byte-identical to the in-process run"
 
 # Only the victim's keys moved: the survivors' keys still hit.
@@ -192,17 +198,6 @@ for j in 0 1 2; do
     --surface "obj:sha256=$(sha256sum "$mdir/torus.obj" | cut -c1-64)" --count 10 -o /dev/null 2> /dev/null && mesh_owner=$j
 done
 [ -n "$mesh_owner" ] || fail "no replica holds the mesh"
-"$cli" sample -q --surface "obj:$mdir/torus.obj" --count 1500000 --seed 9 -o "$mdir/embedded.csv"
-timeout 120 "$cli" sample --server "$proxy" --surface "obj:$mdir/torus.obj" --count 1500000 --seed 9 \
-  --batch-size 2000 -o "$mdir/through-proxy.csv" 2> "$mdir/client.log" &
-client=$!
-for _ in $(seq 400); do
-  [ "$(stat -c %s "$mdir/through-proxy.csv" 2>/dev/null || echo 0)" -gt 10000000 ] && break
-  sleep 0.02
-done
-kill -9 "${rpids[$mesh_owner]}"
-wait "$client" || fail "the mesh stream did not complete after its replica died: $(cat "$mdir/client.log")"
-grep -q "[1-9][0-9]* resumes" "$mdir/client.log" || fail "the client should have resumed: $(cat "$mdir/client.log")"
-cmp -s "$mdir/embedded.csv" "$mdir/through-proxy.csv" || fail "mesh samples after the kill differ from in-process"
+kill_mid_stream "obj:$mdir/torus.obj" "${rpids[$mesh_owner]}" "$mdir"
 echo "model kill: the mesh's replica killed mid-stream; $(grep -o '[0-9]* resumes' "$mdir/client.log") (the model uploaded again to the next replica); 1.5 M samples byte-identical"
 echo "scaleout_test: all checks passed"
