@@ -116,7 +116,7 @@ std::vector<double> EquatorDistances(const SampleBatch& s) {
   return d;
 }
 
-TEST(SingularPlacement, TheReferenceGivesTheSphereLikeAreaOfTheOctahedron) {
+TEST(SingularPlacement, TheReferenceGivesTheOctahedronItsArea) {
   // e = 2 is the octahedron |x| + |y| + |z| = 1: area 4 sqrt(3), one octant sqrt(3)/2.
   const double octant = Quarter([](double a) {
     return Quarter([a](double b) { return AreaElement(2, a, b); });
