@@ -6,6 +6,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_format.h"
 #include "core/status_macros.h"
+#include "core/vector_math.h"
 
 namespace sfc::cad {
 namespace {
@@ -182,9 +183,9 @@ void ModelSampleCursor::KeepInTrim(const ModelTree::Piece& piece, size_t i, Samp
   bool found = false;
   for (double r = 1e-9; r <= 2 && !found; r *= 2) {
     for (int d = 0; d < kDirections && !found; ++d) {
-      const double a = 2 * M_PI * d / kDirections;
-      const double cs = std::clamp(s + r * std::cos(a), 0.0, 1.0);
-      const double ct = std::clamp(t + r * std::sin(a), 0.0, 1.0);
+      const SinCos a = SinCosPi(2.0 * d / kDirections);
+      const double cs = std::clamp(s + r * a.cos, 0.0, 1.0);
+      const double ct = std::clamp(t + r * a.sin, 0.0, 1.0);
       if (face.Contains(cs, ct)) best_s = cs, best_t = ct, found = true;
     }
   }

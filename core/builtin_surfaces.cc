@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/vector_math.h"
+
 namespace sfc {
 namespace {
 
@@ -13,6 +15,25 @@ constexpr double kPi = 3.14159265358979323846;
 // holds every point Point computes on the rectangle.
 Interval Pt(double x) { return Interval::Point(x); }
 Interval Range(double lo, double hi) { return Interval::Of(lo, hi); }
+
+// Points in chunks: sin and cos of pi a[i] and pi b[i] (the scaled
+// parameters) by the vector path, then `combine`(i, sa, ca, sb, cb) per
+// point, which must do what the surface's Point does with SinCosPi's values.
+template <typename Scale, typename Combine>
+void SinCosPoints(const double* u, const double* v, size_t n, Scale scale_u, Scale scale_v,
+                  Combine combine) {
+  constexpr size_t kChunk = 256;
+  double a[kChunk], b[kChunk], sa[kChunk], ca[kChunk], sb[kChunk], cb[kChunk];
+  for (size_t at = 0; at < n; at += kChunk) {
+    const size_t m = std::min(kChunk, n - at);
+    for (size_t i = 0; i < m; ++i) a[i] = scale_u(u[at + i]), b[i] = scale_v(v[at + i]);
+    SinCosPi(a, m, sa, ca);
+    SinCosPi(b, m, sb, cb);
+    for (size_t i = 0; i < m; ++i) combine(at + i, sa[i], ca[i], sb[i], cb[i]);
+  }
+}
+double Same(double x) { return x; }
+double Twice(double x) { return 2 * x; }
 
 class Plane final : public Surface {
  public:
@@ -35,15 +56,17 @@ class Plane final : public Surface {
 
 class Sphere final : public Surface {
  public:
+  // theta = pi u, phi = 2 pi v.
   void Points(const double* u, const double* v, size_t n, double* x, double* y,
               double* z) const override {
-    PointsOf(*this, u, v, n, x, y, z);
+    SinCosPoints(u, v, n, Same, Twice, [&](size_t i, double st, double ct, double sp, double cp) {
+      x[i] = r_ * st * cp, y[i] = r_ * st * sp, z[i] = r_ * ct;
+    });
   }
   explicit Sphere(double r) : r_(r) {}
   Vec3 Point(double u, double v) const override {
-    const double st = std::sin(kPi * u), ct = std::cos(kPi * u);
-    const double sp = std::sin(2 * kPi * v), cp = std::cos(2 * kPi * v);
-    return {r_ * st * cp, r_ * st * sp, r_ * ct};
+    const SinCos t = SinCosPi(u), p = SinCosPi(2 * v);
+    return {r_ * t.sin * p.cos, r_ * t.sin * p.sin, r_ * t.cos};
   }
   std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override {
     const Interval a = Pt(kPi) * Range(u0, u1), b = Pt(2 * kPi) * Range(v0, v1);
@@ -51,18 +74,17 @@ class Sphere final : public Surface {
     return BoxOf(Pt(r_) * st * cp, Pt(r_) * st * sp, Pt(r_) * ct);
   }
   SurfaceJet Jet(double u, double v, int order) const override {
-    const double st = std::sin(kPi * u), ct = std::cos(kPi * u);
-    const double sp = std::sin(2 * kPi * v), cp = std::cos(2 * kPi * v);
-    return JetFrom(st, ct, sp, cp, order);
+    const SinCos t = SinCosPi(u), p = SinCosPi(2 * v);
+    return JetFrom(t.sin, t.cos, p.sin, p.cos, order);
   }
   void JetGrid(const double* us, int nu, const double* vs, int nv, int order,
                SurfaceJet* out) const override {
-    double sp[9], cp[9];
+    SinCos p[9];
     if (nv > 9) return Surface::JetGrid(us, nu, vs, nv, order, out);
-    for (int j = 0; j < nv; ++j) sp[j] = std::sin(2 * kPi * vs[j]), cp[j] = std::cos(2 * kPi * vs[j]);
+    for (int j = 0; j < nv; ++j) p[j] = SinCosPi(2 * vs[j]);
     for (int i = 0; i < nu; ++i) {
-      const double st = std::sin(kPi * us[i]), ct = std::cos(kPi * us[i]);
-      for (int j = 0; j < nv; ++j) out[i * nv + j] = JetFrom(st, ct, sp[j], cp[j], order);
+      const SinCos t = SinCosPi(us[i]);
+      for (int j = 0; j < nv; ++j) out[i * nv + j] = JetFrom(t.sin, t.cos, p[j].sin, p[j].cos, order);
     }
   }
 
@@ -86,15 +108,19 @@ class Sphere final : public Surface {
 
 class Torus final : public Surface {
  public:
+  // a = 2 pi u, b = 2 pi v.
   void Points(const double* u, const double* v, size_t n, double* x, double* y,
               double* z) const override {
-    PointsOf(*this, u, v, n, x, y, z);
+    SinCosPoints(u, v, n, Twice, Twice, [&](size_t i, double sa, double ca, double sb, double cb) {
+      const double w = big_r_ + r_ * cb;
+      x[i] = w * ca, y[i] = w * sa, z[i] = r_ * sb;
+    });
   }
   Torus(double big_r, double r) : big_r_(big_r), r_(r) {}
   Vec3 Point(double u, double v) const override {
-    const double a = 2 * kPi * u, b = 2 * kPi * v;
-    const double w = big_r_ + r_ * std::cos(b);
-    return {w * std::cos(a), w * std::sin(a), r_ * std::sin(b)};
+    const SinCos a = SinCosPi(2 * u), b = SinCosPi(2 * v);
+    const double w = big_r_ + r_ * b.cos;
+    return {w * a.cos, w * a.sin, r_ * b.sin};
   }
   std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override {
     const Interval a = Pt(2 * kPi) * Range(u0, u1), b = Pt(2 * kPi) * Range(v0, v1);
@@ -102,8 +128,8 @@ class Torus final : public Surface {
     return BoxOf(w * Cos(a), w * Sin(a), Pt(r_) * Sin(b));
   }
   SurfaceJet Jet(double u, double v, int order) const override {
-    const double sa = std::sin(2 * kPi * u), ca = std::cos(2 * kPi * u);
-    const double sb = std::sin(2 * kPi * v), cb = std::cos(2 * kPi * v);
+    const SinCos a = SinCosPi(2 * u), b = SinCosPi(2 * v);
+    const double sa = a.sin, ca = a.cos, sb = b.sin, cb = b.cos;
     const double w = big_r_ + r_ * cb;
     const double k = 2 * kPi;
     SurfaceJet j;
@@ -158,10 +184,12 @@ class EightSurface final : public Surface {
               double* z) const override {
     PointsOf(*this, u, v, n, x, y, z);
   }
+  // a = 2 pi u, b = pi v - pi/2: sin b = -cos(pi v), cos b = sin(pi v),
+  // sin 2b = -sin(2 pi v), cos 2b = -cos(2 pi v).
   Vec3 Point(double u, double v) const override {
-    const double a = 2 * kPi * u, b = kPi * v - kPi / 2;
-    const double s2b = std::sin(2 * b);
-    return {std::cos(a) * s2b, std::sin(a) * s2b, std::sin(b)};
+    const SinCos a = SinCosPi(2 * u), b2 = SinCosPi(2 * v);
+    const double s2b = -b2.sin;
+    return {a.cos * s2b, a.sin * s2b, -SinCosPi(v).cos};
   }
   std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override {
     const Interval a = Pt(2 * kPi) * Range(u0, u1), b = Pt(kPi) * Range(v0, v1) - Pt(kPi / 2);
@@ -169,10 +197,10 @@ class EightSurface final : public Surface {
     return BoxOf(Cos(a) * s2b, Sin(a) * s2b, Sin(b));
   }
   SurfaceJet Jet(double u, double v, int order) const override {
-    const double a = 2 * kPi * u, b = kPi * v - kPi / 2;
-    const double sa = std::sin(a), ca = std::cos(a);
-    const double s2b = std::sin(2 * b), c2b = std::cos(2 * b);
-    const double sb = std::sin(b), cb = std::cos(b);
+    const SinCos a = SinCosPi(2 * u), b = SinCosPi(v), b2 = SinCosPi(2 * v);
+    const double sa = a.sin, ca = a.cos;
+    const double s2b = -b2.sin, c2b = -b2.cos;
+    const double sb = -b.cos, cb = b.sin;
     SurfaceJet j;
     j.p = {ca * s2b, sa * s2b, sb};
     j.fu = Vec3{-sa * s2b, ca * s2b, 0} * (2 * kPi);
@@ -212,7 +240,7 @@ class WhitneyUmbrella final : public Surface {
 };
 
 // Signed power sign(c)|c|^e.
-double SignedPow(double c, double e) { return std::copysign(std::pow(std::fabs(c), e), c); }
+double SignedPow(double c, double e) { return std::copysign(Pow(std::fabs(c), e), c); }
 
 // g(x) = sign(c(x)) |c(x)|^e for c = cos or sin, with its first two
 // derivatives. With e < 1 the derivatives are infinite where c = 0 (the
@@ -225,13 +253,13 @@ struct PowTrig {
 PowTrig SignedPowOf(double c, double dc, double e, int order) {
   PowTrig r;
   const double a = std::fabs(c);
-  r.g = std::copysign(std::pow(a, e), c);
+  r.g = std::copysign(Pow(a, e), c);
   // d/dx sign(c)|c|^e = e |c|^(e-1) c'
-  r.d1 = e == 1 ? dc : e * std::pow(a, e - 1) * dc;
+  r.d1 = e == 1 ? dc : e * Pow(a, e - 1) * dc;
   if (order >= 2) {
     // d2 = e (e-1) |c|^(e-2) sign(c) c'^2 + e |c|^(e-1) c''
-    const double curv = e == 1 ? 0 : e * (e - 1) * std::copysign(std::pow(a, e - 2), c) * dc * dc;
-    r.d2 = curv + (e == 1 ? -c : -e * std::pow(a, e - 1) * c);
+    const double curv = e == 1 ? 0 : e * (e - 1) * std::copysign(Pow(a, e - 2), c) * dc * dc;
+    r.d2 = curv + (e == 1 ? -c : -e * Pow(a, e - 1) * c);
   }
   return r;
 }
@@ -283,7 +311,8 @@ class Superellipsoid final : public Surface {
     int quarter;
     double offset, d1, d2;
     void CosSin(double* c, double* s) const {
-      const double co = std::cos(offset), so = std::sin(offset);
+      const SinCos r = SinCosOf(offset);
+      const double co = r.cos, so = r.sin;
       switch (((quarter % 4) + 4) % 4) {
         case 0: *c = co, *s = so; break;
         case 1: *c = -so, *s = co; break;

@@ -6,6 +6,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/status_macros.h"
+#include "core/vector_math.h"
 
 namespace sfc {
 namespace {
@@ -36,22 +37,28 @@ double TriangleArea(const Vec3& a, const Vec3& b, const Vec3& c) {
   return 0.5 * Norm(Cross(b - a, c - a));
 }
 
+// N^(1/2) and N^(1/4) by square roots: correctly rounded on every machine,
+// and cheap in the tree's inner loop.
+double RootN(double n) { return std::sqrt(n); }
+double FourthRootN(double n) { return std::sqrt(std::sqrt(n)); }
+static_assert(CurveTree::kErrorFloorPower == 0.5, "the floors are square roots (RootN)");
+
 // The leaf's error allowance in samples at grade g (file comment of
 // curve_tree.h), and whether the leaf carries enough samples to be split.
 bool FailsAt(int g, double error, double mass, double base, double rho) {
   const double n = std::ldexp(1.0, g);
   const double mu = mass / base;
   return mu * n >= std::max(CurveTree::kMinSamples,
-                           CurveTree::kErrorFloor * std::pow(n, CurveTree::kErrorFloorPower)) &&
-         error / base * n > rho * CurveTree::kErrorShare * std::pow(n, 0.25) * mu;
+                           CurveTree::kErrorFloor * RootN(n)) &&
+         error / base * n > rho * CurveTree::kErrorShare * FourthRootN(n) * mu;
 }
 
-// The smallest grade g at which the leaf carries scale * N^power samples
-// (N = 2^g, power < 1, so the condition only tightens as g grows).
-int SamplesGrade(double mass, double base, double scale, double power) {
+// The smallest grade g at which the leaf carries scale * N^(1/2) samples
+// (N = 2^g, so the condition only tightens as g grows).
+int SamplesGrade(double mass, double base, double scale) {
   for (int g = 0; g <= 62; ++g) {
     const double n = std::ldexp(1.0, g);
-    if (mass / base * n >= std::max(CurveTree::kMinSamples, scale * std::pow(n, power))) return g;
+    if (mass / base * n >= std::max(CurveTree::kMinSamples, scale * RootN(n))) return g;
   }
   return kNeverFails;
 }
@@ -362,7 +369,7 @@ class CurveTree::Builder {
       if (!(t[q] > 0) || !std::isfinite(m[q]) || !(m[q] > 0)) return NAN;
     }
     if (!(t[1] < t[0])) return NAN;
-    return std::log(m[1] / m[0]) / std::log(t[1] / t[0]);
+    return Log(m[1] / m[0]) / Log(t[1] / t[0]);
   }
 
   // The power law of the cell's axis `axis` toward an edge (LeafModel::warp,
@@ -481,7 +488,7 @@ class CurveTree::Builder {
     // A leaf too light to fail at this grade is not examined: it keeps the
     // grade at which it must be (a pure function of the cell), and a later
     // refinement examines it then, as a fresh build would.
-    int fail = SamplesGrade(eval.mass, base_, kErrorFloor, kErrorFloorPower);
+    int fail = SamplesGrade(eval.mass, base_, kErrorFloor);
     double error = 0;
     CellEval children[9];
     if (fail <= grade_ && depth < curve_.max_depth()) {
@@ -492,7 +499,7 @@ class CurveTree::Builder {
       }
       fail = FailGrade(error, eval.mass, base_, options_.rho);
       // The paper's flatness test, for leaves that carry a whole sample.
-      int flat = SamplesGrade(eval.mass, base_, kFlatnessFloor, 0.5);
+      int flat = SamplesGrade(eval.mass, base_, kFlatnessFloor);
       // Beside a line where the area element blows up (a warp with power
       // above 1) the mapped probes spread like h^(1 + p), p < 0, and the test
       // would split down to the sample floors: many small leaves, each a
@@ -809,7 +816,7 @@ void CurveTree::ComputeReport() {
     if (warped) ++r.warped_leaves;
     const int fail = leaf_fail_grade(l);
     const double mass = mass_end(l) - mass_begin(l);
-    const double allowance = options_.rho * kErrorShare * std::pow(n, 0.25) * mass / base_mass_;
+    const double allowance = options_.rho * kErrorShare * FourthRootN(n) * mass / base_mass_;
     const bool error_fails = error > allowance;
     if (fail <= grade_) {
       ++r.mass_capped_leaves;

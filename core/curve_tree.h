@@ -156,7 +156,7 @@ class CurveTree {
   // The error test's constants (file comment).
   static constexpr double kErrorShare = 0.25;
   // A leaf is examined by the error test only while it carries at least
-  // max(kMinSamples, kErrorFloor N^(1/4)) samples, by the flatness test only
+  // max(kMinSamples, kErrorFloor N^(1/2)) samples, by the flatness test only
   // while it carries max(kMinSamples, kFlatnessFloor N^(1/2)).
   static constexpr double kMinSamples = 0.125;
   static constexpr double kErrorFloor = 1.0 / 64;

@@ -6,6 +6,8 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config   # compiler and build
   libabsl-dev                                    # Status, StatusOr, strings, Mutex (core)
+  libsleef-dev                                   # sin, cos, pow with the same bits on every x86-64 machine and
+                                                 # vector width (core/vector_math.h): glibc picks FMA variants
   libmuparser-dev                                # user-defined surface and density expressions
   libcli11-dev                                   # command-line flags
   libgtest-dev libgmock-dev                      # tests

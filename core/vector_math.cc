@@ -1,0 +1,102 @@
+#include "core/vector_math.h"
+
+#include <emmintrin.h>
+#include <cstdlib>
+#include <sleef.h>
+
+namespace sfc {
+namespace {
+
+VectorPath Widest() {
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx512f")) return VectorPath::kAvx512;
+  if (__builtin_cpu_supports("avx")) return VectorPath::kAvx;
+  return VectorPath::kSse2;  // every x86-64 CPU
+}
+
+// The widest path, or a narrower one named by SFCSAMPLER_VECTOR_PATH (for
+// checking that every path gives the same bytes end to end).
+VectorPath Detect() {
+  const VectorPath widest = Widest();
+  const char* name = std::getenv("SFCSAMPLER_VECTOR_PATH");
+  if (name == nullptr) return widest;
+  for (VectorPath path : {VectorPath::kScalar, VectorPath::kSse2, VectorPath::kAvx}) {
+    if (VectorPathName(path) == name && static_cast<int>(path) <= static_cast<int>(widest)) return path;
+  }
+  return widest;
+}
+
+// Whole vectors of `width` by `body`, the tail through the scalar reference.
+template <typename Body>
+void Batched(const double* x, size_t n, double* s, double* c, size_t width, Body body) {
+  const size_t whole = n / width * width;
+  body(x, whole, s, c);
+  for (size_t i = whole; i < n; ++i) {
+    const SinCos r = SinCosPi(x[i]);
+    s[i] = r.sin, c[i] = r.cos;
+  }
+}
+
+void SinCosPiSse2(const double* x, size_t n, double* s, double* c) {
+  for (size_t i = 0; i < n; i += 2) {
+    const Sleef___m128d_2 r = Sleef_cinz_sincospid2_u05sse2(_mm_loadu_pd(x + i));
+    _mm_storeu_pd(s + i, r.x);
+    _mm_storeu_pd(c + i, r.y);
+  }
+}
+
+}  // namespace
+
+SinCos SinCosPi(double x) {
+  const Sleef_double_2 r = Sleef_cinz_sincospid1_u05purec(x);
+  return {r.x, r.y};
+}
+
+SinCos SinCosOf(double x) {
+  const Sleef_double_2 r = Sleef_cinz_sincosd1_u10purec(x);
+  return {r.x, r.y};
+}
+
+double Pow(double x, double y) { return Sleef_cinz_powd1_u10purec(x, y); }
+double Log(double x) { return Sleef_cinz_logd1_u10purec(x); }
+double Atan2(double y, double x) { return Sleef_cinz_atan2d1_u10purec(y, x); }
+
+VectorPath BestVectorPath() {
+  static const VectorPath best = Detect();
+  return best;
+}
+
+std::string_view VectorPathName(VectorPath path) {
+  switch (path) {
+    case VectorPath::kScalar: return "scalar";
+    case VectorPath::kSse2: return "sse2";
+    case VectorPath::kAvx: return "avx";
+    case VectorPath::kAvx512: return "avx512f";
+  }
+  return "?";
+}
+
+bool Runs(VectorPath path) {
+  static const VectorPath widest = Widest();
+  return static_cast<int>(path) <= static_cast<int>(widest);
+}
+
+void SinCosPiOn(VectorPath path, const double* x, size_t n, double* s, double* c) {
+  switch (path) {
+    case VectorPath::kScalar:
+      for (size_t i = 0; i < n; ++i) {
+        const SinCos r = SinCosPi(x[i]);
+        s[i] = r.sin, c[i] = r.cos;
+      }
+      return;
+    case VectorPath::kSse2: return Batched(x, n, s, c, 2, SinCosPiSse2);
+    case VectorPath::kAvx: return Batched(x, n, s, c, 4, vector_math_internal::SinCosPiAvx);
+    case VectorPath::kAvx512: return Batched(x, n, s, c, 8, vector_math_internal::SinCosPiAvx512);
+  }
+}
+
+void SinCosPi(const double* x, size_t n, double* s, double* c) {
+  SinCosPiOn(BestVectorPath(), x, n, s, c);
+}
+
+}  // namespace sfc

@@ -1,0 +1,59 @@
+// Elementary functions with the same bits everywhere: SLEEF's deterministic
+// ("cinz": no fused multiply-add) functions, so a sample's bytes depend on
+// neither the C library's choice of code path (glibc picks FMA variants of
+// sin, cos and pow on machines that have FMA) nor the vector width.
+//
+// Each batch function is dispatched once per process to the widest vector
+// path the CPU offers (SSE2, AVX, AVX-512F). Every path, and the scalar
+// reference each batch function has, returns the same bits: SLEEF makes the
+// cinz functions alike across instruction sets, and tests/vector_math_test.cc
+// checks it bit for bit on the paths this machine has.
+//
+// Thread-safety: pure functions.
+#ifndef SFCSAMPLER_CORE_VECTOR_MATH_H_
+#define SFCSAMPLER_CORE_VECTOR_MATH_H_
+
+#include <cstddef>
+#include <string_view>
+
+namespace sfc {
+
+// sin(pi x) and cos(pi x), within 0.506 ulp, exact at multiples of 1/2 (the
+// argument is reduced exactly, so no rounding of pi x creeps in).
+struct SinCos {
+  double sin, cos;
+};
+SinCos SinCosPi(double x);
+// The same for x[0..n): s[i], c[i] equal SinCosPi(x[i]) bit for bit.
+void SinCosPi(const double* x, size_t n, double* s, double* c);
+
+// sin x and cos x within 1 ulp.
+SinCos SinCosOf(double x);
+// x^y, ln x and atan2(y, x) within 1 ulp (C's values at special arguments).
+double Pow(double x, double y);
+double Log(double x);
+double Atan2(double y, double x);
+
+// The vector paths, for tests and benchmarks.
+enum class VectorPath { kScalar, kSse2, kAvx, kAvx512 };
+// The path the batch functions use: the widest this CPU runs, or a narrower
+// one (scalar, sse2, avx) named by the environment variable
+// SFCSAMPLER_VECTOR_PATH, read once.
+VectorPath BestVectorPath();
+std::string_view VectorPathName(VectorPath path);
+// Whether this CPU runs `path`.
+bool Runs(VectorPath path);
+// SinCosPi over a batch on one given path. REQUIRES: Runs(path).
+void SinCosPiOn(VectorPath path, const double* x, size_t n, double* s, double* c);
+
+namespace vector_math_internal {
+// The AVX and AVX-512F loops, each in a file built for its instruction set
+// (vector_math_avx.cc, vector_math_avx512.cc); whole vectors only: n is a
+// multiple of 4 resp. 8.
+void SinCosPiAvx(const double* x, size_t n, double* s, double* c);
+void SinCosPiAvx512(const double* x, size_t n, double* s, double* c);
+}  // namespace vector_math_internal
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_CORE_VECTOR_MATH_H_

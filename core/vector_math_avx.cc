@@ -1,0 +1,18 @@
+// Built with -mavx (core/CMakeLists.txt): only loads, stores and SLEEF's
+// cinz call, so no arithmetic of ours can be contracted differently.
+#include <immintrin.h>
+#include <sleef.h>
+
+#include "core/vector_math.h"
+
+namespace sfc::vector_math_internal {
+
+void SinCosPiAvx(const double* x, size_t n, double* s, double* c) {
+  for (size_t i = 0; i < n; i += 4) {
+    const Sleef___m256d_2 r = Sleef_cinz_sincospid4_u05avx(_mm256_loadu_pd(x + i));
+    _mm256_storeu_pd(s + i, r.x);
+    _mm256_storeu_pd(c + i, r.y);
+  }
+}
+
+}  // namespace sfc::vector_math_internal

@@ -1,0 +1,18 @@
+// Built with -mavx512f (core/CMakeLists.txt): only loads, stores and SLEEF's
+// cinz call, so no arithmetic of ours can be contracted differently.
+#include <immintrin.h>
+#include <sleef.h>
+
+#include "core/vector_math.h"
+
+namespace sfc::vector_math_internal {
+
+void SinCosPiAvx512(const double* x, size_t n, double* s, double* c) {
+  for (size_t i = 0; i < n; i += 8) {
+    const Sleef___m512d_2 r = Sleef_cinz_sincospid8_u05avx512fnofma(_mm512_loadu_pd(x + i));
+    _mm512_storeu_pd(s + i, r.x);
+    _mm512_storeu_pd(c + i, r.y);
+  }
+}
+
+}  // namespace sfc::vector_math_internal

@@ -1,0 +1,73 @@
+// Every vector path of core/vector_math.h that this CPU runs gives the scalar
+// reference's bits, over arguments the samplers use ([0, 2]: pi u and 2 pi v)
+// and beyond, with the tails a batch leaves to the scalar path; and the
+// values are sin and cos of pi x.
+#include "core/vector_math.h"
+
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "gtest/gtest.h"
+
+namespace sfc {
+namespace {
+
+std::vector<double> Arguments() {
+  std::vector<double> x = {0, 0.5, 1, 1.5, 2, -0.5, 0x1p-1074, 0x1p-30, 1 - 0x1p-53, 0.25, 1e6 + 0.25};
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(0, 2), wide(-1e3, 1e3);
+  for (int i = 0; i < 100000; ++i) x.push_back(unit(rng));
+  for (int i = 0; i < 10000; ++i) x.push_back(wide(rng));
+  for (int i = 0; i < 10000; ++i) x.push_back(std::ldexp(unit(rng), -static_cast<int>(rng() % 60)));
+  x.push_back(0.75);  // an odd length: every path has a tail
+  return x;
+}
+
+bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+TEST(VectorMath, EveryPathGivesTheScalarBits) {
+  const std::vector<double> x = Arguments();
+  std::vector<double> s0(x.size()), c0(x.size());
+  SinCosPiOn(VectorPath::kScalar, x.data(), x.size(), s0.data(), c0.data());
+  int paths = 0;
+  for (VectorPath path : {VectorPath::kSse2, VectorPath::kAvx, VectorPath::kAvx512}) {
+    if (!Runs(path)) continue;
+    ++paths;
+    for (size_t offset : {0, 1, 3}) {  // unaligned starts and every tail length
+      std::vector<double> s(x.size() - offset), c(x.size() - offset);
+      SinCosPiOn(path, x.data() + offset, s.size(), s.data(), c.data());
+      for (size_t i = 0; i < s.size(); ++i) {
+        ASSERT_TRUE(SameBits(s[i], s0[i + offset]) && SameBits(c[i], c0[i + offset]))
+            << VectorPathName(path) << " x = " << x[i + offset];
+      }
+    }
+  }
+  EXPECT_GE(paths, 1);
+  std::vector<double> s(x.size()), c(x.size());
+  SinCosPi(x.data(), x.size(), s.data(), c.data());
+  for (size_t i = 0; i < x.size(); ++i) ASSERT_TRUE(SameBits(s[i], s0[i]) && SameBits(c[i], c0[i]));
+}
+
+TEST(VectorMath, ValuesAreSineAndCosineOfPiX) {
+  for (double x : Arguments()) {
+    if (std::fabs(x) > 4) continue;
+    const SinCos r = SinCosPi(x);
+    const long double a = 3.141592653589793238462643383279502884L * x;
+    EXPECT_NEAR(r.sin, static_cast<double>(std::sin(a)), 4e-16) << x;
+    EXPECT_NEAR(r.cos, static_cast<double>(std::cos(a)), 4e-16) << x;
+  }
+  // Exact where sin and cos are 0 or +-1.
+  EXPECT_EQ(SinCosPi(1).sin, 0);
+  EXPECT_EQ(SinCosPi(0.5).cos, 0);
+  EXPECT_EQ(SinCosPi(2).cos, 1);
+  const SinCos a = SinCosOf(0.3);
+  EXPECT_NEAR(a.sin, std::sin(0.3), 1e-16);
+  EXPECT_NEAR(a.cos, std::cos(0.3), 1e-16);
+  EXPECT_NEAR(Pow(2.5, 1.0 / 3), std::cbrt(2.5), 1e-15);
+  EXPECT_EQ(Pow(0, 0.5), 0);
+}
+
+}  // namespace
+}  // namespace sfc
