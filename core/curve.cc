@@ -132,6 +132,23 @@ Curve::Curve(const Definition& def)
     }
   }
 
+  // Cells in curve order, up to 32 per side.
+  table_levels_ = arity_ == 4 ? 5 : 3;
+  cell_order_.resize(table_levels_ + 1);
+  for (int levels = 1; levels <= table_levels_; ++levels) {
+    const int cells = static_cast<int>(pow_w_[levels]);
+    cell_order_[levels].resize(8 * cells);
+    for (int s = 0; s < 8; ++s) {
+      for (int k = 0; k < cells; ++k) {
+        uint64_t x, y;
+        int state = s;
+        DescendByTables(k, levels, &x, &y, &state);
+        cell_order_[levels][s * cells + k] =
+            Child{static_cast<uint8_t>(x), static_cast<uint8_t>(y), static_cast<uint8_t>(state)};
+      }
+    }
+  }
+
   for (int a = 0; a < 8; ++a) {
     for (int b = 0; b < 8; ++b) compose_[a][b] = static_cast<uint8_t>(Compose(a, b));
   }

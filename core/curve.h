@@ -70,6 +70,16 @@ class Curve {
   // Child `c` (0 <= c < w, in curve order) of a cell with orientation `state`.
   const Child& ChildOf(int state, int c) const { return children_[state * arity_ + c]; }
 
+  // The most levels CellsInOrder gives: up to 32 cells per side (Hilbert 5,
+  // the 3x3 curves 3).
+  int table_levels() const { return table_levels_; }
+  // The w^levels cells `levels` below a cell with orientation `state`, in
+  // curve order: each one's position in units of g^-levels of that cell and
+  // its orientation. REQUIRES: 1 <= levels <= table_levels().
+  const Child* CellsInOrder(int state, int levels) const {
+    return cell_order_[levels].data() + state * pow_w_[levels];
+  }
+
   // Follows `levels` base-w digits of `digits` (most significant first) down
   // from a cell with orientation `*state`. On return (*x, *y) is the reached
   // cell's position in units of g^-levels of the start cell, and *state its
@@ -146,19 +156,20 @@ class Curve {
   // at each level is a swap and a mirror whose parities are prefix XORs of
   // per-digit flags over the levels above; the start orientation is applied
   // to the whole result (every orientation acts on all bit levels alike).
-  void DescendBitParallel(uint64_t digits, int levels, uint64_t* x, uint64_t* y,
-                          int* state) const {
+  // Kept scalar: GCC's vectorised version of the four masks went through the
+  // stack and stalled on store forwarding (a third of the sampler's time).
+  __attribute__((optimize("no-tree-vectorize"))) void DescendBitParallel(
+      uint64_t digits, int levels, uint64_t* x, uint64_t* y, int* state) const {
     const uint64_t used = levels == 64 ? ~uint64_t{0} : (uint64_t{1} << levels) - 1;
     const uint64_t lo = PackEvenBits(digits), hi = PackEvenBits(digits >> 1);
-    // match[d]: bit j set where the digit at level bit j is d.
-    const uint64_t match[4] = {~hi & ~lo & used, ~hi & lo & used, hi & ~lo & used, hi & lo & used};
-    uint64_t qx = 0, qy = 0, swap = 0, mirror = 0;
-    for (int d = 0; d < 4; ++d) {
-      qx |= match[d] & digit_x_[d];
-      qy |= match[d] & digit_y_[d];
-      swap |= match[d] & digit_swap_[d];
-      mirror |= match[d] & digit_mirror_[d];
-    }
+    // m<d>: bit j set where the digit at level bit j is d.
+    const uint64_t m0 = ~hi & ~lo & used, m1 = ~hi & lo & used, m2 = hi & ~lo & used,
+                   m3 = hi & lo & used;
+    const auto pick = [&](const uint64_t* mask) {
+      return (m0 & mask[0]) | (m1 & mask[1]) | (m2 & mask[2]) | (m3 & mask[3]);
+    };
+    const uint64_t qx = pick(digit_x_), qy = pick(digit_y_);
+    const uint64_t swap = pick(digit_swap_), mirror = pick(digit_mirror_);
     const uint64_t swap_above = ParityAbove(swap), mirror_above = ParityAbove(mirror);
     uint64_t px = ((qx & ~swap_above) | (qy & swap_above)) ^ (mirror_above & used);
     uint64_t py = ((qy & ~swap_above) | (qx & swap_above)) ^ (mirror_above & used);
@@ -182,6 +193,8 @@ class Curve {
   std::vector<double> pow_g_;
   std::vector<Child> children_;       // [state][child]
   std::vector<ChunkEntry> chunks_;    // [state][chunk value]
+  int table_levels_;
+  std::vector<std::vector<Child>> cell_order_;  // [levels][state][cell]
   // Bit-parallel Hilbert decoding (DescendBitParallel): per digit of
   // orientation 0, all-ones or zero masks of its cell's x and y and of its
   // child's swap and mirror-both; and a o b for orientations.

@@ -84,20 +84,49 @@ double ModelIntegral(const LeafModel& model, LeafModel::Kind kind, int grid, dou
   return sum;
 }
 
-namespace leaf_model_internal {
-
-void PiecewiseSubSquareIntegrals(const LeafModel& model, int grid, double x0, double y0,
-                                 double side, double out[9]) {
-  const double step = side / grid;
-  for (int i = 0; i < grid; ++i) {
-    for (int j = 0; j < grid; ++j) {
-      out[i * grid + j] = ModelIntegral(model, LeafModel::Kind::kPiecewise, grid, x0 + i * step,
-                                        x0 + (i + 1) * step, y0 + j * step, y0 + (j + 1) * step);
+void GridIntegrals(const LeafModel& model, LeafModel::Kind kind, int grid, double x0, double y0,
+                   double side, int n, double* out) {
+  const bool quadratic = kind == LeafModel::Kind::kQuadratic;
+  const int factors = quadratic ? 3 : grid;
+  const double step = side / n;
+  // f[axis][b][k]: the integral of factor b along `axis` over its cell k.
+  double f[2][3][kMaxGridCells];
+  for (int axis = 0; axis < 2; ++axis) {
+    const double origin = axis == 0 ? x0 : y0;
+    double edge[kMaxGridCells + 1];
+    for (int k = 0; k <= n; ++k) edge[k] = origin + k * step;
+    if (quadratic && model.warp[axis].power < 1) {
+      // Descended in leaf coordinates: the cells' images in warped ones.
+      for (int k = 0; k <= n; ++k) edge[k] = Unwarp(model.warp[axis], edge[k]);
+    }
+    for (int k = 0; k < n; ++k) {
+      if (quadratic) {
+        double basis[3];
+        leaf_model_internal::BasisIntegrals(edge[k], edge[k + 1], basis);
+        for (int b = 0; b < 3; ++b) f[axis][b][k] = basis[b];
+      } else {
+        const double piece = 1.0 / grid;
+        for (int b = 0; b < grid; ++b) f[axis][b][k] = Overlap(edge[k], edge[k + 1], b * piece, (b + 1) * piece);
+      }
+    }
+  }
+  // row[a][j] = sum_b c[a, b] f_y[b][j]; then out = sum_a f_x[a][i] row[a][j].
+  double row[3][kMaxGridCells];
+  for (int a = 0; a < factors; ++a) {
+    for (int j = 0; j < n; ++j) {
+      double sum = 0;
+      for (int b = 0; b < factors; ++b) sum += static_cast<double>(model.c[a * factors + b]) * f[1][b][j];
+      row[a][j] = sum;
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      double sum = 0;
+      for (int a = 0; a < factors; ++a) sum += f[0][a][i] * row[a][j];
+      out[i * n + j] = sum;
     }
   }
 }
-
-}  // namespace leaf_model_internal
 
 double QuadraticIntegral(const double values[9], double x0, double x1, double y0, double y1,
                          const AxisWarp* warp) {

@@ -30,6 +30,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "core/vector_math.h"
+
 namespace sfc {
 
 // 3-point Gauss-Legendre on [0,1]: nodes and weights.
@@ -54,27 +56,27 @@ inline double WarpSplit(const AxisWarp& w) {
   if (w.centre <= 0) return 0;
   if (w.centre >= 1) return 1;
   const double r = 1 / static_cast<double>(w.power);
-  const double a = std::pow(static_cast<double>(w.centre), r);
-  return a / (a + std::pow(1 - static_cast<double>(w.centre), r));
+  const double a = Pow(static_cast<double>(w.centre), r);
+  return a / (a + Pow(1 - static_cast<double>(w.centre), r));
 }
 // x = W(s), W'(s) and s = W^-1(x): each maps [0,1] onto itself, increasing.
 inline double Warp(const AxisWarp& w, double s) {
   if (w.power == 1) return s;
   const double k = w.power, c = w.centre, sc = WarpSplit(w);
-  if (s <= sc && sc > 0) return c - c * std::pow(1 - s / sc, k);
-  return c + (1 - c) * std::pow((s - sc) / (1 - sc), k);
+  if (s <= sc && sc > 0) return c - c * Pow(1 - s / sc, k);
+  return c + (1 - c) * Pow((s - sc) / (1 - sc), k);
 }
 inline double WarpSlope(const AxisWarp& w, double s) {
   if (w.power == 1) return 1;
   const double k = w.power, c = w.centre, sc = WarpSplit(w);
-  if (s <= sc && sc > 0) return c * k * std::pow(1 - s / sc, k - 1) / sc;
-  return (1 - c) * k * std::pow((s - sc) / (1 - sc), k - 1) / (1 - sc);
+  if (s <= sc && sc > 0) return c * k * Pow(1 - s / sc, k - 1) / sc;
+  return (1 - c) * k * Pow((s - sc) / (1 - sc), k - 1) / (1 - sc);
 }
 inline double Unwarp(const AxisWarp& w, double x) {
   if (w.power == 1) return x;
   const double r = 1 / static_cast<double>(w.power), c = w.centre, sc = WarpSplit(w);
-  if (x <= c && c > 0) return sc * (1 - std::pow((c - x) / c, r));
-  return sc + (1 - sc) * std::pow((x - c) / (1 - c), r);
+  if (x <= c && c > 0) return sc * (1 - Pow((c - x) / c, r));
+  return sc + (1 - sc) * Pow((x - c) / (1 - c), r);
 }
 
 // Whether the walk descends a leaf's curve in the warped coordinate of this
@@ -166,82 +168,22 @@ inline void BasisIntegrals(double a, double b, double out[3]) {
   }
 }
 
-void PiecewiseSubSquareIntegrals(const LeafModel& model, int grid, double x0, double y0,
-                                 double side, double out[9]);
-
 }  // namespace leaf_model_internal
 
-// The integrals over the grid x grid sub-squares of the square
-// [x0, x0 + side] x [y0, y0 + side] in the coordinates the walk descends in
-// (DescendsWarped): warped along an axis whose power law blows up, the leaf's
-// own along the others. out[i * grid + j] for the sub-square i along x, j
-// along y. Shares
-// the 1D integrals, and each y row of the quadratic, between sub-squares.
-// Inline: the sampler's descent calls it once per model level. REQUIRES:
-// grid is 2 or 3 (the curves' grids).
-template <int kGrid>
-inline void SubSquareIntegralsOnGrid(const LeafModel& model, LeafModel::Kind kind, double x0,
-                                     double y0, double side, double out[9]) {
-  if (kind == LeafModel::Kind::kPiecewise) {
-    leaf_model_internal::PiecewiseSubSquareIntegrals(model, kGrid, x0, y0, side, out);
-    return;
-  }
-  // The 1D integrals of the basis over the kGrid cells along y (k < kGrid)
-  // and along x (k >= kGrid): BasisIntegrals' arithmetic, written as loops
-  // over the cells so the compiler pairs their divisions in vector registers.
-  const double step = side / kGrid;
-  constexpr int kCells = 2 * kGrid;
-  double a[kCells], b[kCells], d[kCells], mid[kCells], d3[kCells], integral[kCells][3];
-  for (int k = 0; k < kGrid; ++k) {
-    a[k] = y0 + k * step, b[k] = y0 + (k + 1) * step;
-    a[kGrid + k] = x0 + k * step, b[kGrid + k] = x0 + (k + 1) * step;
-  }
-  // An axis whose power law vanishes (power < 1) is descended in leaf
-  // coordinates: integrate over the sub-cells' images in warped ones.
-  if (model.warp[1].power < 1) {
-    for (int k = 0; k < kGrid; ++k) a[k] = Unwarp(model.warp[1], a[k]), b[k] = Unwarp(model.warp[1], b[k]);
-  }
-  if (model.warp[0].power < 1) {
-    for (int k = kGrid; k < kCells; ++k) {
-      a[k] = Unwarp(model.warp[0], a[k]), b[k] = Unwarp(model.warp[0], b[k]);
-    }
-  }
-  for (int k = 0; k < kCells; ++k) {
-    d[k] = b[k] - a[k];
-    mid[k] = (a[k] + b[k]) / 2;
-    d3[k] = d[k] * d[k] * d[k] / 12;
-  }
-  for (int k = 0; k < kCells; ++k) {
-    for (int i = 0; i < 3; ++i) {
-      const double* c = leaf_model_internal::kBasisTable.k[i];
-      integral[k][i] = d[k] * (c[0] + mid[k] * (c[1] + mid[k] * c[2])) + c[2] * d3[k];
-    }
-  }
-  double row[kGrid][3];  // row[j][a] = sum_b c[3a + b] int_{y-cell j} L_b
-  for (int j = 0; j < kGrid; ++j) {
-    const double* iy = integral[j];
-    for (int a = 0; a < 3; ++a) {
-      row[j][a] = model.c[3 * a] * iy[0] + model.c[3 * a + 1] * iy[1] + model.c[3 * a + 2] * iy[2];
-    }
-  }
-  for (int i = 0; i < kGrid; ++i) {
-    const double* ix = integral[kGrid + i];
-    for (int j = 0; j < kGrid; ++j) {
-      double sum = 0;
-      for (int a = 0; a < 3; ++a) sum += ix[a] * row[j][a];
-      out[i * kGrid + j] = sum;
-    }
-  }
-}
+// Largest n of GridIntegrals: cells per side of a walk's table.
+inline constexpr int kMaxGridCells = 32;
 
-inline void SubSquareIntegrals(const LeafModel& model, LeafModel::Kind kind, int grid, double x0,
-                               double y0, double side, double out[9]) {
-  if (grid == 2) {
-    SubSquareIntegralsOnGrid<2>(model, kind, x0, y0, side, out);
-  } else {
-    SubSquareIntegralsOnGrid<3>(model, kind, x0, y0, side, out);
-  }
-}
+// The integrals of the model over the n x n sub-squares of the square
+// [x0, x0 + side] x [y0, y0 + side], in the coordinates the walk descends in
+// (DescendsWarped): warped along an axis whose power law blows up, the
+// leaf's own along the others. out[i * n + j] for the sub-square i along x,
+// j along y; a quadratic may give negative values where it dips below zero.
+// The model is a sum of products of 1D functions (the Lagrange basis of the
+// quadratic, the pieces' indicators of the piecewise model), so the work is
+// 1D integrals along each axis and then 3 products per sub-square. `grid` is
+// the piecewise model's grid (the curve's). REQUIRES: 1 <= n <= kMaxGridCells.
+void GridIntegrals(const LeafModel& model, LeafModel::Kind kind, int grid, double x0, double y0,
+                   double side, int n, double* out);
 
 // The same for unnormalised quadratic node values (double precision) in the
 // coordinates warped by `warp` (null: none), used by the tree's error test.

@@ -17,6 +17,9 @@ LeafWalk::LeafWalk(const CurveTree& tree)
       grade_samples_(std::ldexp(1.0, tree.grade())) {
   int exponent;
   cells_power_of_two_ = std::frexp(continuation_cells_, &exponent) == 0.5;
+  tables_.resize(kMaxModelLevels + 1);
+  const int cells = static_cast<int>(curve_.PowG(curve_.table_levels()));
+  grid_mass_.resize(static_cast<size_t>(cells) * cells);
   last_positive_leaf_ = tree.leaf_count() - 1;
   while (last_positive_leaf_ > 0 &&
          !(tree.mass_end(last_positive_leaf_) > tree.mass_begin(last_positive_leaf_))) {
@@ -66,47 +69,34 @@ double LeafWalk::PlaceOnAxis(const AxisWarp& w, double x0, double side, double x
   return std::clamp(Warp(w, s0 + (x - x0) / side * (s1 - s0)), x0, x0 + side);
 }
 
-template <int kGrid>
-bool LeafWalk::Split(Node& node) const {
-  // The children's t bounds from the model's exact integrals.
-  constexpr int g = kGrid, w = kGrid * kGrid;
-  double by_grid[9], share[9], sum = 0;
-  SubSquareIntegralsOnGrid<kGrid>(*model_, kind_, node.x0, node.y0, node.side, by_grid);
-  for (int c = 0; c < w; ++c) {
-    const Curve::Child& ch = curve_.ChildOf(node.state, c);
-    share[c] = std::max(0.0, by_grid[ch.dx * g + ch.dy]);
-    sum += share[c];
-  }
-  if (!(sum > 0)) return false;  // the model vanishes here: pure curve bits
-  // bounds[c] = t0 + (t1 - t0) * (share[0] + ... + share[c]) / sum, the
-  // running sums first so the divisions pair in vector registers.
-  double acc[9], fraction[9], running = 0;
-  for (int c = 0; c < w; ++c) acc[c] = running += share[c];
-  for (int c = 0; c + 1 < w; ++c) fraction[c] = acc[c] / sum;
-  for (int c = 0; c + 1 < w; ++c) node.bounds[c] = node.t0 + (node.t1 - node.t0) * fraction[c];
-  node.bounds[w - 1] = node.t1;
-  node.ordered = true;
-  for (int c = 0; c + 1 < w; ++c) node.ordered = node.ordered && node.bounds[c] <= node.bounds[c + 1];
-  return true;
+int LeafWalk::TableLevels(double carried, int depth) const {
+  if (!(carried >= (depth == 0 ? kNegligibleSamples : kTableSamples))) return 0;
+  const int most = std::min(curve_.table_levels(), kMaxModelLevels - depth);
+  int levels = 1;
+  while (levels < most && carried > kCellSamples * static_cast<double>(curve_.PowW(levels))) ++levels;
+  return std::max(0, std::min(levels, most));
 }
 
-template <int kArity>
-int LeafWalk::ChildHolding(const Node& node, double t) {
-  constexpr int w = kArity;
-  if (node.ordered) {
-    // Bounds in order from t0 up: the first bound above t ends a non-empty
-    // interval that holds t. Counted without branches (t falls anywhere).
-    int c = 0;
-    for (int i = 0; i < w; ++i) c += node.bounds[i] <= t;
-    return c;
+int LeafWalk::Tabulate(const Square& square, int levels, std::vector<double>& bounds) {
+  const int n = static_cast<int>(curve_.PowG(levels));
+  const int cells = n * n;
+  GridIntegrals(*model_, kind_, grid_, square.x0, square.y0, square.side, n, grid_mass_.data());
+  const Curve::Child* order = curve_.CellsInOrder(square.state, levels);
+  bounds.resize(cells);
+  // Running sums in curve order (a quadratic's dips below zero count as no mass).
+  double sum = 0;
+  for (int k = 0; k < cells; ++k) {
+    sum += std::max(0.0, grid_mass_[order[k].dx * n + order[k].dy]);
+    bounds[k] = sum;
   }
-  double t0 = node.t0;
-  for (int c = 0; c < w; ++c) {
-    const double t1 = node.bounds[c];
-    if (t < t1 && t1 > t0) return c;
-    t0 = t1;
-  }
-  return w;
+  if (!(sum > 0)) return -1;  // the model vanishes here: pure curve bits
+  int last = cells - 1;
+  while (last > 0 && bounds[last - 1] == sum) --last;
+  // Running sums to t: monotone, so the bounds do not decrease.
+  const double scale = (square.t1 - square.t0) / sum;
+  for (int k = 0; k < last; ++k) bounds[k] = std::min(square.t0 + bounds[k] * scale, square.t1);
+  for (int k = last; k < cells; ++k) bounds[k] = square.t1;
+  return last;
 }
 
 void LeafWalk::Place(const double* m, size_t n, double* u, double* v, double* curve_position) {
@@ -119,106 +109,85 @@ void LeafWalk::Place(const double* m, size_t n, double* u, double* v, double* cu
     size_t j = i + 1;
     while (j < n && m[j] >= m[j - 1] && (m[j] < end_mass_ || LeafFor(m[j]) == l)) ++j;
     double* position = curve_position == nullptr ? nullptr : curve_position + i;
-    if (grid_ == 2) {
-      PlaceInLeaf<2>(m + i, j - i, u + i, v + i, position);
+    PlaceInLeaf(m + i, j - i, u + i, v + i, position);
+    i = j;
+  }
+}
+
+void LeafWalk::PlaceInLeaf(const double* m, size_t n, double* u, double* v,
+                           double* curve_position) {
+  t_.resize(n);
+  for (size_t i = 0; i < n; ++i) t_[i] = std::clamp((m[i] - begin_mass_) / leaf_mass_, 0.0, 1.0);
+  u_ = u, v_ = v, curve_position_ = curve_position;
+  const Square leaf{0, 1, 0, 0, 1, 0, 1, cell_.state, 0};
+  PlaceInSquare(leaf, 0, static_cast<uint32_t>(n), 0);
+}
+
+void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end, int level) {
+  const int levels = TableLevels((square.t1 - square.t0) * samples_, square.depth);
+  std::vector<double>& bounds = tables_[level];
+  const int last = levels > 0 ? Tabulate(square, levels, bounds) : -1;
+  if (last < 0) {
+    for (uint32_t i = begin; i < end; ++i) Continue(square, i);
+    return;
+  }
+  const Curve::Child* order = curve_.CellsInOrder(square.state, levels);
+  const double side = square.side / curve_.PowG(levels);
+  const double span = square.span / static_cast<double>(curve_.PowW(levels));
+  // Samples in t order meet the cells in curve order: t goes to the first
+  // cell whose bound is above it (that cell has mass), and t >= t1 to the last.
+  int k = 0;
+  uint32_t i = begin;
+  while (i < end) {
+    while (k < last && bounds[k] <= t_[i]) ++k;
+    uint32_t j = i + 1;
+    if (k == last) {
+      j = end;
     } else {
-      PlaceInLeaf<3>(m + i, j - i, u + i, v + i, position);
+      while (j < end && t_[j] < bounds[k]) ++j;
+    }
+    Square cell;
+    cell.t0 = k == 0 ? square.t0 : bounds[k - 1], cell.t1 = bounds[k];
+    cell.x0 = square.x0 + order[k].dx * side, cell.y0 = square.y0 + order[k].dy * side;
+    cell.side = side;
+    cell.pos = square.pos + k * span, cell.span = span;
+    cell.state = order[k].state;
+    cell.depth = square.depth + levels;
+    if (level < kMaxModelLevels && (cell.t1 - cell.t0) * samples_ >= kTableSamples) {
+      PlaceInSquare(cell, i, j, level + 1);
+    } else {
+      for (uint32_t q = i; q < j; ++q) Continue(cell, q);
     }
     i = j;
   }
 }
 
-template <int kGrid>
-void LeafWalk::PlaceInLeaf(const double* m, size_t n, double* u, double* v,
-                           double* curve_position) {
-  constexpr int g = kGrid, w = kGrid * kGrid;
-  t_.resize(n);
-  final_.resize(n);
-  for (size_t i = 0; i < n; ++i) t_[i] = std::clamp((m[i] - begin_mass_) / leaf_mass_, 0.0, 1.0);
-
-  // Model descent, level by level: a node holding a noticeable part of a
-  // sample is split by its model's integrals, and its samples (in t order)
-  // go to the children holding them; each sample ends at the deepest node
-  // it reaches.
-  // nodes_[0, count) are the nodes so far; a level adds at most n (each
-  // child holds a sample), so room for n more is made before each level and
-  // references stay valid while it runs.
-  if (nodes_.size() < n + 1) nodes_.resize(n + 1);
-  Node& root = nodes_[0];
-  root.t0 = 0, root.t1 = 1, root.x0 = 0, root.y0 = 0, root.side = 1, root.pos = 0, root.span = 1;
-  root.state = cell_.state;
-  root.depth = 0;
-  root.begin = 0, root.end = static_cast<uint32_t>(n);
-  size_t count = 1, level_begin = 0;
-  while (level_begin < count) {
-    const size_t level_end = count;
-    if (nodes_.size() < count + n) nodes_.resize(std::max(count + n, 2 * nodes_.size()));
-    // The level's splits first: independent of each other and of the samples.
-    for (size_t q = level_begin; q < level_end; ++q) {
-      Node& node = nodes_[q];
-      node.split = node.depth < kMaxModelLevels &&
-                   (node.t1 - node.t0) * samples_ >= kNegligibleSamples && Split<kGrid>(node);
-    }
-    for (size_t q = level_begin; q < level_end; ++q) {
-      const Node& node = nodes_[q];
-      if (!node.split) {
-        for (uint32_t i = node.begin; i < node.end; ++i) final_[i] = static_cast<uint32_t>(q);
-        continue;
-      }
-      const double side = node.side / g, span = node.span / w;
-      uint32_t i = node.begin;
-      while (i < node.end) {
-        const int c = ChildHolding<w>(node, t_[i]);
-        if (c == w) {  // rounding left t past the last child: it stays here
-          final_[i++] = static_cast<uint32_t>(q);
-          continue;
-        }
-        uint32_t end = i + 1;
-        while (end < node.end && ChildHolding<w>(node, t_[end]) == c) ++end;
-        const Curve::Child& ch = curve_.ChildOf(node.state, c);
-        Node& child = nodes_[count++];
-        child.t0 = c == 0 ? node.t0 : node.bounds[c - 1], child.t1 = node.bounds[c];
-        child.x0 = node.x0 + ch.dx * side, child.y0 = node.y0 + ch.dy * side, child.side = side;
-        child.pos = node.pos + c * span, child.span = span;
-        child.state = ch.state;
-        child.depth = node.depth + 1;
-        child.begin = i, child.end = end;
-        i = end;
-      }
-    }
-    level_begin = level_end;
-  }
-
-  // Analytic continuation: each sample follows the rest of its t down its
-  // node's own curve and sits at the centre of the cell reached.
+void LeafWalk::Continue(const Square& at, uint32_t i) {
+  // The rest of t down the square's own curve, to the centre of the cell reached.
   const uint64_t scale = continuation_scale_;
-  for (size_t i = 0; i < n; ++i) {
-    const Node& at = nodes_[final_[i]];
-    const double t = t_[i];
-    const double tr = at.t1 > at.t0 ? std::clamp((t - at.t0) / (at.t1 - at.t0), 0.0, 1.0) : 0.0;
-    // Conversions through int64_t: every value here is below 2^63, so they
-    // are exact either way, and the signed ones are single instructions.
-    const uint64_t digits = std::min(
-        static_cast<uint64_t>(static_cast<int64_t>(tr * static_cast<double>(scale))), scale - 1);
-    uint64_t cx, cy;
-    int state = at.state;
-    curve_.Descend(digits, continuation_levels_, &cx, &cy, &state);
-    // For Hilbert the division is by 2^26: a multiplication, with the same bits.
-    const double cell = cells_power_of_two_ ? at.side * inverse_cells_ : at.side / continuation_cells_;
-    const double x = static_cast<double>(static_cast<int64_t>(cx));
-    const double y = static_cast<double>(static_cast<int64_t>(cy));
-    double px = at.x0 + (x + 0.5) * cell, py = at.y0 + (y + 0.5) * cell;
-    if (warped_) {
-      px = PlaceOnAxis(model_->warp[0], at.x0, at.side, px);
-      py = PlaceOnAxis(model_->warp[1], at.y0, at.side, py);
-    }
-    u[i] = cell_.u0 + px * cell_.size;
-    v[i] = cell_.v0 + py * cell_.size;
-    if (curve_position != nullptr) {
-      const double pos = at.pos + tr * at.span;
-      curve_position[i] =
-          (leaf_start_ + pos * leaf_span_) / static_cast<double>(curve_.Span(0));
-    }
+  const double t = t_[i];
+  const double tr = at.t1 > at.t0 ? std::clamp((t - at.t0) / (at.t1 - at.t0), 0.0, 1.0) : 0.0;
+  // Conversions through int64_t: every value here is below 2^63, so they
+  // are exact either way, and the signed ones are single instructions.
+  const uint64_t digits = std::min(
+      static_cast<uint64_t>(static_cast<int64_t>(tr * static_cast<double>(scale))), scale - 1);
+  uint64_t cx, cy;
+  int state = at.state;
+  curve_.Descend(digits, continuation_levels_, &cx, &cy, &state);
+  // For Hilbert the division is by 2^26: a multiplication, with the same bits.
+  const double cell = cells_power_of_two_ ? at.side * inverse_cells_ : at.side / continuation_cells_;
+  const double x = static_cast<double>(static_cast<int64_t>(cx));
+  const double y = static_cast<double>(static_cast<int64_t>(cy));
+  double px = at.x0 + (x + 0.5) * cell, py = at.y0 + (y + 0.5) * cell;
+  if (warped_) {
+    px = PlaceOnAxis(model_->warp[0], at.x0, at.side, px);
+    py = PlaceOnAxis(model_->warp[1], at.y0, at.side, py);
+  }
+  u_[i] = cell_.u0 + px * cell_.size;
+  v_[i] = cell_.v0 + py * cell_.size;
+  if (curve_position_ != nullptr) {
+    const double pos = at.pos + tr * at.span;
+    curve_position_[i] = (leaf_start_ + pos * leaf_span_) / static_cast<double>(curve_.Span(0));
   }
 }
 

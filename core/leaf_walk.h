@@ -2,28 +2,29 @@
 // docs/ALGORITHM.md step 4 and "Inside a leaf, follow the model"), as a walk.
 //
 // Mass coordinate m = q_k S_M lands in the leaf l with S_{l-1} <= m < S_l.
-// Inside it, t = (m - S_{l-1}) / s_l descends the leaf's own curve, at each
-// level entering the child whose share of the model's exact integral holds t,
-// until the sub-cell reached carries less than kNegligibleSamples of one
-// sample (counted at the tree's grade, so every sequence on one tree places a
-// given t alike). The rest of t is followed as pure curve bits for
-// continuation_levels() more levels, and the sample sits at the centre of the
-// cell reached. In a leaf whose model is warped toward a singular line
-// (LeafModel::warp) where the area element blows up, the leaf's curve runs in
-// the warped coordinates, where the model is smooth, and the point reached is
+// Inside it, t = (m - S_{l-1}) / s_l is placed by an inverse CDF at fixed
+// resolution: the leaf's square is cut into the n x n cells some levels of
+// its own curve reach (a table), the model's exact integral over each cell is
+// summed in curve order, and t falls into the cell whose share of the sum
+// holds it. The table is as fine as the leaf's samples need, a quarter of a
+// sample a cell or less (counted at the tree's grade, so every sequence on one tree
+// places a given t alike, and limited to 32 x 32 cells); a cell that still
+// carries many samples, where the mass is uneven or the leaf is large, gets
+// a table of its own. The rest of t is followed as pure curve bits for
+// continuation_levels() more levels, and the sample sits at the centre of
+// the cell reached. In a leaf whose model is warped toward a singular line
+// (LeafModel::warp) where the area element blows up, the tables run in the
+// warped coordinates, where the model is smooth, and the point reached is
 // mapped back through the warp: the paper's reparameterisation (Sect. 5.3)
 // inside one leaf, whose cells are then thin strips along the line. Where it
-// vanishes, the curve stays in leaf coordinates and the continuation inside
-// the last sub-cell is uniform in warped ones (DescendsWarped).
+// vanishes, the tables stay in leaf coordinates and the continuation inside
+// the last cell is uniform in warped ones (DescendsWarped).
 //
 // Coordinates handed over in non-decreasing order make this a merge: the
-// leaf advances by a forward step, and the samples of one leaf descend
-// together, level by level: each model sub-cell that holds samples is
-// integrated once for all of them, the sub-cells of one level one after
-// another with no sample's branches in between, and the samples are then
-// split among the children in order. The result is a pure function of
-// (tree, m): a sub-cell's values are computed the same way whichever samples
-// it holds, so any split of a run of samples between calls or walks gives
+// leaf advances by a forward step, a table is made once for the samples of
+// its square, and they are matched to its cells by a forward step too. The
+// result is a pure function of (tree, m): a table's values depend only on
+// its square, so any split of a run of samples between calls or walks gives
 // the same bits.
 //
 // Thread-safety: a LeafWalk is used by one thread at a time; many walks may
@@ -41,9 +42,17 @@ namespace sfc {
 
 class LeafWalk {
  public:
-  // Below this many samples' worth a sub-cell's placement is pure curve bits.
+  // Below this many samples' worth a leaf's placement is pure curve bits.
   static constexpr double kNegligibleSamples = 1.0 / 8;
-  // The model descent stops after this many levels in any case.
+  // A table's cells carry at most this many samples on average. Inside a
+  // cell the sample follows the curve uniformly, which ignores the mass's
+  // gradient there: a bias of the order of a cell's area, seen beside
+  // singular lines (the Monte Carlo check of docs/QUALITY.md: a quarter
+  // sample keeps it below what 8 seeds resolve, a whole sample does not).
+  static constexpr double kCellSamples = 0.25;
+  // A table cell carrying at least this many samples gets a table of its own.
+  static constexpr double kTableSamples = 1;
+  // Tables stop this many curve levels below the leaf in any case.
   static constexpr int kMaxModelLevels = 40;
 
   // REQUIRES: `tree` outlives the walk and has positive total mass.
@@ -57,37 +66,38 @@ class LeafWalk {
   void Place(const double* m, size_t n, double* u, double* v, double* curve_position);
 
  private:
-  // A sub-cell of the model descent: leaf-fraction interval [t0, t1), its
-  // square [x0, x0 + side) x [y0, y0 + side) in leaf units, its orientation,
-  // its start along the leaf's curve (a fraction of the leaf's span), and the
-  // run's samples it holds.
-  struct Node {
-    double t0, t1, x0, y0, side, pos, span;  // span: the node's share of the leaf's curve
+  // A square reached inside the current leaf: leaf-fraction interval
+  // [t0, t1), its square [x0, x0 + side) x [y0, y0 + side) in leaf units (in
+  // the coordinates the walk descends in), its orientation, its start and
+  // share along the leaf's curve (fractions of the leaf's span), and how many
+  // curve levels below the leaf it is.
+  struct Square {
+    double t0, t1, x0, y0, side, pos, span;
     int state;
-    int depth;               // 0 for the leaf itself
-    uint32_t begin, end;     // its samples: [begin, end) of the run
-    bool split;              // children's bounds[] filled
-    bool ordered;            // bounds[] is non-decreasing (all but rounding corners)
-    double bounds[9];        // upper t of each child, in curve order
+    int depth;
   };
 
-  // Leaf coordinate along one axis of the point at x in the sub-cell
-  // [x0, x0 + side] the descent reached (DescendsWarped: x is warped).
+  // Leaf coordinate along one axis of the point at x in the cell
+  // [x0, x0 + side] the walk reached (DescendsWarped: x is warped).
   static double PlaceOnAxis(const AxisWarp& w, double x0, double side, double x);
   // The leaf holding m: a forward step from the current one, else a search.
   size_t LeafFor(double m) const;
   // Makes l the current leaf.
   void Enter(size_t l);
-  // Fills the node's child bounds from the model; false where the model
-  // vanishes (its samples then follow pure curve bits from there).
-  template <int kGrid>
-  bool Split(Node& node) const;
-  // The child of `node` holding t: the first whose interval [t0, bounds[c])
-  // is not empty and holds t; w when rounding left t past the last one.
-  template <int kArity>
-  static int ChildHolding(const Node& node, double t);
+  // Curve levels of the table of a square carrying `carried` samples' worth;
+  // 0: none (pure curve bits).
+  int TableLevels(double carried, int depth) const;
+  // Fills `bounds` with the upper t of each of the square's w^levels table
+  // cells in curve order (non-decreasing, the last with mass and all after
+  // it ending at t1); returns the index of the last cell with mass, or -1
+  // where the model vanishes.
+  int Tabulate(const Square& square, int levels, std::vector<double>& bounds);
+  // Places the current leaf's samples [begin, end), which lie in `square` in
+  // t order, using the table of recursion `level`.
+  void PlaceInSquare(const Square& square, uint32_t begin, uint32_t end, int level);
+  // Places sample i by pure curve bits inside `square`.
+  void Continue(const Square& square, uint32_t i);
   // Places n samples of the current leaf with non-decreasing m.
-  template <int kGrid>
   void PlaceInLeaf(const double* m, size_t n, double* u, double* v, double* curve_position);
 
   const CurveTree& tree_;
@@ -110,9 +120,11 @@ class LeafWalk {
   LeafModel::Kind kind_ = LeafModel::Kind::kQuadratic;
   bool warped_ = false;  // the model has a power law (LeafModel::warp)
   // Scratch of PlaceInLeaf, kept to reuse its memory.
-  std::vector<double> t_;           // each sample's fraction of the leaf's mass
-  std::vector<Node> nodes_;         // the descent's sub-cells, level by level
-  std::vector<uint32_t> final_;     // each sample's deepest node
+  std::vector<double> t_;                     // each sample's fraction of the leaf's mass
+  std::vector<std::vector<double>> tables_;  // cell bounds, one table per recursion level
+  std::vector<double> grid_mass_;             // a table's cell integrals, row by row
+  // The run being placed: output columns (curve_position_ may be null).
+  double *u_ = nullptr, *v_ = nullptr, *curve_position_ = nullptr;
 };
 
 }  // namespace sfc

@@ -17,7 +17,9 @@ namespace sfc {
 
 // Bumped whenever the same request could yield different samples.
 // 2: error-controlled tree, in-leaf model descent; 3: per-cell power laws
-// toward singular edges (LeafModel::warp).
+// toward singular edges (LeafModel::warp), placement inside a leaf by tables
+// (core/leaf_walk.h), elementary functions from SLEEF (core/vector_math.h).
+// Its bytes are pinned by tests/pinned_bytes.txt.
 inline constexpr char kAlgorithmVersion[] = "sfcsampler-3";
 
 // Everything that shapes a curve tree (the cache key) except its grade.

@@ -120,8 +120,8 @@ TEST(LeafModel, WarpedModelFollowsAPowerLawAboutALine) {
           const double side = 1.0 / 64, y0 = 0.5;
           const double x0 = c == 1 ? 1 - side : warped ? WarpSplit(w) : c;
           double out[9];
-          SubSquareIntegrals(m, LeafModel::Kind::kQuadratic, grid, axis == 0 ? x0 : y0,
-                             axis == 0 ? y0 : x0, side, out);
+          GridIntegrals(m, LeafModel::Kind::kQuadratic, grid, axis == 0 ? x0 : y0,
+                        axis == 0 ? y0 : x0, side, grid, out);
           const double step = side / grid;
           for (int i = 0; i < grid; ++i) {
             for (int j = 0; j < grid; ++j) {

@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# The bytes of algorithm version sfcsampler-3, pinned. Each line of
+# tests/pinned_bytes.txt is "SHA256 NAME ARGS...": the SHA-256 of the NPY file
+# `sfcsampler sample -q --format npy ARGS` writes, over every curve, sequence,
+# density kind and region kind, ranges and shards, float32, singular
+# surfaces, a CAD model and a mesh. Lines may repeat a hash with other
+# arguments that must not change the bytes (batch sizes), and every line of
+# kVectorPaths runs again under each narrower vector path the CPU has
+# (SFCSAMPLER_VECTOR_PATH: scalar, sse2, avx) and must give the same hash.
+#
+# A changed hash means the same request now gives other samples: that needs
+# a new algorithm version (engine/sample_request.h), not a new pin.
+#   tests/pinned_bytes_test.sh CLI MAKE_CAD_FIXTURES PINS [--print]
+# --print writes the current hashes in the PINS format instead of checking.
+set -euo pipefail
+cli=$1 make_fixtures=$2 pins=$3 mode=${4:-check}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+"$make_fixtures" "$tmp" > /dev/null
+# A small closed mesh (an octahedron with one vertex pulled out), as OBJ.
+cat > "$tmp/mesh.obj" <<'OBJ'
+v 1 0 0
+v -1 0 0
+v 0 1 0
+v 0 -1 0
+v 0 0 1.5
+v 0 0 -1
+f 1 3 5
+f 3 2 5
+f 2 4 5
+f 4 1 5
+f 3 1 6
+f 2 3 6
+f 4 2 6
+f 1 4 6
+OBJ
+hash_of() {  # ARGS...: the SHA-256 of the NPY the CLI writes
+  "$cli" sample -q --format npy "$@" -o "$tmp/out.npy" 2> "$tmp/stderr" ||
+    { cat "$tmp/stderr" >&2; echo "FAIL: sample $*" >&2; exit 1; }
+  sha256sum < "$tmp/out.npy" | cut -c1-64
+}
+failures=0 checked=0
+while read -r expected name rest; do
+  [[ -z "$expected" || "$expected" == \#* ]] && continue
+  eval "args=($rest)"  # the file's own quoting; MODELS is the fixtures' folder
+  args=("${args[@]//MODELS/$tmp}")
+  got=$(hash_of "${args[@]}")
+  if [[ "$mode" == --print ]]; then
+    echo "$got $name $rest"
+    continue
+  fi
+  checked=$((checked + 1))
+  if [[ "$got" != "$expected" ]]; then
+    echo "FAIL: $name ($rest): $got, pinned $expected" >&2
+    failures=$((failures + 1))
+  fi
+  if [[ "$name" == *@paths ]]; then
+    for path in scalar sse2 avx; do
+      got=$(SFCSAMPLER_VECTOR_PATH=$path hash_of "${args[@]}")
+      checked=$((checked + 1))
+      [[ "$got" == "$expected" ]] || { echo "FAIL: $name on the $path path: $got" >&2; failures=$((failures + 1)); }
+    done
+  fi
+done < "$pins"
+[[ "$mode" == --print ]] && exit 0
+echo "$checked hashes checked, $failures differ"
+[[ $failures -eq 0 ]]
