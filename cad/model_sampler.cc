@@ -183,7 +183,7 @@ void ModelSampleCursor::KeepInTrim(const ModelTree::Piece& piece, size_t i, Samp
   bool found = false;
   for (double r = 1e-9; r <= 2 && !found; r *= 2) {
     for (int d = 0; d < kDirections && !found; ++d) {
-      const SinCos a = SinCosPi(2.0 * d / kDirections);
+      const math::SinCos a = math::SinCosPi(2.0 * d / kDirections);
       const double cs = std::clamp(s + r * a.cos, 0.0, 1.0);
       const double ct = std::clamp(t + r * a.sin, 0.0, 1.0);
       if (face.Contains(cs, ct)) best_s = cs, best_t = ct, found = true;

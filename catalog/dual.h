@@ -17,6 +17,8 @@
 
 #include <cmath>
 
+#include "core/vector_math.h"
+
 namespace sfc {
 
 // muparser's semantics of the functions that are not plain C library calls.
@@ -27,7 +29,10 @@ inline double MinOf(double a, double b) { return b < a ? b : a; }  // std::min
 inline double MaxOf(double a, double b) { return a < b ? b : a; }  // std::max
 // sin and cos of x in one library call. Every path (double, dual, constant
 // folding) takes sin and cos from here, so they agree bit for bit.
-inline void SinCosOf(double x, double* s, double* c) { ::sincos(x, s, c); }
+inline void SinCosOf(double x, double* s, double* c) {
+  const math::SinCos r = math::SinCosOf(x);
+  *s = r.sin, *c = r.cos;
+}
 
 // kOrder 1: value and gradient. kOrder 2: also the Hessian.
 template <int kOrder>
@@ -156,19 +161,19 @@ Dual<N> operator/(const Dual<N>& a, const Dual<N>& b) {
 
 template <int N>
 Dual<N> Pow(const Dual<N>& a, const Dual<N>& b) {
-  const double value = std::pow(a.v, b.v);
+  const double value = math::Pow(a.v, b.v);
   if (b.IsConstant()) {
     const double n = b.v;
     if (n == 0) return Dual<N>::Constant(value);
-    const double f1 = n * std::pow(a.v, n - 1);
+    const double f1 = n * math::Pow(a.v, n - 1);
     double f2 = 0;
-    if constexpr (N == 2) f2 = n == 1 ? 0 : n * (n - 1) * std::pow(a.v, n - 2);
+    if constexpr (N == 2) f2 = n == 1 ? 0 : n * (n - 1) * math::Pow(a.v, n - 2);
     return Chain(a, value, f1, f2);
   }
-  const double ln = std::log(a.v);
+  const double ln = math::Log(a.v);
   if (a.IsConstant()) return Chain(b, value, value * ln, value * ln * ln);
-  const double pb1 = std::pow(a.v, b.v - 1);
-  return Chain2(a, b, value, b.v * pb1, value * ln, b.v * (b.v - 1) * std::pow(a.v, b.v - 2),
+  const double pb1 = math::Pow(a.v, b.v - 1);
+  return Chain2(a, b, value, b.v * pb1, value * ln, b.v * (b.v - 1) * math::Pow(a.v, b.v - 2),
                 pb1 * (1 + b.v * ln), value * ln * ln);
 }
 
@@ -195,80 +200,80 @@ Dual<N> Cos(const Dual<N>& a) {
 }
 template <int N>
 Dual<N> Tan(const Dual<N>& a) {
-  const double t = std::tan(a.v), sec2 = 1 + t * t;
+  const double t = math::Tan(a.v), sec2 = 1 + t * t;
   return Chain(a, t, sec2, 2 * t * sec2);
 }
 template <int N>
 Dual<N> Asin(const Dual<N>& a) {
   const double f1 = 1 / std::sqrt(1 - a.v * a.v);
-  return Chain(a, std::asin(a.v), f1, a.v * f1 * f1 * f1);
+  return Chain(a, math::Asin(a.v), f1, a.v * f1 * f1 * f1);
 }
 template <int N>
 Dual<N> Acos(const Dual<N>& a) {
   const double f1 = 1 / std::sqrt(1 - a.v * a.v);
-  return Chain(a, std::acos(a.v), -f1, -a.v * f1 * f1 * f1);
+  return Chain(a, math::Acos(a.v), -f1, -a.v * f1 * f1 * f1);
 }
 template <int N>
 Dual<N> Atan(const Dual<N>& a) {
   const double f1 = 1 / (1 + a.v * a.v);
-  return Chain(a, std::atan(a.v), f1, -2 * a.v * f1 * f1);
+  return Chain(a, math::Atan(a.v), f1, -2 * a.v * f1 * f1);
 }
 // atan2(y, x).
 template <int N>
 Dual<N> Atan2(const Dual<N>& y, const Dual<N>& x) {
   const double r2 = x.v * x.v + y.v * y.v, r4 = r2 * r2;
-  return Chain2(y, x, std::atan2(y.v, x.v), x.v / r2, -y.v / r2, -2 * x.v * y.v / r4,
+  return Chain2(y, x, math::Atan2(y.v, x.v), x.v / r2, -y.v / r2, -2 * x.v * y.v / r4,
                 (y.v * y.v - x.v * x.v) / r4, 2 * x.v * y.v / r4);
 }
 template <int N>
 Dual<N> Sinh(const Dual<N>& a) {
-  const double s = std::sinh(a.v);
-  return Chain(a, s, std::cosh(a.v), s);
+  const double s = math::Sinh(a.v);
+  return Chain(a, s, math::Cosh(a.v), s);
 }
 template <int N>
 Dual<N> Cosh(const Dual<N>& a) {
-  const double c = std::cosh(a.v);
-  return Chain(a, c, std::sinh(a.v), c);
+  const double c = math::Cosh(a.v);
+  return Chain(a, c, math::Sinh(a.v), c);
 }
 template <int N>
 Dual<N> Tanh(const Dual<N>& a) {
-  const double t = std::tanh(a.v), f1 = 1 - t * t;
+  const double t = math::Tanh(a.v), f1 = 1 - t * t;
   return Chain(a, t, f1, -2 * t * f1);
 }
 template <int N>
 Dual<N> Asinh(const Dual<N>& a) {
   const double f1 = 1 / std::sqrt(a.v * a.v + 1);
-  return Chain(a, std::asinh(a.v), f1, -a.v * f1 * f1 * f1);
+  return Chain(a, math::Asinh(a.v), f1, -a.v * f1 * f1 * f1);
 }
 template <int N>
 Dual<N> Acosh(const Dual<N>& a) {
   const double f1 = 1 / std::sqrt(a.v * a.v - 1);
-  return Chain(a, std::acosh(a.v), f1, -a.v * f1 * f1 * f1);
+  return Chain(a, math::Acosh(a.v), f1, -a.v * f1 * f1 * f1);
 }
 template <int N>
 Dual<N> Atanh(const Dual<N>& a) {
   const double f1 = 1 / (1 - a.v * a.v);
-  return Chain(a, std::atanh(a.v), f1, 2 * a.v * f1 * f1);
+  return Chain(a, math::Atanh(a.v), f1, 2 * a.v * f1 * f1);
 }
 template <int N>
 Dual<N> Exp(const Dual<N>& a) {
-  const double e = std::exp(a.v);
+  const double e = math::Exp(a.v);
   return Chain(a, e, e, e);
 }
 template <int N>
 Dual<N> Log(const Dual<N>& a) {
   const double q = 1 / a.v;
-  return Chain(a, std::log(a.v), q, -q * q);
+  return Chain(a, math::Log(a.v), q, -q * q);
 }
 template <int N>
 Dual<N> Log2(const Dual<N>& a) {
   const double q = 1 / (a.v * 0.69314718055994530942);  // ln 2
-  return Chain(a, std::log2(a.v), q, -q / a.v);
+  return Chain(a, math::Log2(a.v), q, -q / a.v);
 }
 template <int N>
 Dual<N> Log10(const Dual<N>& a) {
   const double q = 1 / (a.v * 2.30258509299404568402);  // ln 10
-  return Chain(a, std::log10(a.v), q, -q / a.v);
+  return Chain(a, math::Log10(a.v), q, -q / a.v);
 }
 template <int N>
 Dual<N> Sqrt(const Dual<N>& a) {

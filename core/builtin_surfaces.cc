@@ -27,8 +27,8 @@ void SinCosPoints(const double* u, const double* v, size_t n, Scale scale_u, Sca
   for (size_t at = 0; at < n; at += kChunk) {
     const size_t m = std::min(kChunk, n - at);
     for (size_t i = 0; i < m; ++i) a[i] = scale_u(u[at + i]), b[i] = scale_v(v[at + i]);
-    SinCosPi(a, m, sa, ca);
-    SinCosPi(b, m, sb, cb);
+    math::SinCosPi(a, m, sa, ca);
+    math::SinCosPi(b, m, sb, cb);
     for (size_t i = 0; i < m; ++i) combine(at + i, sa[i], ca[i], sb[i], cb[i]);
   }
 }
@@ -65,7 +65,7 @@ class Sphere final : public Surface {
   }
   explicit Sphere(double r) : r_(r) {}
   Vec3 Point(double u, double v) const override {
-    const SinCos t = SinCosPi(u), p = SinCosPi(2 * v);
+    const math::SinCos t = math::SinCosPi(u), p = math::SinCosPi(2 * v);
     return {r_ * t.sin * p.cos, r_ * t.sin * p.sin, r_ * t.cos};
   }
   std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override {
@@ -74,16 +74,16 @@ class Sphere final : public Surface {
     return BoxOf(Pt(r_) * st * cp, Pt(r_) * st * sp, Pt(r_) * ct);
   }
   SurfaceJet Jet(double u, double v, int order) const override {
-    const SinCos t = SinCosPi(u), p = SinCosPi(2 * v);
+    const math::SinCos t = math::SinCosPi(u), p = math::SinCosPi(2 * v);
     return JetFrom(t.sin, t.cos, p.sin, p.cos, order);
   }
   void JetGrid(const double* us, int nu, const double* vs, int nv, int order,
                SurfaceJet* out) const override {
-    SinCos p[9];
+    math::SinCos p[9];
     if (nv > 9) return Surface::JetGrid(us, nu, vs, nv, order, out);
-    for (int j = 0; j < nv; ++j) p[j] = SinCosPi(2 * vs[j]);
+    for (int j = 0; j < nv; ++j) p[j] = math::SinCosPi(2 * vs[j]);
     for (int i = 0; i < nu; ++i) {
-      const SinCos t = SinCosPi(us[i]);
+      const math::SinCos t = math::SinCosPi(us[i]);
       for (int j = 0; j < nv; ++j) out[i * nv + j] = JetFrom(t.sin, t.cos, p[j].sin, p[j].cos, order);
     }
   }
@@ -118,7 +118,7 @@ class Torus final : public Surface {
   }
   Torus(double big_r, double r) : big_r_(big_r), r_(r) {}
   Vec3 Point(double u, double v) const override {
-    const SinCos a = SinCosPi(2 * u), b = SinCosPi(2 * v);
+    const math::SinCos a = math::SinCosPi(2 * u), b = math::SinCosPi(2 * v);
     const double w = big_r_ + r_ * b.cos;
     return {w * a.cos, w * a.sin, r_ * b.sin};
   }
@@ -128,7 +128,7 @@ class Torus final : public Surface {
     return BoxOf(w * Cos(a), w * Sin(a), Pt(r_) * Sin(b));
   }
   SurfaceJet Jet(double u, double v, int order) const override {
-    const SinCos a = SinCosPi(2 * u), b = SinCosPi(2 * v);
+    const math::SinCos a = math::SinCosPi(2 * u), b = math::SinCosPi(2 * v);
     const double sa = a.sin, ca = a.cos, sb = b.sin, cb = b.cos;
     const double w = big_r_ + r_ * cb;
     const double k = 2 * kPi;
@@ -187,9 +187,9 @@ class EightSurface final : public Surface {
   // a = 2 pi u, b = pi v - pi/2: sin b = -cos(pi v), cos b = sin(pi v),
   // sin 2b = -sin(2 pi v), cos 2b = -cos(2 pi v).
   Vec3 Point(double u, double v) const override {
-    const SinCos a = SinCosPi(2 * u), b2 = SinCosPi(2 * v);
+    const math::SinCos a = math::SinCosPi(2 * u), b2 = math::SinCosPi(2 * v);
     const double s2b = -b2.sin;
-    return {a.cos * s2b, a.sin * s2b, -SinCosPi(v).cos};
+    return {a.cos * s2b, a.sin * s2b, -math::SinCosPi(v).cos};
   }
   std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override {
     const Interval a = Pt(2 * kPi) * Range(u0, u1), b = Pt(kPi) * Range(v0, v1) - Pt(kPi / 2);
@@ -197,7 +197,7 @@ class EightSurface final : public Surface {
     return BoxOf(Cos(a) * s2b, Sin(a) * s2b, Sin(b));
   }
   SurfaceJet Jet(double u, double v, int order) const override {
-    const SinCos a = SinCosPi(2 * u), b = SinCosPi(v), b2 = SinCosPi(2 * v);
+    const math::SinCos a = math::SinCosPi(2 * u), b = math::SinCosPi(v), b2 = math::SinCosPi(2 * v);
     const double sa = a.sin, ca = a.cos;
     const double s2b = -b2.sin, c2b = -b2.cos;
     const double sb = -b.cos, cb = b.sin;
@@ -240,7 +240,7 @@ class WhitneyUmbrella final : public Surface {
 };
 
 // Signed power sign(c)|c|^e.
-double SignedPow(double c, double e) { return std::copysign(Pow(std::fabs(c), e), c); }
+double SignedPow(double c, double e) { return std::copysign(math::Pow(std::fabs(c), e), c); }
 
 // g(x) = sign(c(x)) |c(x)|^e for c = cos or sin, with its first two
 // derivatives. With e < 1 the derivatives are infinite where c = 0 (the
@@ -253,13 +253,13 @@ struct PowTrig {
 PowTrig SignedPowOf(double c, double dc, double e, int order) {
   PowTrig r;
   const double a = std::fabs(c);
-  r.g = std::copysign(Pow(a, e), c);
+  r.g = std::copysign(math::Pow(a, e), c);
   // d/dx sign(c)|c|^e = e |c|^(e-1) c'
-  r.d1 = e == 1 ? dc : e * Pow(a, e - 1) * dc;
+  r.d1 = e == 1 ? dc : e * math::Pow(a, e - 1) * dc;
   if (order >= 2) {
     // d2 = e (e-1) |c|^(e-2) sign(c) c'^2 + e |c|^(e-1) c''
-    const double curv = e == 1 ? 0 : e * (e - 1) * std::copysign(Pow(a, e - 2), c) * dc * dc;
-    r.d2 = curv + (e == 1 ? -c : -e * Pow(a, e - 1) * c);
+    const double curv = e == 1 ? 0 : e * (e - 1) * std::copysign(math::Pow(a, e - 2), c) * dc * dc;
+    r.d2 = curv + (e == 1 ? -c : -e * math::Pow(a, e - 1) * c);
   }
   return r;
 }
@@ -311,7 +311,7 @@ class Superellipsoid final : public Surface {
     int quarter;
     double offset, d1, d2;
     void CosSin(double* c, double* s) const {
-      const SinCos r = SinCosOf(offset);
+      const math::SinCos r = math::SinCosOf(offset);
       const double co = r.cos, so = r.sin;
       switch (((quarter % 4) + 4) % 4) {
         case 0: *c = co, *s = so; break;

@@ -369,7 +369,7 @@ class CurveTree::Builder {
       if (!(t[q] > 0) || !std::isfinite(m[q]) || !(m[q] > 0)) return NAN;
     }
     if (!(t[1] < t[0])) return NAN;
-    return Log(m[1] / m[0]) / Log(t[1] / t[0]);
+    return math::Log(m[1] / m[0]) / math::Log(t[1] / t[0]);
   }
 
   // The power law of the cell's axis `axis` toward an edge (LeafModel::warp,

@@ -56,27 +56,27 @@ inline double WarpSplit(const AxisWarp& w) {
   if (w.centre <= 0) return 0;
   if (w.centre >= 1) return 1;
   const double r = 1 / static_cast<double>(w.power);
-  const double a = Pow(static_cast<double>(w.centre), r);
-  return a / (a + Pow(1 - static_cast<double>(w.centre), r));
+  const double a = math::Pow(static_cast<double>(w.centre), r);
+  return a / (a + math::Pow(1 - static_cast<double>(w.centre), r));
 }
 // x = W(s), W'(s) and s = W^-1(x): each maps [0,1] onto itself, increasing.
 inline double Warp(const AxisWarp& w, double s) {
   if (w.power == 1) return s;
   const double k = w.power, c = w.centre, sc = WarpSplit(w);
-  if (s <= sc && sc > 0) return c - c * Pow(1 - s / sc, k);
-  return c + (1 - c) * Pow((s - sc) / (1 - sc), k);
+  if (s <= sc && sc > 0) return c - c * math::Pow(1 - s / sc, k);
+  return c + (1 - c) * math::Pow((s - sc) / (1 - sc), k);
 }
 inline double WarpSlope(const AxisWarp& w, double s) {
   if (w.power == 1) return 1;
   const double k = w.power, c = w.centre, sc = WarpSplit(w);
-  if (s <= sc && sc > 0) return c * k * Pow(1 - s / sc, k - 1) / sc;
-  return (1 - c) * k * Pow((s - sc) / (1 - sc), k - 1) / (1 - sc);
+  if (s <= sc && sc > 0) return c * k * math::Pow(1 - s / sc, k - 1) / sc;
+  return (1 - c) * k * math::Pow((s - sc) / (1 - sc), k - 1) / (1 - sc);
 }
 inline double Unwarp(const AxisWarp& w, double x) {
   if (w.power == 1) return x;
   const double r = 1 / static_cast<double>(w.power), c = w.centre, sc = WarpSplit(w);
-  if (x <= c && c > 0) return sc * (1 - Pow((c - x) / c, r));
-  return sc + (1 - sc) * Pow((x - c) / (1 - c), r);
+  if (x <= c && c > 0) return sc * (1 - math::Pow((c - x) / c, r));
+  return sc + (1 - sc) * math::Pow((x - c) / (1 - c), r);
 }
 
 // Whether the walk descends a leaf's curve in the warped coordinate of this

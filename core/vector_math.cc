@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <sleef.h>
 
-namespace sfc {
+namespace sfc::math {
 namespace {
 
 VectorPath Widest() {
@@ -58,8 +58,21 @@ SinCos SinCosOf(double x) {
 }
 
 double Pow(double x, double y) { return Sleef_cinz_powd1_u10purec(x, y); }
+double Exp(double x) { return Sleef_cinz_expd1_u10purec(x); }
 double Log(double x) { return Sleef_cinz_logd1_u10purec(x); }
+double Log2(double x) { return Sleef_cinz_log2d1_u10purec(x); }
+double Log10(double x) { return Sleef_cinz_log10d1_u10purec(x); }
+double Tan(double x) { return Sleef_cinz_tand1_u10purec(x); }
+double Asin(double x) { return Sleef_cinz_asind1_u10purec(x); }
+double Acos(double x) { return Sleef_cinz_acosd1_u10purec(x); }
+double Atan(double x) { return Sleef_cinz_atand1_u10purec(x); }
 double Atan2(double y, double x) { return Sleef_cinz_atan2d1_u10purec(y, x); }
+double Sinh(double x) { return Sleef_cinz_sinhd1_u10purec(x); }
+double Cosh(double x) { return Sleef_cinz_coshd1_u10purec(x); }
+double Tanh(double x) { return Sleef_cinz_tanhd1_u10purec(x); }
+double Asinh(double x) { return Sleef_cinz_asinhd1_u10purec(x); }
+double Acosh(double x) { return Sleef_cinz_acoshd1_u10purec(x); }
+double Atanh(double x) { return Sleef_cinz_atanhd1_u10purec(x); }
 
 VectorPath BestVectorPath() {
   static const VectorPath best = Detect();
@@ -99,4 +112,4 @@ void SinCosPi(const double* x, size_t n, double* s, double* c) {
   SinCosPiOn(BestVectorPath(), x, n, s, c);
 }
 
-}  // namespace sfc
+}  // namespace sfc::math

@@ -16,7 +16,7 @@
 #include <cstddef>
 #include <string_view>
 
-namespace sfc {
+namespace sfc::math {
 
 // sin(pi x) and cos(pi x), within 0.506 ulp, exact at multiples of 1/2 (the
 // argument is reduced exactly, so no rounding of pi x creeps in).
@@ -29,10 +29,24 @@ void SinCosPi(const double* x, size_t n, double* s, double* c);
 
 // sin x and cos x within 1 ulp.
 SinCos SinCosOf(double x);
-// x^y, ln x and atan2(y, x) within 1 ulp (C's values at special arguments).
+// The C library's functions of the same names, within 1 ulp, with C's
+// values at special arguments.
 double Pow(double x, double y);
+double Exp(double x);
 double Log(double x);
+double Log2(double x);
+double Log10(double x);
+double Tan(double x);
+double Asin(double x);
+double Acos(double x);
+double Atan(double x);
 double Atan2(double y, double x);
+double Sinh(double x);
+double Cosh(double x);
+double Tanh(double x);
+double Asinh(double x);
+double Acosh(double x);
+double Atanh(double x);
 
 // The vector paths, for tests and benchmarks.
 enum class VectorPath { kScalar, kSse2, kAvx, kAvx512 };
@@ -54,6 +68,6 @@ void SinCosPiAvx(const double* x, size_t n, double* s, double* c);
 void SinCosPiAvx512(const double* x, size_t n, double* s, double* c);
 }  // namespace vector_math_internal
 
-}  // namespace sfc
+}  // namespace sfc::math
 
 #endif  // SFCSAMPLER_CORE_VECTOR_MATH_H_

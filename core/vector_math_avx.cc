@@ -5,7 +5,7 @@
 
 #include "core/vector_math.h"
 
-namespace sfc::vector_math_internal {
+namespace sfc::math::vector_math_internal {
 
 void SinCosPiAvx(const double* x, size_t n, double* s, double* c) {
   for (size_t i = 0; i < n; i += 4) {
@@ -15,4 +15,4 @@ void SinCosPiAvx(const double* x, size_t n, double* s, double* c) {
   }
 }
 
-}  // namespace sfc::vector_math_internal
+}  // namespace sfc::math::vector_math_internal

@@ -30,7 +30,7 @@ VertexCurvature ComputeVertexCurvature(const TriangleMesh& mesh) {
       const double cos_part = Dot(a, b);
       const double sin_part = Norm(Cross(a, b));
       cot[c] = cos_part / sin_part;
-      angle[c] = Atan2(sin_part, cos_part);
+      angle[c] = math::Atan2(sin_part, cos_part);
     }
     const bool obtuse = angle[0] > M_PI / 2 || angle[1] > M_PI / 2 || angle[2] > M_PI / 2;
     for (int c = 0; c < 3; ++c) {

@@ -11,7 +11,7 @@
 
 #include "gtest/gtest.h"
 
-namespace sfc {
+namespace sfc::math {
 namespace {
 
 std::vector<double> Arguments() {
@@ -70,4 +70,4 @@ TEST(VectorMath, ValuesAreSineAndCosineOfPiX) {
 }
 
 }  // namespace
-}  // namespace sfc
+}  // namespace sfc::math
