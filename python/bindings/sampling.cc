@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "core/curve.h"
+#include "core/vector_math.h"
 #include "engine/sampling_engine.h"
 #include "python/bindings/arrays.h"
 #include "python/bindings/errors.h"
@@ -216,6 +217,8 @@ class PyEngine {
 
 void RegisterSampling(py::module_& m) {
   m.attr("ALGORITHM_VERSION") = kAlgorithmVersion;
+  // The vector path the elementary functions take here (never changes the bytes).
+  m.attr("VECTOR_PATH") = std::string(math::VectorPathName(math::BestVectorPath()));
 
   py::class_<PyJob>(m, "Job", "One request's samples, in curve order; made by Engine.start().")
       .def("next", &PyJob::Next, py::arg("max_samples"),

@@ -1,0 +1,170 @@
+#!/usr/bin/python3
+"""Issue 20's throughput table, every row in one run, each next to its peer.
+
+    PYTHONPATH=build/python /usr/bin/python3 bench/throughput_table.py [BUILD_DIR=build] [--quick]
+
+Rows (the peer in brackets; ratios are taken round by round, A B A B, so a
+noisy machine's load hits both sides alike):
+ 1. 4 M sphere samples from a cached tree, in process, one thread, columns
+    u, v, x, y, z float64 (the Python package), against numpy computing the
+    same five columns for i.i.d. points on the sphere. Also scipy's scrambled
+    Sobol points mapped to the sphere, the other low-discrepancy peer.
+ 2. Tree build plus 10^6 sphere samples, one core (bench/core_benchmark).
+ 3. Cold CLI, 4 M sphere samples to a binary PLY file, against a numpy
+    script writing the same file; 5 paired runs.
+ 4. float32 stream over loopback against a raw bytes stream of the same size,
+    and 5. a cache hit against a cold request (eight, curvature density,
+    10^6): both from bench/stream_benchmark.
+ 6. STEP box with a fillet and a hole, 10^6 cold, against the built-in
+    sphere (bench/model_benchmark).
+ 7. Mesh, 10^6 cold on the 81 920-triangle icosphere, against Open3D's
+    sample_points_uniformly (bench/mesh_vs_open3d.py).
+--quick runs rows 1-3 only. The CPU's vector path (SSE2/AVX/AVX-512) is
+printed first; the bytes never depend on it.
+"""
+
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+BUILD = next((a for a in sys.argv[1:] if not a.startswith("--")), "build")
+QUICK = "--quick" in sys.argv
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROUNDS = 5
+
+
+def run(cmd, **kw):
+    return subprocess.run(cmd, check=True, capture_output=True, text=True, **kw).stdout
+
+
+def timed(fn):
+    t = time.perf_counter()
+    fn()
+    return time.perf_counter() - t
+
+
+def paired(a, b, rounds=ROUNDS):
+    """Times of a and b, alternating; returns (times_a, times_b)."""
+    ta, tb = [], []
+    for _ in range(rounds):
+        ta.append(timed(a))
+        tb.append(timed(b))
+    return ta, tb
+
+
+def numpy_sphere(n, rng):
+    """u, v, x, y, z float64 for n i.i.d. uniform points on the unit sphere."""
+    u = rng.random(n)
+    v = rng.random(n)
+    z = 1 - 2 * u
+    r = np.sqrt(1 - z * z)
+    phi = 2 * np.pi * v
+    return u, v, r * np.cos(phi), r * np.sin(phi), z
+
+
+def row_python(n=4_000_000):
+    import sfcsampler
+    sampler = sfcsampler.Sampler(max_trees=4, threads=1)
+    request = dict(surface="sphere", count=n, seed=1)
+    sampler.sample(**request)  # builds and keeps the tree
+    rng = np.random.default_rng(1)
+    ours, theirs = paired(lambda: sampler.sample(**request), lambda: numpy_sphere(n, rng))
+    ratios = [b / a for a, b in zip(ours, theirs)]
+    rows = [(f"1. {n / 1e6:.0f} M sphere samples, cached tree, Python, 1 thread, u v x y z float64",
+             f"{statistics.median(ours):.3f} s ({n / statistics.median(ours) / 1e6:.1f} M/s)",
+             f"numpy i.i.d. {statistics.median(theirs):.3f} s",
+             f"speed ratio {statistics.median(ratios):.2f} (rounds {min(ratios):.2f}-{max(ratios):.2f})")]
+    try:
+        from scipy.stats import qmc
+        sobol = qmc.Sobol(d=2, scramble=True, seed=1)
+        m = 1 << (n - 1).bit_length()
+        t = timed(lambda: sobol.random(m))
+        rows.append(("   scipy scrambled Sobol, the 2D points alone (2^22)", "", f"{t:.3f} s",
+                     f"{m / t / 1e6:.1f} M points/s before mapping"))
+    except ImportError:
+        pass
+    return rows
+
+
+def row_core():
+    out = run(["taskset", "-c", "0", f"{BUILD}/bench/core_benchmark",
+               "--benchmark_filter=BuildTreeAndSampleSphere/1000000/1$|BuildTreeOnly|SampleFromBuiltTree/0/0",
+               "--benchmark_repetitions=3", "--benchmark_report_aggregates_only=true"])
+    median = {}
+    for line in out.splitlines():
+        if "_median" in line:
+            parts = line.split()
+            median[parts[0]] = f"{parts[1]} {parts[2]}"
+    build_and_sample = next((v for k, v in median.items() if "BuildTreeAndSample" in k), "?")
+    build = next((v for k, v in median.items() if "BuildTreeOnly" in k), "?")
+    sample = next((v for k, v in median.items() if "SampleFromBuiltTree" in k), "?")
+    return [("2. tree build + 10^6 sphere samples, one core", build_and_sample,
+             f"of it: build {build}, 10^6 samples from a built tree {sample}", "target 60 ms")]
+
+
+NUMPY_PLY = """
+import sys, numpy as np
+n = int(sys.argv[1]); rng = np.random.default_rng(1)
+u = rng.random(n); v = rng.random(n); z = 1 - 2 * u; r = np.sqrt(1 - z * z); phi = 2 * np.pi * v
+a = np.empty(n, dtype=[(c, '<f8') for c in ('x', 'y', 'z')])
+a['x'] = r * np.cos(phi); a['y'] = r * np.sin(phi); a['z'] = z
+with open(sys.argv[2], 'wb') as f:
+    f.write(f"ply\\nformat binary_little_endian 1.0\\nelement vertex {n}\\nproperty double x\\n"
+            f"property double y\\nproperty double z\\nend_header\\n".encode())
+    f.write(a.tobytes())
+"""
+
+
+def row_cold_cli(n=4_000_000):
+    with tempfile.TemporaryDirectory() as tmp:
+        script = os.path.join(tmp, "numpy_ply.py")
+        with open(script, "w") as f:
+            f.write(NUMPY_PLY)
+        ours, theirs = paired(
+            lambda: run([f"{BUILD}/client/sfcsampler", "sample", "-n", str(n), "-q", "--format", "ply",
+                         "-o", os.path.join(tmp, "a.ply")]),
+            lambda: run([sys.executable, script, str(n), os.path.join(tmp, "b.ply")]))
+    return [(f"3. cold CLI, {n / 1e6:.0f} M sphere samples to a binary PLY file, 5 paired runs",
+             f"median {statistics.median(ours):.2f} s ({min(ours):.2f}-{max(ours):.2f})",
+             f"numpy script {min(theirs):.2f}-{max(theirs):.2f} s",
+             "target: our median <= the script's fastest: " +
+             ("met" if statistics.median(ours) <= min(theirs) else "not met"))]
+
+
+def table_of(cmd, title):
+    try:
+        out = run(cmd)
+    except (subprocess.CalledProcessError, FileNotFoundError) as e:
+        return f"\n{title}: failed ({e})\n"
+    return f"\n{title}\n{out}"
+
+
+def main():
+    sys.path.insert(0, os.path.join(BUILD, "python"))
+    import sfcsampler
+    from sfcsampler import _core
+    path = getattr(_core, "VECTOR_PATH", None)
+    print(f"# Throughput, algorithm {sfcsampler.ALGORITHM_VERSION}"
+          + (f", vector path {path}" if path else "") + f", {os.cpu_count()} CPUs\n")
+    print("| measure | ours | peer | ratio / target |\n|---|---|---|---|")
+    for rows in (row_python(), row_core(), row_cold_cli()):
+        for r in rows:
+            print("| " + " | ".join(r) + " |")
+    sys.stdout.flush()
+    if QUICK:
+        return
+    print(table_of([f"{BUILD}/bench/stream_benchmark", "4000000"],
+                   "## 4, 5. Streams over loopback and cache hits (bench/stream_benchmark)"))
+    print(table_of(["taskset", "-c", "0", f"{BUILD}/bench/model_benchmark", "1000000", "3"],
+                   "## 6. Models against the built-in sphere (bench/model_benchmark)"))
+    print(table_of(["/usr/bin/python3", os.path.join(HERE, "mesh_vs_open3d.py"), BUILD, "1000000"],
+                   "## 7. Mesh against Open3D (bench/mesh_vs_open3d.py)"))
+
+
+if __name__ == "__main__":
+    main()
