@@ -141,7 +141,8 @@ def table_of(cmd, title):
         out = run(cmd)
     except (subprocess.CalledProcessError, FileNotFoundError) as e:
         return f"\n{title}: failed ({e})\n"
-    return f"\n{title}\n{out}"
+    table = "\n".join(line for line in out.splitlines() if line.startswith("|"))  # no log lines
+    return f"\n{title}\n{table}"
 
 
 def main():
