@@ -3,6 +3,8 @@
 #include <cassert>
 #include <functional>
 
+#include "core/vector_math.h"
+
 namespace sfc {
 namespace {
 
@@ -152,6 +154,12 @@ Curve::Curve(const Definition& def)
   for (int a = 0; a < 8; ++a) {
     for (int b = 0; b < 8; ++b) compose_[a][b] = static_cast<uint8_t>(Compose(a, b));
   }
+  constexpr int kWholes[4] = {0, 1, 6, 7};  // by swap parity + 2 mirror parity
+  for (int a = 0; a < 8; ++a) {
+    for (int w = 0; w < 4; ++w) {
+      batch_masks_.compose[a >> 2] |= uint64_t{compose_[a][kWholes[w]]} << (4 * (4 * (a & 3) + w));
+    }
+  }
   // Bit-parallel decoding needs a 2 x 2 curve whose children's orientations
   // are only swaps and mirrors of both axes (true of Hilbert).
   bit_parallel_ = arity_ == 4;
@@ -163,6 +171,27 @@ Curve::Curve(const Definition& def)
     digit_y_[d] = mask(def.order[d].j == 1);
     digit_swap_[d] = mask(o & 1);
     digit_mirror_[d] = mask(o & 6);
+  }
+  for (int d = 0; d < 4; ++d) {
+    batch_masks_.x[d] = digit_x_[d], batch_masks_.y[d] = digit_y_[d];
+    batch_masks_.swap[d] = digit_swap_[d], batch_masks_.mirror[d] = digit_mirror_[d];
+  }
+}
+
+void Curve::DescendMany(const uint64_t* digits, int levels, size_t n, uint64_t* states, uint64_t* x,
+                        uint64_t* y) const {
+  if (bit_parallel_ && levels <= 32) {
+    if (math::BestVectorPath() == math::VectorPath::kAvx512) {
+      hilbert_batch::DescendAvx512(batch_masks_, digits, levels, n, states, x, y);
+    } else {
+      hilbert_batch::Descend(batch_masks_, digits, levels, n, states, x, y);
+    }
+    return;
+  }
+  for (size_t i = 0; i < n; ++i) {
+    int state = static_cast<int>(states[i]);
+    DescendByTables(digits[i], levels, &x[i], &y[i], &state);
+    states[i] = static_cast<uint64_t>(state);
   }
 }
 

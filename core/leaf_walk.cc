@@ -120,7 +120,16 @@ void LeafWalk::PlaceInLeaf(const double* m, size_t n, double* u, double* v,
   for (size_t i = 0; i < n; ++i) t_[i] = std::clamp((m[i] - begin_mass_) / leaf_mass_, 0.0, 1.0);
   u_ = u, v_ = v, curve_position_ = curve_position;
   const Square leaf{0, 1, 0, 0, 1, 0, 1, cell_.state, 0};
+  reached_.clear();
+  reached_of_.resize(n);
   PlaceInSquare(leaf, 0, static_cast<uint32_t>(n), 0);
+  Continue(n);
+}
+
+void LeafWalk::Reached(const Square& square, uint32_t begin, uint32_t end) {
+  const uint32_t index = static_cast<uint32_t>(reached_.size());
+  reached_.push_back(square);
+  for (uint32_t i = begin; i < end; ++i) reached_of_[i] = index;
 }
 
 void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end, int level) {
@@ -128,7 +137,7 @@ void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end,
   std::vector<double>& bounds = tables_[level];
   const int last = levels > 0 ? Tabulate(square, levels, bounds) : -1;
   if (last < 0) {
-    for (uint32_t i = begin; i < end; ++i) Continue(square, i);
+    Reached(square, begin, end);
     return;
   }
   const Curve::Child* order = curve_.CellsInOrder(square.state, levels);
@@ -156,38 +165,47 @@ void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end,
     if (level < kMaxModelLevels && (cell.t1 - cell.t0) * samples_ >= kTableSamples) {
       PlaceInSquare(cell, i, j, level + 1);
     } else {
-      for (uint32_t q = i; q < j; ++q) Continue(cell, q);
+      Reached(cell, i, j);
     }
     i = j;
   }
 }
 
-void LeafWalk::Continue(const Square& at, uint32_t i) {
-  // The rest of t down the square's own curve, to the centre of the cell reached.
+void LeafWalk::Continue(size_t n) {
+  // The rest of t down its square's own curve, to the centre of the cell
+  // reached: the curve digits of all n samples first, then one batch of
+  // curve decoding, then the coordinates.
   const uint64_t scale = continuation_scale_;
-  const double t = t_[i];
-  const double tr = at.t1 > at.t0 ? std::clamp((t - at.t0) / (at.t1 - at.t0), 0.0, 1.0) : 0.0;
-  // Conversions through int64_t: every value here is below 2^63, so they
-  // are exact either way, and the signed ones are single instructions.
-  const uint64_t digits = std::min(
-      static_cast<uint64_t>(static_cast<int64_t>(tr * static_cast<double>(scale))), scale - 1);
-  uint64_t cx, cy;
-  int state = at.state;
-  curve_.Descend(digits, continuation_levels_, &cx, &cy, &state);
-  // For Hilbert the division is by 2^26: a multiplication, with the same bits.
-  const double cell = cells_power_of_two_ ? at.side * inverse_cells_ : at.side / continuation_cells_;
-  const double x = static_cast<double>(static_cast<int64_t>(cx));
-  const double y = static_cast<double>(static_cast<int64_t>(cy));
-  double px = at.x0 + (x + 0.5) * cell, py = at.y0 + (y + 0.5) * cell;
-  if (warped_) {
-    px = PlaceOnAxis(model_->warp[0], at.x0, at.side, px);
-    py = PlaceOnAxis(model_->warp[1], at.y0, at.side, py);
+  fraction_.resize(n), digits_.resize(n), states_.resize(n), cx_.resize(n), cy_.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Square& at = reached_[reached_of_[i]];
+    const double t = t_[i];
+    const double tr = at.t1 > at.t0 ? std::clamp((t - at.t0) / (at.t1 - at.t0), 0.0, 1.0) : 0.0;
+    fraction_[i] = tr;
+    // Conversions through int64_t: every value here is below 2^63, so they
+    // are exact either way, and the signed ones are single instructions.
+    digits_[i] = std::min(
+        static_cast<uint64_t>(static_cast<int64_t>(tr * static_cast<double>(scale))), scale - 1);
+    states_[i] = static_cast<uint64_t>(at.state);
   }
-  u_[i] = cell_.u0 + px * cell_.size;
-  v_[i] = cell_.v0 + py * cell_.size;
-  if (curve_position_ != nullptr) {
-    const double pos = at.pos + tr * at.span;
-    curve_position_[i] = (leaf_start_ + pos * leaf_span_) / static_cast<double>(curve_.Span(0));
+  curve_.DescendMany(digits_.data(), continuation_levels_, n, states_.data(), cx_.data(), cy_.data());
+  for (size_t i = 0; i < n; ++i) {
+    const Square& at = reached_[reached_of_[i]];
+    // For Hilbert the division is by 2^26: a multiplication, with the same bits.
+    const double cell = cells_power_of_two_ ? at.side * inverse_cells_ : at.side / continuation_cells_;
+    const double x = static_cast<double>(static_cast<int64_t>(cx_[i]));
+    const double y = static_cast<double>(static_cast<int64_t>(cy_[i]));
+    double px = at.x0 + (x + 0.5) * cell, py = at.y0 + (y + 0.5) * cell;
+    if (warped_) {
+      px = PlaceOnAxis(model_->warp[0], at.x0, at.side, px);
+      py = PlaceOnAxis(model_->warp[1], at.y0, at.side, py);
+    }
+    u_[i] = cell_.u0 + px * cell_.size;
+    v_[i] = cell_.v0 + py * cell_.size;
+    if (curve_position_ != nullptr) {
+      const double pos = at.pos + fraction_[i] * at.span;
+      curve_position_[i] = (leaf_start_ + pos * leaf_span_) / static_cast<double>(curve_.Span(0));
+    }
   }
 }
 

@@ -95,8 +95,11 @@ class LeafWalk {
   // Places the current leaf's samples [begin, end), which lie in `square` in
   // t order, using the table of recursion `level`.
   void PlaceInSquare(const Square& square, uint32_t begin, uint32_t end, int level);
-  // Places sample i by pure curve bits inside `square`.
-  void Continue(const Square& square, uint32_t i);
+  // Records that samples [begin, end) end in `square` (pure curve bits from there).
+  void Reached(const Square& square, uint32_t begin, uint32_t end);
+  // Places the current run's n samples by pure curve bits inside the
+  // squares they reached.
+  void Continue(size_t n);
   // Places n samples of the current leaf with non-decreasing m.
   void PlaceInLeaf(const double* m, size_t n, double* u, double* v, double* curve_position);
 
@@ -123,6 +126,11 @@ class LeafWalk {
   std::vector<double> t_;                     // each sample's fraction of the leaf's mass
   std::vector<std::vector<double>> tables_;  // cell bounds, one table per recursion level
   std::vector<double> grid_mass_;             // a table's cell integrals, row by row
+  std::vector<Square> reached_;               // the squares samples end in
+  std::vector<uint32_t> reached_of_;          // each sample's square in reached_
+  std::vector<double> fraction_;              // each sample's fraction of its square's t
+  std::vector<uint64_t> digits_, cx_, cy_;    // its curve digits and the cell they reach
+  std::vector<uint64_t> states_;              // its square's orientation, then the cell's
   // The run being placed: output columns (curve_position_ may be null).
   double *u_ = nullptr, *v_ = nullptr, *curve_position_ = nullptr;
 };
