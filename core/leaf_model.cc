@@ -84,10 +84,11 @@ double ModelIntegral(const LeafModel& model, LeafModel::Kind kind, int grid, dou
   return sum;
 }
 
-void GridIntegrals(const LeafModel& model, LeafModel::Kind kind, int grid, double x0, double y0,
-                   double side, int n, double* out) {
+void ComputeGridFactors(const LeafModel& model, LeafModel::Kind kind, int grid, double x0,
+                        double y0, double side, int n, GridFactors* out) {
   const bool quadratic = kind == LeafModel::Kind::kQuadratic;
   const int factors = quadratic ? 3 : grid;
+  out->factors = factors;
   const double step = side / n;
   // f[axis][b][k]: the integral of factor b along `axis` over its cell k.
   double f[2][3][kMaxGridCells];
@@ -110,21 +111,22 @@ void GridIntegrals(const LeafModel& model, LeafModel::Kind kind, int grid, doubl
       }
     }
   }
-  // row[a][j] = sum_b c[a, b] f_y[b][j]; then out = sum_a f_x[a][i] row[a][j].
-  double row[3][kMaxGridCells];
   for (int a = 0; a < factors; ++a) {
+    for (int i = 0; i < n; ++i) out->x[a][i] = f[0][a][i];
     for (int j = 0; j < n; ++j) {
       double sum = 0;
       for (int b = 0; b < factors; ++b) sum += static_cast<double>(model.c[a * factors + b]) * f[1][b][j];
-      row[a][j] = sum;
+      out->row[a][j] = sum;
     }
   }
+}
+
+void GridIntegrals(const LeafModel& model, LeafModel::Kind kind, int grid, double x0, double y0,
+                   double side, int n, double* out) {
+  GridFactors factors;
+  ComputeGridFactors(model, kind, grid, x0, y0, side, n, &factors);
   for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) {
-      double sum = 0;
-      for (int a = 0; a < factors; ++a) sum += f[0][a][i] * row[a][j];
-      out[i * n + j] = sum;
-    }
+    for (int j = 0; j < n; ++j) out[i * n + j] = factors.Integral(i, j);
   }
 }
 

@@ -185,6 +185,22 @@ inline constexpr int kMaxGridCells = 32;
 void GridIntegrals(const LeafModel& model, LeafModel::Kind kind, int grid, double x0, double y0,
                    double side, int n, double* out);
 
+// GridIntegrals in two steps, for callers that take the sub-squares in
+// another order: the factors once, then Integral(i, j) for any sub-square,
+// with GridIntegrals' bits.
+struct GridFactors {
+  int factors;                     // 3 (quadratic) or the piecewise grid
+  double x[3][kMaxGridCells];      // x[a][i]: factor a's integral over column i
+  double row[3][kMaxGridCells];    // row[a][j] = sum_b c[a, b] (factor b's integral over row j)
+  double Integral(int i, int j) const {
+    double sum = 0;
+    for (int a = 0; a < factors; ++a) sum += x[a][i] * row[a][j];
+    return sum;
+  }
+};
+void ComputeGridFactors(const LeafModel& model, LeafModel::Kind kind, int grid, double x0,
+                        double y0, double side, int n, GridFactors* out);
+
 // The same for unnormalised quadratic node values (double precision) in the
 // coordinates warped by `warp` (null: none), used by the tree's error test.
 double QuadraticIntegral(const double values[9], double x0, double x1, double y0, double y1,

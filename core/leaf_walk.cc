@@ -18,8 +18,6 @@ LeafWalk::LeafWalk(const CurveTree& tree)
   int exponent;
   cells_power_of_two_ = std::frexp(continuation_cells_, &exponent) == 0.5;
   tables_.resize(kMaxModelLevels + 1);
-  const int cells = static_cast<int>(curve_.PowG(curve_.table_levels()));
-  grid_mass_.resize(static_cast<size_t>(cells) * cells);
   last_positive_leaf_ = tree.leaf_count() - 1;
   while (last_positive_leaf_ > 0 &&
          !(tree.mass_end(last_positive_leaf_) > tree.mass_begin(last_positive_leaf_))) {
@@ -80,13 +78,14 @@ int LeafWalk::TableLevels(double carried, int depth) const {
 int LeafWalk::Tabulate(const Square& square, int levels, std::vector<double>& bounds) {
   const int n = static_cast<int>(curve_.PowG(levels));
   const int cells = n * n;
-  GridIntegrals(*model_, kind_, grid_, square.x0, square.y0, square.side, n, grid_mass_.data());
+  ComputeGridFactors(*model_, kind_, grid_, square.x0, square.y0, square.side, n, &factors_);
   const Curve::Child* order = curve_.CellsInOrder(square.state, levels);
   bounds.resize(cells);
-  // Running sums in curve order (a quadratic's dips below zero count as no mass).
+  // Running sums in curve order of the cells' integrals (GridIntegrals' bits;
+  // a quadratic's dips below zero count as no mass).
   double sum = 0;
   for (int k = 0; k < cells; ++k) {
-    sum += std::max(0.0, grid_mass_[order[k].dx * n + order[k].dy]);
+    sum += std::max(0.0, factors_.Integral(order[k].dx, order[k].dy));
     bounds[k] = sum;
   }
   if (!(sum > 0)) return -1;  // the model vanishes here: pure curve bits

@@ -125,7 +125,7 @@ class LeafWalk {
   // Scratch of PlaceInLeaf, kept to reuse its memory.
   std::vector<double> t_;                     // each sample's fraction of the leaf's mass
   std::vector<std::vector<double>> tables_;  // cell bounds, one table per recursion level
-  std::vector<double> grid_mass_;             // a table's cell integrals, row by row
+  GridFactors factors_;                       // a table's cell integrals, as factors
   std::vector<Square> reached_;               // the squares samples end in
   std::vector<uint32_t> reached_of_;          // each sample's square in reached_
   std::vector<double> fraction_;              // each sample's fraction of its square's t
