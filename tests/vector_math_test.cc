@@ -9,6 +9,8 @@
 #include <random>
 #include <vector>
 
+#include <sleef.h>
+
 #include "gtest/gtest.h"
 
 namespace sfc::math {
@@ -47,7 +49,22 @@ TEST(VectorMath, EveryPathGivesTheScalarBits) {
   EXPECT_GE(paths, 1);
   std::vector<double> s(x.size()), c(x.size());
   SinCosPi(x.data(), x.size(), s.data(), c.data());
-  for (size_t i = 0; i < x.size(); ++i) ASSERT_TRUE(SameBits(s[i], s0[i]) && SameBits(c[i], c0[i]));
+  for (size_t i = 0; i < x.size(); ++i) {
+    ASSERT_TRUE(SameBits(s[i], s0[i]) && SameBits(c[i], c0[i]));
+    const SinCos one = SinCosPi(x[i]);  // the one-value function too
+    ASSERT_TRUE(SameBits(one.sin, s0[i]) && SameBits(one.cos, c0[i])) << x[i];
+  }
+}
+
+// The one-value sin, cos and pow give SLEEF's portable scalar bits.
+TEST(VectorMath, OneValueFunctionsGiveThePortableBits) {
+  for (double x : Arguments()) {
+    const SinCos r = SinCosOf(x);
+    const Sleef_double_2 e = Sleef_cinz_sincosd1_u10purec(x);
+    ASSERT_TRUE(SameBits(r.sin, e.x) && SameBits(r.cos, e.y)) << x;
+    const double y = 0.3 + std::fabs(std::fmod(x, 3.0));
+    ASSERT_TRUE(SameBits(Pow(std::fabs(x), y), Sleef_cinz_powd1_u10purec(std::fabs(x), y))) << x;
+  }
 }
 
 TEST(VectorMath, ValuesAreSineAndCosineOfPiX) {
