@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace sfc {
 
@@ -80,7 +81,9 @@ int LeafWalk::Tabulate(const Square& square, int levels, std::vector<double>& bo
   const int cells = n * n;
   ComputeGridFactors(*model_, kind_, grid_, square.x0, square.y0, square.side, n, &factors_);
   const Curve::Child* order = curve_.CellsInOrder(square.state, levels);
-  bounds.resize(cells);
+  // kScanWidth more entries past the cells, +inf: LeafWalk::CellsAtOrBelow
+  // reads whole windows.
+  bounds.assign(cells + kScanWidth, std::numeric_limits<double>::infinity());
   // Running sums in curve order of the cells' integrals (GridIntegrals' bits;
   // a quadratic's dips below zero count as no mass).
   double sum = 0;
@@ -125,6 +128,17 @@ void LeafWalk::PlaceInLeaf(const double* m, size_t n, double* u, double* v,
   Continue(n);
 }
 
+int LeafWalk::CellsAtOrBelow(const double* bounds, int from, double t) {
+  // A window of kScanWidth comparisons at a time, without branches inside:
+  // the count of bounds <= t there is how far to move (they do not decrease).
+  while (true) {
+    int count = 0;
+    for (int d = 0; d < kScanWidth; ++d) count += bounds[from + d] <= t;
+    from += count;
+    if (count < kScanWidth) return from;
+  }
+}
+
 void LeafWalk::Reached(const Square& square, uint32_t begin, uint32_t end) {
   const uint32_t index = static_cast<uint32_t>(reached_.size());
   reached_.push_back(square);
@@ -144,10 +158,11 @@ void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end,
   const double span = square.span / static_cast<double>(curve_.PowW(levels));
   // Samples in t order meet the cells in curve order: t goes to the first
   // cell whose bound is above it (that cell has mass), and t >= t1 to the last.
-  int k = 0;
+  int first = 0;  // bounds below first are <= every t from here on
   uint32_t i = begin;
   while (i < end) {
-    while (k < last && bounds[k] <= t_[i]) ++k;
+    first = CellsAtOrBelow(bounds.data(), first, t_[i]);
+    const int k = std::min(first, last);
     uint32_t j = i + 1;
     if (k == last) {
       j = end;

@@ -95,6 +95,12 @@ class LeafWalk {
   // Places the current leaf's samples [begin, end), which lie in `square` in
   // t order, using the table of recursion `level`.
   void PlaceInSquare(const Square& square, uint32_t begin, uint32_t end, int level);
+  // Bounds compared at once when matching samples to cells.
+  static constexpr int kScanWidth = 16;
+  // The number of entries of `bounds` that are <= t, counted from `from`,
+  // where every entry before `from` is (bounds do not decrease and end in
+  // kScanWidth entries of +inf).
+  static int CellsAtOrBelow(const double* bounds, int from, double t);
   // Records that samples [begin, end) end in `square` (pure curve bits from there).
   void Reached(const Square& square, uint32_t begin, uint32_t end);
   // Places the current run's n samples by pure curve bits inside the
