@@ -1,8 +1,8 @@
 // Bit-parallel Hilbert decoding over a batch (Curve::DescendMany), written
 // branch-free on 64-bit words so that a compiler vectorises it across the
 // batch: integer work only, so every vector width gives the scalar bits.
-// Included by curve.cc (baseline) and curve_avx512.cc (built with
-// -mavx512f, run only on CPUs that have it).
+// Included by curve.cc (baseline), curve_avx2.cc and curve_avx512.cc (built
+// for those instruction sets, run only on CPUs that have them).
 #ifndef SFCSAMPLER_CORE_HILBERT_BATCH_H_
 #define SFCSAMPLER_CORE_HILBERT_BATCH_H_
 
@@ -70,7 +70,9 @@ inline void Descend(const Masks& m, const uint64_t* digits, int levels, size_t n
   }
 }
 
-// The same, built for AVX-512F (curve_avx512.cc).
+// The same, built for AVX2 (curve_avx2.cc) and AVX-512F (curve_avx512.cc).
+void DescendAvx2(const Masks& m, const uint64_t* digits, int levels, size_t n, uint64_t* states,
+                 uint64_t* xs, uint64_t* ys);
 void DescendAvx512(const Masks& m, const uint64_t* digits, int levels, size_t n, uint64_t* states,
                    uint64_t* xs, uint64_t* ys);
 
