@@ -52,14 +52,6 @@ void SampleWriter::AppendNumber(std::string* out, double value) const {
   }
 }
 
-void SampleWriter::AppendValue(std::string* out, double value) const {
-  if (precision_ == OutputPrecision::kFloat32) {
-    AppendBinary(out, static_cast<float>(value));
-  } else {
-    AppendBinary(out, value);
-  }
-}
-
 // NPY format 1.0: magic, version, a little-endian uint16 header length, and a
 // Python dict literal padded with spaces and a newline so the data starts at
 // a multiple of 64 bytes (numpy/lib/format.py).
@@ -153,6 +145,10 @@ absl::Status SampleWriter::WriteHeader(uint64_t count) {
 
 absl::Status SampleWriter::WriteRows(std::FILE* to, const SampleBatch& b) {
   buffer_.clear();
+  if (format_ == OutputFormat::kNpy || format_ == OutputFormat::kPlyBinary) {
+    PackBinary(b);
+    return WriteAll(to, buffer_);
+  }
   for (size_t i = 0; i < b.size(); ++i) {
     if (format_ == OutputFormat::kCsv) {
       AppendUint(&buffer_, b.index[i]);
@@ -165,17 +161,6 @@ absl::Status SampleWriter::WriteRows(std::FILE* to, const SampleBatch& b) {
       if (fields_.face) buffer_ += ',', AppendUint(&buffer_, b.face[i]);
       if (fields_.triangle) buffer_ += ',', AppendUint(&buffer_, b.triangle[i]);
       buffer_ += '\n';
-    } else if (format_ == OutputFormat::kNpy) {
-      // One packed record per sample, fields in the header's order.
-      AppendBinary(&buffer_, b.index[i]);
-      for (double d : {b.u[i], b.v[i], b.x[i], b.y[i], b.z[i]}) AppendValue(&buffer_, d);
-      if (fields_.normal) {
-        for (double d : {b.nx[i], b.ny[i], b.nz[i]}) AppendValue(&buffer_, d);
-      }
-      if (fields_.density) AppendValue(&buffer_, b.density[i]);
-      if (fields_.curve_position) AppendValue(&buffer_, b.curve_position[i]);
-      if (fields_.face) AppendBinary(&buffer_, b.face[i]);
-      if (fields_.triangle) AppendBinary(&buffer_, b.triangle[i]);
     } else if (format_ == OutputFormat::kPlyAscii) {
       std::string row;
       for (double d : {b.x[i], b.y[i], b.z[i]}) AppendNumber(&row, d), row += ' ';
@@ -190,21 +175,65 @@ absl::Status SampleWriter::WriteRows(std::FILE* to, const SampleBatch& b) {
       if (fields_.face) row += ' ', AppendUint(&row, b.face[i]);
       if (fields_.triangle) row += ' ', AppendUint(&row, b.triangle[i]);
       buffer_ += row + '\n';
-    } else {
-      for (double d : {b.x[i], b.y[i], b.z[i]}) AppendValue(&buffer_, d);
-      if (fields_.normal) {
-        for (double d : {b.nx[i], b.ny[i], b.nz[i]}) AppendValue(&buffer_, d);
-      }
-      AppendValue(&buffer_, b.u[i]);
-      AppendValue(&buffer_, b.v[i]);
-      AppendBinary(&buffer_, static_cast<uint32_t>(b.index[i]));
-      if (fields_.density) AppendValue(&buffer_, b.density[i]);
-      if (fields_.curve_position) AppendValue(&buffer_, b.curve_position[i]);
-      if (fields_.face) AppendBinary(&buffer_, b.face[i]);
-      if (fields_.triangle) AppendBinary(&buffer_, b.triangle[i]);
     }
   }
   return WriteAll(to, buffer_);
+}
+
+void SampleWriter::PackBinary(const SampleBatch& b) {
+  // Fixed-size little-endian records (x86-64 and aarch64 are little-endian,
+  // as both formats require), filled a column at a time: each column is
+  // copied into its place in every record of the buffer.
+  const size_t n = b.size();
+  const size_t real = precision_ == OutputPrecision::kFloat32 ? sizeof(float) : sizeof(double);
+  struct Column {
+    const double* real = nullptr;     // a float column, written in the precision
+    const uint64_t* index = nullptr;  // the index: uint64 in NPY, uint32 in PLY
+    const uint32_t* uint = nullptr;   // face or triangle
+  };
+  std::vector<Column> columns;
+  const auto add_real = [&](const std::vector<double>& c) { columns.push_back({c.data(), nullptr, nullptr}); };
+  const bool npy = format_ == OutputFormat::kNpy;
+  if (npy) columns.push_back({nullptr, b.index.data(), nullptr});
+  if (npy) add_real(b.u), add_real(b.v);
+  add_real(b.x), add_real(b.y), add_real(b.z);
+  if (fields_.normal) add_real(b.nx), add_real(b.ny), add_real(b.nz);
+  if (!npy) add_real(b.u), add_real(b.v), columns.push_back({nullptr, b.index.data(), nullptr});
+  if (fields_.density) add_real(b.density);
+  if (fields_.curve_position) add_real(b.curve_position);
+  if (fields_.face) columns.push_back({nullptr, nullptr, b.face.data()});
+  if (fields_.triangle) columns.push_back({nullptr, nullptr, b.triangle.data()});
+  const size_t index_width = npy ? sizeof(uint64_t) : sizeof(uint32_t);
+  size_t record = 0;
+  for (const Column& c : columns) record += c.real ? real : c.index ? index_width : sizeof(uint32_t);
+  buffer_.resize(n * record);
+  char* out = buffer_.data();
+  size_t offset = 0;
+  for (const Column& c : columns) {
+    char* at = out + offset;
+    if (c.real && real == sizeof(float)) {
+      for (size_t i = 0; i < n; ++i, at += record) {
+        const float f = static_cast<float>(c.real[i]);
+        std::memcpy(at, &f, sizeof f);
+      }
+      offset += sizeof(float);
+    } else if (c.real) {
+      for (size_t i = 0; i < n; ++i, at += record) std::memcpy(at, &c.real[i], sizeof(double));
+      offset += sizeof(double);
+    } else if (c.index && npy) {
+      for (size_t i = 0; i < n; ++i, at += record) std::memcpy(at, &c.index[i], sizeof(uint64_t));
+      offset += sizeof(uint64_t);
+    } else if (c.index) {
+      for (size_t i = 0; i < n; ++i, at += record) {
+        const uint32_t k = static_cast<uint32_t>(c.index[i]);
+        std::memcpy(at, &k, sizeof k);
+      }
+      offset += sizeof(uint32_t);
+    } else {
+      for (size_t i = 0; i < n; ++i, at += record) std::memcpy(at, &c.uint[i], sizeof(uint32_t));
+      offset += sizeof(uint32_t);
+    }
+  }
 }
 
 absl::Status SampleWriter::Write(const SampleBatch& batch) {

@@ -53,9 +53,10 @@ class SampleWriter {
                OutputPrecision precision);
   absl::Status WriteHeader(uint64_t count);
   absl::Status WriteRows(std::FILE* to, const SampleBatch& batch);
+  // The batch's records in NPY or binary PLY, into buffer_.
+  void PackBinary(const SampleBatch& batch);
   std::string NpyHeader(uint64_t count) const;
   void AppendNumber(std::string* out, double value) const;  // shortest text
-  void AppendValue(std::string* out, double value) const;   // little-endian binary
 
   std::FILE* out_;
   bool owns_;

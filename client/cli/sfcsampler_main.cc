@@ -73,9 +73,9 @@ absl::StatusOr<std::unique_ptr<SamplerClient>> Connect(
   return SamplerClient::Connect(options);
 }
 
-// What `sample` prints on stderr: -q drops the summary and the progress
-// lines, --no-warnings the depth-cap warnings (which -q keeps: they say the
-// samples' density is only approximate somewhere).
+// What `sample` prints on stderr: -q drops the summary, the progress lines
+// and the note on fitted power laws, --no-warnings the warnings too (which
+// -q keeps: they say the samples' density is only approximate somewhere).
 struct Verbosity {
   bool quiet = false;
   bool no_warnings = false;
@@ -101,7 +101,8 @@ void PrintTreeInfo(const ::sfcsampler::v1::TreeInfo& t, const Verbosity& verbosi
                  t.error_samples(), t.unresolved_error_samples(), t.grade());
   }
   if (verbosity.no_warnings) return;
-  if (t.warped_leaves() > 0) {
+  // A note, not a warning: the power laws follow the mass (-q drops it).
+  if (t.warped_leaves() > 0 && !verbosity.quiet) {
     std::fprintf(stderr,
                  "note: the parameterisation is singular (the area element blows up or vanishes on "
                  "parameter lines, paper Sect. 5.3); %llu leaves beside those lines follow a fitted "
