@@ -151,13 +151,10 @@ Curve::Curve(const Definition& def)
     }
   }
 
-  for (int a = 0; a < 8; ++a) {
-    for (int b = 0; b < 8; ++b) compose_[a][b] = static_cast<uint8_t>(Compose(a, b));
-  }
   constexpr int kWholes[4] = {0, 1, 6, 7};  // by swap parity + 2 mirror parity
   for (int a = 0; a < 8; ++a) {
     for (int w = 0; w < 4; ++w) {
-      batch_masks_.compose[a >> 2] |= uint64_t{compose_[a][kWholes[w]]} << (4 * (4 * (a & 3) + w));
+      batch_masks_.compose[a >> 2] |= uint64_t(Compose(a, kWholes[w])) << (4 * (4 * (a & 3) + w));
     }
   }
   // Bit-parallel decoding needs a 2 x 2 curve whose children's orientations
@@ -167,14 +164,10 @@ Curve::Curve(const Definition& def)
     const int o = orient[d];
     bit_parallel_ = o == 0 || o == 1 || o == 6 || o == 7;
     const auto mask = [](bool on) { return on ? ~uint64_t{0} : uint64_t{0}; };
-    digit_x_[d] = mask(def.order[d].i == 1);
-    digit_y_[d] = mask(def.order[d].j == 1);
-    digit_swap_[d] = mask(o & 1);
-    digit_mirror_[d] = mask(o & 6);
-  }
-  for (int d = 0; d < 4; ++d) {
-    batch_masks_.x[d] = digit_x_[d], batch_masks_.y[d] = digit_y_[d];
-    batch_masks_.swap[d] = digit_swap_[d], batch_masks_.mirror[d] = digit_mirror_[d];
+    batch_masks_.x[d] = mask(def.order[d].i == 1);
+    batch_masks_.y[d] = mask(def.order[d].j == 1);
+    batch_masks_.swap[d] = mask(o & 1);
+    batch_masks_.mirror[d] = mask(o & 6);
   }
 }
 

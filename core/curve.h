@@ -146,51 +146,11 @@ class Curve {
     uint8_t state;
   };
 
-  // The bits of `word` at even positions 0, 2, 4, ... packed into bits 0, 1, 2, ...
-  static uint64_t PackEvenBits(uint64_t word) {
-    word &= 0x5555555555555555ULL;
-    word = (word | word >> 1) & 0x3333333333333333ULL;
-    word = (word | word >> 2) & 0x0f0f0f0f0f0f0f0fULL;
-    word = (word | word >> 4) & 0x00ff00ff00ff00ffULL;
-    word = (word | word >> 8) & 0x0000ffff0000ffffULL;
-    return (word | word >> 16) & 0x00000000ffffffffULL;
-  }
-  // Bit j of the result: the parity of the bits of `word` above j.
-  static uint64_t ParityAbove(uint64_t word) {
-    for (int shift = 1; shift < 64; shift *= 2) word ^= word >> shift;
-    return word >> 1;
-  }
-
-  // Hilbert: the orientations of orientation 0's children form the abelian
-  // group {identity, swap, mirror both, swap and mirror both}, so the frame
-  // at each level is a swap and a mirror whose parities are prefix XORs of
-  // per-digit flags over the levels above; the start orientation is applied
-  // to the whole result (every orientation acts on all bit levels alike).
-  // Kept scalar: GCC's vectorised version of the four masks went through the
-  // stack and stalled on store forwarding (a third of the sampler's time).
-  __attribute__((optimize("no-tree-vectorize"))) void DescendBitParallel(
-      uint64_t digits, int levels, uint64_t* x, uint64_t* y, int* state) const {
-    const uint64_t used = levels == 64 ? ~uint64_t{0} : (uint64_t{1} << levels) - 1;
-    const uint64_t lo = PackEvenBits(digits), hi = PackEvenBits(digits >> 1);
-    // m<d>: bit j set where the digit at level bit j is d.
-    const uint64_t m0 = ~hi & ~lo & used, m1 = ~hi & lo & used, m2 = hi & ~lo & used,
-                   m3 = hi & lo & used;
-    const auto pick = [&](const uint64_t* mask) {
-      return (m0 & mask[0]) | (m1 & mask[1]) | (m2 & mask[2]) | (m3 & mask[3]);
-    };
-    const uint64_t qx = pick(digit_x_), qy = pick(digit_y_);
-    const uint64_t swap = pick(digit_swap_), mirror = pick(digit_mirror_);
-    const uint64_t swap_above = ParityAbove(swap), mirror_above = ParityAbove(mirror);
-    uint64_t px = ((qx & ~swap_above) | (qy & swap_above)) ^ (mirror_above & used);
-    uint64_t py = ((qy & ~swap_above) | (qx & swap_above)) ^ (mirror_above & used);
-    const int s = *state;
-    if (s & 1) std::swap(px, py);
-    if (s & 2) px ^= used;
-    if (s & 4) py ^= used;
-    const int whole = (__builtin_parityll(swap) ? 1 : 0) | (__builtin_parityll(mirror) ? 6 : 0);
-    *x = px;
-    *y = py;
-    *state = compose_[s][whole];
+  // Hilbert, one string: hilbert_batch::Descend (bit-parallel decoding).
+  void DescendBitParallel(uint64_t digits, int levels, uint64_t* x, uint64_t* y, int* state) const {
+    uint64_t s = static_cast<uint64_t>(*state);
+    hilbert_batch::Descend(batch_masks_, &digits, levels, 1, &s, x, y);
+    *state = static_cast<int>(s);
   }
 
   CurveType type_;
@@ -205,13 +165,10 @@ class Curve {
   std::vector<ChunkEntry> chunks_;    // [state][chunk value]
   int table_levels_;
   std::vector<std::vector<Child>> cell_order_;  // [levels][state][cell]
-  // Bit-parallel Hilbert decoding (DescendBitParallel): per digit of
-  // orientation 0, all-ones or zero masks of its cell's x and y and of its
-  // child's swap and mirror-both; and a o b for orientations.
+  // Bit-parallel Hilbert decoding (DescendBitParallel, DescendMany) and its
+  // constants.
   bool bit_parallel_ = false;
-  uint64_t digit_x_[4] = {}, digit_y_[4] = {}, digit_swap_[4] = {}, digit_mirror_[4] = {};
-  uint8_t compose_[8][8] = {};
-  hilbert_batch::Masks batch_masks_{};  // the same constants for DescendMany
+  hilbert_batch::Masks batch_masks_{};
 };
 
 }  // namespace sfc

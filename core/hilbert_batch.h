@@ -40,7 +40,12 @@ inline uint64_t EvenBits(uint64_t word) {
   return (word | word >> 16) & 0x00000000ffffffffULL;
 }
 
-// Curve::DescendBitParallel for n strings of `levels` (<= 32) levels.
+// Curve::Descend for n Hilbert strings of `levels` (<= 32) levels. The
+// orientations of orientation 0's children form the abelian group
+// {identity, swap, mirror both, swap and mirror both}, so the frame at each
+// level is a swap and a mirror whose parities are XORs of per-digit flags
+// over the levels above; the start orientation is applied to the whole
+// result (every orientation acts on all bit levels alike).
 inline void Descend(const Masks& m, const uint64_t* digits, int levels, size_t n, uint64_t* states,
                     uint64_t* xs, uint64_t* ys) {
   const uint64_t used = (uint64_t{1} << levels) - 1;
