@@ -121,15 +121,6 @@ void ComputeGridFactors(const LeafModel& model, LeafModel::Kind kind, int grid, 
   }
 }
 
-void GridIntegrals(const LeafModel& model, LeafModel::Kind kind, int grid, double x0, double y0,
-                   double side, int n, double* out) {
-  GridFactors factors;
-  ComputeGridFactors(model, kind, grid, x0, y0, side, n, &factors);
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) out[i * n + j] = factors.Integral(i, j);
-  }
-}
-
 double QuadraticIntegral(const double values[9], double x0, double x1, double y0, double y1,
                          const AxisWarp* warp) {
   if (warp != nullptr) {

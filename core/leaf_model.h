@@ -170,24 +170,17 @@ inline void BasisIntegrals(double a, double b, double out[3]) {
 
 }  // namespace leaf_model_internal
 
-// Largest n of GridIntegrals: cells per side of a walk's table.
+// Largest n of GridFactors: cells per side of a walk's table.
 inline constexpr int kMaxGridCells = 32;
 
 // The integrals of the model over the n x n sub-squares of the square
 // [x0, x0 + side] x [y0, y0 + side], in the coordinates the walk descends in
 // (DescendsWarped): warped along an axis whose power law blows up, the
-// leaf's own along the others. out[i * n + j] for the sub-square i along x,
-// j along y; a quadratic may give negative values where it dips below zero.
-// The model is a sum of products of 1D functions (the Lagrange basis of the
-// quadratic, the pieces' indicators of the piecewise model), so the work is
-// 1D integrals along each axis and then 3 products per sub-square. `grid` is
-// the piecewise model's grid (the curve's). REQUIRES: 1 <= n <= kMaxGridCells.
-void GridIntegrals(const LeafModel& model, LeafModel::Kind kind, int grid, double x0, double y0,
-                   double side, int n, double* out);
-
-// GridIntegrals in two steps, for callers that take the sub-squares in
-// another order: the factors once, then Integral(i, j) for any sub-square,
-// with GridIntegrals' bits.
+// leaf's own along the others. The model is a sum of products of 1D
+// functions (the Lagrange basis of the quadratic, the pieces' indicators of
+// the piecewise model), so ComputeGridFactors does the 1D integrals along
+// each axis once, and Integral(i, j) (sub-square i along x, j along y) is 3
+// products; a quadratic may give negative values where it dips below zero.
 struct GridFactors {
   int factors;                     // 3 (quadratic) or the piecewise grid
   double x[3][kMaxGridCells];      // x[a][i]: factor a's integral over column i
@@ -198,6 +191,7 @@ struct GridFactors {
     return sum;
   }
 };
+// `grid` is the piecewise model's grid (the curve's). REQUIRES: 1 <= n <= kMaxGridCells.
 void ComputeGridFactors(const LeafModel& model, LeafModel::Kind kind, int grid, double x0,
                         double y0, double side, int n, GridFactors* out);
 

@@ -84,7 +84,7 @@ int LeafWalk::Tabulate(const Square& square, int levels, std::vector<double>& bo
   // kScanWidth more entries past the cells, +inf: LeafWalk::CellsAtOrBelow
   // reads whole windows.
   bounds.assign(cells + kScanWidth, std::numeric_limits<double>::infinity());
-  // Running sums in curve order of the cells' integrals (GridIntegrals' bits;
+  // Running sums in curve order of the cells' integrals (GridFactors;
   // a quadratic's dips below zero count as no mass).
   double sum = 0;
   for (int k = 0; k < cells; ++k) {

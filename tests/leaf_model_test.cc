@@ -119,15 +119,15 @@ TEST(LeafModel, WarpedModelFollowsAPowerLawAboutALine) {
         for (int grid : {2, 3}) {
           const double side = 1.0 / 64, y0 = 0.5;
           const double x0 = c == 1 ? 1 - side : warped ? WarpSplit(w) : c;
-          double out[9];
-          GridIntegrals(m, LeafModel::Kind::kQuadratic, grid, axis == 0 ? x0 : y0,
-                        axis == 0 ? y0 : x0, side, grid, out);
+          GridFactors factors;
+          ComputeGridFactors(m, LeafModel::Kind::kQuadratic, grid, axis == 0 ? x0 : y0,
+                             axis == 0 ? y0 : x0, side, grid, &factors);
           const double step = side / grid;
           for (int i = 0; i < grid; ++i) {
             for (int j = 0; j < grid; ++j) {
               const double lo = x0 + (axis == 0 ? i : j) * step;
               const double exact = (cdf(leaf(lo + step)) - cdf(leaf(lo))) * step;
-              EXPECT_NEAR(out[i * grid + j] / exact, 1.0, 2e-5)
+              EXPECT_NEAR(factors.Integral(i, j) / exact, 1.0, 2e-5)
                   << "p " << p << " c " << c << " axis " << axis << " grid " << grid;
             }
           }
