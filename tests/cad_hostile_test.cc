@@ -106,14 +106,25 @@ TEST(CadHostile, CensusCountsTheFixturesFaces) {
   }
 }
 
+// The first STEP record containing `marker` (e.g. "= ADVANCED_FACE("): where
+// the marker is, and the record's entity name "#N"; npos and "" if none.
+struct Entity {
+  size_t at;
+  std::string id;
+};
+Entity FindEntity(const std::string& step, const std::string& marker) {
+  const size_t at = step.find(marker);
+  if (at == std::string::npos) return {at, ""};
+  const size_t id_start = step.rfind('#', at);
+  return {at, step.substr(id_start, step.find(' ', id_start) - id_start)};
+}
+
 // A face whose surface reference dangles: the reader drops the face without
 // a word; Load names it.
 TEST(CadHostile, DanglingReferenceInAFaceIsNamed) {
   std::string step = Bytes(Solid::kBoxWithHole, ModelFormat::kStep);
-  const size_t face = step.find("= ADVANCED_FACE(");
+  const auto [face, id] = FindEntity(step, "= ADVANCED_FACE(");
   ASSERT_NE(face, std::string::npos);
-  const size_t id_start = step.rfind('#', face);
-  const std::string id = step.substr(id_start, step.find(' ', id_start) - id_start);
   const size_t end = step.find(';', face);
   const size_t surface = step.rfind("),#", end);  // "(bounds),#SURFACE,.T."
   ASSERT_LT(face, surface);
@@ -141,10 +152,8 @@ TEST(CadHostile, DanglingReferenceInAFaceIsNamed) {
 // turned into an error on the load's thread, and the process lives on.
 TEST(CadHostile, AnEdgeThatIsItselfOverflowsNoStack) {
   std::string step = Bytes(Solid::kBoxWithHole, ModelFormat::kStep);
-  const size_t edge = step.find("= ORIENTED_EDGE('',*,*,#");
+  const auto [edge, id] = FindEntity(step, "= ORIENTED_EDGE('',*,*,#");
   ASSERT_NE(edge, std::string::npos);
-  const size_t id_start = step.rfind('#', edge);
-  const std::string id = step.substr(id_start, step.find(' ', id_start) - id_start);
   const size_t ref = step.find('#', edge);
   step.replace(ref, step.find(',', ref) - ref, id);
   for (int i = 0; i < 2; ++i) {  // twice: the thread's handler set-up survives a fault
