@@ -46,6 +46,7 @@
 #include "engine/sampling_engine.h"
 #include "grpcpp/client_context.h"
 #include "grpcpp/create_channel.h"
+#include "kinds/registered_kinds.h"
 #include "proto/convert.h"
 
 namespace sfc {
@@ -522,7 +523,7 @@ int Main(int argc, char** argv) {
   engine_limits.max_spec_length = limits.max_spec_length;
   engine_limits.max_sorted_range = limits.max_sorted_range;
   DirectTreeSource source;
-  SamplingEngine engine(engine_limits, &source);
+  SamplingEngine engine(RegisteredSurfaceKinds(), engine_limits, &source);
 
   grpc::ChannelArguments args;
   args.SetMaxReceiveMessageSize(-1);

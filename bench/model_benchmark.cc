@@ -15,6 +15,7 @@
 
 #include "cad/fixtures.h"
 #include "engine/sampling_engine.h"
+#include "kinds/registered_kinds.h"
 
 namespace {
 
@@ -32,7 +33,7 @@ Run Cold(const std::string& surface, uint64_t count) {
   sfc::EngineLimits limits;
   limits.generation_threads = 1;
   const auto start = Clock::now();
-  sfc::SamplingEngine engine(limits, &source, &files);
+  sfc::SamplingEngine engine(sfc::RegisteredSurfaceKinds(), limits, &source, &files);
   sfc::SampleRequest r;
   r.tree.surface = surface;
   r.count = count;

@@ -19,6 +19,7 @@
 #include "engine/sampling_engine.h"
 #include "grpcpp/create_channel.h"
 #include "grpcpp/server_builder.h"
+#include "kinds/registered_kinds.h"
 #include "proto/convert.h"
 #include "server/sampler_server.h"
 
@@ -147,7 +148,7 @@ double GenerationSeconds(const SampleRequest& request, int threads, uint32_t bat
   EngineLimits limits;
   limits.generation_threads = threads;
   limits.max_tree_leaves = uint64_t{1} << 26;
-  SamplingEngine engine(limits, &source);
+  SamplingEngine engine(RegisteredSurfaceKinds(), limits, &source);
   auto job = engine.Start(request);
   if (!job.ok()) {
     std::fprintf(stderr, "generation failed: %s\n", job.status().ToString().c_str());

@@ -1,20 +1,29 @@
 #include "engine/sampling_engine.h"
 
 #include "absl/strings/str_format.h"
-#include "catalog/catalog.h"
 #include "core/status_macros.h"
 #include "engine/model_source.h"
-#ifdef SFC_HAVE_MESH
-#include "engine/mesh_jobs.h"
-#endif
-#ifdef SFC_HAVE_CAD
-#include "engine/cad_jobs.h"
-#endif
 
 namespace sfc {
+namespace {
 
-SamplingEngine::SamplingEngine(EngineLimits limits, TreeSource* source, const ModelSource* models)
-    : limits_(limits),
+// OK if `kind` fills the kind-specific column `fills` (&KindInfo::face_column,
+// ...), else which kind of surface to ask it of.
+absl::Status CheckColumn(const SurfaceKinds& kinds, const SurfaceKind* kind, bool KindInfo::*fills,
+                         const char* column) {
+  if (kind && kind->info().*fills) return absl::OkStatus();
+  const SurfaceKind* filling = kinds.Find([fills](const KindInfo& i) { return i.*fills; });
+  return absl::InvalidArgumentError(
+      absl::StrFormat("the %s column needs %s", column,
+                      filling ? filling->info().what : "a kind of surface this build does not have"));
+}
+
+}  // namespace
+
+SamplingEngine::SamplingEngine(const SurfaceKinds& kinds, EngineLimits limits, TreeSource* source,
+                               const ModelSource* models)
+    : kinds_(kinds),
+      limits_(limits),
       source_(source),
       models_(models),
       loaded_(std::make_unique<LoadedModels>([&limits] {
@@ -27,91 +36,48 @@ SamplingEngine::SamplingEngine(EngineLimits limits, TreeSource* source, const Mo
         return o;
       }())) {}
 
-const char* TreeKindName(TreeKind kind) {
-  switch (kind) {
-    case TreeKind::kSurface: return "surface";
-    case TreeKind::kMesh: return "mesh";
-    case TreeKind::kCadModel: return "model";
-  }
-  return "surface";
+KindContext SamplingEngine::Context(const BuildControl& caller) const {
+  KindContext context;
+  context.limits = &limits_;
+  context.loaded = loaded_.get();
+  context.caller = caller.check;
+  return context;
 }
 
-absl::StatusOr<PreparedTree> SamplingEngine::PrepareModel(const ModelSpec& model,
-                                                          const TreeSpec& spec, uint64_t count,
-                                                          const BuildControl& caller) const {
-  const bool mesh = model.format == ModelFormat::kObj || model.format == ModelFormat::kPly;
-#ifndef SFC_HAVE_MESH
-  if (mesh) {
-    return absl::UnimplementedError(
-        "this build of sfcsampler has no mesh support (configured with SFC_BUILD_MESH=OFF)");
+absl::StatusOr<SamplingEngine::SpecKind> SamplingEngine::KindOf(const std::string& spec) const {
+  ASSIGN_OR_RETURN(const std::optional<ModelSpec> model, ParseModelSpec(spec));
+  SpecKind out;
+  out.kind = kinds_.For(model);
+  if (!out.kind) {
+    return absl::UnimplementedError(absl::StrFormat(
+        "this build of sfcsampler has no kind of surface for %s specs (it was configured "
+        "without it: SFC_BUILD_CAD=OFF or SFC_BUILD_MESH=OFF)",
+        model ? absl::StrFormat("%s:", ModelFormatName(model->format)) : "formula"));
   }
-#endif
-#ifndef SFC_HAVE_CAD
-  if (!mesh) {
-    return absl::UnimplementedError(
-        "this build of sfcsampler has no CAD support (configured with SFC_BUILD_CAD=OFF)");
-  }
-#endif
+  if (!model) return out;
   if (!models_) {
     return absl::InvalidArgumentError(absl::StrFormat(
-        "\"%s\" names a model, and this engine has no model source to read it from",
-        spec.surface));
+        "\"%s\" names a model, and this engine has no model source to read it from", spec));
   }
-  ASSIGN_OR_RETURN(const StoredModel stored, models_->Resolve(model));
-  PreparedTree prepared;
-  prepared.grade = CurveTree::GradeFor(count);
-  TreeFactory factory;
-  if (mesh) {
-#ifdef SFC_HAVE_MESH
-    ASSIGN_OR_RETURN(MeshTreeRecipe recipe,
-                     MeshTreeFor(stored, spec.density, spec.options.tolerance,
-                                 limits_.max_tree_leaves, loaded_.get(), caller.check));
-    CurveTreeOptions options;  // a mesh's curve has no options but the tolerance
-    options.tolerance = spec.options.tolerance;
-    prepared.kind = TreeKind::kMesh;
-    prepared.key = MakeTreeKey(stored.Spec(), recipe.canonical_density, options);
-    factory = std::move(recipe.factory);
-#endif
-  } else {
-#ifdef SFC_HAVE_CAD
-    CurveTreeOptions options = spec.options;
-    options.max_leaves = limits_.max_tree_leaves;
-    ASSIGN_OR_RETURN(CadTreeRecipe recipe,
-                     CadTreeFor(stored, spec.density, options, loaded_.get(), caller.check));
-    prepared.kind = TreeKind::kCadModel;
-    prepared.key = MakeTreeKey(stored.Spec(), recipe.canonical_density, options);
-    factory = std::move(recipe.factory);
-#endif
-  }
-  auto lookup = source_->Get(prepared.key, prepared.grade, factory, caller);
-  if (!lookup.ok()) {
-    // A model whose tree failed is not kept for a next request (its memory
-    // goes once no request holds it); a request that left keeps it.
-    const absl::StatusCode code = lookup.status().code();
-    if (code != absl::StatusCode::kCancelled && code != absl::StatusCode::kDeadlineExceeded &&
-        code != absl::StatusCode::kUnavailable) {
-      loaded_->ForgetModel(stored.sha256);
-    }
-    return lookup.status();
-  }
-  prepared.lookup = *std::move(lookup);
-  return prepared;
+  ASSIGN_OR_RETURN(out.model, models_->Resolve(*model));
+  return out;
 }
 
 absl::StatusOr<std::string> SamplingEngine::DescribeModel(const std::string& spec) const {
+  const SurfaceKind* describing = kinds_.Find([](const KindInfo& i) { return i.describes; });
   ASSIGN_OR_RETURN(const std::optional<ModelSpec> model, ParseModelSpec(spec));
-  if (!model || model->format == ModelFormat::kObj || model->format == ModelFormat::kPly) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "\"%s\" is not a CAD model; inspect takes step:FILE, iges:FILE or nurbs:FILE", spec));
+  const SurfaceKind* kind = kinds_.For(model);
+  if (!describing) {
+    return absl::UnimplementedError(
+        "this build of sfcsampler has no kind of surface that inspect describes (configured with "
+        "SFC_BUILD_CAD=OFF)");
   }
-#ifndef SFC_HAVE_CAD
-  return absl::UnimplementedError(
-      "this build of sfcsampler has no CAD support (configured with SFC_BUILD_CAD=OFF)");
-#else
-  if (!models_) return absl::InvalidArgumentError("this engine has no model source");
-  ASSIGN_OR_RETURN(const StoredModel stored, models_->Resolve(*model));
-  return DescribeCadModel(stored, loaded_.get());
-#endif
+  if (!model || !kind || !kind->info().describes) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "\"%s\" is not %s, which inspect describes", spec, describing->info().what));
+  }
+  ASSIGN_OR_RETURN(const SpecKind found, KindOf(spec));
+  return kind->Describe(*found.model, Context({}));
 }
 
 absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint64_t count,
@@ -131,31 +97,26 @@ absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint6
           text->size(), limits_.max_spec_length));
     }
   }
-  ASSIGN_OR_RETURN(const std::optional<ModelSpec> model, ParseModelSpec(spec.surface));
-  if (model) return PrepareModel(*model, spec, count, caller);
-  ASSIGN_OR_RETURN(SurfaceFromSpec surface, MakeSurface(spec.surface));
-  ASSIGN_OR_RETURN(DensityFromSpec density, MakeDensity(spec.density));
-  CurveTreeOptions options = spec.options;
-  options.max_leaves = limits_.max_tree_leaves;  // the server sets the budget, not the request
-
+  ASSIGN_OR_RETURN(const SpecKind found, KindOf(spec.surface));
+  ASSIGN_OR_RETURN(ResolvedSurface resolved,
+                   found.kind->Resolve(spec, found.model ? &*found.model : nullptr, Context(caller)));
   PreparedTree prepared;
-  prepared.key = MakeTreeKey(surface.canonical, density.canonical, options);
+  prepared.key = std::move(resolved.key);
   prepared.grade = CurveTree::GradeFor(count);
-  prepared.surface = surface.surface;
-  prepared.density = density.density;
-  TreeFactory factory;
-  factory.build = [surface = prepared.surface, density = prepared.density, options](
-                      int grade, const BuildControl& control) -> TreeFactory::Result {
-    return AsAnyTree(CurveTree::Build(*surface, *density, options, grade, control));
-  };
-  factory.refine = [surface = prepared.surface, density = prepared.density](
-                       const AnyTree& coarser, int grade,
-                       const BuildControl& control) -> TreeFactory::Result {
-    const auto tree = TreeAs<CurveTree>(&coarser);
-    if (!tree) return absl::InternalError("refining a tree of another kind");
-    return AsAnyTree(tree->Refined(*surface, *density, grade, control));
-  };
-  ASSIGN_OR_RETURN(prepared.lookup, source_->Get(prepared.key, prepared.grade, factory, caller));
+  prepared.kind = found.kind->info().name;
+  prepared.open_cursor = std::move(resolved.open_cursor);
+  auto lookup = source_->Get(prepared.key, prepared.grade, resolved.factory, caller);
+  if (!lookup.ok()) {
+    // What was parsed for a tree that failed is not kept for a next request
+    // (its memory goes once no request holds it); a request that left keeps it.
+    const absl::StatusCode code = lookup.status().code();
+    if (resolved.forget && code != absl::StatusCode::kCancelled &&
+        code != absl::StatusCode::kDeadlineExceeded && code != absl::StatusCode::kUnavailable) {
+      resolved.forget();
+    }
+    return lookup.status();
+  }
+  prepared.lookup = *std::move(lookup);
   return prepared;
 }
 
@@ -213,13 +174,10 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
   RETURN_IF_ERROR(request.region.Validate());
   if (request.fields.face || request.fields.triangle) {
     ASSIGN_OR_RETURN(const std::optional<ModelSpec> model, ParseModelSpec(request.tree.surface));
-    const bool mesh = model && (model->format == ModelFormat::kObj || model->format == ModelFormat::kPly);
-    if (request.fields.face && (!model || mesh)) {
-      return absl::InvalidArgumentError(
-          "the face column needs a CAD model surface (step:, iges: or nurbs:)");
-    }
-    if (request.fields.triangle && !mesh) {
-      return absl::InvalidArgumentError("the triangle column needs a mesh surface (obj: or ply:)");
+    const SurfaceKind* kind = kinds_.For(model);
+    if (request.fields.face) RETURN_IF_ERROR(CheckColumn(kinds_, kind, &KindInfo::face_column, "face"));
+    if (request.fields.triangle) {
+      RETURN_IF_ERROR(CheckColumn(kinds_, kind, &KindInfo::triangle_column, "triangle"));
     }
   }
   if (request.tree_count != 0 && request.tree_count < request.count) {
@@ -234,29 +192,15 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
   ASSIGN_OR_RETURN(job.tree, Prepare(request.tree, tree_count, caller));
   job.begin = range.first;
   job.end = range.second;
-  Sequence sequence(request.sequence, request.count, request.seed);
-#ifdef SFC_HAVE_MESH
-  if (job.tree.kind == TreeKind::kMesh) {
-    ASSIGN_OR_RETURN(job.cursor, MeshCursor(*job.tree.lookup.any, std::move(sequence), job.begin,
-                                            job.end, request.region, request.fields,
-                                            limits_.generation_threads));
-    return job;
-  }
-#endif
-#ifdef SFC_HAVE_CAD
-  if (job.tree.kind == TreeKind::kCadModel) {
-    ASSIGN_OR_RETURN(job.cursor, CadCursor(*job.tree.lookup.any, sequence, job.begin, job.end,
-                                           request.region, request.fields,
-                                           limits_.generation_threads));
-    return job;
-  }
-#endif
-  job.sampler = std::make_shared<const Sampler>(job.tree.lookup.tree, job.tree.surface,
-                                                job.tree.density, std::move(sequence));
-  ASSIGN_OR_RETURN(std::unique_ptr<SampleCursor> cursor,
-                   SampleCursor::Create(job.sampler, job.begin, job.end, request.region,
-                                        request.fields, limits_.generation_threads));
-  job.cursor = std::make_unique<SurfaceBatchCursor>(std::move(cursor));
+  CursorSpec cursor;
+  cursor.begin = job.begin;
+  cursor.end = job.end;
+  cursor.region = request.region;
+  cursor.fields = request.fields;
+  cursor.threads = limits_.generation_threads;
+  ASSIGN_OR_RETURN(job.cursor,
+                   job.tree.open_cursor(job.tree.lookup,
+                                        Sequence(request.sequence, request.count, request.seed), cursor));
   return job;
 }
 

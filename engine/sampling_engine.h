@@ -1,7 +1,7 @@
-// Turns a SampleRequest into a validated sampling job: resolves the specs,
-// checks every limit, gets the curve tree from a TreeSource and opens a
-// cursor over the requested part of the set. Shared by the embedded CLI and
-// the gRPC server.
+// Turns a SampleRequest into a validated sampling job: checks every limit,
+// has the spec's kind of surface (engine/surface_kind.h) resolve it, gets the
+// tree from a TreeSource and opens the kind's cursor over the requested part
+// of the set. Shared by the embedded CLI, the gRPC server and Python.
 //
 // Thread-safety: SamplingEngine is thread-safe (it holds only constants and a
 // thread-safe TreeSource). A Job is used by one thread at a time.
@@ -9,49 +9,43 @@
 #define SFCSAMPLER_ENGINE_SAMPLING_ENGINE_H_
 
 #include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
 
 #include "absl/status/statusor.h"
-#include "core/sampler.h"
 #include "engine/batch_cursor.h"
 #include "engine/loaded_models.h"
 #include "engine/model_source.h"
 #include "engine/sample_request.h"
+#include "engine/surface_kind.h"
 #include "engine/tree_key.h"
 #include "engine/tree_source.h"
 
 namespace sfc {
 
-// What a tree is over: a parametric surface (catalogue, expression; its
-// CurveTree is lookup.tree), a triangle mesh or a CAD model (lookup.any holds
-// its trees).
-enum class TreeKind { kSurface, kMesh, kCadModel };
-
-// "surface", "mesh", "model" (TreeInfo.kind).
-const char* TreeKindName(TreeKind kind);
-
 struct PreparedTree {
   TreeKey key;
   int grade = 0;
-  TreeKind kind = TreeKind::kSurface;
+  std::string_view kind = "surface";  // its SurfaceKind's name: TreeInfo.kind
   TreeLookup lookup;
-  // kSurface only.
-  std::shared_ptr<const Surface> surface;
-  std::shared_ptr<const Density> density;
+  CursorOpener open_cursor;  // how its kind samples it
 };
 
 struct SamplingJob {
   PreparedTree tree;
-  std::shared_ptr<const Sampler> sampler;  // kSurface only
   uint64_t begin = 0, end = 0;  // the resolved index range
   std::unique_ptr<BatchCursor> cursor;
 };
 
 class SamplingEngine {
  public:
-  // `source` and `models` are not owned and must outlive the engine. `models`
-  // resolves model specs (step:, obj:, ...): files for the embedded CLI, the
-  // upload store for the server; null refuses model specs.
-  SamplingEngine(EngineLimits limits, TreeSource* source, const ModelSource* models = nullptr);
+  // `kinds` (usually kinds/registered_kinds.h's), `source` and `models` are
+  // not owned and must outlive the engine. `models` resolves model specs
+  // (step:, obj:, ...): files for the embedded CLI, the upload store for the
+  // server; null refuses model specs.
+  SamplingEngine(const SurfaceKinds& kinds, EngineLimits limits, TreeSource* source,
+                 const ModelSource* models = nullptr);
 
   const EngineLimits& limits() const { return limits_; }
 
@@ -74,17 +68,21 @@ class SamplingEngine {
   // The parsed models (for statistics, and to forget an evicted upload's).
   LoadedModels& loaded_models() const { return *loaded_; }
 
- private:
-  absl::StatusOr<PreparedTree> PrepareModel(const ModelSpec& model, const TreeSpec& spec,
-                                            uint64_t count, const BuildControl& caller) const;
-
- public:
-  // The faces of the CAD model `spec` names, as a table (sfcsampler
-  // inspect). INVALID_ARGUMENT for a spec that is not a CAD model.
+  // The parts of the model `spec` names, as a table (sfcsampler inspect: a
+  // CAD model's faces). INVALID_ARGUMENT for a spec whose kind has no
+  // description.
   absl::StatusOr<std::string> DescribeModel(const std::string& spec) const;
 
  private:
+  // The kind that samples `spec`, and the stored model it names (if any).
+  struct SpecKind {
+    const SurfaceKind* kind = nullptr;
+    std::optional<StoredModel> model;
+  };
+  absl::StatusOr<SpecKind> KindOf(const std::string& spec) const;
+  KindContext Context(const BuildControl& caller) const;
 
+  const SurfaceKinds& kinds_;
   const EngineLimits limits_;
   TreeSource* const source_;
   const ModelSource* const models_;

@@ -1,4 +1,5 @@
 #include "fuzz/fuzz_job.h"
+#include "kinds/registered_kinds.h"
 
 #include <cmath>
 #include <cstdio>
@@ -45,7 +46,7 @@ EngineLimits SmallLimits() {
 
 void CheckRequest(const SampleRequest& request) {
   static DirectTreeSource* const source = new DirectTreeSource;
-  static const SamplingEngine* const engine = new SamplingEngine(SmallLimits(), source);
+  static const SamplingEngine* const engine = new SamplingEngine(RegisteredSurfaceKinds(), SmallLimits(), source);
 
   const auto range = SamplingEngine::ResolveRange(request);
   if (!range.ok()) CheckError(range.status(), request);

@@ -401,7 +401,7 @@ void ToProto(const PreparedTree& t, v1::TreeInfo* out) {
   out->set_grade(t.grade);
   out->set_cache_hit(t.lookup.cache_hit);
   out->set_refined(t.lookup.refined);
-  out->set_kind(TreeKindName(t.kind));
+  out->set_kind(std::string(t.kind));
   if (!t.lookup.tree) {  // a mesh's or a model's trees: their size only
     out->set_leaves(t.lookup.any->leaves());
     out->set_bytes(t.lookup.any->bytes());

@@ -5,6 +5,7 @@
 #include "absl/strings/str_format.h"
 #include "catalog/catalog.h"
 #include "core/status_macros.h"
+#include "kinds/registered_kinds.h"
 #include "proto/convert.h"
 #include "server/message_pipeline.h"
 #include "util/echo.h"
@@ -77,7 +78,7 @@ SamplerService::SamplerService(const ServerOptions& options, TreeCache* cache, M
       cache_(cache),
       models_(models),
       metrics_(metrics),
-      engine_(
+      engine_(RegisteredSurfaceKinds(),
           [&options] {
             EngineLimits limits = options.limits;
             limits.parse_failure_ttl_seconds = options.failure_ttl_seconds;

@@ -14,6 +14,7 @@
 #include "cad/load.h"
 #include "engine/sampling_engine.h"
 #include "evaluation/discrepancy.h"
+#include "kinds/registered_kinds.h"
 #include "gtest/gtest.h"
 #include "tests/engine_helpers.h"
 
@@ -38,7 +39,7 @@ struct Engine {
   DirectTreeSource source;
   FileModelSource files;
   SamplingEngine engine;
-  explicit Engine(int threads = 1) : engine(Limits(threads), &source, &files) {}
+  explicit Engine(int threads = 1) : engine(RegisteredSurfaceKinds(), Limits(threads), &source, &files) {}
   static EngineLimits Limits(int threads) {
     EngineLimits limits;
     limits.generation_threads = threads;

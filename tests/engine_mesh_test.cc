@@ -11,6 +11,7 @@
 
 #include "engine/sampling_engine.h"
 #include "gtest/gtest.h"
+#include "kinds/registered_kinds.h"
 #include "tests/engine_helpers.h"
 #include "mesh/icosphere.h"
 #include "mesh/mesh_writer.h"
@@ -57,7 +58,8 @@ TEST(EngineMesh, AFileAndItsHashGiveTheSameSamplesOnTheirTriangles) {
   FileModelSource files;
   MemoryModels store;
   const std::string by_hash = store.Add(ModelFormat::kPly, ply);
-  SamplingEngine local({}, &source, &files), remote({}, &source, &store);
+  SamplingEngine local(RegisteredSurfaceKinds(), {}, &source, &files);
+  SamplingEngine remote(RegisteredSurfaceKinds(), {}, &source, &store);
 
   const SampleBatch a = DrawAll(local, MeshRequest("ply:" + path, 5000));
   const SampleBatch b = DrawAll(remote, MeshRequest(by_hash, 5000));
@@ -87,7 +89,8 @@ TEST(EngineMesh, LargeBatchesOnTwoThreadsAreTheSameSamples) {
   FileModelSource files;
   EngineLimits one, two;
   one.generation_threads = 1, two.generation_threads = 2;
-  SamplingEngine a({one}, &source, &files), b({two}, &source, &files);
+  SamplingEngine a(RegisteredSurfaceKinds(), {one}, &source, &files);
+  SamplingEngine b(RegisteredSurfaceKinds(), {two}, &source, &files);
   SampleRequest r = MeshRequest("ply:" + path, 100000);
   r.tree.density = "mean:floor=0.1";
   r.fields.density = r.fields.curve_position = true;
@@ -118,7 +121,7 @@ TEST(EngineMesh, ADensityInXYZMovesSamplesWhereItIsLarger) {
   const std::string path = WriteTemp("engine_mesh_density.obj", MeshToObj(MakeIcosphere(3)));
   DirectTreeSource source;
   FileModelSource files;
-  SamplingEngine engine({}, &source, &files);
+  SamplingEngine engine(RegisteredSurfaceKinds(), {}, &source, &files);
   SampleRequest r = MeshRequest("obj:" + path, 20000);
   r.tree.density = "expr:1+3*(z>0)";
   const SampleBatch b = DrawAll(engine, r);
@@ -132,7 +135,7 @@ TEST(EngineMesh, ADensityInXYZMovesSamplesWhereItIsLarger) {
 TEST(EngineMesh, BadMeshSpecsAndFilesAreRefusedWithTheFileNamed) {
   DirectTreeSource source;
   FileModelSource files;
-  SamplingEngine engine({}, &source, &files);
+  SamplingEngine engine(RegisteredSurfaceKinds(), {}, &source, &files);
   const std::string truncated = WriteTemp("engine_mesh_truncated.ply",
                                           MeshToPly(MakeIcosphere(1), true).substr(0, 300));
   auto status = engine.Start(MeshRequest("ply:" + truncated, 10)).status();
@@ -151,7 +154,7 @@ TEST(EngineMesh, BadMeshSpecsAndFilesAreRefusedWithTheFileNamed) {
   r.fields.face = true;  // faces are CAD models'
   EXPECT_EQ(engine.Start(r).status().code(), absl::StatusCode::kInvalidArgument);
 
-  SamplingEngine no_models({}, &source);
+  SamplingEngine no_models(RegisteredSurfaceKinds(), {}, &source);
   EXPECT_EQ(no_models.Start(MeshRequest("obj:" + ok, 10)).status().code(),
             absl::StatusCode::kInvalidArgument);
 }
@@ -163,7 +166,7 @@ TEST(EngineMesh, PerVertexWeightsFromAPlyPropertyShiftTheSamples) {
   const std::string path = WriteTemp("engine_mesh_weights.ply", MeshToPly(sphere, false, "quality"));
   DirectTreeSource source;
   FileModelSource files;
-  SamplingEngine engine({}, &source, &files);
+  SamplingEngine engine(RegisteredSurfaceKinds(), {}, &source, &files);
   SampleRequest r = MeshRequest("ply:" + path, 20000);
   r.tree.density = "vertex:quality";
   const SampleBatch b = DrawAll(engine, r);

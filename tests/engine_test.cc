@@ -6,6 +6,7 @@
 
 #include "catalog/catalog.h"
 #include "core/builtin_surfaces.h"
+#include "kinds/registered_kinds.h"
 #include "gtest/gtest.h"
 
 namespace sfc {
@@ -14,7 +15,7 @@ namespace {
 absl::StatusOr<SamplingJob> StartWith(const std::string& surface, const std::string& density,
                                       uint64_t count, EngineLimits limits = {}) {
   static DirectTreeSource source;
-  SamplingEngine engine(limits, &source);
+  SamplingEngine engine(RegisteredSurfaceKinds(), limits, &source);
   SampleRequest r;
   r.tree.surface = surface;
   r.tree.density = density;
@@ -109,7 +110,7 @@ TEST(Engine, OverlongSpecIsInvalidArgument) {
 
 TEST(Engine, BadRangeShardOrRegionIsInvalidArgument) {
   DirectTreeSource source;
-  SamplingEngine engine({}, &source);
+  SamplingEngine engine(RegisteredSurfaceKinds(), {}, &source);
   SampleRequest r;
   r.count = 100;
   r.begin = 50;
@@ -131,7 +132,7 @@ TEST(Engine, BadRangeShardOrRegionIsInvalidArgument) {
 TEST(Engine, AModelSpecIsAModelNotAnUnknownSurface) {
   DirectTreeSource source;
   FileModelSource files;
-  SamplingEngine engine({}, &source, &files);
+  SamplingEngine engine(RegisteredSurfaceKinds(), {}, &source, &files);
   SampleRequest r;
   r.count = 10;
   r.tree.surface = "obj:/nonexistent/part.obj";
@@ -142,7 +143,7 @@ TEST(Engine, AModelSpecIsAModelNotAnUnknownSurface) {
 
 TEST(Engine, ATreeSizedForFewerSamplesThanTheSetIsRefused) {
   DirectTreeSource source;
-  SamplingEngine engine({}, &source);
+  SamplingEngine engine(RegisteredSurfaceKinds(), {}, &source);
   SampleRequest r;
   r.tree.surface = "plane";
   r.count = 5000;
@@ -158,7 +159,7 @@ TEST(Engine, UnorderedSequencesAreBoundedPerRequest) {
   DirectTreeSource source;
   EngineLimits limits;
   limits.max_sorted_range = 1000;
-  SamplingEngine engine(limits, &source);
+  SamplingEngine engine(RegisteredSurfaceKinds(), limits, &source);
   SampleRequest r;
   r.tree.surface = "plane";
   r.count = 5000;

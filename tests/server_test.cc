@@ -12,6 +12,7 @@
 #include "engine/model_source.h"
 #include "grpcpp/create_channel.h"
 #include "gtest/gtest.h"
+#include "kinds/registered_kinds.h"
 #include "server/sampler_server.h"
 #include "tests/server_test_util.h"
 
@@ -170,7 +171,7 @@ TEST(Server, AResumeOnAServerOfAnotherReleaseFailsInsteadOfMixingSets) {
 // All samples of a request from the embedded engine, in process.
 SampleBatch Embedded(const SampleRequest& request) {
   DirectTreeSource source;
-  SamplingEngine engine({}, &source);
+  SamplingEngine engine(RegisteredSurfaceKinds(), {}, &source);
   auto job = engine.Start(request);
   EXPECT_TRUE(job.ok()) << job.status();
   SampleBatch local;

@@ -24,6 +24,7 @@
 #include "core/status_macros.h"
 #include "engine/model_source.h"
 #include "engine/sampling_engine.h"
+#include "kinds/registered_kinds.h"
 
 namespace sfc {
 namespace {
@@ -378,7 +379,7 @@ int RunSampleMany(const SampleManyFlags& flags) {
   EngineLimits limits;
   // Models run side by side; one model alone may use up to four threads.
   limits.generation_threads = jobs > 1 ? 1 : static_cast<int>(std::min(4u, hardware));
-  SamplingEngine engine(limits, &source, &files);
+  SamplingEngine engine(RegisteredSurfaceKinds(), limits, &source, &files);
   job.engine = &engine;
   job.client = nullptr;
   std::unique_ptr<SamplerClient> client;

@@ -27,6 +27,7 @@
 #include "evaluation/discrepancy.h"
 #include "evaluation/plot.h"
 #include "evaluation/protocol.h"
+#include "kinds/registered_kinds.h"
 #include "render/render.h"
 #include "proto/convert.h"
 
@@ -197,7 +198,7 @@ absl::Status StreamSamples(const SampleRequest& request, const Connection& conn,
   DirectTreeSource source;
   EngineLimits limits;
   limits.generation_threads = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
-  SamplingEngine engine(limits, &source, &LocalModels());
+  SamplingEngine engine(RegisteredSurfaceKinds(), limits, &source, &LocalModels());
   progress->StartPhase("building the curve tree");
   auto job = engine.Start(request);
   progress->EndPhase();
@@ -294,7 +295,7 @@ int RunPrepare(const RequestFlags& flags, const Connection& conn) {
     return 0;
   }
   DirectTreeSource source;
-  SamplingEngine engine(EngineLimits{}, &source, &LocalModels());
+  SamplingEngine engine(RegisteredSurfaceKinds(), EngineLimits{}, &source, &LocalModels());
   const auto start = std::chrono::steady_clock::now();
   Progress progress(true);
   progress.StartPhase("building the curve tree");
@@ -363,7 +364,7 @@ int RunUpload(const std::vector<std::string>& specs, const Connection& conn) {
 // The faces of CAD models, read in process (the file is on this machine).
 int RunInspect(const std::vector<std::string>& specs) {
   DirectTreeSource source;
-  SamplingEngine engine(EngineLimits{}, &source, &LocalModels());
+  SamplingEngine engine(RegisteredSurfaceKinds(), EngineLimits{}, &source, &LocalModels());
   for (const std::string& spec : specs) {
     auto table = engine.DescribeModel(spec);
     if (!table.ok()) return Fail(table.status());
@@ -578,7 +579,7 @@ int RunRender(const RequestFlags& flags, const RenderFlags& r, const Connection&
           "without --server (the tree is the same), or draw samples"));
     }
     DirectTreeSource source;
-    SamplingEngine engine(EngineLimits{}, &source, &LocalModels());
+    SamplingEngine engine(RegisteredSurfaceKinds(), EngineLimits{}, &source, &LocalModels());
     auto job = engine.Start(*request);
     if (!job.ok()) return Fail(job.status());
     if (!job->tree.lookup.tree) {
@@ -587,7 +588,9 @@ int RunRender(const RequestFlags& flags, const RenderFlags& r, const Connection&
           "draw its samples (--what samples)"));
     }
     const CurveTree& tree = *job->tree.lookup.tree;
-    status = r.what == "curve" ? RenderCurve(tree, *job->tree.surface, view, r.output)
+    const auto surface = MakeSurface(request->tree.surface);  // the surface its tree is over
+    if (!surface.ok()) return Fail(surface.status());
+    status = r.what == "curve" ? RenderCurve(tree, *surface->surface, view, r.output)
                                : RenderParameterCurve(tree, view, r.output);
     if (status.ok()) {
       std::fprintf(stderr, "wrote %s (%s, %zu leaves)\n", r.output.c_str(), r.what.c_str(), tree.leaf_count());

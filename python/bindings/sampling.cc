@@ -15,6 +15,7 @@
 #include "core/curve.h"
 #include "core/vector_math.h"
 #include "engine/sampling_engine.h"
+#include "kinds/registered_kinds.h"
 #include "python/bindings/arrays.h"
 #include "python/bindings/errors.h"
 #include "python/bindings/memory_models.h"
@@ -157,7 +158,7 @@ class PyJob {
 class PyEngine {
  public:
   PyEngine(size_t max_trees, int threads)
-      : source_(max_trees), engine_(Limits(threads), &source_, &models_) {}
+      : source_(max_trees), engine_(RegisteredSurfaceKinds(), Limits(threads), &source_, &models_) {}
 
   std::string HoldModel(const std::string& format, const py::bytes& data, const std::string& name) {
     const auto parsed = ModelFormatFromName(format);

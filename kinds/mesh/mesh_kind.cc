@@ -1,4 +1,4 @@
-#include "engine/mesh_jobs.h"
+#include "kinds/mesh/mesh_kind.h"
 
 #include <utility>
 
@@ -101,8 +101,15 @@ uint64_t MeshSurfaceBytes(const MeshSurface& surface) {
          (k.gaussian.capacity() + k.mean.capacity() + k.mixed_area.capacity()) * sizeof(double);
 }
 
-}  // namespace
+struct MeshTreeRecipe {
+  std::string canonical_density;
+  TreeFactory factory;
+};
 
+// Parses `density` for a mesh, loads `model` (through `loaded`, on its parse
+// threads; `caller` is asked while the request waits) as that density needs
+// it, and returns how to build its tree. `tolerance` 0 takes the mesh tree's
+// default.
 absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::string& density,
                                            double tolerance, uint64_t max_leaves,
                                            LoadedModels* loaded,
@@ -149,15 +156,45 @@ absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::
   return recipe;
 }
 
-absl::StatusOr<std::unique_ptr<BatchCursor>> MeshCursor(const AnyTree& tree, Sequence sequence,
-                                                        uint64_t begin, uint64_t end,
-                                                        const Region& region,
-                                                        const SampleFields& fields, int threads) {
-  auto mesh_tree = TreeAs<MeshCurveTree>(&tree);
+absl::StatusOr<std::unique_ptr<BatchCursor>> OpenMeshCursor(const TreeLookup& lookup,
+                                                            Sequence sequence,
+                                                            const CursorSpec& spec) {
+  auto mesh_tree = TreeAs<MeshCurveTree>(lookup.any.get());
   if (!mesh_tree) return absl::InternalError("a mesh request found a tree of another kind");
   auto sampler = std::make_shared<const MeshSampler>(std::move(mesh_tree), std::move(sequence));
-  ASSIGN_OR_RETURN(auto cursor, MeshSampleCursor::Create(sampler, begin, end, region, fields, threads));
-  return std::make_unique<MeshBatchCursor>(std::move(cursor), fields.triangle);
+  ASSIGN_OR_RETURN(auto cursor, MeshSampleCursor::Create(sampler, spec.begin, spec.end, spec.region,
+                                                         spec.fields, spec.threads));
+  return std::make_unique<MeshBatchCursor>(std::move(cursor), spec.fields.triangle);
 }
+
+class MeshKind final : public SurfaceKind {
+ public:
+  const KindInfo& info() const override {
+    static const KindInfo* const info =
+        new KindInfo{"mesh", "a mesh surface (obj: or ply:)", {ModelFormat::kObj, ModelFormat::kPly},
+                     /*face_column=*/false, /*triangle_column=*/true};
+    return *info;
+  }
+
+  absl::StatusOr<ResolvedSurface> Resolve(const TreeSpec& spec, const StoredModel* model,
+                                          const KindContext& context) const override {
+    if (!model) return absl::InternalError("the mesh kind was given a spec that names no model");
+    ASSIGN_OR_RETURN(MeshTreeRecipe recipe,
+                     MeshTreeFor(*model, spec.density, spec.options.tolerance,
+                                 context.limits->max_tree_leaves, context.loaded, context.caller));
+    CurveTreeOptions options;  // a mesh's curve has no options but the tolerance
+    options.tolerance = spec.options.tolerance;
+    ResolvedSurface out;
+    out.key = MakeTreeKey(model->Spec(), recipe.canonical_density, options);
+    out.factory = std::move(recipe.factory);
+    out.open_cursor = OpenMeshCursor;
+    out.forget = [loaded = context.loaded, sha256 = model->sha256] { loaded->ForgetModel(sha256); };
+    return out;
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<const SurfaceKind> MakeMeshKind() { return std::make_unique<MeshKind>(); }
 
 }  // namespace sfc

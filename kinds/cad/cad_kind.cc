@@ -1,0 +1,123 @@
+#include "kinds/cad/cad_kind.h"
+
+#include <malloc.h>
+
+#include <algorithm>
+#include <utility>
+
+#include "absl/strings/str_format.h"
+#include "cad/load.h"
+#include "cad/model_sampler.h"
+#include "catalog/catalog.h"
+#include "core/status_macros.h"
+
+namespace sfc {
+namespace {
+
+// Heap bytes in use now (glibc), for what a parse keeps: OpenCASCADE's
+// objects have no size of their own to ask.
+uint64_t HeapInUse() {
+  const struct mallinfo2 info = mallinfo2();
+  return info.uordblks + info.hblkhd;
+}
+
+absl::StatusOr<cad::ModelFormat> CadFormat(ModelFormat format) {
+  switch (format) {
+    case ModelFormat::kStep: return cad::ModelFormat::kStep;
+    case ModelFormat::kIges: return cad::ModelFormat::kIges;
+    case ModelFormat::kNurbs: return cad::ModelFormat::kNurbs;
+    default: return absl::InternalError("the CAD kind was given a model of another format");
+  }
+}
+
+absl::StatusOr<std::shared_ptr<const cad::Model>> LoadCad(const StoredModel& model,
+                                                          LoadedModels* loaded,
+                                                          const std::function<absl::Status()>& caller) {
+  // The parse owns its inputs: it runs on a parse thread and may outlive the
+  // request that started it.
+  return loaded->Get<cad::Model>(
+      model.Spec(),
+      [model](const ParseCheck& check) -> absl::StatusOr<LoadedModels::Parsed> {
+        ASSIGN_OR_RETURN(const cad::ModelFormat format, CadFormat(model.format));
+        cad::LoadOptions options;
+        options.max_bytes = std::max<size_t>(options.max_bytes, model.bytes->size());
+        options.check = check;
+        const uint64_t before = HeapInUse();
+        ASSIGN_OR_RETURN(std::shared_ptr<const cad::Model> parsed,
+                         cad::Load(format, *model.bytes, model.name.empty() ? model.Spec() : model.name,
+                                   options));
+        const uint64_t after = HeapInUse();
+        // What the model holds: the heap's growth across the load (other
+        // threads' allocations make this approximate), at least 4 KiB a face.
+        const uint64_t bytes =
+            std::max<uint64_t>(after > before ? after - before : 0, 4096 * parsed->faces().size());
+        return LoadedModels::Parsed{std::move(parsed), bytes};
+      },
+      caller);
+}
+
+class CadBatchCursor final : public BatchCursor {
+ public:
+  explicit CadBatchCursor(std::unique_ptr<cad::ModelSampleCursor> cursor)
+      : cursor_(std::move(cursor)) {}
+  absl::StatusOr<size_t> Next(size_t max, SampleBatch* batch) override {
+    return cursor_->Next(max, batch);
+  }
+
+ private:
+  std::unique_ptr<cad::ModelSampleCursor> cursor_;
+};
+
+class CadKind final : public SurfaceKind {
+ public:
+  const KindInfo& info() const override {
+    static const KindInfo* const info = new KindInfo{
+        "model", "a CAD model surface (step:, iges: or nurbs:)",
+        {ModelFormat::kStep, ModelFormat::kIges, ModelFormat::kNurbs},
+        /*face_column=*/true, /*triangle_column=*/false, /*describes=*/true};
+    return *info;
+  }
+
+  absl::StatusOr<ResolvedSurface> Resolve(const TreeSpec& spec, const StoredModel* model,
+                                          const KindContext& context) const override {
+    if (!model) return absl::InternalError("the CAD kind was given a spec that names no model");
+    CurveTreeOptions options = spec.options;
+    options.max_leaves = context.limits->max_tree_leaves;
+    ASSIGN_OR_RETURN(DensityFromSpec density, MakeDensity(spec.density));
+    ASSIGN_OR_RETURN(std::shared_ptr<const cad::Model> cad_model,
+                     LoadCad(*model, context.loaded, context.caller));
+    ResolvedSurface out;
+    out.key = MakeTreeKey(model->Spec(), density.canonical, options);
+    out.factory.build = [cad_model, density = density.density, options](
+                            int grade, const BuildControl& control) -> TreeFactory::Result {
+      ASSIGN_OR_RETURN(std::shared_ptr<const cad::ModelTree> tree,
+                       cad::ModelTree::Build(cad_model, density, options, uint64_t{1} << grade, control));
+      const uint64_t bytes = tree->bytes(), leaves = tree->leaf_count();
+      return std::make_shared<const TypedTree<cad::ModelTree>>(std::move(tree), bytes, leaves);
+    };
+    out.open_cursor = [](const TreeLookup& lookup, Sequence sequence,
+                         const CursorSpec& spec) -> absl::StatusOr<std::unique_ptr<BatchCursor>> {
+      auto model_tree = TreeAs<cad::ModelTree>(lookup.any.get());
+      if (!model_tree) return absl::InternalError("a CAD request found a tree of another kind");
+      ASSIGN_OR_RETURN(auto cursor,
+                       cad::ModelSampleCursor::Create(std::move(model_tree), sequence, spec.begin,
+                                                      spec.end, spec.region, spec.fields, spec.threads));
+      return std::make_unique<CadBatchCursor>(std::move(cursor));
+    };
+    out.forget = [loaded = context.loaded, sha256 = model->sha256] { loaded->ForgetModel(sha256); };
+    return out;
+  }
+
+  absl::StatusOr<std::string> Describe(const StoredModel& model,
+                                       const KindContext& context) const override {
+    ASSIGN_OR_RETURN(std::shared_ptr<const cad::Model> cad_model,
+                     LoadCad(model, context.loaded, context.caller));
+    return cad::DescribeModel(*cad_model);
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<const SurfaceKind> MakeCadKind() { return std::make_unique<CadKind>(); }
+
+}  // namespace sfc

@@ -1,0 +1,113 @@
+// The seam for kinds of surface (engine/surface_kind.h): the engine samples
+// whatever kinds it is given and refuses the rest with a clear error, and a
+// new kind needs no change to the engine.
+#include "engine/surface_kind.h"
+
+#include <algorithm>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "engine/sampling_engine.h"
+#include "gtest/gtest.h"
+#include "kinds/formula/formula_kind.h"
+#include "kinds/registered_kinds.h"
+#include "tests/engine_helpers.h"
+
+namespace sfc {
+namespace {
+
+SurfaceKinds FormulaOnly() {
+  std::vector<std::unique_ptr<const SurfaceKind>> kinds;
+  kinds.push_back(MakeFormulaKind());
+  return SurfaceKinds(std::move(kinds));
+}
+
+void ExpectError(const absl::Status& status, absl::StatusCode code, const std::string& mentions) {
+  EXPECT_EQ(status.code(), code) << status;
+  EXPECT_NE(status.message().find(mentions), std::string::npos)
+      << "message \"" << status.message() << "\" should mention \"" << mentions << "\"";
+}
+
+TEST(SurfaceKinds, AModelWithoutItsKindIsRefusedByName) {
+  const SurfaceKinds kinds = FormulaOnly();
+  DirectTreeSource source;
+  FileModelSource files;
+  SamplingEngine engine(kinds, {}, &source, &files);
+  SampleRequest r;
+  r.count = 100;
+  r.tree.surface = "step:" + WriteTemp("kindless.step", "ISO-10303-21;");
+  ExpectError(engine.Start(r).status(), absl::StatusCode::kUnimplemented, "step:");
+  r.tree.surface = "sphere";
+  r.fields.face = true;
+  ExpectError(engine.Start(r).status(), absl::StatusCode::kInvalidArgument,
+              "face column needs a kind of surface this build does not have");
+  ExpectError(engine.DescribeModel("step:part.step").status(), absl::StatusCode::kUnimplemented,
+              "inspect");
+  r.fields.face = false;
+  EXPECT_EQ(DrawAll(engine, r).size(), 100u);  // its own kind still works
+}
+
+TEST(SurfaceKinds, TheRegisteredKindsAreEachFoundForTheirSpecs) {
+  const SurfaceKinds& kinds = RegisteredSurfaceKinds();
+  const SurfaceKind* formula = kinds.For(std::nullopt);
+  ASSERT_NE(formula, nullptr);
+  EXPECT_EQ(formula->info().name, "surface");
+  for (const ModelFormat format : {ModelFormat::kStep, ModelFormat::kIges, ModelFormat::kNurbs,
+                                   ModelFormat::kObj, ModelFormat::kPly}) {
+    const SurfaceKind* kind = kinds.For(ModelSpec{format, "x", ""});
+    if (!kind) continue;  // a build without that kind
+    EXPECT_NE(kind, formula);
+    const auto& formats = kind->info().formats;
+    EXPECT_NE(std::find(formats.begin(), formats.end(), format), formats.end());
+  }
+}
+
+// A kind the engine has never heard of: "ply:" files sampled as the unit
+// square, whatever they hold. It only forwards to the formula kind.
+class SquareFromPlyKind final : public SurfaceKind {
+ public:
+  const KindInfo& info() const override {
+    static const KindInfo* const info = new KindInfo{"square", "a square", {ModelFormat::kPly}};
+    return *info;
+  }
+  absl::StatusOr<ResolvedSurface> Resolve(const TreeSpec& spec, const StoredModel* model,
+                                          const KindContext& context) const override {
+    if (!model) return absl::InternalError("no model");
+    TreeSpec plane = spec;
+    plane.surface = "plane";
+    return formula_->Resolve(plane, nullptr, context);
+  }
+
+ private:
+  std::unique_ptr<const SurfaceKind> formula_ = MakeFormulaKind();
+};
+
+TEST(SurfaceKinds, ANewKindIsSampledWithoutChangingTheEngine) {
+  std::vector<std::unique_ptr<const SurfaceKind>> list;
+  list.push_back(MakeFormulaKind());
+  list.push_back(std::make_unique<SquareFromPlyKind>());
+  const SurfaceKinds kinds(std::move(list));
+  DirectTreeSource source;
+  FileModelSource files;
+  SamplingEngine engine(kinds, {}, &source, &files);
+  SampleRequest r;
+  r.count = 1000;
+  r.seed = 7;
+  r.tree.surface = "ply:" + WriteTemp("anything.ply", "not a mesh at all");
+  auto prepared = engine.Prepare(r.tree, r.count);
+  ASSERT_TRUE(prepared.ok()) << prepared.status();
+  EXPECT_EQ(prepared->kind, "square");  // named by its kind (TreeInfo.kind)
+  const SampleBatch square = DrawAll(engine, r);
+  r.tree.surface = "plane";
+  const SampleBatch plane = DrawAll(engine, r);
+  ASSERT_EQ(square.size(), 1000u);
+  EXPECT_EQ(square.x, plane.x);  // the same tree and placement, reached through the new kind
+  EXPECT_EQ(square.y, plane.y);
+  r.fields.triangle = true;  // a column the new kind does not fill
+  r.tree.surface = "ply:" + WriteTemp("anything.ply", "not a mesh at all");
+  EXPECT_EQ(engine.Start(r).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace sfc
