@@ -48,6 +48,8 @@
 #include "grpcpp/create_channel.h"
 #include "kinds/registered_kinds.h"
 #include "proto/convert.h"
+#include "request/index_range.h"
+#include "request/routing_key.h"
 
 namespace sfc {
 namespace {
@@ -335,7 +337,7 @@ class Worker {
     }
     // Without a region the count is known; the client library already checked
     // it against the header and the server's trailer, check it here again.
-    const auto range = SamplingEngine::ResolveRange(request);
+    const auto range = ResolveIndexRange(request);
     if (request.region.kind == Region::Kind::kAll &&
         summary->received != range->second - range->first) {
       Report("complete", grpc::StatusCode::DATA_LOSS, false,
@@ -373,7 +375,7 @@ class Worker {
                                                               uint32_t batch_size) {
     v1::SampleRequest wire = ToProto(request);
     wire.set_batch_size(batch_size);
-    context->AddMetadata("x-surface-key", SamplerClient::SurfaceKey(request.tree));
+    context->AddMetadata("x-surface-key", RoutingKey(request.tree));
     return stub_->Sample(context, wire);
   }
 

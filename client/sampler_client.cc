@@ -6,15 +6,15 @@
 #include <thread>
 
 #include "absl/strings/str_format.h"
-#include "catalog/catalog.h"
-#include "engine/model_source.h"
-#include "engine/tree_key.h"
 #include "grpc/grpc.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "grpcpp/client_context.h"
 #include "grpcpp/create_channel.h"
 #include "grpcpp/security/credentials.h"
 #include "proto/convert.h"
+#include "request/index_range.h"
+#include "request/model_spec.h"
+#include "request/routing_key.h"
 
 namespace sfc {
 namespace {
@@ -93,22 +93,6 @@ absl::StatusOr<std::unique_ptr<SamplerClient>> SamplerClient::Connect(const Clie
   return std::unique_ptr<SamplerClient>(new SamplerClient(options, std::move(channel)));
 }
 
-std::string SamplerClient::SurfaceKey(const TreeSpec& spec) {
-  // A model routes by itself, not by its tree: its bytes are stored on the
-  // replica that its FindModel and UploadModel reached.
-  if (auto model = ParseModelSpec(spec.surface); model.ok() && model->has_value() &&
-                                                 !(*model)->sha256.empty()) {
-    return ModelRoutingKey((*model)->format, (*model)->sha256);
-  }
-  auto surface = MakeSurface(spec.surface);
-  auto density = MakeDensity(spec.density);
-  if (surface.ok() && density.ok()) {
-    return MakeTreeKey(surface->canonical, density->canonical, spec.options).Hex();
-  }
-  // The server will reject the spec; any stable key routes the error.
-  return absl::StrFormat("%016x", Fnv1a64(spec.surface + "|" + spec.density));
-}
-
 void SamplerClient::Decorate(grpc::ClientContext* context, const std::string& surface_key) const {
   if (!options_.token.empty()) context->AddMetadata("authorization", "Bearer " + options_.token);
   context->AddMetadata("x-surface-key", surface_key);
@@ -140,11 +124,11 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
   auto surface = EnsureModel(asked.tree.surface);
   if (!surface.ok()) return surface.status();
   request.tree.surface = *std::move(surface);
-  const std::string key = SurfaceKey(request.tree);
+  const std::string key = RoutingKey(request.tree);
   const auto asked_model = ParseModelSpec(asked.tree.surface);
   const bool from_file =
       asked_model.ok() && asked_model->has_value() && (*asked_model)->sha256.empty();
-  const bool monotone = Sequence(request.sequence, 1, 0).monotone();
+  const bool monotone = SequenceIsMonotone(request.sequence);
   StreamSummary summary;
   bool have_header = false;
   // What to ask for next: monotone sets resume at the index after the last
@@ -255,7 +239,7 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
       if (!again.ok()) return again.status();
     }
     if (monotone && summary.received > 0) {
-      const auto range = SamplingEngine::ResolveRange(request);
+      const auto range = ResolveIndexRange(request);
       if (!range.ok()) return range.status();
       next = Range(request, last_index + 1, range->second);
     } else if (!monotone) {
@@ -273,7 +257,7 @@ absl::StatusOr<v1::PrepareResponse> SamplerClient::Prepare(const TreeSpec& asked
   *request.mutable_tree() = ToProto(spec);
   request.set_count(count);
   grpc::ClientContext context;
-  Decorate(&context, SurfaceKey(spec));
+  Decorate(&context, RoutingKey(spec));
   v1::PrepareResponse response;
   const grpc::Status status = stub_->Prepare(&context, request, &response);
   if (!status.ok()) return FromGrpcStatus(status);
@@ -334,8 +318,7 @@ absl::StatusOr<std::string> SamplerClient::EnsureModel(const std::string& spec) 
   std::string sha256 = model_spec.sha256;
   StoredModel local;
   if (sha256.empty()) {
-    FileModelSource files;
-    auto read = files.Resolve(model_spec);
+    auto read = ReadModelFile(model_spec, kMaxModelFileBytes);
     if (!read.ok()) return read.status();
     local = *std::move(read);
     sha256 = local.sha256;

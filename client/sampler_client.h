@@ -25,8 +25,8 @@
 
 #include "absl/status/statusor.h"
 #include "core/sample_batch.h"
-#include "engine/sample_request.h"
 #include "grpcpp/channel.h"
+#include "request/sample_request.h"
 #include "sfcsampler/v1/sampler.grpc.pb.h"
 
 namespace sfc {
@@ -89,10 +89,6 @@ class SamplerClient {
   static SampleRequest Range(SampleRequest request, uint64_t begin, uint64_t end);
   static SampleRequest Shard(SampleRequest request, uint64_t i, uint64_t k);
 
-  // The routing key sent in x-surface-key: the tree key the server will use
-  // for `spec`, or for a model named by hash (FORMAT:sha256=HEX) the model's
-  // ModelRoutingKey, which FindModel and UploadModel of that model send too.
-  static std::string SurfaceKey(const TreeSpec& spec);
 
  private:
   explicit SamplerClient(const ClientOptions& options, std::shared_ptr<grpc::Channel> channel);

@@ -156,26 +156,5 @@ absl::StatusOr<double> TriangleMass(const Surface& surface, const Density& densi
   return d.delta * TriangleArea(a, b, c);
 }
 
-std::string_view AreaEstimatorName(AreaEstimator e) {
-  switch (e) {
-    case AreaEstimator::kTriangle:
-      return "triangle";
-    case AreaEstimator::kSquare:
-      return "square";
-    case AreaEstimator::kFirstFundamentalForm:
-      return "fff";
-    case AreaEstimator::kQuadrature:
-      return "quadrature";
-  }
-  return "fff";
-}
-
-std::optional<AreaEstimator> AreaEstimatorFromName(std::string_view name) {
-  for (AreaEstimator e : {AreaEstimator::kTriangle, AreaEstimator::kSquare,
-                          AreaEstimator::kFirstFundamentalForm, AreaEstimator::kQuadrature}) {
-    if (name == AreaEstimatorName(e)) return e;
-  }
-  return std::nullopt;
-}
 
 }  // namespace sfc

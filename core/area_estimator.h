@@ -13,18 +13,10 @@
 #include "absl/status/statusor.h"
 #include "core/density.h"
 #include "core/surface.h"
+#include "core/tree_options.h"
 
 namespace sfc {
 
-enum class AreaEstimator {
-  kTriangle,               // (a) area of f(v_{l-1}) f(v_l) f(v_{l+1}) x delta at its centroid
-  kSquare,                 // (b) area of the mapped cell (two triangles) x delta at the centre
-  kFirstFundamentalForm,   // (c) delta sqrt(EG - F^2) at the centre x cell area: the reference
-  kQuadrature,             // (c) integrated by 3x3 Gauss-Legendre over the cell
-};
-
-std::string_view AreaEstimatorName(AreaEstimator e);  // "triangle", "square", "fff", "quadrature"
-std::optional<AreaEstimator> AreaEstimatorFromName(std::string_view name);
 
 // INVALID_ARGUMENT saying the surface is not finite at (u, v) and what to fix.
 absl::Status SurfaceNotFiniteError(double u, double v);

@@ -238,23 +238,5 @@ const Curve& Curve::Get(CurveType type) {
   return *kCurves[static_cast<int>(type)];
 }
 
-std::string_view CurveName(CurveType type) {
-  switch (type) {
-    case CurveType::kHilbert:
-      return "hilbert";
-    case CurveType::kHilbert2:
-      return "hilbert2";
-    case CurveType::kPeano:
-      return "peano";
-  }
-  return "hilbert";
-}
-
-std::optional<CurveType> CurveFromName(std::string_view name) {
-  for (CurveType t : {CurveType::kHilbert, CurveType::kHilbert2, CurveType::kPeano}) {
-    if (name == CurveName(t)) return t;
-  }
-  return std::nullopt;
-}
 
 }  // namespace sfc

@@ -23,17 +23,10 @@
 #include <vector>
 
 #include "core/hilbert_batch.h"
+#include "core/tree_options.h"
 
 namespace sfc {
 
-enum class CurveType {
-  kHilbert,   // 2x2, w = 4
-  kHilbert2,  // "Hilbert II": 3x3 meander from a corner to an adjacent corner, no axis of symmetry
-  kPeano,     // 3x3 serpentine from a corner to the opposite corner
-};
-
-std::string_view CurveName(CurveType type);              // "hilbert", "hilbert2", "peano"
-std::optional<CurveType> CurveFromName(std::string_view name);
 
 class Curve {
  public:

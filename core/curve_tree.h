@@ -65,24 +65,10 @@
 #include "core/leaf_model.h"
 #include "core/pod_array.h"
 #include "core/surface.h"
+#include "core/tree_options.h"
 
 namespace sfc {
 
-struct CurveTreeOptions {
-  CurveType curve = CurveType::kHilbert;
-  AreaEstimator estimator = AreaEstimator::kFirstFundamentalForm;
-  // The paper's a, in surface units; 0 means automatic: 1% of the diagonal of
-  // the surface's bounding box (measured on a 17 x 17 parameter grid).
-  double tolerance = 0;
-  // The paper's r; 0 means the curve's deepest level (31 Hilbert, 20 3x3).
-  int depth_cap = 0;
-  // Scales the model-error allowance (see the file comment); > 0. Larger
-  // values trade accuracy for a smaller tree.
-  double rho = 1.0;
-  // Budget: building or refining past this many leaves is RESOURCE_EXHAUSTED.
-  // The default, 2^22 leaves at 73 bytes, is 306 MB (292 MiB).
-  uint64_t max_leaves = uint64_t{1} << 22;
-};
 
 // Where the depth cap stopped a split that a test still wanted (paper Sect. 5.3).
 struct DepthCapHit {

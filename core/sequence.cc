@@ -76,28 +76,5 @@ void Sequence::AtMany(uint64_t k0, size_t n, double* out) const {
   }
 }
 
-std::string_view SequenceName(SequenceKind kind) {
-  switch (kind) {
-    case SequenceKind::kJittered:
-      return "jittered";
-    case SequenceKind::kEqual:
-      return "equal";
-    case SequenceKind::kRandom:
-      return "random";
-    case SequenceKind::kVanDerCorput:
-      return "vandercorput";
-    case SequenceKind::kProgressive:
-      return "progressive";
-  }
-  return "jittered";
-}
-
-std::optional<SequenceKind> SequenceFromName(std::string_view name) {
-  for (SequenceKind k : {SequenceKind::kJittered, SequenceKind::kEqual, SequenceKind::kRandom,
-                         SequenceKind::kVanDerCorput, SequenceKind::kProgressive}) {
-    if (name == SequenceName(k)) return k;
-  }
-  return std::nullopt;
-}
 
 }  // namespace sfc

@@ -14,19 +14,10 @@
 #include <utility>
 #include <vector>
 
+#include "core/sequence_kind.h"
+
 namespace sfc {
 
-enum class SequenceKind {
-  kJittered,      // q_k = (k + U_k) / N: the paper's method of choice (default)
-  kEqual,         // q_k = (k + 1/2) / N
-  kRandom,        // q_k = U'_k, independent uniforms
-  kVanDerCorput,  // q_k = base-2 radical inverse of k
-  kProgressive,   // Owen-scrambled base-2 radical inverse: every prefix of
-                  // length 2^m puts exactly one q in each [j/2^m, (j+1)/2^m)
-};
-
-std::string_view SequenceName(SequenceKind kind);  // "jittered", "equal", ...
-std::optional<SequenceKind> SequenceFromName(std::string_view name);
 
 class Sequence {
  public:
@@ -40,7 +31,7 @@ class Sequence {
 
   // True when q_k is non-decreasing in k, so index order is curve order and an
   // index range is a contiguous stretch of the curve.
-  bool monotone() const { return kind_ == SequenceKind::kJittered || kind_ == SequenceKind::kEqual; }
+  bool monotone() const { return SequenceIsMonotone(kind_); }
 
   // q_k in [0,1]. REQUIRES: k < count() (the radical-inverse kinds accept any
   // k < 2^32: they do not depend on count). For a window, (q_k - lo)/(hi - lo).

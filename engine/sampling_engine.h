@@ -15,12 +15,13 @@
 
 #include "absl/status/statusor.h"
 #include "engine/batch_cursor.h"
+#include "engine/engine_limits.h"
 #include "engine/loaded_models.h"
 #include "engine/model_source.h"
-#include "engine/sample_request.h"
 #include "engine/surface_kind.h"
-#include "engine/tree_key.h"
 #include "engine/tree_source.h"
+#include "request/sample_request.h"
+#include "request/tree_key.h"
 
 namespace sfc {
 
@@ -62,8 +63,6 @@ class SamplingEngine {
   absl::StatusOr<SamplingJob> Start(const SampleRequest& request,
                                     const BuildControl& caller = {}) const;
 
-  // The index range [begin, end) a request selects (before its region).
-  static absl::StatusOr<std::pair<uint64_t, uint64_t>> ResolveRange(const SampleRequest& request);
 
   // The parsed models (for statistics, and to forget an evicted upload's).
   LoadedModels& loaded_models() const { return *loaded_; }

@@ -21,10 +21,11 @@
 #include "core/sample_batch.h"
 #include "core/sequence.h"
 #include "engine/batch_cursor.h"
+#include "engine/engine_limits.h"
 #include "engine/loaded_models.h"
 #include "engine/model_source.h"
-#include "engine/sample_request.h"
-#include "engine/tree_key.h"
+#include "request/sample_request.h"
+#include "request/tree_key.h"
 #include "engine/tree_source.h"
 
 namespace sfc {

@@ -9,7 +9,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/curve_tree.h"
-#include "engine/tree_key.h"
+#include "request/tree_key.h"
 
 namespace sfc {
 

@@ -1,5 +1,4 @@
 #include "fuzz/fuzz_job.h"
-#include "kinds/registered_kinds.h"
 
 #include <cmath>
 #include <cstdio>
@@ -48,7 +47,7 @@ void CheckRequest(const SampleRequest& request) {
   static DirectTreeSource* const source = new DirectTreeSource;
   static const SamplingEngine* const engine = new SamplingEngine(RegisteredSurfaceKinds(), SmallLimits(), source);
 
-  const auto range = SamplingEngine::ResolveRange(request);
+  const auto range = ResolveIndexRange(request);
   if (!range.ok()) CheckError(range.status(), request);
   auto job = engine->Start(request);
   if (!job.ok()) {

@@ -5,7 +5,7 @@
 #ifndef SFCSAMPLER_FUZZ_FUZZ_JOB_H_
 #define SFCSAMPLER_FUZZ_FUZZ_JOB_H_
 
-#include "engine/sample_request.h"
+#include "request/sample_request.h"
 #include "engine/sampling_engine.h"
 
 namespace sfc::fuzz {

@@ -1,5 +1,6 @@
-// Conversions between the sfcsampler.v1 wire types and the engine's types,
-// shared by the server and the client library so both sides agree exactly.
+// Conversions between the sfcsampler.v1 wire types and the request library's
+// types, shared by the server and the client library so both sides agree
+// exactly (what only a sampler has is in proto/service_convert.h).
 // Also the one place that maps absl::Status to and from grpc::Status.
 // Thread-safety: pure functions.
 #ifndef SFCSAMPLER_PROTO_CONVERT_H_
@@ -7,11 +8,9 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "catalog/catalog.h"
 #include "core/sample_batch.h"
-#include "engine/sample_request.h"
-#include "engine/sampling_engine.h"
 #include "grpcpp/support/status.h"
+#include "request/sample_request.h"
 #include "sfcsampler/v1/sampler.pb.h"
 
 namespace sfc {
@@ -43,9 +42,6 @@ uint32_t MaxSamplesPerMessage(const SampleFields& fields, v1::Precision precisio
 // uses (a raw column is one memcpy on little-endian hosts). DATA_LOSS when a
 // column has the wrong length or a requested column is missing.
 absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fields, SampleBatch* out);
-
-void ToProto(const PreparedTree& tree, v1::TreeInfo* out);
-void ToProto(const CatalogEntry& entry, v1::CatalogEntry* out);
 
 // The longest status message the server sends, in bytes; longer ones are
 // clipped by ToGrpcStatus (util/echo.h ClipMessage).

@@ -6,7 +6,9 @@
 #include "catalog/catalog.h"
 #include "core/status_macros.h"
 #include "kinds/registered_kinds.h"
+#include "request/index_range.h"
 #include "proto/convert.h"
+#include "proto/service_convert.h"
 #include "server/message_pipeline.h"
 #include "util/echo.h"
 #include "spdlog/spdlog.h"
@@ -54,7 +56,7 @@ BuildControl RequestControl(const grpc::ServerContext* context, Clock::time_poin
 // Start refuses it.
 uint64_t StreamWorkingBytes(const SampleRequest& request, const v1::SampleRequest& wire,
                             int pipeline_depth) {
-  const auto range = SamplingEngine::ResolveRange(request);
+  const auto range = ResolveIndexRange(request);
   const uint64_t n = range.ok() ? range->second - range->first : 0;
   const uint64_t sort = Sequence(request.sequence, 1, 0).monotone() ? 0 : 16 * n;
   const SampleFields& f = request.fields;

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "engine/sample_request.h"
+#include "request/sample_request.h"
 
 namespace sfc {
 

@@ -7,6 +7,8 @@
 #include "catalog/catalog.h"
 #include "core/builtin_surfaces.h"
 #include "kinds/registered_kinds.h"
+#include "request/index_range.h"
+#include "request/routing_key.h"
 #include "gtest/gtest.h"
 
 namespace sfc {
@@ -177,7 +179,7 @@ TEST(Engine, ShardsPartitionTheIndexRange) {
   uint64_t expected_begin = 0;
   for (uint64_t i = 0; i < 8; ++i) {
     r.shard_index = i;
-    auto range = SamplingEngine::ResolveRange(r);
+    auto range = ResolveIndexRange(r);
     ASSERT_TRUE(range.ok());
     EXPECT_EQ(range->first, expected_begin);
     expected_begin = range->second;
@@ -241,6 +243,32 @@ TEST(Surfaces, CurvaturesOfTheSphereAndTorusMatchTheirFormulas) {
   auto torus = MakeTorus(big_r, r);
   EXPECT_NEAR(GeometryOf(torus->Jet(0.7, v, 2)).gaussian_curvature,
               std::cos(b) / (r * (big_r + r * std::cos(b))), 1e-10);
+}
+
+// The client routes by the tree key of the specs as written (no catalogue in
+// the client): that is the server's own tree key when they are canonical, and
+// whitespace does not change it.
+TEST(Engine, TheRoutingKeyOfCanonicalSpecsIsTheTreeKey) {
+  DirectTreeSource source;
+  SamplingEngine engine(RegisteredSurfaceKinds(), {}, &source);
+  for (const char* surface : {"torus:R=2;r=0.5", "superellipsoid:e=1/3", "expr:x=u;y=v;z=u*v"}) {
+    TreeSpec spec;
+    spec.surface = surface;
+    spec.density = "gaussian:floor=0.1";
+    spec.options.curve = CurveType::kPeano;
+    auto prepared = engine.Prepare(spec, 1000);
+    ASSERT_TRUE(prepared.ok()) << prepared.status();
+    TreeSpec canonical = spec;
+    canonical.surface = MakeSurface(spec.surface)->canonical;
+    canonical.density = MakeDensity(spec.density)->canonical;
+    EXPECT_EQ(RoutingKey(canonical), prepared->key.Hex()) << surface;
+    TreeSpec spaced = canonical;
+    spaced.surface = " " + canonical.surface + " ";
+    spaced.surface.insert(spaced.surface.find(':') + 1, "  ");
+    EXPECT_EQ(RoutingKey(spaced), RoutingKey(canonical)) << surface;
+    spaced.options.curve = CurveType::kHilbert;  // another tree, another key
+    EXPECT_NE(RoutingKey(spaced), RoutingKey(canonical)) << surface;
+  }
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include "engine/model_source.h"
 #include "gtest/gtest.h"
 #include "proto/convert.h"
+#include "request/routing_key.h"
 #include "server/sampler_server.h"
 #include "tests/server_test_util.h"
 
@@ -100,11 +101,11 @@ TEST(ServerModels, EveryRequestAboutAModelCarriesTheModelsRoutingKey) {
   EXPECT_EQ(key, "obj:sha256=" + sha);
   TreeSpec spec;
   spec.surface = "obj:sha256=" + sha;
-  EXPECT_EQ(SamplerClient::SurfaceKey(spec), key);
+  EXPECT_EQ(RoutingKey(spec), key);
   spec.density = "expr:1+x*x";
-  EXPECT_EQ(SamplerClient::SurfaceKey(spec), key);
+  EXPECT_EQ(RoutingKey(spec), key);
   spec.surface = "sphere";
-  EXPECT_NE(SamplerClient::SurfaceKey(spec), key);
+  EXPECT_NE(RoutingKey(spec), key);
 }
 
 

@@ -11,7 +11,7 @@
 #include <thread>
 
 #include "catalog/catalog.h"
-#include "engine/tree_key.h"
+#include "request/tree_key.h"
 #include "gtest/gtest.h"
 
 namespace sfc {

@@ -7,7 +7,7 @@
 
 #include "CLI/CLI.hpp"
 #include "absl/status/statusor.h"
-#include "engine/sample_request.h"
+#include "request/sample_request.h"
 
 namespace sfc {
 

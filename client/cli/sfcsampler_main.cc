@@ -30,6 +30,7 @@
 #include "kinds/registered_kinds.h"
 #include "render/render.h"
 #include "proto/convert.h"
+#include "proto/service_convert.h"
 
 namespace sfc {
 namespace {

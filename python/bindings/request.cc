@@ -5,7 +5,8 @@
 #include "core/curve.h"
 #include "core/sequence.h"
 #include "engine/sampling_engine.h"
-#include "engine/tree_key.h"
+#include "request/index_range.h"
+#include "request/routing_key.h"
 #include "python/bindings/errors.h"
 #include "python/bindings/register.h"
 
@@ -26,17 +27,6 @@ std::string ShardText(const py::object& shard) {
   }
   throw StatusException(
       absl::InvalidArgumentError("shard takes \"i/K\" or a pair (i, K) with 0 <= i < K"));
-}
-
-// The tree key a server will use, as the C++ client sends it in
-// x-surface-key (client/sampler_client.cc, SamplerClient::SurfaceKey).
-std::string SurfaceKey(const TreeSpec& spec) {
-  auto surface = MakeSurface(spec.surface);
-  auto density = MakeDensity(spec.density);
-  if (surface.ok() && density.ok()) {
-    return MakeTreeKey(surface->canonical, density->canonical, spec.options).Hex();
-  }
-  return absl::StrFormat("%016x", Fnv1a64(spec.surface + "|" + spec.density));
 }
 
 PyRequest MakeRequest(std::string surface, std::string density, std::string curve,
@@ -154,8 +144,8 @@ Raises sfcsampler.InvalidArgumentError for malformed values.)doc")
       .def_property_readonly("face", [](const PyRequest& r) { return r.request.fields.face; })
       .def_property_readonly("triangle", [](const PyRequest& r) { return r.request.fields.triangle; })
       .def_property_readonly(
-          "surface_key", [](const PyRequest& r) { return SurfaceKey(r.request.tree); },
-          "the tree key (16 hex digits) sent as x-surface-key for consistent-hash proxies")
+          "surface_key", [](const PyRequest& r) { return RoutingKey(r.request.tree); },
+          "the routing key sent as x-surface-key for consistent-hash proxies (request/routing_key.h)")
       .def_property_readonly(
           "monotone",
           [](const PyRequest& r) { return Sequence(r.request.sequence, 1, 0).monotone(); },
@@ -163,7 +153,7 @@ Raises sfcsampler.InvalidArgumentError for malformed values.)doc")
       .def_property_readonly(
           "index_range",
           [](const PyRequest& r) {
-            auto range = SamplingEngine::ResolveRange(r.request);
+            auto range = ResolveIndexRange(r.request);
             ThrowIfError(range.status());
             return py::make_tuple(range->first, range->second);
           },

@@ -7,7 +7,7 @@
 #define SFCSAMPLER_PYTHON_BINDINGS_REQUEST_H_
 
 #include "client/cli/request_flags.h"
-#include "engine/sample_request.h"
+#include "request/sample_request.h"
 #include "pybind11/pybind11.h"
 
 namespace sfc::python {

@@ -2,7 +2,7 @@
 
 Speaks sfcsampler.v1 (proto/sfcsampler/v1/sampler.proto) through Debian's
 python3-grpcio with stubs generated from our proto at build time. Like the
-C++ client (client/sampler_client.h) it sends x-surface-key (the tree key)
+C++ client (client/sampler_client.h) it sends x-surface-key (request/routing_key.h)
 for consistent-hash proxies and the bearer token; it resumes a stream broken
 by UNAVAILABLE (or a proxy's RST_STREAM) from the first index not yet
 received, checks that a resumed stream comes from the same tree and

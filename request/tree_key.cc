@@ -1,9 +1,7 @@
-#include "engine/tree_key.h"
+#include "request/tree_key.h"
 
 #include "absl/strings/str_format.h"
-#include "core/area_estimator.h"
-#include "core/curve.h"
-#include "engine/sample_request.h"
+#include "request/sample_request.h"
 
 namespace sfc {
 

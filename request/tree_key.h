@@ -1,13 +1,13 @@
 // A stable identity for curve trees: the canonical text of everything that
 // shapes a tree, and a 64-bit FNV-1a hash of it that does not change between
 // runs, machines or builds (absl::Hash would). Thread-safe, pure functions.
-#ifndef SFCSAMPLER_ENGINE_TREE_KEY_H_
-#define SFCSAMPLER_ENGINE_TREE_KEY_H_
+#ifndef SFCSAMPLER_REQUEST_TREE_KEY_H_
+#define SFCSAMPLER_REQUEST_TREE_KEY_H_
 
 #include <cstdint>
 #include <string>
 
-#include "core/curve_tree.h"
+#include "core/tree_options.h"
 
 namespace sfc {
 
@@ -29,4 +29,4 @@ uint64_t Fnv1a64(const std::string& text);
 
 }  // namespace sfc
 
-#endif  // SFCSAMPLER_ENGINE_TREE_KEY_H_
+#endif  // SFCSAMPLER_REQUEST_TREE_KEY_H_

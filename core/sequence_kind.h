@@ -1,0 +1,31 @@
+// Which 1D sequence a request places along the curve (paper Sect. 4), and
+// its name. A value type with no sampling code (see core/tree_options.h).
+#ifndef SFCSAMPLER_CORE_SEQUENCE_KIND_H_
+#define SFCSAMPLER_CORE_SEQUENCE_KIND_H_
+
+#include <optional>
+#include <string_view>
+
+namespace sfc {
+
+enum class SequenceKind {
+  kJittered,      // q_k = (k + U_k) / N: the paper's method of choice (default)
+  kEqual,         // q_k = (k + 1/2) / N
+  kRandom,        // q_k = U'_k, independent uniforms
+  kVanDerCorput,  // q_k = base-2 radical inverse of k
+  kProgressive,   // Owen-scrambled base-2 radical inverse: every prefix of
+                  // length 2^m puts exactly one q in each [j/2^m, (j+1)/2^m)
+};
+
+std::string_view SequenceName(SequenceKind kind);  // "jittered", "equal", ...
+std::optional<SequenceKind> SequenceFromName(std::string_view name);
+
+// Whether q_k grows with k (jittered, equal): such a sequence is in curve
+// order as it is; the others are sorted per request.
+inline bool SequenceIsMonotone(SequenceKind kind) {
+  return kind == SequenceKind::kJittered || kind == SequenceKind::kEqual;
+}
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_CORE_SEQUENCE_KIND_H_

@@ -1,0 +1,33 @@
+// The limits every request is checked against (the server's flags; the CLI
+// and Python take the defaults). Value type.
+#ifndef SFCSAMPLER_ENGINE_ENGINE_LIMITS_H_
+#define SFCSAMPLER_ENGINE_ENGINE_LIMITS_H_
+
+#include <cstddef>
+#include <cstdint>
+
+namespace sfc {
+
+struct EngineLimits {
+  uint64_t max_count = 100'000'000;              // largest N
+  uint64_t max_tree_leaves = uint64_t{1} << 22;  // per tree: 73 B a leaf (CurveTree::kBytesPerLeaf), 292 MiB
+  size_t max_spec_length = 4096;                 // surface/density spec, in characters
+  int generation_threads = 1;                    // threads filling one stream's large batches
+  // Sequences that are not monotone in k are sorted into curve order per
+  // request (16 bytes a sample): at most this many samples per request.
+  uint64_t max_sorted_range = uint64_t{1} << 24;
+  // Model files (CAD, meshes) are parsed on threads of their own
+  // (engine/loaded_models.h): parsed models kept, bytes (LRU past it);
+  // parses at once; parses that may wait for a thread; CPU seconds one parse
+  // may take (0 = no limit: the CLI's own files); how long a failed parse is
+  // remembered.
+  uint64_t parsed_model_bytes = uint64_t{256} << 20;
+  int model_parse_threads = 1;
+  int max_queued_parses = 8;
+  double model_parse_seconds = 0;
+  double parse_failure_ttl_seconds = 60;
+};
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_ENGINE_ENGINE_LIMITS_H_

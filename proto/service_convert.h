@@ -1,0 +1,18 @@
+// Conversions into the sfcsampler.v1 wire types of what only a sampler has:
+// a prepared tree (TreeInfo) and the catalogue. Used by the server; the
+// client library does without them (proto/convert.h). Pure functions.
+#ifndef SFCSAMPLER_PROTO_SERVICE_CONVERT_H_
+#define SFCSAMPLER_PROTO_SERVICE_CONVERT_H_
+
+#include "catalog/catalog.h"
+#include "engine/sampling_engine.h"
+#include "sfcsampler/v1/sampler.pb.h"
+
+namespace sfc {
+
+void ToProto(const PreparedTree& tree, ::sfcsampler::v1::TreeInfo* out);
+void ToProto(const CatalogEntry& entry, ::sfcsampler::v1::CatalogEntry* out);
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_PROTO_SERVICE_CONVERT_H_
