@@ -27,8 +27,8 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "base/status_macros.h"
 #include "cad/internal/kernel_setup.h"
-#include "core/status_macros.h"
 
 namespace sfc::cad::fixtures {
 namespace {

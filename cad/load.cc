@@ -55,12 +55,12 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "absl/synchronization/mutex.h"
+#include "base/echo.h"
+#include "base/status_macros.h"
 #include "cad/internal/kernel_setup.h"
 #include "cad/internal/occ_face.h"
 #include "cad/nurbs_patch.h"
 #include "cad/preflight.h"
-#include "core/status_macros.h"
-#include "util/echo.h"
 
 namespace sfc::cad {
 namespace {

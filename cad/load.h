@@ -47,7 +47,7 @@ struct LoadOptions {
 
 // Reads a model from `bytes`. `name` names the input in every error message
 // (e.g. the file name the user gave); it is escaped and clipped there
-// (util/echo.h), as is every piece of the input a message quotes. Errors:
+// (base/echo.h), as is every piece of the input a message quotes. Errors:
 //   RESOURCE_EXHAUSTED  bytes.size() > options.max_bytes;
 //   INVALID_ARGUMENT    a STEP/IGES past a PreflightLimits limit (nesting,
 //                       entities, record or line length); face entities of

@@ -9,8 +9,8 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
-#include "core/status_macros.h"
-#include "util/echo.h"
+#include "base/echo.h"
+#include "base/status_macros.h"
 
 namespace sfc::cad {
 namespace {

@@ -6,7 +6,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "util/echo.h"
+#include "base/echo.h"
 
 namespace sfc::cad {
 namespace {

@@ -9,9 +9,9 @@
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
+#include "base/status_macros.h"
 #include "catalog/expression.h"
 #include "core/builtin_surfaces.h"
-#include "core/status_macros.h"
 
 namespace sfc {
 namespace {

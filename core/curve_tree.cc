@@ -5,7 +5,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "core/status_macros.h"
+#include "base/status_macros.h"
 #include "core/vector_math.h"
 
 namespace sfc {
@@ -165,7 +165,7 @@ class CurveTree::Builder {
     tree->errors_ = std::move(errors_);
     tree->info_ = std::move(info_);
     tree->mass_end_ = std::move(masses_);
-    // In place for large arrays (core/pod_array.h): bytes() counts what is kept.
+    // In place for large arrays (base/pod_array.h): bytes() counts what is kept.
     tree->starts_.shrink_to_fit();
     tree->models_.shrink_to_fit();
     tree->errors_.shrink_to_fit();

@@ -59,11 +59,11 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "base/pod_array.h"
 #include "core/area_estimator.h"
 #include "core/curve.h"
 #include "core/density.h"
 #include "core/leaf_model.h"
-#include "core/pod_array.h"
 #include "core/surface.h"
 #include "core/tree_options.h"
 
@@ -220,7 +220,7 @@ class CurveTree {
   static constexpr uint8_t kFailGradeMask = 63;
   static constexpr uint8_t kPiecewiseBit = 64;
 
-  // PodArray, not std::vector: growing them moves no bytes (core/pod_array.h).
+  // PodArray, not std::vector: growing them moves no bytes (base/pod_array.h).
   PodArray<uint64_t> starts_;
   PodArray<uint64_t> mass_end_;  // fixed point, units of mass_unit_
   double mass_unit_ = 0;            // base_mass_ / 2^56

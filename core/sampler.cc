@@ -5,9 +5,9 @@
 #include <functional>
 
 #include "absl/strings/str_format.h"
-#include "core/column_memory.h"
-#include "core/status_macros.h"
-#include "core/worker_pool.h"
+#include "base/column_memory.h"
+#include "base/status_macros.h"
+#include "base/worker_pool.h"
 
 namespace sfc {
 

@@ -1,6 +1,6 @@
 #include "core/sequence.h"
 
-#include "core/counter_hash.h"
+#include "base/counter_hash.h"
 
 namespace sfc {
 namespace {

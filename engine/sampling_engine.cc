@@ -1,7 +1,7 @@
 #include "engine/sampling_engine.h"
 
 #include "absl/strings/str_format.h"
-#include "core/status_macros.h"
+#include "base/status_macros.h"
 #include "engine/model_source.h"
 #include "request/index_range.h"
 

@@ -7,15 +7,15 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "base/counter_hash.h"
+#include "base/status_macros.h"
 #include "catalog/catalog.h"
 #include "core/area_estimator.h"
 #include "core/builtin_surfaces.h"
 #include "evaluation/reference_measure.h"
-#include "core/counter_hash.h"
 #include "evaluation/discrepancy.h"
 #include "evaluation/reference_sets.h"
 #include "core/sampler.h"
-#include "core/status_macros.h"
 
 namespace sfc {
 namespace {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/counter_hash.h"
+#include "base/counter_hash.h"
 
 namespace sfc {
 namespace {

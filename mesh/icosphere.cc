@@ -4,7 +4,7 @@
 #include <map>
 #include <utility>
 
-#include "core/status_macros.h"
+#include "base/status_macros.h"
 
 namespace sfc {
 

@@ -106,7 +106,7 @@ class MeshSampleCursor {
   // boxes meet the region; other sequences sort the range into curve order
   // first (O(n log n), n = end - begin). `threads` > 1 lets Next() fill large
   // batches of plain index ranges on the shared worker pool
-  // (core/worker_pool.h); the samples do not change.
+  // (base/worker_pool.h); the samples do not change.
   static absl::StatusOr<std::unique_ptr<MeshSampleCursor>> Create(
       std::shared_ptr<const MeshSampler> sampler, uint64_t begin, uint64_t end,
       const Region& region, const SampleFields& fields, int threads = 1);

@@ -1,6 +1,6 @@
 #include "proto/convert.h"
 
-#include "util/echo.h"
+#include "base/echo.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -10,7 +10,7 @@
 
 #include "absl/base/config.h"
 #include "absl/strings/str_format.h"
-#include "core/status_macros.h"
+#include "base/status_macros.h"
 
 namespace sfc {
 namespace {

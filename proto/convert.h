@@ -44,7 +44,7 @@ uint32_t MaxSamplesPerMessage(const SampleFields& fields, v1::Precision precisio
 absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fields, SampleBatch* out);
 
 // The longest status message the server sends, in bytes; longer ones are
-// clipped by ToGrpcStatus (util/echo.h ClipMessage).
+// clipped by ToGrpcStatus (base/echo.h ClipMessage).
 inline constexpr size_t kMaxStatusMessageBytes = 1024;
 
 // The one conversion of the server's statuses for the wire: same code, the

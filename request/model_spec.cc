@@ -10,7 +10,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/strip.h"
-#include "util/echo.h"
+#include "base/echo.h"
 
 namespace sfc {
 namespace {

@@ -3,7 +3,7 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
-#include "util/echo.h"
+#include "base/echo.h"
 
 namespace sfc {
 

@@ -3,14 +3,14 @@
 #include <chrono>
 
 #include "absl/strings/str_format.h"
+#include "base/echo.h"
+#include "base/status_macros.h"
 #include "catalog/catalog.h"
-#include "core/status_macros.h"
 #include "kinds/registered_kinds.h"
-#include "request/index_range.h"
 #include "proto/convert.h"
 #include "proto/service_convert.h"
+#include "request/index_range.h"
 #include "server/message_pipeline.h"
-#include "util/echo.h"
 #include "spdlog/spdlog.h"
 
 namespace sfc {

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <set>
 
-#include "core/counter_hash.h"
+#include "base/counter_hash.h"
 #include "evaluation/reference_sets.h"
 #include "gtest/gtest.h"
 

@@ -1,5 +1,5 @@
-// util/echo.h: escaped, bounded echoes of untrusted text.
-#include "util/echo.h"
+// base/echo.h: escaped, bounded echoes of untrusted text.
+#include "base/echo.h"
 
 #include <string>
 

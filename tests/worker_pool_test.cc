@@ -1,7 +1,7 @@
 // The shared worker pool: every task runs exactly once, loops from many
 // callers at once all finish (callers run what no worker takes), and the
 // pool's threads are the only ones it starts.
-#include "core/worker_pool.h"
+#include "base/worker_pool.h"
 
 #include <atomic>
 #include <thread>

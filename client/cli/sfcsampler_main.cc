@@ -11,6 +11,7 @@
 
 #include "CLI/CLI.hpp"
 #include "absl/strings/str_format.h"
+#include "base/status_macros.h"
 #include "catalog/catalog.h"
 #include "client/cli/eval_quality.h"
 #include "client/cli/progress.h"
@@ -21,7 +22,6 @@
 #include "core/area_estimator.h"
 #include "core/curve.h"
 #include "core/sequence.h"
-#include "core/status_macros.h"
 #include "engine/model_source.h"
 #include "engine/sampling_engine.h"
 #include "evaluation/discrepancy.h"

@@ -6,10 +6,10 @@
 #include <utility>
 
 #include "absl/strings/str_format.h"
+#include "base/status_macros.h"
 #include "cad/load.h"
 #include "cad/model_sampler.h"
 #include "catalog/catalog.h"
-#include "core/status_macros.h"
 
 namespace sfc {
 namespace {

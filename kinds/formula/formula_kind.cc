@@ -2,10 +2,10 @@
 
 #include <utility>
 
+#include "base/status_macros.h"
 #include "catalog/catalog.h"
 #include "core/curve_tree.h"
 #include "core/sampler.h"
-#include "core/status_macros.h"
 
 namespace sfc {
 namespace {

@@ -9,8 +9,8 @@
 // own outputs, which the caller joins in task order.
 //
 // Thread-safety: thread-safe.
-#ifndef SFCSAMPLER_CORE_WORKER_POOL_H_
-#define SFCSAMPLER_CORE_WORKER_POOL_H_
+#ifndef SFCSAMPLER_BASE_WORKER_POOL_H_
+#define SFCSAMPLER_BASE_WORKER_POOL_H_
 
 #include <condition_variable>
 #include <deque>
@@ -53,4 +53,4 @@ class WorkerPool {
 
 }  // namespace sfc
 
-#endif  // SFCSAMPLER_CORE_WORKER_POOL_H_
+#endif  // SFCSAMPLER_BASE_WORKER_POOL_H_

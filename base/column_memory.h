@@ -5,8 +5,8 @@
 // (Debian's default), large columns ask for them.
 //
 // Thread-safety: ResizeColumn is as thread-safe as the vector it resizes.
-#ifndef SFCSAMPLER_CORE_COLUMN_MEMORY_H_
-#define SFCSAMPLER_CORE_COLUMN_MEMORY_H_
+#ifndef SFCSAMPLER_BASE_COLUMN_MEMORY_H_
+#define SFCSAMPLER_BASE_COLUMN_MEMORY_H_
 
 #include <cstddef>
 #include <vector>
@@ -34,4 +34,4 @@ void ResizeColumn(std::vector<T>* column, size_t rows) {
 
 }  // namespace sfc
 
-#endif  // SFCSAMPLER_CORE_COLUMN_MEMORY_H_
+#endif  // SFCSAMPLER_BASE_COLUMN_MEMORY_H_

@@ -1,4 +1,4 @@
-#include "core/column_memory.h"
+#include "base/column_memory.h"
 
 #include <cstdint>
 

@@ -4,8 +4,8 @@
 // so a message stays short whatever the input's length.
 //
 // Thread-safety: pure functions.
-#ifndef SFCSAMPLER_UTIL_ECHO_H_
-#define SFCSAMPLER_UTIL_ECHO_H_
+#ifndef SFCSAMPLER_BASE_ECHO_H_
+#define SFCSAMPLER_BASE_ECHO_H_
 
 #include <cstddef>
 #include <string>
@@ -31,4 +31,4 @@ std::string ClipMessage(absl::string_view message, size_t max);
 
 }  // namespace sfc
 
-#endif  // SFCSAMPLER_UTIL_ECHO_H_
+#endif  // SFCSAMPLER_BASE_ECHO_H_

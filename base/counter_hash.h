@@ -3,8 +3,8 @@
 // docs/ALGORITHM.md "Random access": jitter U_k is a hash of (seed, k), so any
 // sample can be computed alone. The mixer is SplitMix64's finaliser (Steele,
 // Lea and Flood 2014), applied twice. Stateless and thread-safe.
-#ifndef SFCSAMPLER_CORE_COUNTER_HASH_H_
-#define SFCSAMPLER_CORE_COUNTER_HASH_H_
+#ifndef SFCSAMPLER_BASE_COUNTER_HASH_H_
+#define SFCSAMPLER_BASE_COUNTER_HASH_H_
 
 #include <cstdint>
 
@@ -29,4 +29,4 @@ inline double CounterUniform(uint64_t seed, uint64_t stream, uint64_t counter) {
 
 }  // namespace sfc
 
-#endif  // SFCSAMPLER_CORE_COUNTER_HASH_H_
+#endif  // SFCSAMPLER_BASE_COUNTER_HASH_H_

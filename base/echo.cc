@@ -1,4 +1,4 @@
-#include "util/echo.h"
+#include "base/echo.h"
 
 #include <algorithm>
 

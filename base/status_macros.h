@@ -2,8 +2,8 @@
 //
 // Abseil 20220623 (Debian bookworm) ships no status macros; these follow the
 // semantics of the newer absl/status/status_macros.h. Thread-safe: stateless.
-#ifndef SFCSAMPLER_CORE_STATUS_MACROS_H_
-#define SFCSAMPLER_CORE_STATUS_MACROS_H_
+#ifndef SFCSAMPLER_BASE_STATUS_MACROS_H_
+#define SFCSAMPLER_BASE_STATUS_MACROS_H_
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -30,4 +30,4 @@
   if (!statusor.ok()) return std::move(statusor).status(); \
   lhs = std::move(statusor).value()
 
-#endif  // SFCSAMPLER_CORE_STATUS_MACROS_H_
+#endif  // SFCSAMPLER_BASE_STATUS_MACROS_H_

@@ -7,8 +7,8 @@
 //
 // Thread-compatible. Allocation failure throws std::bad_alloc, like
 // std::vector.
-#ifndef SFCSAMPLER_CORE_POD_ARRAY_H_
-#define SFCSAMPLER_CORE_POD_ARRAY_H_
+#ifndef SFCSAMPLER_BASE_POD_ARRAY_H_
+#define SFCSAMPLER_BASE_POD_ARRAY_H_
 
 #include <algorithm>
 #include <cstdlib>
@@ -96,4 +96,4 @@ class PodArray {
 
 }  // namespace sfc
 
-#endif  // SFCSAMPLER_CORE_POD_ARRAY_H_
+#endif  // SFCSAMPLER_BASE_POD_ARRAY_H_
