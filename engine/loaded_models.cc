@@ -48,10 +48,9 @@ absl::StatusOr<std::shared_ptr<const void>> LoadedModels::GetAny(
   std::shared_ptr<Job> job;
   {
     absl::MutexLock lock(&mu_);
-    if (auto it = entries_.find(key); it != entries_.end()) {
-      lru_.splice(lru_.begin(), lru_, it->second.lru);
+    if (const Parsed* kept = kept_.Touch(key)) {
       ++stats_.hits;
-      return it->second.parsed.model;
+      return kept->model;
     }
     if (auto it = failures_.find(key); it != failures_.end()) {
       const double age = std::chrono::duration<double>(Clock::now() - it->second.when).count();
@@ -197,15 +196,9 @@ void LoadedModels::ParserLoop() {
 
 void LoadedModels::Keep(const std::string& key, const Parsed& parsed) {
   if (parsed.bytes > options_.budget_bytes) return;  // returned to its requests, not kept
-  if (entries_.count(key)) return;
-  lru_.push_front(key);
-  entries_.emplace(key, Entry{parsed, lru_.begin()});
-  stats_.bytes += parsed.bytes;
-  while (stats_.bytes > options_.budget_bytes && !lru_.empty()) {
-    auto victim = entries_.find(lru_.back());
-    stats_.bytes -= victim->second.parsed.bytes;
-    entries_.erase(victim);
-    lru_.pop_back();
+  if (!kept_.Insert(key, parsed, parsed.bytes)) return;  // kept already
+  while (kept_.total_cost() > options_.budget_bytes && !kept_.empty()) {
+    kept_.PopLeastRecent();
     ++stats_.evictions;
   }
 }
@@ -213,16 +206,9 @@ void LoadedModels::Keep(const std::string& key, const Parsed& parsed) {
 void LoadedModels::ForgetModel(const std::string& sha256) {
   const std::string needle = "sha256=" + sha256;
   absl::MutexLock lock(&mu_);
-  for (auto it = lru_.begin(); it != lru_.end();) {
-    if (absl::StrContains(*it, needle)) {
-      auto entry = entries_.find(*it);
-      stats_.bytes -= entry->second.parsed.bytes;
-      entries_.erase(entry);
-      it = lru_.erase(it);
-    } else {
-      ++it;
-    }
-  }
+  kept_.EraseIf([&needle](const std::string& key, const Parsed&) {
+    return absl::StrContains(key, needle);
+  });
   for (auto it = failures_.begin(); it != failures_.end();) {
     it = absl::StrContains(it->first, needle) ? failures_.erase(it) : std::next(it);
   }
@@ -231,7 +217,8 @@ void LoadedModels::ForgetModel(const std::string& sha256) {
 LoadedModelsStats LoadedModels::stats() const {
   absl::MutexLock lock(&mu_);
   LoadedModelsStats s = stats_;
-  s.models = entries_.size();
+  s.models = kept_.size();
+  s.bytes = kept_.total_cost();
   s.queued = queue_.size();
   return s;
 }

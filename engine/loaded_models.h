@@ -24,7 +24,6 @@
 #include <chrono>
 #include <deque>
 #include <functional>
-#include <list>
 #include <memory>
 #include <string>
 #include <thread>
@@ -34,6 +33,7 @@
 #include "absl/base/thread_annotations.h"
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
+#include "base/lru.h"
 
 namespace sfc {
 
@@ -107,10 +107,6 @@ class LoadedModels {
     bool done = false;
     absl::StatusOr<Parsed> result;
   };
-  struct Entry {
-    Parsed parsed;
-    std::list<std::string>::iterator lru;
-  };
   struct Failure {
     absl::Status status;
     Clock::time_point when;
@@ -126,13 +122,12 @@ class LoadedModels {
   const LoadedModelsOptions options_;
 
   mutable absl::Mutex mu_;
-  std::unordered_map<std::string, Entry> entries_ ABSL_GUARDED_BY(mu_);
-  std::list<std::string> lru_ ABSL_GUARDED_BY(mu_);  // front: most recently used
+  Lru<std::string, Parsed> kept_ ABSL_GUARDED_BY(mu_);  // by key, costing Parsed::bytes
   std::unordered_map<std::string, std::shared_ptr<Job>> pending_ ABSL_GUARDED_BY(mu_);
   std::deque<std::shared_ptr<Job>> queue_ ABSL_GUARDED_BY(mu_);
   std::unordered_map<std::string, Failure> failures_ ABSL_GUARDED_BY(mu_);
   bool stopping_ ABSL_GUARDED_BY(mu_) = false;
-  LoadedModelsStats stats_ ABSL_GUARDED_BY(mu_);
+  LoadedModelsStats stats_ ABSL_GUARDED_BY(mu_);  // models and bytes: see kept_
   std::vector<std::thread> threads_;  // started in the constructor, joined in the destructor
 };
 

@@ -28,26 +28,19 @@ absl::StatusOr<StoredModel> ModelStore::Put(ModelFormat format, std::string byte
   std::vector<std::string> evicted;
   {
   absl::MutexLock lock(&mu_);
-  if (auto it = entries_.find(model.sha256); it != entries_.end()) {
-    lru_.splice(lru_.begin(), lru_, it->second.lru);
+  if (const StoredModel* stored = models_.Touch(model.sha256)) {
     ++stats_.already_stored;
     if (already) *already = true;
-    StoredModel found = it->second.model;
+    StoredModel found = *stored;
     found.format = format;  // the same bytes may be named under another format
     return found;
   }
   if (already) *already = false;
   model.bytes = std::make_shared<const std::string>(std::move(bytes));
-  stats_.bytes += model.bytes->size();
   ++stats_.uploads;
-  lru_.push_front(model.sha256);
-  entries_.emplace(model.sha256, Entry{model, lru_.begin()});
-  while (stats_.bytes > budget_bytes_ && lru_.size() > 1) {
-    auto victim = entries_.find(lru_.back());
-    stats_.bytes -= victim->second.model.bytes->size();
-    evicted.push_back(victim->first);
-    entries_.erase(victim);
-    lru_.pop_back();
+  models_.Insert(model.sha256, model, model.bytes->size());
+  while (models_.total_cost() > budget_bytes_ && models_.size() > 1) {  // the newest stays
+    evicted.push_back(models_.PopLeastRecent().key);
     ++stats_.evictions;
   }
   }
@@ -65,15 +58,14 @@ absl::StatusOr<StoredModel> ModelStore::Resolve(const ModelSpec& spec) const {
         ModelFormatName(spec.format), ModelFormatName(spec.format)));
   }
   absl::MutexLock lock(&mu_);
-  auto it = entries_.find(spec.sha256);
-  if (it == entries_.end()) {
+  const StoredModel* stored = models_.Touch(spec.sha256);
+  if (stored == nullptr) {
     return absl::NotFoundError(absl::StrFormat(
         "no model with sha256 %s is stored on this server (never uploaded, or evicted for the "
         "model budget); upload it again",
         spec.sha256));
   }
-  lru_.splice(lru_.begin(), lru_, it->second.lru);
-  StoredModel model = it->second.model;
+  StoredModel model = *stored;
   model.format = spec.format;
   return model;
 }
@@ -86,7 +78,8 @@ void ModelStore::CountRejected() {
 ModelStoreStats ModelStore::stats() const {
   absl::MutexLock lock(&mu_);
   ModelStoreStats s = stats_;
-  s.models = entries_.size();
+  s.models = models_.size();
+  s.bytes = models_.total_cost();
   return s;
 }
 

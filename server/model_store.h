@@ -14,12 +14,11 @@
 #define SFCSAMPLER_SERVER_MODEL_STORE_H_
 
 #include <functional>
-#include <list>
 #include <string>
-#include <unordered_map>
 
 #include "absl/base/thread_annotations.h"
 #include "absl/synchronization/mutex.h"
+#include "base/lru.h"
 #include "engine/model_source.h"
 
 namespace sfc {
@@ -63,21 +62,16 @@ class ModelStore final : public ModelSource {
   uint64_t max_model_bytes() const { return max_model_bytes_; }
 
  private:
-  struct Entry {
-    StoredModel model;
-    std::list<std::string>::iterator lru;
-  };
-
   // Constant after construction.
   const uint64_t budget_bytes_;
   const uint64_t max_model_bytes_;
   std::function<void(const std::string&)> on_evict_;  // set before use
 
   mutable absl::Mutex mu_;
-  // sha256 -> model; a model stored under two formats keeps the first.
-  mutable std::unordered_map<std::string, Entry> entries_ ABSL_GUARDED_BY(mu_);
-  mutable std::list<std::string> lru_ ABSL_GUARDED_BY(mu_);  // front: most recently used
-  ModelStoreStats stats_ ABSL_GUARDED_BY(mu_);
+  // sha256 -> model, costing its bytes; a model stored under two formats
+  // keeps the first. Resolve touches it, hence mutable.
+  mutable Lru<std::string, StoredModel> models_ ABSL_GUARDED_BY(mu_);
+  ModelStoreStats stats_ ABSL_GUARDED_BY(mu_);  // models and bytes: see models_
 };
 
 }  // namespace sfc

@@ -34,10 +34,9 @@ absl::StatusOr<TreeLookup> TreeCache::Get(const TreeKey& key, int grade, const T
   const std::string id = absl::StrCat(key.canonical, "#g", grade);
   absl::MutexLock lock(&mu_);
   while (true) {
-    if (auto it = entries_.find(id); it != entries_.end()) {
-      lru_.splice(lru_.begin(), lru_, it->second.lru);
+    if (const Entry* cached = cached_.Touch(id)) {
       ++stats_.hits;
-      return TreeLookup{it->second.tree, TreeAs<CurveTree>(it->second.tree.get()), true, false};
+      return TreeLookup{cached->tree, TreeAs<CurveTree>(cached->tree.get()), true, false};
     }
     if (auto it = retired_.find(id); it != retired_.end()) {
       // Evicted while a stream held it: take it back rather than build a copy.
@@ -91,7 +90,7 @@ absl::StatusOr<TreeLookup> TreeCache::Get(const TreeKey& key, int grade, const T
         auto below = g->second.lower_bound(grade);
         if (below != g->second.begin()) {
           job->coarser_grade = *std::prev(below);
-          job->coarser = entries_.at(absl::StrCat(key.canonical, "#g", job->coarser_grade)).tree;
+          job->coarser = cached_.Find(absl::StrCat(key.canonical, "#g", job->coarser_grade))->tree;
         }
       }
       pending_.emplace(id, job);
@@ -276,10 +275,8 @@ void TreeCache::Stop() {
 
 void TreeCache::Insert(const std::string& id, std::shared_ptr<const AnyTree> tree, uint64_t bytes,
                        const std::string& canonical, int grade) {
-  lru_.push_front(id);
-  entries_.emplace(id, Entry{std::move(tree), bytes, canonical, grade, lru_.begin()});
+  cached_.Insert(id, Entry{std::move(tree), canonical, grade}, bytes);
   grades_[canonical].insert(grade);
-  stats_.bytes += bytes;
 }
 
 void TreeCache::PruneRetired() {
@@ -295,21 +292,20 @@ void TreeCache::PruneRetired() {
 
 void TreeCache::EvictOverBudget() {
   PruneRetired();
-  while (stats_.bytes + stats_.building_bytes + stats_.retired_bytes > options_.budget_bytes &&
-         !lru_.empty()) {
-    auto it = entries_.find(lru_.back());
-    Entry& entry = it->second;
-    stats_.bytes -= entry.bytes;
+  // A retired tree's bytes still count: evicting it frees no room.
+  while (cached_.total_cost() + stats_.building_bytes + stats_.retired_bytes >
+             options_.budget_bytes &&
+         !cached_.empty()) {
+    Lru<std::string, Entry>::Entry evicted = cached_.PopLeastRecent();
+    const Entry& entry = evicted.value;
     auto grades = grades_.find(entry.canonical);
     grades->second.erase(entry.grade);
     if (grades->second.empty()) grades_.erase(grades);
     if (entry.tree.use_count() > 1) {  // a stream or a refinement holds it
-      stats_.retired_bytes += entry.bytes;
-      retired_[it->first] = Retired{entry.tree, entry.tree.get(), entry.bytes, entry.canonical,
-                                    entry.grade};
+      stats_.retired_bytes += evicted.cost;
+      retired_[evicted.key] = Retired{entry.tree, entry.tree.get(), evicted.cost, entry.canonical,
+                                      entry.grade};
     }
-    entries_.erase(it);
-    lru_.pop_back();
     ++stats_.evictions;
   }
 }
@@ -317,7 +313,8 @@ void TreeCache::EvictOverBudget() {
 TreeCacheStats TreeCache::stats() const {
   absl::MutexLock lock(&mu_);
   TreeCacheStats s = stats_;
-  s.entries = entries_.size();
+  s.entries = cached_.size();
+  s.bytes = cached_.total_cost();
   s.retired_bytes = s.retired_trees = 0;  // those still held now
   for (const auto& [id, retired] : retired_) {
     if (retired.tree.expired()) continue;

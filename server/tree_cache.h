@@ -37,7 +37,6 @@
 #include <chrono>
 #include <deque>
 #include <functional>
-#include <list>
 #include <map>
 #include <memory>
 #include <set>
@@ -48,6 +47,7 @@
 
 #include "absl/base/thread_annotations.h"
 #include "absl/synchronization/mutex.h"
+#include "base/lru.h"
 #include "engine/tree_source.h"
 
 namespace sfc {
@@ -106,12 +106,11 @@ class TreeCache final : public TreeSource {
  private:
   using Clock = std::chrono::steady_clock;
   using Result = TreeFactory::Result;
+  // A cached tree; its bytes are its cost in cached_.
   struct Entry {
     std::shared_ptr<const AnyTree> tree;
-    uint64_t bytes;
     std::string canonical;
     int grade;
-    std::list<std::string>::iterator lru;
   };
   // One build or refinement, shared by every request that waits for it.
   struct Job {
@@ -149,7 +148,7 @@ class TreeCache final : public TreeSource {
   void EvictOverBudget() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   // Drops the retired trees nobody holds any more from the count.
   void PruneRetired() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
-  // Puts a cached tree at the front of the LRU, counted in bytes.
+  // Caches a tree as the most recently used, counted in bytes.
   void Insert(const std::string& id, std::shared_ptr<const AnyTree> tree, uint64_t bytes,
               const std::string& canonical, int grade) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   void Forget(const std::shared_ptr<Job>& job) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
@@ -159,15 +158,14 @@ class TreeCache final : public TreeSource {
   const std::function<void(double)> on_build_;
 
   mutable absl::Mutex mu_;
-  std::unordered_map<std::string, Entry> entries_ ABSL_GUARDED_BY(mu_);
-  std::list<std::string> lru_ ABSL_GUARDED_BY(mu_);  // front: most recently used
+  Lru<std::string, Entry> cached_ ABSL_GUARDED_BY(mu_);  // by id, costing bytes
   std::unordered_map<std::string, std::shared_ptr<Job>> pending_ ABSL_GUARDED_BY(mu_);
   std::deque<std::shared_ptr<Job>> queue_ ABSL_GUARDED_BY(mu_);  // not yet started
   std::map<std::string, std::set<int>> grades_ ABSL_GUARDED_BY(mu_);  // canonical -> cached grades
   std::unordered_map<std::string, Failure> failures_ ABSL_GUARDED_BY(mu_);
   std::unordered_map<std::string, Retired> retired_ ABSL_GUARDED_BY(mu_);  // by id
   bool stopping_ ABSL_GUARDED_BY(mu_) = false;
-  TreeCacheStats stats_ ABSL_GUARDED_BY(mu_);
+  TreeCacheStats stats_ ABSL_GUARDED_BY(mu_);  // entries and bytes: see cached_
   std::vector<std::thread> builders_;  // started in the constructor, joined by Stop()
 };
 

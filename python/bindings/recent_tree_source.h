@@ -6,13 +6,12 @@
 #ifndef SFCSAMPLER_PYTHON_BINDINGS_RECENT_TREE_SOURCE_H_
 #define SFCSAMPLER_PYTHON_BINDINGS_RECENT_TREE_SOURCE_H_
 
-#include <list>
 #include <memory>
 #include <string>
-#include <utility>
 
 #include "absl/base/thread_annotations.h"
 #include "absl/synchronization/mutex.h"
+#include "base/lru.h"
 #include "engine/tree_source.h"
 
 namespace sfc::python {
@@ -20,7 +19,8 @@ namespace sfc::python {
 // Keeps the last `capacity` trees (by key and grade), so repeated requests on
 // one surface skip the build, as the server's cache does. Exact matches only:
 // a different grade builds afresh. Two threads asking for the same new tree
-// at once may both build it (the result is the same tree).
+// at once may both build it (the result is the same tree; the first kept
+// stays).
 class RecentTreeSource final : public TreeSource {
  public:
   explicit RecentTreeSource(size_t capacity) : capacity_(capacity) {}
@@ -30,19 +30,16 @@ class RecentTreeSource final : public TreeSource {
     const std::string id = key.HexWithGrade(grade) + "|" + key.canonical;
     if (capacity_ > 0) {
       absl::MutexLock lock(&mu_);
-      for (auto it = recent_.begin(); it != recent_.end(); ++it) {
-        if (it->first == id) {
-          recent_.splice(recent_.begin(), recent_, it);
-          return TreeLookup{it->second, TreeAs<CurveTree>(it->second.get()), true, false};
-        }
+      if (const auto* kept = recent_.Touch(id)) {
+        return TreeLookup{*kept, TreeAs<CurveTree>(kept->get()), true, false};
       }
     }
     auto tree = factory.build(grade, caller);
     if (!tree.ok()) return tree.status();
     if (capacity_ > 0) {
       absl::MutexLock lock(&mu_);
-      recent_.emplace_front(id, *tree);
-      while (recent_.size() > capacity_) recent_.pop_back();
+      recent_.Insert(id, *tree, 1);
+      while (recent_.size() > capacity_) recent_.PopLeastRecent();
     }
     return TreeLookup{*tree, TreeAs<CurveTree>(tree->get()), false, false};
   }
@@ -50,7 +47,7 @@ class RecentTreeSource final : public TreeSource {
  private:
   const size_t capacity_;
   absl::Mutex mu_;
-  std::list<std::pair<std::string, std::shared_ptr<const AnyTree>>> recent_ ABSL_GUARDED_BY(mu_);
+  Lru<std::string, std::shared_ptr<const AnyTree>> recent_ ABSL_GUARDED_BY(mu_);  // by id
 };
 
 }  // namespace sfc::python
