@@ -24,9 +24,9 @@
 #include "engine/engine_limits.h"
 #include "engine/loaded_models.h"
 #include "engine/model_source.h"
+#include "engine/tree_source.h"
 #include "request/sample_request.h"
 #include "request/tree_key.h"
-#include "engine/tree_source.h"
 
 namespace sfc {
 

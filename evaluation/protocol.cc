@@ -12,10 +12,10 @@
 #include "catalog/catalog.h"
 #include "core/area_estimator.h"
 #include "core/builtin_surfaces.h"
-#include "evaluation/reference_measure.h"
-#include "evaluation/discrepancy.h"
-#include "evaluation/reference_sets.h"
 #include "core/sampler.h"
+#include "evaluation/discrepancy.h"
+#include "evaluation/reference_measure.h"
+#include "evaluation/reference_sets.h"
 
 namespace sfc {
 namespace {

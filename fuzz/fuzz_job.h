@@ -5,8 +5,8 @@
 #ifndef SFCSAMPLER_FUZZ_FUZZ_JOB_H_
 #define SFCSAMPLER_FUZZ_FUZZ_JOB_H_
 
-#include "request/sample_request.h"
 #include "engine/sampling_engine.h"
+#include "request/sample_request.h"
 
 namespace sfc::fuzz {
 

@@ -14,8 +14,8 @@
 #include "cad/load.h"
 #include "engine/sampling_engine.h"
 #include "evaluation/discrepancy.h"
-#include "kinds/registered_kinds.h"
 #include "gtest/gtest.h"
+#include "kinds/registered_kinds.h"
 #include "tests/engine_helpers.h"
 
 namespace sfc {

@@ -12,9 +12,9 @@
 #include "engine/sampling_engine.h"
 #include "gtest/gtest.h"
 #include "kinds/registered_kinds.h"
-#include "tests/engine_helpers.h"
 #include "mesh/icosphere.h"
 #include "mesh/mesh_writer.h"
+#include "tests/engine_helpers.h"
 
 namespace sfc {
 namespace {

@@ -6,10 +6,10 @@
 
 #include "catalog/catalog.h"
 #include "core/builtin_surfaces.h"
+#include "gtest/gtest.h"
 #include "kinds/registered_kinds.h"
 #include "request/index_range.h"
 #include "request/routing_key.h"
-#include "gtest/gtest.h"
 
 namespace sfc {
 namespace {

@@ -11,8 +11,8 @@
 #include <thread>
 
 #include "catalog/catalog.h"
-#include "request/tree_key.h"
 #include "gtest/gtest.h"
+#include "request/tree_key.h"
 
 namespace sfc {
 namespace {

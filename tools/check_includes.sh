@@ -35,15 +35,24 @@ find . -mindepth 2 \( -path './build*' -o -path './.*' \) -prune -o \
           for (i = 1; i <= n; i++) if (allowed[i] != "") may[head, allowed[i]] = 1
         }
       }
-      for (f in ruled) ours[f] = 1
       bad = 0
     }
+    # The most specific ruled folder holding `path` ("client/cli" before
+    # "client"), or "" if none does.
+    function ruled_folder(path,    f, best) {
+      best = ""
+      for (f in ruled) if (index(path, f "/") == 1 && length(f) > length(best)) best = f
+      return best
+    }
     FNR == 1 {
-      folder = FILENAME; sub(/\/.*/, "", folder)
-      if (!(folder in ruled) && !(folder in unruled)) {
-        unruled[folder] = 1
-        printf "%s: the folder %s/ has C++ but no line in %s\n", FILENAME, folder, rules
-        bad = 1
+      folder = ruled_folder(FILENAME)
+      if (folder == "") {
+        folder = FILENAME; sub(/\/.*/, "", folder)
+        if (!(folder in unruled)) {
+          unruled[folder] = 1
+          printf "%s: the folder %s/ has C++ but no line in %s\n", FILENAME, folder, rules
+          bad = 1
+        }
       }
     }
     /^[ \t]*#[ \t]*include[ \t]*"/ {
@@ -52,7 +61,8 @@ find . -mindepth 2 \( -path './build*' -o -path './.*' \) -prune -o \
       if (target !~ /\//) next
       top = target; sub(/\/.*/, "", top)
       if (top in generated) top = generated[top]
-      if (!(top in ours) || top == folder) next
+      else top = ruled_folder(target)
+      if (top == "" || top == folder) next
       if (!((folder, top) in may)) {
         printf "%s:%d: %s/ may not include %s (%s)\n", FILENAME, FNR, folder, target, rules
         bad = 1

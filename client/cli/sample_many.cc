@@ -20,11 +20,12 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/strip.h"
 #include "base/status_macros.h"
+#include "client/cli/commands.h"
+#include "client/cli/connection_flags.h"
+#include "client/cli/progress.h"
+#include "client/cli/sample_source.h"
 #include "client/sample_writer.h"
-#include "client/sampler_client.h"
 #include "engine/model_source.h"
-#include "engine/sampling_engine.h"
-#include "kinds/registered_kinds.h"
 
 namespace sfc {
 namespace {
@@ -152,35 +153,8 @@ struct Job {
   const SampleManyFlags* flags;
   OutputFormat format;
   OutputPrecision precision;
-  const SamplingEngine* engine;  // in process, or
-  SamplerClient* client;         // over the wire
+  SampleSource* source;  // in process, or the server
 };
-
-// Every sample of `request` to `on_batch` (expected count when known), in
-// process or from the server.
-absl::Status Stream(const Job& job, const SampleRequest& request,
-                    const std::function<absl::Status(std::optional<uint64_t>, const SampleBatch&)>& on_batch) {
-  if (job.client != nullptr) {
-    return job.client
-        ->Sample(request,
-                 [&](const ::sfcsampler::v1::StreamHeader& header, const SampleBatch& batch) {
-                   std::optional<uint64_t> expected;
-                   if (header.expected_samples() >= 0) expected = header.expected_samples();
-                   return on_batch(expected, batch);
-                 })
-        .status();
-  }
-  ASSIGN_OR_RETURN(SamplingJob sampling, job.engine->Start(request));
-  std::optional<uint64_t> expected;
-  if (request.region.kind == Region::Kind::kAll) expected = sampling.end - sampling.begin;
-  SampleBatch batch;
-  while (true) {
-    batch.Clear();
-    ASSIGN_OR_RETURN(const size_t n, sampling.cursor->Next(65536, &batch));
-    if (n == 0) return absl::OkStatus();
-    RETURN_IF_ERROR(on_batch(expected, batch));
-  }
-}
 
 // Samples one model into its output file (written under a temporary name,
 // renamed when complete). Fills `o` and returns the model's error, if any.
@@ -202,12 +176,18 @@ absl::Status SampleOne(const Job& job, Outcome* o) {
   fs::create_directories(fs::path(o->output).parent_path(), error);
   const std::string part = o->output + ".part";
   std::unique_ptr<SampleWriter> writer;
-  absl::Status status = Stream(job, request, [&](std::optional<uint64_t> expected, const SampleBatch& batch) {
-    if (!writer) {
-      ASSIGN_OR_RETURN(writer, SampleWriter::Open(part, job.format, request.fields, expected, job.precision));
-    }
-    return writer->Write(batch);
-  });
+  Progress silent(false);
+  absl::Status status =
+      job.source
+          ->Sample(request, &silent, /*on_tree=*/nullptr,
+                   [&](std::optional<uint64_t> expected, const SampleBatch& batch) {
+                     if (!writer) {
+                       ASSIGN_OR_RETURN(writer, SampleWriter::Open(part, job.format, request.fields,
+                                                                   expected, job.precision));
+                     }
+                     return writer->Write(batch);
+                   })
+          .status();
   if (status.ok() && !writer) {  // a region with no samples: still a valid, empty file
     auto opened = SampleWriter::Open(part, job.format, request.fields, std::nullopt, job.precision);
     if (opened.ok()) writer = *std::move(opened);
@@ -277,8 +257,10 @@ uint64_t ModelSeed(uint64_t base_seed, const std::string& sha256_hex) {
   return seed & ((uint64_t{1} << 63) - 1);
 }
 
-CLI::App* AddSampleManyCommand(CLI::App* app, SampleManyFlags* f) {
-  CLI::App* cmd = app->add_subcommand(
+Command AddSampleManyCommand(CLI::App& app) {
+  auto flags = std::make_shared<SampleManyFlags>();
+  SampleManyFlags* f = flags.get();
+  CLI::App* cmd = app.add_subcommand(
       "sample-many",
       "sample many model files (a folder, a glob, a list file) in parallel, one output per model; "
       "each model's seed comes from --seed and its content hash");
@@ -319,7 +301,7 @@ CLI::App* AddSampleManyCommand(CLI::App* app, SampleManyFlags* f) {
   AddSampleFlags(cmd, r);
   cmd->get_option("--seed")->description(
       "base seed: each model's seed is derived from it and the model's SHA-256 (--manifest lists them)");
-  return cmd;
+  return {cmd, [flags] { return RunSampleMany(*flags); }};
 }
 
 int RunSampleMany(const SampleManyFlags& flags) {
@@ -374,32 +356,18 @@ int RunSampleMany(const SampleManyFlags& flags) {
 
   const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
   const size_t jobs = std::min<size_t>(outcomes.size(), flags.jobs > 0 ? flags.jobs : std::min(8u, hardware));
-  DirectTreeSource source;
-  FileModelSource files;
-  EngineLimits limits;
+  SampleSourceOptions options;
+  options.precision = job.precision;
   // Models run side by side; one model alone may use up to four threads.
-  limits.generation_threads = jobs > 1 ? 1 : static_cast<int>(std::min(4u, hardware));
-  SamplingEngine engine(RegisteredSurfaceKinds(), limits, &source, &files);
-  job.engine = &engine;
-  job.client = nullptr;
-  std::unique_ptr<SamplerClient> client;
-  if (!flags.server.empty()) {
-    ClientOptions options;
-    options.target = flags.server;
-    options.tls = flags.tls || !flags.tls_roots.empty();
-    options.tls_root_certs_file = flags.tls_roots;
-    options.precision = job.precision == OutputPrecision::kFloat32 ? ::sfcsampler::v1::PRECISION_FLOAT32
-                                                                    : ::sfcsampler::v1::PRECISION_FLOAT64;
-    if (!flags.token_file.empty()) {
-      auto token = ReadFile(flags.token_file);
-      if (!token.ok()) return Usage("cannot read --token-file " + flags.token_file);
-      options.token = std::string(absl::StripTrailingAsciiWhitespace(*token));
-    }
-    auto connected = SamplerClient::Connect(options);
-    if (!connected.ok()) return Usage(std::string(connected.status().message()));
-    client = *std::move(connected);
-    job.client = client.get();
-  }
+  options.generation_threads = jobs > 1 ? 1 : 0;
+  ConnectionFlags connection;
+  connection.server = flags.server;
+  connection.token_file = flags.token_file;
+  connection.tls = flags.tls;
+  connection.tls_roots = flags.tls_roots;
+  const std::unique_ptr<SampleSource> source = OpenSampleSource(connection, options);
+  if (auto connected = source->Connect(); !connected.ok()) return Usage(std::string(connected.message()));
+  job.source = source.get();
 
   const auto start = std::chrono::steady_clock::now();
   Bar bar(outcomes.size(), !flags.quiet);

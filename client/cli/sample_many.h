@@ -28,7 +28,7 @@
 #include <vector>
 
 #include "CLI/CLI.hpp"
-#include "client/cli/request_flags.h"
+#include "request/request_flags.h"
 
 namespace sfc {
 
@@ -48,10 +48,8 @@ struct SampleManyFlags {
   RequestFlags request;         // every model's request but the surface and seed
 };
 
-// Adds the subcommand and its flags to `app`; `flags` must outlive parsing.
-CLI::App* AddSampleManyCommand(CLI::App* app, SampleManyFlags* flags);
-
-// Runs it; returns the exit status.
+// Runs it; returns the exit status. AddSampleManyCommand (commands.h) adds
+// the subcommand and its flags.
 int RunSampleMany(const SampleManyFlags& flags);
 
 // The seed of a model with content hash `sha256_hex` (64 hex digits) under

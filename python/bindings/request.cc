@@ -5,10 +5,10 @@
 #include "core/curve.h"
 #include "core/sequence.h"
 #include "engine/sampling_engine.h"
-#include "request/index_range.h"
-#include "request/routing_key.h"
 #include "python/bindings/errors.h"
 #include "python/bindings/register.h"
+#include "request/index_range.h"
+#include "request/routing_key.h"
 
 namespace py = pybind11;
 

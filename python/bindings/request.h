@@ -6,9 +6,9 @@
 #ifndef SFCSAMPLER_PYTHON_BINDINGS_REQUEST_H_
 #define SFCSAMPLER_PYTHON_BINDINGS_REQUEST_H_
 
-#include "client/cli/request_flags.h"
-#include "request/sample_request.h"
+#include "request/request_flags.h"
 #include "pybind11/pybind11.h"
+#include "request/sample_request.h"
 
 namespace sfc::python {
 

@@ -198,7 +198,7 @@ class PyEngine {
   }
 
  private:
-  // The CLI's embedded limits (client/cli/sfcsampler_main.cc): the server's
+  // The CLI's embedded limits (client/cli/in_process_sample_source.cc): the server's
   // defaults, with up to four generation threads.
   static EngineLimits Limits(int threads) {
     EngineLimits limits;

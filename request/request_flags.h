@@ -1,7 +1,7 @@
 // Command-line flags that describe a sampling request, shared by the CLI's
 // subcommands, and their conversion into a SampleRequest.
-#ifndef SFCSAMPLER_CLIENT_CLI_REQUEST_FLAGS_H_
-#define SFCSAMPLER_CLIENT_CLI_REQUEST_FLAGS_H_
+#ifndef SFCSAMPLER_REQUEST_REQUEST_FLAGS_H_
+#define SFCSAMPLER_REQUEST_REQUEST_FLAGS_H_
 
 #include <string>
 
@@ -41,4 +41,4 @@ absl::StatusOr<SampleRequest> ToSampleRequest(const RequestFlags& flags);
 
 }  // namespace sfc
 
-#endif  // SFCSAMPLER_CLIENT_CLI_REQUEST_FLAGS_H_
+#endif  // SFCSAMPLER_REQUEST_REQUEST_FLAGS_H_

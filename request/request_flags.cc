@@ -1,4 +1,4 @@
-#include "client/cli/request_flags.h"
+#include "request/request_flags.h"
 
 #include <vector>
 

@@ -1,0 +1,39 @@
+// `sfcsampler inspect`: lists the faces of CAD models read in process (the
+// files are on this machine): index as in the face column, type, trimmed
+// area, parameter box, orientation, trim, and the order the curve visits
+// them.
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "client/cli/commands.h"
+#include "client/cli/exit_status.h"
+#include "client/cli/sample_source.h"
+
+namespace sfc {
+namespace {
+
+int RunInspect(const std::vector<std::string>& specs) {
+  const std::unique_ptr<SampleSource> source = OpenSampleSource(ConnectionFlags{});  // in process
+  for (const std::string& spec : specs) {
+    auto table = source->DescribeModel(spec);
+    if (!table.ok()) return Fail(table.status());
+    std::printf("%s", table->c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command AddInspectCommand(CLI::App& app) {
+  auto specs = std::make_shared<std::vector<std::string>>();
+  CLI::App* inspect = app.add_subcommand(
+      "inspect",
+      "list a CAD model's faces (index as in the face column, type, trimmed area, "
+      "parameter box, orientation, trim) and the order the curve visits them");
+  inspect->add_option("models", *specs, "step:FILE, iges:FILE or nurbs:FILE")->required();
+  return {inspect, [specs] { return RunInspect(*specs); }};
+}
+
+}  // namespace sfc

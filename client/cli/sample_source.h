@@ -1,0 +1,99 @@
+// SampleSource: where the CLI's samples and trees come from, the sampler in
+// this process (InProcessSampleSource) or an sfcsampler-server over gRPC
+// (ServerSampleSource), so that a subcommand is written once for both.
+// Both give the same samples for the same request. What only one of them
+// can do (the server's cache statistics, health and uploads; the curve tree
+// itself and model inspection in process) fails on the other with
+// FAILED_PRECONDITION saying what to do instead. A server source connects
+// at the first call that needs the server (or at Connect()), so that a
+// subcommand's own checks come first; a failed connection fails that call.
+//
+// Thread-safety: Sample() may be called from several threads at once; the
+// other methods from one thread.
+#ifndef SFCSAMPLER_CLIENT_CLI_SAMPLE_SOURCE_H_
+#define SFCSAMPLER_CLIENT_CLI_SAMPLE_SOURCE_H_
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "client/cli/connection_flags.h"
+#include "client/cli/progress.h"
+#include "client/cli/tree_summary.h"
+#include "client/sample_writer.h"
+#include "core/sample_batch.h"
+#include "engine/sampling_engine.h"
+#include "request/sample_request.h"
+
+namespace sfc {
+
+struct SampleSourceOptions {
+  size_t batch_size =
+      0;  // samples per batch; 0: 65536 in process, the server's choice over the wire
+  // The precision the samples are written in: float32 lets a server send
+  // float32 columns (half the bytes; the writer rounds the same way).
+  OutputPrecision precision = OutputPrecision::kFloat64;
+  // In process: threads filling one batch; 0 = the hardware's, at most 4.
+  int generation_threads = 0;
+};
+
+class SampleSource {
+ public:
+  // The tree once it is known: before the first batch in process, with it
+  // over the wire (so not at all for a stream with no samples).
+  using TreeCallback = std::function<void(const TreeSummary&)>;
+  // A batch in curve order, with the set's size when known (not for a region).
+  using BatchCallback =
+      std::function<absl::Status(std::optional<uint64_t> expected, const SampleBatch&)>;
+
+  virtual ~SampleSource() = default;
+
+  // True for a server: the samples are made elsewhere.
+  virtual bool IsRemote() const = 0;
+
+  // Connects now rather than at the first call that needs it; OK in process.
+  virtual absl::Status Connect() = 0;
+
+  // Builds (or warms) the tree for `spec` sized for `count` samples;
+  // `progress` shows the wait.
+  virtual absl::StatusOr<TreeSummary> Prepare(const TreeSpec& spec, uint64_t count,
+                                              Progress* progress) = 0;
+
+  // Streams every sample of `request` in curve order to `on_batch` (whose
+  // error ends the stream and is returned); `on_tree` (may be empty) gets the
+  // tree, `progress` shows the wait and the stream. Returns where the samples
+  // came from, e.g. "(sfcsampler-3, seed 1)" or "from HOST:PORT (...)".
+  virtual absl::StatusOr<std::string> Sample(const SampleRequest& request, Progress* progress,
+                                             const TreeCallback& on_tree,
+                                             const BatchCallback& on_batch) = 0;
+
+  // Server only: the tree cache's statistics and limits, as text.
+  virtual absl::StatusOr<std::string> CacheStats() = 0;
+  // Server only: whether grpc.health.v1 says SERVING.
+  virtual absl::StatusOr<bool> Serving() = 0;
+  // Server only: makes the model file "FORMAT:FILE" names available there
+  // (uploading it only if the server lacks it) and returns its wire spec
+  // "FORMAT:sha256=HASH". INVALID_ARGUMENT for a spec that names no file.
+  virtual absl::StatusOr<std::string> UploadModel(const std::string& spec) = 0;
+
+  // In process only: the table of a CAD model's faces (sfcsampler inspect).
+  virtual absl::StatusOr<std::string> DescribeModel(const std::string& spec) = 0;
+  // In process only: the tree `request` samples from, itself (to draw it).
+  virtual absl::StatusOr<PreparedTree> LocalTree(const SampleRequest& request) = 0;
+};
+
+// The server `connection` names, or the in-process sampler when it names none.
+std::unique_ptr<SampleSource> OpenSampleSource(const ConnectionFlags& connection,
+                                               const SampleSourceOptions& options = {});
+
+// Every sample of `request`, in curve order, in one batch; nothing on stderr.
+absl::StatusOr<SampleBatch> CollectSamples(SampleSource& source, const SampleRequest& request);
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_CLIENT_CLI_SAMPLE_SOURCE_H_
