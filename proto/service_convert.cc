@@ -56,4 +56,12 @@ void ToProto(const CatalogEntry& e, v1::CatalogEntry* out) {
   }
 }
 
+void ToProto(const StoredModel& model, bool already, v1::ModelInfo* out) {
+  out->set_sha256(model.sha256);
+  out->set_format(std::string(ModelFormatName(model.format)));
+  out->set_bytes(model.bytes->size());
+  out->set_already_stored(already);
+  out->set_spec(model.Spec());
+}
+
 }  // namespace sfc

@@ -1,10 +1,11 @@
 // Conversions into the sfcsampler.v1 wire types of what only a sampler has:
-// a prepared tree (TreeInfo) and the catalogue. Used by the server; the
+// a prepared tree (TreeInfo), the catalogue and stored models. Used by the server; the
 // client library does without them (proto/convert.h). Pure functions.
 #ifndef SFCSAMPLER_PROTO_SERVICE_CONVERT_H_
 #define SFCSAMPLER_PROTO_SERVICE_CONVERT_H_
 
 #include "catalog/catalog.h"
+#include "engine/model_source.h"
 #include "engine/sampling_engine.h"
 #include "sfcsampler/v1/sampler.pb.h"
 
@@ -12,6 +13,8 @@ namespace sfc {
 
 void ToProto(const PreparedTree& tree, ::sfcsampler::v1::TreeInfo* out);
 void ToProto(const CatalogEntry& entry, ::sfcsampler::v1::CatalogEntry* out);
+// A stored model; `already`: it was stored before this upload.
+void ToProto(const StoredModel& model, bool already, ::sfcsampler::v1::ModelInfo* out);
 
 }  // namespace sfc
 

@@ -1,5 +1,9 @@
 // The sfcsampler.v1.Sampler service: a thin adapter that parses requests into
-// engine types, calls the engine, and converts results and errors.
+// engine types, calls the engine, and converts results and errors (the
+// conversions are proto/'s). One file per RPC: sample_rpc.cc, prepare_rpc.cc,
+// catalog_rpc.cc, cache_stats_rpc.cc (the server's statistics, mapped here:
+// they are the server's own types) and model_rpcs.cc (UploadModel, FindModel);
+// this file has the constructor and the admission check.
 //
 // Sample streams use the synchronous API with generation pipelined: a
 // producer thread per stream generates and encodes its messages while the

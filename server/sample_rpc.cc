@@ -1,0 +1,222 @@
+#include "server/sampler_service.h"
+
+#include <chrono>
+
+#include "absl/strings/str_format.h"
+#include "base/echo.h"
+#include "base/status_macros.h"
+#include "proto/convert.h"
+#include "proto/service_convert.h"
+#include "request/index_range.h"
+#include "server/message_pipeline.h"
+#include "server/request_control.h"
+#include "spdlog/spdlog.h"
+
+namespace sfc {
+
+namespace v1 = ::sfcsampler::v1;
+namespace {
+
+constexpr uint32_t kDefaultBatchSize = 65536;
+
+// What a stream holds while it runs: the sort of a non-monotone sequence's
+// range (16 bytes a sample), the producer's batch (per sample the index and
+// the columns in float64, the model columns uint32), and the messages of its
+// pipeline, at most pipeline_depth + 2 (queued, being made, being written;
+// MessagePipeline; one without a pipeline), each per sample the columns on
+// the wire (float32 if asked; indices listed, at most). The batch is the requested size, or the
+// largest the server would choose. An invalid range counts nothing here:
+// Start refuses it.
+uint64_t StreamWorkingBytes(const SampleRequest& request, const v1::SampleRequest& wire,
+                            int pipeline_depth) {
+  const auto range = ResolveIndexRange(request);
+  const uint64_t n = range.ok() ? range->second - range->first : 0;
+  const uint64_t sort = Sequence(request.sequence, 1, 0).monotone() ? 0 : 16 * n;
+  const SampleFields& f = request.fields;
+  const uint64_t columns = 5 + (f.normal ? 3 : 0) + (f.density ? 1 : 0) + (f.curve_position ? 1 : 0);
+  const uint64_t index_columns = (f.face ? 1 : 0) + (f.triangle ? 1 : 0);
+  const uint64_t width = wire.precision() == v1::PRECISION_FLOAT32 ? 4 : 8;
+  // The messages the stream holds, plus the serialized copy gRPC keeps of the
+  // one being written until the transport has sent it.
+  const uint64_t messages = (pipeline_depth <= 0 ? 1 : static_cast<uint64_t>(pipeline_depth) + 2) + 1;
+  const uint64_t per_sample =
+      (8 + 8 * columns + 4 * index_columns) + messages * (8 + width * columns + 4 * index_columns);
+  const uint64_t batch = wire.batch_size() != 0 ? wire.batch_size() : kDefaultBatchSize;
+  return sort + per_sample * std::min(n, batch);
+}
+
+}  // namespace
+
+grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::SampleRequest* request,
+                                    grpc::ServerWriter<v1::SampleResponse>* writer) {
+  const auto start = Clock::now();
+  uint64_t sent = 0;
+  grpc::Status status = Admit(*context);
+  if (status.ok()) status = PrepareModelOutsideSlot(context, *request);
+  if (status.ok()) {
+    // Claim a stream slot; give it back on every path out.
+    if (active_streams_.fetch_add(1) >= options_.max_concurrent_streams) {
+      active_streams_.fetch_sub(1);
+      status = grpc::Status(
+          grpc::StatusCode::RESOURCE_EXHAUSTED,
+          absl::StrFormat("%d sample streams are already running, the server's limit "
+                          "(max_concurrent_streams); retry later",
+                          options_.max_concurrent_streams));
+    } else {
+      metrics_->StreamStarted();
+      status = RunSample(context, *request, writer, &sent);
+      metrics_->StreamEnded();
+      active_streams_.fetch_sub(1);
+    }
+  }
+  metrics_->CountRequest("Sample", status.error_code());
+  spdlog::info("rpc=Sample peer={} surface=\"{}\" count={} sent={} seconds={:.3f} code={} msg=\"{}\"",
+               Echo(context->peer()), Echo(request->tree().surface(), kMaxNameEcho),
+               request->count(), sent, SecondsSince(start), static_cast<int>(status.error_code()),
+               Echo(status.error_message(), kMaxStatusMessageBytes));
+  return status;
+}
+
+grpc::Status SamplerService::PrepareModelOutsideSlot(grpc::ServerContext* context,
+                                                     const v1::SampleRequest& request) {
+  auto model = ParseModelSpec(request.tree().surface());
+  if (!model.ok() || !model->has_value()) return grpc::Status::OK;  // RunSample says why
+  auto parsed = FromProto(request);
+  if (!parsed.ok()) return ToGrpcStatus(parsed.status());
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(options_.request_deadline_seconds));
+  auto prepared = engine_.Prepare(parsed->tree, parsed->tree_count ? parsed->tree_count : parsed->count,
+                                  RequestControl(context, deadline, options_.request_deadline_seconds));
+  if (!prepared.ok()) return ToGrpcStatus(prepared.status());
+  return grpc::Status::OK;
+}
+
+grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::SampleRequest& request,
+                                       grpc::ServerWriter<v1::SampleResponse>* writer,
+                                       uint64_t* sent) {
+  const auto start = Clock::now();
+  const auto deadline = start + std::chrono::duration_cast<Clock::duration>(
+                                    std::chrono::duration<double>(options_.request_deadline_seconds));
+  auto parsed = FromProto(request);
+  if (!parsed.ok()) return ToGrpcStatus(parsed.status());
+  if (request.batch_size() > options_.max_batch_size) {
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                        absl::StrFormat("batch_size %d is above the server's limit of %d "
+                                        "(max_batch_size)",
+                                        request.batch_size(), options_.max_batch_size));
+  }
+  const BuildControl control = RequestControl(context, deadline, options_.request_deadline_seconds);
+  // The stream's working memory, reserved before its cursor sorts anything.
+  auto memory = stream_memory_.Reserve(
+      StreamWorkingBytes(*parsed, request, options_.stream_pipeline_depth), "this stream",
+      control.check);
+  if (!memory.ok()) return ToGrpcStatus(memory.status());
+  auto job = engine_.Start(*parsed, control);
+  if (!job.ok()) return ToGrpcStatus(job.status());
+
+  v1::StreamHeader header;
+  ToProto(job->tree, header.mutable_tree());
+  header.set_algorithm_version(options_.algorithm_version);
+  header.set_seed(parsed->seed);
+  *header.mutable_request() = request;
+  header.set_begin(job->begin);
+  header.set_end(job->end);
+  header.set_expected_samples(parsed->region.kind == Region::Kind::kAll
+                                   ? static_cast<int64_t>(job->end - job->begin)
+                                   : -1);
+
+  // Every message, the first with its header too, fits max_message_bytes.
+  const bool indices_listed =
+      parsed->region.kind != Region::Kind::kAll || !Sequence(parsed->sequence, 1, 0).monotone();
+  const uint32_t fits = MaxSamplesPerMessage(parsed->fields, request.precision(), indices_listed,
+                                             header.ByteSizeLong(), options_.max_message_bytes);
+  if (fits == 0) {
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                        absl::StrFormat("the stream header alone is %d bytes, more than the server's "
+                                        "max_message_bytes of %d; use shorter specs",
+                                        header.ByteSizeLong(), options_.max_message_bytes));
+  }
+  if (request.batch_size() > fits) {
+    return grpc::Status(
+        grpc::StatusCode::INVALID_ARGUMENT,
+        absl::StrFormat("batch_size %d with these columns makes messages larger than the server's "
+                        "max_message_bytes of %d; ask for at most %d samples a batch (or 0 to let "
+                        "the server choose)",
+                        request.batch_size(), options_.max_message_bytes, fits));
+  }
+  const uint32_t batch_size =
+      request.batch_size() == 0 ? std::min(kDefaultBatchSize, fits) : request.batch_size();
+
+  const auto watch = watchdog_.Start(context);
+  auto deadline_status = [&] {
+    return grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED,
+                        absl::StrFormat("the stream ran past the server's request deadline of %g s "
+                                        "after sending %d samples; resume after the last index "
+                                        "received",
+                                        options_.request_deadline_seconds, *sent));
+  };
+  // Why the stream ended early: the watchdog's cut also shows as a cancelled
+  // context.
+  auto cut_status = [&](const char* otherwise) {
+    switch (watch->reason()) {
+      case StreamWatchdog::Reason::kWriteTimeout:
+        metrics_->CountStalledStream();
+        return grpc::Status(
+            grpc::StatusCode::DEADLINE_EXCEEDED,
+            absl::StrFormat("the client read nothing for %g s (the server's write_timeout), so the "
+                            "stream was cut after %d samples; read faster or resume after the last "
+                            "index received",
+                            options_.write_timeout_seconds, *sent));
+      case StreamWatchdog::Reason::kNone:
+        break;
+    }
+    return grpc::Status(grpc::StatusCode::CANCELLED, otherwise);
+  };
+
+  // Generation runs on the pipeline's producer thread, one batch ahead of
+  // (at most stream_pipeline_depth messages ahead of) the writes here. The
+  // pipeline is declared last so that it stops before what it uses goes.
+  SampleBatch batch;  // the producer's
+  BatchCursor* const cursor = job->cursor.get();
+  const SampleFields fields = parsed->fields;
+  const v1::Precision precision = request.precision();
+  const v1::ColumnEncoding encoding = request.column_encoding();
+  MessagePipeline pipeline(options_.stream_pipeline_depth,
+                           [&batch, cursor, fields, precision, encoding,
+                            batch_size](v1::SampleBatch* out) -> absl::StatusOr<size_t> {
+                             batch.Clear();
+                             ASSIGN_OR_RETURN(const size_t n, cursor->Next(batch_size, &batch));
+                             ToProto(batch, fields, precision, out, encoding);
+                             return n;
+                           });
+  bool first = true;
+  while (true) {
+    if (context->IsCancelled()) return cut_status("the client cancelled the stream");
+    if (Clock::now() > deadline) return deadline_status();
+    // Wait in short steps, so that a cancel or the deadline is seen while a
+    // batch is being generated.
+    std::optional<MessagePipeline::Item> item = pipeline.Next(absl::Milliseconds(50));
+    if (!item) continue;
+    if (!item->response) {
+      const absl::Status& s = item->status;
+      if (s.ok()) break;
+      return ToGrpcStatus(absl::Status(
+          s.code(), absl::StrFormat("%s (after %d samples were sent)", s.message(), *sent)));
+    }
+    if (first) {
+      *item->response->mutable_header() = std::move(header);
+      first = false;
+    }
+    watch->BeginWrite();
+    const bool written = writer->Write(*item->response);
+    watch->EndWrite();
+    if (!written) return cut_status("the client went away mid-stream");
+    *sent += item->samples;
+    metrics_->AddSamples(item->samples);
+    pipeline.Recycle(std::move(item->response));
+  }
+  context->AddTrailingMetadata("x-samples-sent", std::to_string(*sent));
+  return grpc::Status::OK;
+}
+
+}  // namespace sfc
