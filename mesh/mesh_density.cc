@@ -1,5 +1,6 @@
 #include "mesh/mesh_density.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "absl/strings/str_format.h"
@@ -23,18 +24,22 @@ class VertexWeight : public MeshDensity {
 
 class Curvature : public MeshDensity {
  public:
-  Curvature(bool gaussian, double floor) : gaussian_(gaussian), floor_(floor) {}
+  Curvature(bool gaussian, double f, CurvatureFloor rule)
+      : gaussian_(gaussian), f_(f), rule_(rule) {}
   double Evaluate(const MeshPoint& p) const override {
-    return std::abs(gaussian_ ? p.gaussian_curvature : p.mean_curvature) + floor_;
+    const double k = std::abs(gaussian_ ? p.gaussian_curvature : p.mean_curvature);
+    return rule_ == CurvatureFloor::kMax ? std::max(k, f_) : k + f_;
   }
   bool needs_curvature() const override { return true; }
   std::string spec() const override {
-    return absl::StrFormat("%s:floor=%.17g", gaussian_ ? "gaussian" : "mean", floor_);
+    return absl::StrFormat("%s:%s=%.17g", gaussian_ ? "gaussian" : "mean",
+                           rule_ == CurvatureFloor::kMax ? "floor" : "offset", f_);
   }
 
  private:
   bool gaussian_;
-  double floor_;
+  double f_;
+  CurvatureFloor rule_;
 };
 
 }  // namespace
@@ -43,11 +48,11 @@ std::shared_ptr<const MeshDensity> UniformMeshDensity() { return std::make_share
 std::shared_ptr<const MeshDensity> VertexWeightMeshDensity() {
   return std::make_shared<VertexWeight>();
 }
-std::shared_ptr<const MeshDensity> GaussianCurvatureMeshDensity(double floor) {
-  return std::make_shared<Curvature>(true, floor);
+std::shared_ptr<const MeshDensity> GaussianCurvatureMeshDensity(double f, CurvatureFloor rule) {
+  return std::make_shared<Curvature>(true, f, rule);
 }
-std::shared_ptr<const MeshDensity> MeanCurvatureMeshDensity(double floor) {
-  return std::make_shared<Curvature>(false, floor);
+std::shared_ptr<const MeshDensity> MeanCurvatureMeshDensity(double f, CurvatureFloor rule) {
+  return std::make_shared<Curvature>(false, f, rule);
 }
 
 }  // namespace sfc

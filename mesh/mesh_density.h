@@ -46,10 +46,16 @@ std::shared_ptr<const MeshDensity> UniformMeshDensity();
 // delta = interpolated per-vertex weight. REQUIRES: the mesh has weights
 // (MeshLoadOptions::weight_property); otherwise building a tree fails.
 std::shared_ptr<const MeshDensity> VertexWeightMeshDensity();
-// delta = |K| + floor (gaussian) or |H| + floor (mean), from per-vertex
-// curvature interpolated linearly. REQUIRES: floor >= 0.
-std::shared_ptr<const MeshDensity> GaussianCurvatureMeshDensity(double floor);
-std::shared_ptr<const MeshDensity> MeanCurvatureMeshDensity(double floor);
+// How a curvature density keeps flat regions sampled: max(|K|, f), the rule
+// of the catalogue's gaussian:floor=F and mean:floor=F on every kind of
+// surface; or |K| + f, meshes' gaussian:offset=F and mean:offset=F.
+enum class CurvatureFloor { kMax, kOffset };
+// delta from |K| (gaussian) or |H| (mean), per-vertex curvature interpolated
+// linearly, kept off zero by `f` as `rule` says. REQUIRES: f >= 0.
+std::shared_ptr<const MeshDensity> GaussianCurvatureMeshDensity(
+    double f, CurvatureFloor rule = CurvatureFloor::kMax);
+std::shared_ptr<const MeshDensity> MeanCurvatureMeshDensity(
+    double f, CurvatureFloor rule = CurvatureFloor::kMax);
 
 // Wraps a callable (e.g. a catalog expression in x, y, z).
 class FunctionMeshDensity : public MeshDensity {

@@ -9,6 +9,7 @@
 #include <map>
 #include <string>
 
+#include "absl/strings/str_cat.h"
 #include "engine/sampling_engine.h"
 #include "gtest/gtest.h"
 #include "kinds/registered_kinds.h"
@@ -114,6 +115,38 @@ TEST(EngineMesh, LargeBatchesOnTwoThreadsAreTheSameSamples) {
     EXPECT_EQ(other->density, serial.density);
     EXPECT_EQ(other->curve_position, serial.curve_position);
     EXPECT_EQ(other->triangle, serial.triangle);
+  }
+}
+
+// One density vocabulary: gaussian:floor=F means max(|K|, F) on a mesh as on
+// every surface; the additive rule has its own name, gaussian:offset=F.
+TEST(EngineMesh, AFloorIsAMaximumAndAnOffsetIsAdded) {
+  const std::string path = WriteTemp("engine_mesh_floor.ply", MeshToPly(MakeIcosphere(3), true));
+  DirectTreeSource source;
+  FileModelSource files;
+  SamplingEngine engine(RegisteredSurfaceKinds(), {}, &source, &files);
+  SampleRequest r = MeshRequest("ply:" + path, 2000);
+  r.fields.density = true;
+  const double f = 1000;  // above |K| everywhere on a unit sphere
+  for (const char* name : {"gaussian", "mean"}) {
+    r.tree.density = absl::StrCat(name, ":floor=", f);
+    const SampleBatch floor = DrawAll(engine, r);
+    r.tree.density = absl::StrCat(name, ":offset=", f);
+    const SampleBatch offset = DrawAll(engine, r);
+    ASSERT_EQ(floor.size(), 2000u);
+    ASSERT_EQ(offset.size(), 2000u);
+    for (size_t i = 0; i < floor.size(); ++i) {
+      ASSERT_EQ(floor.density[i], f) << name << " sample " << i;  // max(|K|, f) = f
+      ASSERT_GT(offset.density[i], f) << name << " sample " << i;  // |K| + f, |K| > 0
+    }
+    auto key = [&](const std::string& density) {
+      TreeSpec spec = r.tree;
+      spec.density = density;
+      auto prepared = engine.Prepare(spec, r.count);
+      EXPECT_TRUE(prepared.ok()) << prepared.status();
+      return prepared.ok() ? prepared->key.canonical : "";
+    };
+    EXPECT_NE(key(absl::StrCat(name, ":floor=0.5")), key(absl::StrCat(name, ":offset=0.5")));
   }
 }
 

@@ -7,6 +7,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_replace.h"
 #include "base/status_macros.h"
 #include "catalog/catalog.h"
 #include "catalog/expression.h"
@@ -49,9 +50,16 @@ absl::StatusOr<MeshDensityChoice> ParseMeshDensity(const std::string& text) {
     out.canonical = "expr:" + body;
     return out;
   }
-  // Catalogue densities: validated and made canonical by the catalogue.
-  ASSIGN_OR_RETURN(const DensityFromSpec catalog, MakeDensity(spec));
-  out.canonical = catalog.canonical;
+  // Catalogue densities: validated and made canonical by the catalogue, with
+  // the catalogue's meaning. Meshes add gaussian:offset=F and mean:offset=F
+  // (|K| + F), whose number the catalogue reads as a floor's.
+  const bool offset = (absl::StartsWith(spec, "gaussian:") || absl::StartsWith(spec, "mean:")) &&
+                      absl::StrContains(spec, "offset=");
+  ASSIGN_OR_RETURN(const DensityFromSpec catalog,
+                   MakeDensity(offset ? absl::StrReplaceAll(spec, {{"offset=", "floor="}}) : spec));
+  out.canonical = offset ? absl::StrReplaceAll(catalog.canonical, {{"floor=", "offset="}})
+                         : catalog.canonical;
+  const CurvatureFloor rule = offset ? CurvatureFloor::kOffset : CurvatureFloor::kMax;
   if (catalog.canonical == "uniform") {
     out.density = UniformMeshDensity();
     return out;
@@ -62,11 +70,13 @@ absl::StatusOr<MeshDensityChoice> ParseMeshDensity(const std::string& text) {
   double floor = 0;
   if ((gaussian || mean) && at != std::string::npos &&
       absl::SimpleAtod(catalog.canonical.substr(at + 6), &floor)) {
-    out.density = gaussian ? GaussianCurvatureMeshDensity(floor) : MeanCurvatureMeshDensity(floor);
+    out.density = gaussian ? GaussianCurvatureMeshDensity(floor, rule)
+                           : MeanCurvatureMeshDensity(floor, rule);
     return out;
   }
   return absl::InvalidArgumentError(absl::StrFormat(
-      "density \"%s\" is not available on meshes; use uniform, gaussian:floor=F, mean:floor=F, "
+      "density \"%s\" is not available on meshes; use uniform, gaussian:floor=F, mean:floor=F "
+      "(max(|K|, F), as on every surface), gaussian:offset=F, mean:offset=F (|K| + F), "
       "expr:EXPRESSION in x, y, z, or vertex:PROPERTY",
       spec));
 }

@@ -2,10 +2,12 @@
 // tree over the mesh's triangles and a cursor with the triangle column (u, v
 // are the barycentric coordinates of the triangle's corners 1 and 2).
 //
-// Densities on a mesh: uniform; gaussian:floor=F and mean:floor=F (|K| + F and
-// |H| + F, from per-vertex discrete curvature, mesh/curvature.h); expr:BODY in
-// x, y, z; vertex:NAME, the PLY vertex property NAME read as per-vertex
-// weights and interpolated linearly over each triangle.
+// Densities on a mesh: uniform; gaussian:floor=F and mean:floor=F (max(|K|, F)
+// and max(|H|, F), the catalogue's meaning on every kind of surface), and
+// gaussian:offset=F and mean:offset=F (|K| + F, |H| + F), from per-vertex
+// discrete curvature (mesh/curvature.h); expr:BODY in x, y, z; vertex:NAME, the
+// PLY vertex property NAME read as per-vertex weights and interpolated
+// linearly over each triangle.
 #ifndef SFCSAMPLER_KINDS_MESH_MESH_KIND_H_
 #define SFCSAMPLER_KINDS_MESH_MESH_KIND_H_
 
