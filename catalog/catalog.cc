@@ -285,6 +285,7 @@ absl::StatusOr<DensityFromSpec> MakeDensity(const std::string& text) {
     ASSIGN_OR_RETURN(auto f, Expression::Compile("density expression", body, {"u", "v", "x", "y", "z"}));
     out.density = std::make_shared<ExpressionDensity>(std::move(f));
     out.canonical = absl::StrCat("expr:", body);
+    out.name = "expr";
     return out;
   }
   ASSIGN_OR_RETURN(const Spec spec, ParseSpec("density", DensityCatalog(), trimmed));
@@ -307,6 +308,8 @@ absl::StatusOr<DensityFromSpec> MakeDensity(const std::string& text) {
                                      : MakeMeanCurvatureDensity(numbers["floor"]);
   }
   out.canonical = Canonical(spec, numbers);
+  out.name = name;
+  out.parameters = std::move(numbers);
   return out;
 }
 

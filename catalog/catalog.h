@@ -14,6 +14,7 @@
 #ifndef SFCSAMPLER_CATALOG_CATALOG_H_
 #define SFCSAMPLER_CATALOG_CATALOG_H_
 
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -47,6 +48,11 @@ struct SurfaceFromSpec {
 struct DensityFromSpec {
   std::shared_ptr<const Density> density;
   std::string canonical;
+  // The catalogue entry ("uniform", "gaussian", "mean", "expr") and its
+  // parameters' values (gaussian and mean: "floor"), for other kinds of
+  // surface that give the same density their own form (meshes).
+  std::string name;
+  std::map<std::string, double> parameters;
 };
 
 // Errors: INVALID_ARGUMENT for an unknown name or parameter, a malformed

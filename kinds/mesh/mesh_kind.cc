@@ -4,7 +4,6 @@
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
-#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_replace.h"
@@ -60,18 +59,14 @@ absl::StatusOr<MeshDensityChoice> ParseMeshDensity(const std::string& text) {
   out.canonical = offset ? absl::StrReplaceAll(catalog.canonical, {{"floor=", "offset="}})
                          : catalog.canonical;
   const CurvatureFloor rule = offset ? CurvatureFloor::kOffset : CurvatureFloor::kMax;
-  if (catalog.canonical == "uniform") {
+  if (catalog.name == "uniform") {
     out.density = UniformMeshDensity();
     return out;
   }
-  const bool gaussian = absl::StartsWith(catalog.canonical, "gaussian");
-  const bool mean = absl::StartsWith(catalog.canonical, "mean");
-  const size_t at = catalog.canonical.find("floor=");
-  double floor = 0;
-  if ((gaussian || mean) && at != std::string::npos &&
-      absl::SimpleAtod(catalog.canonical.substr(at + 6), &floor)) {
-    out.density = gaussian ? GaussianCurvatureMeshDensity(floor, rule)
-                           : MeanCurvatureMeshDensity(floor, rule);
+  if (catalog.name == "gaussian" || catalog.name == "mean") {
+    const double floor = catalog.parameters.at("floor");
+    out.density = catalog.name == "gaussian" ? GaussianCurvatureMeshDensity(floor, rule)
+                                             : MeanCurvatureMeshDensity(floor, rule);
     return out;
   }
   return absl::InvalidArgumentError(absl::StrFormat(
