@@ -1,5 +1,5 @@
 // Sample-anchored density discrepancy over parameter boxes (issue 19,
-// ALGORITHM.md "Evaluation protocol"): D = sup over boxes R of
+// docs/ALGORITHM.md "Evaluation protocol"): D = sup over boxes R of
 // |points in R / N - int_R delta dA / int delta dA|, with box corners at the
 // points' own coordinates, at random points and on a grid graded toward the
 // singular lines, and each box's reference mass integrated on the box itself.
