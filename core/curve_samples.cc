@@ -1,0 +1,31 @@
+#include "core/curve_samples.h"
+
+#include <algorithm>
+
+namespace sfc {
+
+SampleRows SampleRows::From(size_t offset) const {
+  auto at = [offset](auto* column) { return column == nullptr ? nullptr : column + offset; };
+  return {index + offset, at(u),  at(v),  at(x),       at(y),
+          at(z),          at(nx), at(ny), at(nz),      at(density),
+          at(curve_position), at(triangle)};
+}
+
+uint64_t CurveSamples::FirstIndexAtOrAbove(double m) const {
+  return FirstIndexWhere(sequence_.count(), [&](uint64_t k) { return MassCoordinate(k) >= m; });
+}
+
+void CurveSamples::AddMassRange(double m0, double m1, bool through_end, uint64_t begin,
+                                uint64_t end, std::vector<IndexSegment>* segments) const {
+  const uint64_t kb = FirstIndexAtOrAbove(m0);
+  const uint64_t ke = through_end ? sequence_.count() : FirstIndexAtOrAbove(m1);
+  const uint64_t lo = std::max(kb, begin), hi = std::min(ke, end);
+  if (lo >= hi) return;
+  if (!segments->empty() && segments->back().end == lo) {
+    segments->back().end = hi;
+  } else {
+    segments->push_back({lo, hi});
+  }
+}
+
+}  // namespace sfc

@@ -1,0 +1,214 @@
+#include "core/sample_cursor.h"
+
+#include <algorithm>
+#include <utility>
+
+#include "absl/strings/str_format.h"
+#include "base/column_memory.h"
+#include "base/status_macros.h"
+#include "base/worker_pool.h"
+
+namespace sfc {
+namespace {
+
+// The columns a cursor fills: the triangle only where the kind has one; the
+// face is CAD's, added above the cursor (cad/model_sampler.h).
+SampleFields ColumnsOf(const CurveSamples& samples, SampleFields fields) {
+  fields.triangle = fields.triangle && samples.has_triangles();
+  fields.face = false;
+  return fields;
+}
+
+}  // namespace
+
+SampleCursor::SampleCursor(std::shared_ptr<const CurveSamples> samples, Region region,
+                           SampleFields fields)
+    : samples_(std::move(samples)),
+      region_(region),
+      fields_(ColumnsOf(*samples_, fields)),
+      filler_(samples_->NewFiller(region_, fields_)) {}
+
+absl::StatusOr<std::unique_ptr<SampleCursor>> SampleCursor::Create(
+    std::shared_ptr<const CurveSamples> samples, uint64_t begin, uint64_t end,
+    const Region& region, const SampleFields& fields, int threads) {
+  const uint64_t count = samples->sequence().count();
+  if (begin > end || end > count) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the index range [%d, %d) is not inside the set of %d samples; it needs begin <= end <= "
+        "count",
+        begin, end, count));
+  }
+  RETURN_IF_ERROR(samples->AcceptsRegion(region));
+  RETURN_IF_ERROR(region.Validate());
+  auto cursor = std::unique_ptr<SampleCursor>(new SampleCursor(std::move(samples), region, fields));
+  cursor->threads_ = std::max(1, threads);
+  RETURN_IF_ERROR(cursor->Plan(begin, end));
+  return cursor;
+}
+
+absl::Status SampleCursor::Plan(uint64_t begin, uint64_t end) {
+  const CurveSamples& samples = *samples_;
+  if (!samples.sequence().monotone()) {
+    // Index order is not curve order.
+    const Sequence& sequence = samples.sequence();
+    order_ = IndicesInCurveOrder(
+        begin, end, [&](uint64_t k) { return samples.MassCoordinate(k); },
+        [&](uint64_t k) { return sequence.InWindow(k); });
+    use_order_ = true;
+    return absl::OkStatus();
+  }
+  if (region_.kind == Region::Kind::kAll) {
+    if (begin < end) segments_.push_back({begin, end});
+  } else {
+    RETURN_IF_ERROR(samples.PlanRegion(region_, begin, end, &segments_));
+  }
+  if (!segments_.empty()) next_k_ = segments_[0].begin;
+  return absl::OkStatus();
+}
+
+absl::StatusOr<size_t> SampleCursor::Next(size_t max, SampleBatch* batch) {
+  const size_t s0 = batch->size();
+  absl::StatusOr<size_t> produced = NextRuns(max, batch);
+  if (!produced.ok()) Truncate(batch, s0);
+  return produced;
+}
+
+absl::StatusOr<size_t> SampleCursor::NextRuns(size_t max, SampleBatch* batch) {
+  // Large runs inside one plain index range are split over threads.
+  constexpr size_t kMinParallel = 8192;
+  size_t produced = 0;
+  while (produced < max) {
+    // The next run: at most the samples still wanted, inside one segment. A
+    // region keeps fewer than it is handed, so runs repeat until max are kept.
+    size_t kept;
+    if (use_order_) {
+      if (order_pos_ >= order_.size()) break;
+      const size_t n = std::min<size_t>(max - produced, order_.size() - order_pos_);
+      ASSIGN_OR_RETURN(kept, Generate(0, order_.data() + order_pos_, n, batch));
+      order_pos_ += n;
+    } else {
+      if (segment_ >= segments_.size()) break;
+      const size_t n = std::min<uint64_t>(max - produced, segments_[segment_].end - next_k_);
+      if (threads_ > 1 && region_.kind == Region::Kind::kAll && n >= kMinParallel) {
+        RETURN_IF_ERROR(GenerateParallel(next_k_, n, batch));
+        kept = n;
+      } else {
+        ASSIGN_OR_RETURN(kept, Generate(next_k_, nullptr, n, batch));
+      }
+      next_k_ += n;
+      if (next_k_ >= segments_[segment_].end && ++segment_ < segments_.size()) {
+        next_k_ = segments_[segment_].begin;
+      }
+    }
+    produced += kept;
+  }
+  return produced;
+}
+
+SampleRows SampleCursor::Grow(SampleBatch* batch, size_t n) const {
+  const size_t s0 = batch->size(), rows = s0 + n;
+  auto grow = [&](auto* column, bool wanted) -> decltype(column->data()) {
+    if (!wanted) return nullptr;
+    ResizeColumn(column, rows);
+    return column->data() + s0;
+  };
+  SampleRows out;
+  out.index = grow(&batch->index, true);
+  out.u = grow(&batch->u, true), out.v = grow(&batch->v, true);
+  out.x = grow(&batch->x, true), out.y = grow(&batch->y, true), out.z = grow(&batch->z, true);
+  out.nx = grow(&batch->nx, fields_.normal), out.ny = grow(&batch->ny, fields_.normal);
+  out.nz = grow(&batch->nz, fields_.normal);
+  out.density = grow(&batch->density, fields_.density);
+  out.curve_position = grow(&batch->curve_position, fields_.curve_position);
+  out.triangle = grow(&batch->triangle, fields_.triangle);
+  return out;
+}
+
+void SampleCursor::Truncate(SampleBatch* batch, size_t rows) const {
+  batch->index.resize(rows);
+  for (auto* column : {&batch->u, &batch->v, &batch->x, &batch->y, &batch->z}) column->resize(rows);
+  if (fields_.normal) {
+    for (auto* column : {&batch->nx, &batch->ny, &batch->nz}) column->resize(rows);
+  }
+  if (fields_.density) batch->density.resize(rows);
+  if (fields_.curve_position) batch->curve_position.resize(rows);
+  if (fields_.triangle) batch->triangle.resize(rows);
+}
+
+absl::Status SampleCursor::Fill(uint64_t k0, const uint64_t* order, size_t n,
+                                SampleFiller& filler, const SampleRows& out) const {
+  const CurveSamples& samples = *samples_;
+  // Mass coordinates q_k S_M, in x until the filler overwrites them.
+  double* m = out.x;
+  if (order == nullptr) {
+    samples.sequence().AtMany(k0, n, m);
+    const double total_mass = samples.total_mass();
+    for (size_t i = 0; i < n; ++i) {
+      m[i] *= total_mass;
+      out.index[i] = k0 + i;
+    }
+  } else {
+    for (size_t i = 0; i < n; ++i) {
+      m[i] = samples.MassCoordinate(order[i]);
+      out.index[i] = order[i];
+    }
+  }
+  return filler.Fill(n, out);
+}
+
+absl::StatusOr<size_t> SampleCursor::Generate(uint64_t k0, const uint64_t* order, size_t n,
+                                              SampleBatch* batch) {
+  const size_t s0 = batch->size();
+  const SampleRows out = Grow(batch, n);
+  if (absl::Status st = Fill(k0, order, n, *filler_, out); !st.ok()) {
+    Truncate(batch, s0);
+    return st;
+  }
+  if (region_.kind == Region::Kind::kAll) return n;
+  // Keep the rows inside the region, in order.
+  size_t kept = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (!region_.Contains(out.u[i], out.v[i], {out.x[i], out.y[i], out.z[i]})) continue;
+    if (kept != i) {
+      out.index[kept] = out.index[i];
+      for (double* column : {out.u, out.v, out.x, out.y, out.z, out.nx, out.ny, out.nz,
+                             out.density, out.curve_position}) {
+        if (column != nullptr) column[kept] = column[i];
+      }
+      if (out.triangle != nullptr) out.triangle[kept] = out.triangle[i];
+    }
+    ++kept;
+  }
+  Truncate(batch, s0 + kept);
+  return kept;
+}
+
+absl::Status SampleCursor::GenerateParallel(uint64_t k0, size_t n, SampleBatch* batch) {
+  // threads_ contiguous parts of the run, on the shared pool, each filling its
+  // own rows of the grown columns; part 0 with the cursor's filler, the others
+  // with their own. A sample is a pure function of k, so the bytes are the
+  // same for any split.
+  const size_t s0 = batch->size();
+  const SampleRows out = Grow(batch, n);
+  const int parts = threads_;
+  std::vector<absl::Status> status(parts);
+  auto bound = [&](int i) { return n * i / parts; };
+  WorkerPool::Shared().ParallelFor(parts, [&](int i) {
+    const size_t begin = bound(i), count = bound(i + 1) - begin;
+    if (i == 0) {
+      status[i] = Fill(k0, nullptr, count, *filler_, out);
+    } else {
+      const std::unique_ptr<SampleFiller> filler = samples_->NewFiller(region_, fields_);
+      status[i] = Fill(k0 + begin, nullptr, count, *filler, out.From(begin));
+    }
+  });
+  for (const absl::Status& st : status) {
+    if (!st.ok()) {
+      Truncate(batch, s0);
+      return st;
+    }
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace sfc
