@@ -56,7 +56,7 @@ int g_threads = 1;  // the cursor's threads (argv[3])
 
 size_t DrawAll(const std::shared_ptr<const MeshSampler>& sampler, SampleBatch* batch) {
   auto cursor =
-      MeshSampleCursor::Create(sampler, 0, sampler->sequence().count(), {}, {}, g_threads);
+      SampleCursor::Create(sampler, 0, sampler->sequence().count(), {}, {}, g_threads);
   if (!cursor.ok()) {
     std::fprintf(stderr, "%s\n", cursor.status().ToString().c_str());
     std::exit(1);

@@ -40,21 +40,31 @@ std::shared_ptr<const MeshSampler> MakeSampler(std::shared_ptr<const MeshSurface
   return std::make_shared<MeshSampler>(*tree, Sequence(kind, n, seed));
 }
 
+// The mesh columns of a draw: the batch's triangle column, and corner 0's
+// barycentric coordinate from the sample computed alone (MeshSampler::At).
+struct MeshColumns {
+  std::vector<uint32_t> triangle;
+  std::vector<double> w;
+};
+
 struct Drawn {
   SampleBatch batch;
-  MeshSampleColumns mesh;
+  MeshColumns mesh;
 };
 
 Drawn Draw(const std::shared_ptr<const MeshSampler>& sampler, uint64_t begin, uint64_t end,
            const Region& region = {}, SampleFields fields = {}) {
-  auto cursor = MeshSampleCursor::Create(sampler, begin, end, region, fields);
+  fields.triangle = true;
+  auto cursor = SampleCursor::Create(sampler, begin, end, region, fields);
   EXPECT_TRUE(cursor.ok()) << cursor.status();
   Drawn out;
   while (true) {
-    auto n = (*cursor)->Next(1000, &out.batch, &out.mesh);
+    auto n = (*cursor)->Next(1000, &out.batch);
     EXPECT_TRUE(n.ok()) << n.status();
     if (!n.ok() || *n == 0) break;
   }
+  out.mesh.triangle = out.batch.triangle;
+  for (uint64_t k : out.batch.index) out.mesh.w.push_back(sampler->At(k).bary[0]);
   return out;
 }
 
@@ -230,7 +240,7 @@ TEST(MeshSampler, RegionEqualsFilteredFullSet) {
     EXPECT_EQ(part.batch.index, filtered.index);
     EXPECT_EQ(part.batch.y, filtered.y);
   }
-  auto rect = MeshSampleCursor::Create(MakeSampler(Icosphere(2), UniformMeshDensity(), 10), 0, 10,
+  auto rect = SampleCursor::Create(MakeSampler(Icosphere(2), UniformMeshDensity(), 10), 0, 10,
                                        Region::ParameterRect(0, 0.5, 0, 0.5), {});
   EXPECT_EQ(rect.status().code(), absl::StatusCode::kInvalidArgument);
 }

@@ -10,6 +10,7 @@
 #include "base/status_macros.h"
 #include "catalog/catalog.h"
 #include "catalog/expression.h"
+#include "engine/batch_cursor.h"
 #include "mesh/mesh_curve_tree.h"
 #include "mesh/mesh_loader.h"
 #include "mesh/mesh_sampler.h"
@@ -75,25 +76,6 @@ absl::StatusOr<MeshDensityChoice> ParseMeshDensity(const std::string& text) {
       "expr:EXPRESSION in x, y, z, or vertex:PROPERTY",
       spec));
 }
-
-// The mesh cursor as a BatchCursor: moves the triangle column into the batch.
-class MeshBatchCursor final : public BatchCursor {
- public:
-  MeshBatchCursor(std::unique_ptr<MeshSampleCursor> cursor, bool triangle)
-      : cursor_(std::move(cursor)), triangle_(triangle) {}
-
-  absl::StatusOr<size_t> Next(size_t max, SampleBatch* batch) override {
-    columns_.Clear();
-    ASSIGN_OR_RETURN(const size_t n, cursor_->Next(max, batch, triangle_ ? &columns_ : nullptr));
-    if (triangle_) batch->triangle.insert(batch->triangle.end(), columns_.triangle.begin(), columns_.triangle.end());
-    return n;
-  }
-
- private:
-  std::unique_ptr<MeshSampleCursor> cursor_;
-  const bool triangle_;
-  MeshSampleColumns columns_;
-};
 
 // What a kept mesh surface costs: its arrays (positions, triangles,
 // normals, weights, face normals, curvature).
@@ -167,9 +149,9 @@ absl::StatusOr<std::unique_ptr<BatchCursor>> OpenMeshCursor(const TreeLookup& lo
   auto mesh_tree = TreeAs<MeshCurveTree>(lookup.any.get());
   if (!mesh_tree) return absl::InternalError("a mesh request found a tree of another kind");
   auto sampler = std::make_shared<const MeshSampler>(std::move(mesh_tree), std::move(sequence));
-  ASSIGN_OR_RETURN(auto cursor, MeshSampleCursor::Create(sampler, spec.begin, spec.end, spec.region,
-                                                         spec.fields, spec.threads));
-  return std::make_unique<MeshBatchCursor>(std::move(cursor), spec.fields.triangle);
+  ASSIGN_OR_RETURN(auto cursor, SampleCursor::Create(std::move(sampler), spec.begin, spec.end,
+                                                     spec.region, spec.fields, spec.threads));
+  return std::make_unique<SurfaceBatchCursor>(std::move(cursor));
 }
 
 class MeshKind final : public SurfaceKind {
