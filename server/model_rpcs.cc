@@ -1,5 +1,6 @@
 #include "server/sampler_service.h"
 
+#include <algorithm>
 #include <chrono>
 
 #include "absl/strings/str_format.h"
@@ -23,6 +24,9 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
   if (status.ok()) {
     v1::ModelChunk chunk;
     bool first = true;
+    // What Put would take: an upload past the store's whole budget is not
+    // read to its end either.
+    const uint64_t max_bytes = std::min(models_->max_model_bytes(), models_->budget_bytes());
     while (status.ok() && reader->Read(&chunk)) {
       if (first) {
         // The name is the client's: escaped and clipped before any message
@@ -37,14 +41,15 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
         }
         first = false;
       }
-      if (bytes.size() + chunk.data().size() > models_->max_model_bytes()) {
+      if (bytes.size() + chunk.data().size() > max_bytes) {
         // Stop reading now: the rest would only be thrown away.
         models_->CountRejected();
         status = grpc::Status(
             grpc::StatusCode::RESOURCE_EXHAUSTED,
-            absl::StrFormat("the model \"%s\" is larger than this server's max_model_bytes of %d; "
-                            "simplify or split it, or ask the operator to raise the limit",
-                            name, models_->max_model_bytes()));
+            absl::StrFormat("the model \"%s\" is larger than this server takes (max_model_bytes %d, "
+                            "model budget %d); simplify or split it, or ask the operator to raise "
+                            "the limit",
+                            name, models_->max_model_bytes(), models_->budget_bytes()));
       } else {
         bytes += chunk.data();
       }

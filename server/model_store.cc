@@ -36,6 +36,9 @@ absl::StatusOr<StoredModel> ModelStore::Put(ModelFormat format, std::string byte
     return found;
   }
   if (already) *already = false;
+  // An upload grows its string by doubling: up to twice its size reserved,
+  // which the budget (counting the size) would not see.
+  bytes.shrink_to_fit();
   model.bytes = std::make_shared<const std::string>(std::move(bytes));
   ++stats_.uploads;
   models_.Insert(model.sha256, model, model.bytes->size());

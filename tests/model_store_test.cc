@@ -77,6 +77,19 @@ TEST(ModelStore, TurnsAwayLargeModelsAndEvictsTheLeastRecentlyUsed) {
   EXPECT_EQ(second.bytes->size(), 100u);
 }
 
+// An upload's string grows by doubling; the store keeps no more than the
+// bytes it counts against its budget (the soak's model phase found up to 2x).
+TEST(ModelStore, KeepsNoMoreThanTheBytesItCounts) {
+  ModelStore store(/*budget_bytes=*/1 << 20, /*max_model_bytes=*/1 << 20);
+  std::string upload;
+  upload.reserve(1 << 19);
+  upload.assign(1000, 'x');
+  auto stored = store.Put(ModelFormat::kPly, std::move(upload), "grown.ply");
+  ASSERT_TRUE(stored.ok()) << stored.status();
+  EXPECT_EQ(store.stats().bytes, 1000u);
+  EXPECT_LT(stored->bytes->capacity(), 2000u);
+}
+
 TEST(FileModelSource, ReadsAndHashesAFile) {
   const std::string path = ::testing::TempDir() + "/model_source_test.obj";
   std::ofstream(path) << "v 1 2 3\n";

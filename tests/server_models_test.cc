@@ -264,5 +264,27 @@ TEST(ServerModels, ParsedModelsAreCountedAndDroppedWithFailedRequestsAndEvictedU
   EXPECT_EQ(stats.parsed_model_bytes(), 0u);
 }
 
+// A cached mesh tree keeps its mesh alive after the parse is dropped (its
+// upload evicted): the tree cache counts the mesh with the tree, so its
+// budget bounds what trees pin (the soak's model phase found RSS past the
+// budgets when it did not).
+TEST(ServerModels, ACachedMeshTreeCountsTheMeshItKeepsAlive) {
+  ServerOptions options = LoopbackOptions();
+  const std::string a = GridObj(60), b = GridObj(61);
+  options.model_bytes = a.size() + b.size() / 2;  // room for one of them
+  Running r = StartServer(options);
+  auto info_a = r.client->UploadModel("obj", "a.obj", a);
+  ASSERT_TRUE(info_a.ok()) << info_a.status();
+  ASSERT_TRUE(SampleStatus(*r.client, Request(info_a->spec(), 1000)).ok());
+  auto stats = *r.client->GetCacheStats();
+  ASSERT_EQ(stats.parsed_models(), 1u);
+  const uint64_t mesh_bytes = stats.parsed_model_bytes();
+  EXPECT_GE(stats.bytes(), mesh_bytes);
+  ASSERT_TRUE(r.client->UploadModel("obj", "b.obj", b).ok());
+  stats = *r.client->GetCacheStats();
+  EXPECT_EQ(stats.parsed_models(), 0u);  // a's parse dropped; its tree, cached, still holds the mesh
+  EXPECT_GE(stats.bytes(), mesh_bytes);
+}
+
 }  // namespace
 }  // namespace sfc
