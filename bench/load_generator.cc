@@ -14,8 +14,23 @@
 //               DEADLINE_EXCEEDED (or OK if it beat the deadline);
 //   bad         a request outside a limit or malformed: INVALID_ARGUMENT or
 //               RESOURCE_EXHAUSTED as the request deserves.
+// With --model-share P, P % of the workers run the model phase instead
+// (bench/soak_models.h writes the models into --model-dir):
+//   model       a good model (the CAD fixtures as STEP, IGES, NURBS;
+//               icosphere meshes as OBJ and PLY) sampled by file path, so the
+//               client library uploads it when the server lacks it; checked
+//               like complete (one in --check-every against an in-process
+//               run reading the same file);
+//   large model the same with a mesh of 1.3 M triangles (tens of MB parsed),
+//               which pushes the parsed-model budget;
+//   hostile     an upload the server must refuse, at the upload or at its
+//               first Sample: INVALID_ARGUMENT or RESOURCE_EXHAUSTED;
+//   unknown     a Sample naming a hash the server never stored: NOT_FOUND.
+// A model evicted from the server's store between its upload and its stream
+// (NOT_FOUND) is uploaded again, up to 3 times; counted apart.
 // In every scenario a RESOURCE_EXHAUSTED naming the build queue
-// (max_queued_builds) is the server shedding load: expected, and counted;
+// (max_queued_builds) or the parse queue (max_queued_parses) is the server
+// shedding load: expected, and counted;
 // the worker then backs off for 0.25-1 s, as a client told to retry later.
 // Every outcome is classified expected or unexpected. A sampler thread reads
 // the server's VmRSS and VmHWM from /proc/PID/status. At the end it prints a
@@ -23,9 +38,10 @@
 //
 //   load_generator --server 127.0.0.1:PORT --server-pid PID [--streams 64]
 //                  [--seconds 60] [--seed 1] [--slow-read-seconds 3]
-//                  [--stream-deadline 60]
+//                  [--stream-deadline 60] [--model-share 0 --model-dir DIR]
 // --seconds is when workers stop starting streams; the streams under way
 // then finish (a complete stream within --stream-deadline).
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cinttypes>
@@ -34,15 +50,19 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <random>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "CLI/CLI.hpp"
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/synchronization/mutex.h"
+#include "bench/soak_models.h"
 #include "client/sampler_client.h"
+#include "engine/model_source.h"
 #include "engine/sampling_engine.h"
 #include "grpcpp/client_context.h"
 #include "grpcpp/create_channel.h"
@@ -68,6 +88,9 @@ struct Flags {
   int check_every = 4;      // compare one completed stream in this many in-process
   uint32_t batch_size = 8192;
   double stream_deadline_seconds = 60;  // a complete stream that takes longer is unexpected
+  int model_share = 0;         // percent of workers in the model phase
+  std::string model_dir;       // where the model phase writes its models
+  int large_subdivisions = 8;  // the large meshes' icosphere subdivisions
 };
 
 // What the server will hold requests to (from GetCacheStats).
@@ -75,6 +98,8 @@ struct ServerLimits {
   uint64_t max_count = 0, max_tree_leaves = 0, max_spec_length = 0, max_sorted_range = 0;
   uint64_t budget_bytes = 0;         // trees (cache_bytes)
   uint64_t stream_memory_bytes = 0;  // streams' working memory
+  uint64_t model_budget_bytes = 0;   // uploaded models kept (model_bytes)
+  uint64_t parsed_model_budget_bytes = 0;  // parsed models kept (parsed_model_bytes)
   uint32_t max_concurrent_streams = 0;
 };
 
@@ -107,7 +132,8 @@ class Tally {
     ++by_scenario_[scenario];
     if (code == grpc::StatusCode::OK) ++completed_;
     const bool shed = code == grpc::StatusCode::RESOURCE_EXHAUSTED &&
-                      detail.find("max_queued_builds") != std::string::npos;
+                      (detail.find("max_queued_builds") != std::string::npos ||
+                       detail.find("max_queued_parses") != std::string::npos);
     if (shed) {
       ++shed_;
       expected = true;
@@ -119,6 +145,10 @@ class Tally {
       }
     }
     return shed;
+  }
+  void Evicted() {
+    absl::MutexLock lock(&mu_);
+    ++evicted_;
   }
   void Checked(bool same) {
     absl::MutexLock lock(&mu_);
@@ -137,8 +167,10 @@ class Tally {
     for (const auto& [code, n] : by_code_) {
       std::printf("| status %s | %" PRIu64 " | |\n", CodeName(code), n);
     }
-    std::printf("| of which RESOURCE_EXHAUSTED for a full build queue (load shed) | %" PRIu64 " | |\n",
+    std::printf("| of which RESOURCE_EXHAUSTED for a full build or parse queue (load shed) | %" PRIu64
+                " | |\n",
                 shed_);
+    std::printf("| model streams that met their model evicted, uploaded again | %" PRIu64 " | |\n", evicted_);
     for (const auto& [scenario, n] : by_scenario_) {
       std::printf("| scenario %s | %" PRIu64 " | |\n", scenario.c_str(), n);
     }
@@ -148,10 +180,15 @@ class Tally {
     std::printf("| samples received | %" PRIu64 " | |\n", samples_.load());
     std::printf("| samples/s (all streams, %.0f s) | %.3g | |\n", seconds, samples_.load() / seconds);
     const double mib = 1024.0 * 1024.0;
-    // The server's memory budgets: trees plus streams' working memory.
-    const double budget = limits.budget_bytes + limits.stream_memory_bytes;
-    std::printf("| server memory budget: cache + stream memory | %.1f + %.1f MiB | |\n",
-                limits.budget_bytes / mib, limits.stream_memory_bytes / mib);
+    // The server's memory budgets: trees, streams' working memory, uploaded
+    // models and parsed models.
+    const double budget = limits.budget_bytes + limits.stream_memory_bytes + limits.model_budget_bytes +
+                          limits.parsed_model_budget_bytes;
+    std::printf(
+        "| server memory budgets: cache + stream memory + models + parsed models | %.1f + %.1f + %.1f + %.1f = "
+        "%.1f MiB | |\n",
+        limits.budget_bytes / mib, limits.stream_memory_bytes / mib, limits.model_budget_bytes / mib,
+        limits.parsed_model_budget_bytes / mib, budget / mib);
     std::printf("| server peak VmRSS (sampled every 100 ms) | %.1f MiB | <= %.1f MiB |\n", peak_rss / mib,
                 1.2 * budget / mib);
     std::printf("| server VmHWM at the end | %.1f MiB | <= %.1f MiB |\n", hwm / mib, 1.2 * budget / mib);
@@ -167,6 +204,8 @@ class Tally {
       case grpc::StatusCode::OK: return "OK";
       case grpc::StatusCode::CANCELLED: return "CANCELLED";
       case grpc::StatusCode::INVALID_ARGUMENT: return "INVALID_ARGUMENT";
+      case grpc::StatusCode::NOT_FOUND: return "NOT_FOUND";
+      case grpc::StatusCode::FAILED_PRECONDITION: return "FAILED_PRECONDITION";
       case grpc::StatusCode::DEADLINE_EXCEEDED: return "DEADLINE_EXCEEDED";
       case grpc::StatusCode::RESOURCE_EXHAUSTED: return "RESOURCE_EXHAUSTED";
       case grpc::StatusCode::UNAVAILABLE: return "UNAVAILABLE";
@@ -184,6 +223,7 @@ class Tally {
   std::map<std::string, uint64_t> by_scenario_ ABSL_GUARDED_BY(mu_);
   uint64_t completed_ ABSL_GUARDED_BY(mu_) = 0;
   uint64_t shed_ ABSL_GUARDED_BY(mu_) = 0;
+  uint64_t evicted_ ABSL_GUARDED_BY(mu_) = 0;
   uint64_t unexpected_ ABSL_GUARDED_BY(mu_) = 0;
   uint64_t checked_ ABSL_GUARDED_BY(mu_) = 0;
   uint64_t check_mismatches_ ABSL_GUARDED_BY(mu_) = 0;
@@ -288,15 +328,27 @@ BadCase BadRequest(std::mt19937_64& rng, const ServerLimits& limits) {
 class Worker {
  public:
   Worker(const Flags& flags, const ServerLimits& limits, Tally* tally, SamplerClient* client,
-         v1::Sampler::Stub* stub, const SamplingEngine* engine, uint64_t seed)
+         v1::Sampler::Stub* stub, const SamplingEngine* engine, uint64_t seed,
+         const SoakModels* models = nullptr, const SamplingEngine* model_engine = nullptr)
       : flags_(flags), limits_(limits), tally_(tally), client_(client), stub_(stub), engine_(engine),
-        rng_(seed) {}
+        models_(models), model_engine_(model_engine), rng_(seed) {}
 
+  // Formula scenarios, or with `models` the model phase's.
   void Run(Clock::time_point stop) {
     while (Clock::now() < stop) {
       const int roll = static_cast<int>(rng_() % 100);
       tally_->Started();
-      if (roll < 55) {
+      if (models_ != nullptr) {
+        if (roll < 60) {
+          Model("model", models_->good()[rng_() % models_->good().size()]);
+        } else if (roll < 68) {
+          Model("large model", models_->large()[rng_() % models_->large().size()]);
+        } else if (roll < 95) {
+          Hostile();
+        } else {
+          Unknown();
+        }
+      } else if (roll < 55) {
         Complete();
       } else if (roll < 70) {
         Cancel();
@@ -346,12 +398,114 @@ class Worker {
       return;
     }
     Report("complete", grpc::StatusCode::OK, true, "");
-    if (check) tally_->Checked(SameAsInProcess(request, received));
+    if (check) tally_->Checked(SameAsInProcess(*engine_, request, received));
   }
 
-  // Runs `request` in this process and compares every column bit for bit.
-  bool SameAsInProcess(const SampleRequest& request, const SampleBatch& wire) {
-    auto job = engine_->Start(request);
+  // A request for `model`, sampled by its file's path (the client library
+  // uploads it if the server lacks it), its count checked; one in
+  // --check-every compared with an in-process run reading the same file.
+  void Model(const std::string& scenario, const SoakModel& model) {
+    SampleRequest request;
+    request.tree.surface = model.spec;
+    const char* const densities[] = {"uniform", "uniform", "expr:1+x*x", "expr:0.5+z*z"};
+    request.tree.density = densities[rng_() % std::size(densities)];
+    const uint64_t counts[] = {1000, 10000, 50000};
+    request.count = counts[rng_() % std::size(counts)];
+    request.seed = rng_() % 3;
+    request.sequence = rng_() % 3 == 0 ? SequenceKind::kRandom : SequenceKind::kJittered;
+    if (rng_() % 4 == 0) {
+      request.shard_count = 1 + rng_() % 8;
+      request.shard_index = rng_() % request.shard_count;
+    }
+    request.fields.normal = rng_() % 2 == 0;
+    request.fields.face = model.cad && rng_() % 2 == 0;
+    request.fields.triangle = !model.cad && rng_() % 2 == 0;
+    const bool check = (++completes_ % flags_.check_every) == 0;
+    SampleBatch received;
+    absl::StatusOr<StreamSummary> summary;
+    for (int attempt = 0; attempt < 4; ++attempt) {
+      received = SampleBatch();
+      summary = client_->Sample(request, [&](const v1::StreamHeader&, const SampleBatch& b) {
+        tally_->Samples(b.size());
+        if (check) received.Append(b);
+        return absl::OkStatus();
+      });
+      // Evicted from the store between the client's upload and the stream:
+      // the next Sample uploads it again.
+      if (summary.ok() || summary.status().code() != absl::StatusCode::kNotFound) break;
+      tally_->Evicted();
+    }
+    if (!summary.ok()) {
+      Report(scenario, ToGrpcCode(summary.status().code()), false,
+             absl::StrCat(model.spec, ": ", summary.status().message()));
+      return;
+    }
+    const auto range = ResolveIndexRange(request);
+    if (summary->received != range->second - range->first) {
+      Report(scenario, grpc::StatusCode::DATA_LOSS, false,
+             absl::StrFormat("%s: received %d of %d samples", model.spec, summary->received,
+                             range->second - range->first));
+      return;
+    }
+    Report(scenario, grpc::StatusCode::OK, true, "");
+    if (check) tally_->Checked(SameAsInProcess(*model_engine_, request, received));
+  }
+
+  // An upload the server must refuse, at the upload or at the first Sample
+  // of it (INVALID_ARGUMENT or RESOURCE_EXHAUSTED, with a message).
+  void Hostile() {
+    const HostileUpload upload = models_->Hostile(rng_);
+    const std::string scenario = absl::StrFormat("hostile (%s)", upload.what);
+    auto refused = [](absl::StatusCode code) {
+      return code == absl::StatusCode::kInvalidArgument || code == absl::StatusCode::kResourceExhausted;
+    };
+    auto info = client_->UploadModel(upload.format, upload.name, upload.bytes);
+    if (!info.ok()) {
+      Report(scenario, ToGrpcCode(info.status().code()),
+             refused(info.status().code()) && !info.status().message().empty(),
+             std::string(info.status().message()));
+      return;
+    }
+    SampleRequest request;
+    request.tree.surface = info->spec();
+    request.count = 1000;
+    uint64_t got = 0;
+    auto summary = client_->Sample(request, [&](const v1::StreamHeader&, const SampleBatch& b) {
+      got += b.size();
+      return absl::OkStatus();
+    });
+    if (summary.ok()) {
+      Report(scenario, grpc::StatusCode::OK, false, absl::StrFormat("%s accepted (%d samples)", upload.what, got));
+      return;
+    }
+    // Evicted before its Sample: neither accepted nor refused; counted apart.
+    if (summary.status().code() == absl::StatusCode::kNotFound) {
+      tally_->Evicted();
+      Report(scenario, grpc::StatusCode::NOT_FOUND, true, "");
+      return;
+    }
+    Report(scenario, ToGrpcCode(summary.status().code()),
+           refused(summary.status().code()) && got == 0 && !summary.status().message().empty(),
+           std::string(summary.status().message()));
+  }
+
+  // A model hash the server never stored: NOT_FOUND.
+  void Unknown() {
+    SampleRequest request;
+    request.tree.surface = "ply:sha256=" + std::string(63, 'a') + "0123456789abcdef"[rng_() % 16];
+    request.count = 1000;
+    auto summary = client_->Sample(request, [](const v1::StreamHeader&, const SampleBatch&) {
+      return absl::OkStatus();
+    });
+    const absl::StatusCode code = summary.ok() ? absl::StatusCode::kOk : summary.status().code();
+    Report("unknown model", ToGrpcCode(code), code == absl::StatusCode::kNotFound,
+           summary.ok() ? "" : std::string(summary.status().message()));
+  }
+
+  // Runs `request` in `engine` in this process and compares every column bit
+  // for bit.
+  static bool SameAsInProcess(const SamplingEngine& engine, const SampleRequest& request, const SampleBatch& wire) {
+    auto job = engine.Start(request);
     if (!job.ok()) return false;
     SampleBatch local;
     for (;;) {
@@ -365,7 +519,8 @@ class Worker {
     return local.index == wire.index && same(local.u, wire.u) && same(local.v, wire.v) &&
            same(local.x, wire.x) && same(local.y, wire.y) && same(local.z, wire.z) &&
            same(local.nx, wire.nx) && same(local.ny, wire.ny) && same(local.nz, wire.nz) &&
-           same(local.density, wire.density) && same(local.curve_position, wire.curve_position);
+           same(local.density, wire.density) && same(local.curve_position, wire.curve_position) &&
+           local.face == wire.face && local.triangle == wire.triangle;
   }
 
   // Opens a raw stream (no client-library resume, so the server's own status
@@ -457,6 +612,8 @@ class Worker {
   SamplerClient* const client_;
   v1::Sampler::Stub* const stub_;
   const SamplingEngine* const engine_;
+  const SoakModels* const models_;              // null: formula scenarios
+  const SamplingEngine* const model_engine_;   // reads model files, for the model checks
   std::mt19937_64 rng_;
   uint64_t completes_ = 0;
   bool shed_ = false;  // the last stream was turned away by a full build queue
@@ -492,7 +649,22 @@ int Main(int argc, char** argv) {
   app.add_option("--stream-deadline", flags.stream_deadline_seconds,
                  "client deadline of a complete stream, seconds (bounds the run)")
       ->capture_default_str();
+  app.add_option("--model-share", flags.model_share,
+                 "percent of the workers that upload and sample models (the model phase)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100));
+  app.add_option("--model-dir", flags.model_dir, "an existing directory for the model phase's files")
+      ->capture_default_str();
+  app.add_option("--large-subdivisions", flags.large_subdivisions,
+                 "subdivisions of the large icosphere meshes (8: 1.3 M triangles)")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 9));
   CLI11_PARSE(app, argc, argv);
+  const int model_workers = (flags.streams * flags.model_share + 50) / 100;
+  if (model_workers > 0 && flags.model_dir.empty()) {
+    std::fprintf(stderr, "load_generator: --model-share needs --model-dir\n");
+    return 2;
+  }
 
   ClientOptions options;
   options.target = flags.server;
@@ -515,6 +687,8 @@ int Main(int argc, char** argv) {
   limits.max_sorted_range = stats->max_sorted_range();
   limits.budget_bytes = stats->budget_bytes();
   limits.stream_memory_bytes = stats->stream_memory_bytes();
+  limits.model_budget_bytes = stats->model_budget_bytes();
+  limits.parsed_model_budget_bytes = stats->parsed_model_budget_bytes();
   limits.max_concurrent_streams = stats->max_concurrent_streams();
 
   // The in-process reference uses the server's limits, so both accept the
@@ -526,6 +700,25 @@ int Main(int argc, char** argv) {
   engine_limits.max_sorted_range = limits.max_sorted_range;
   DirectTreeSource source;
   SamplingEngine engine(RegisteredSurfaceKinds(), engine_limits, &source);
+  // The model phase's reference reads the same files the client uploads.
+  FileModelSource files;
+  SamplingEngine model_engine(RegisteredSurfaceKinds(), engine_limits, &source, &files);
+  std::optional<SoakModels> models;
+  if (model_workers > 0) {
+    auto written = SoakModels::Write(flags.model_dir, flags.large_subdivisions);
+    if (!written.ok()) {
+      std::fprintf(stderr, "load_generator: %s\n", std::string(written.status().message()).c_str());
+      return 2;
+    }
+    models = *std::move(written);
+    std::string large;
+    for (const SoakModel& m : models->large()) {
+      large += absl::StrFormat(" %s %.1f MiB;", m.spec.substr(m.spec.rfind('/') + 1), m.bytes / (1024.0 * 1024.0));
+    }
+    std::printf("model phase: %d of %d workers; %zu good models; large meshes:%s\n", model_workers,
+                flags.streams, models->good().size(), large.c_str());
+    std::fflush(stdout);
+  }
 
   grpc::ChannelArguments args;
   args.SetMaxReceiveMessageSize(-1);
@@ -547,7 +740,9 @@ int Main(int argc, char** argv) {
   std::vector<std::thread> workers;
   for (int i = 0; i < flags.streams; ++i) {
     workers.emplace_back([&, i] {
-      Worker w(flags, limits, &tally, client->get(), stub.get(), &engine, flags.seed * 1000003 + i);
+      const bool model_worker = i >= flags.streams - model_workers;
+      Worker w(flags, limits, &tally, client->get(), stub.get(), &engine, flags.seed * 1000003 + i,
+               model_worker ? &*models : nullptr, &model_engine);
       w.Run(stop);
     });
   }

@@ -3,21 +3,30 @@
 # loopback with modest limits, runs bench/load_generator against it (STREAMS
 # concurrent streams for SECONDS: complete streams of mixed surfaces,
 # densities, counts, ranges, shards and regions spot-checked against an
-# in-process run; cancels; slow readers; client deadlines; bad requests), and
-# prints its table: outcomes by status code, unexpected outcomes (target 0),
-# samples/s, and the server's peak RSS against its memory budgets, trees
-# plus streams' working memory (target: within budget + 20%). Exits 1 on any
-# unexpected outcome.
+# in-process run; cancels; slow readers; client deadlines; bad requests) and,
+# on a quarter of the workers, the model phase (good STEP, IGES, NURBS, OBJ
+# and PLY models uploaded and sampled, spot-checked in process; meshes of
+# tens of MB; hostile uploads that must be refused), and prints its table:
+# outcomes by status code, unexpected outcomes (target 0), samples/s, and the
+# server's peak RSS against the sum of its memory budgets: trees, streams'
+# working memory, uploaded models and parsed models (target: within the sum
+# + 20%). Exits 1 on any unexpected outcome.
 #   bash tools/soak.sh [SECONDS] [STREAMS]      (defaults 60 and 64)
 # SFC_SOAK_CACHE_BYTES (default 256 MiB) sets the server's cache budget and
 # SFC_SOAK_STREAM_BYTES (default 64 MiB) its streams' working memory;
-# SFC_SOAK_SERVER_FLAGS adds server flags.
+# SFC_SOAK_MODEL_BYTES and SFC_SOAK_PARSED_MODEL_BYTES (default 128 MiB each)
+# its uploaded and parsed models; SFC_SOAK_MODEL_SHARE (default 25, 0 = none)
+# the percent of workers in the model phase; SFC_SOAK_SERVER_FLAGS adds
+# server flags.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-60}"
 streams="${2:-64}"
 cache_bytes="${SFC_SOAK_CACHE_BYTES:-268435456}"
 stream_bytes="${SFC_SOAK_STREAM_BYTES:-67108864}"
+model_bytes="${SFC_SOAK_MODEL_BYTES:-134217728}"
+parsed_model_bytes="${SFC_SOAK_PARSED_MODEL_BYTES:-134217728}"
+model_share="${SFC_SOAK_MODEL_SHARE:-25}"
 bash tools/build.sh
 server=build/server/sfcsampler-server
 dir=$(mktemp -d)
@@ -36,6 +45,14 @@ flags=(--address 127.0.0.1:0 --health-address "" --metrics-address ""
 if "$server" --help 2>&1 | grep -q -- --stream-memory-bytes; then flags+=(--stream-memory-bytes "$stream_bytes"); fi
 # A write timeout for stalled readers, where this server has one.
 if "$server" --help 2>&1 | grep -q -- --write-timeout; then flags+=(--write-timeout 5); fi
+# Budgets for uploaded and parsed models, and a parse CPU budget of 5 s (the
+# hostile uploads' quadratic shell is stopped there; the largest good mesh
+# parses in well under it).
+if "$server" --help 2>&1 | grep -q -- --parsed-model-bytes; then
+  flags+=(--model-bytes "$model_bytes" --parsed-model-bytes "$parsed_model_bytes" --model-parse-seconds 5)
+else
+  model_share=0
+fi
 # shellcheck disable=SC2206
 flags+=(${SFC_SOAK_SERVER_FLAGS:-})
 "$server" "${flags[@]}" > "$dir/server.log" 2>&1 &
@@ -47,8 +64,9 @@ echo "soak: server pid $pid on 127.0.0.1:$port: ${flags[*]}"
 echo "soak: $streams streams for $seconds s"
 
 status=0
+mkdir -p "$dir/models"
 build/bench/load_generator --server "127.0.0.1:$port" --server-pid "$pid" --streams "$streams" \
-  --seconds "$seconds" || status=$?
+  --seconds "$seconds" --model-share "$model_share" --model-dir "$dir/models" || status=$?
 # Every client has gone: a second later no stream should hold a slot.
 sleep 1
 build/client/sfcsampler cache --server "127.0.0.1:$port" > "$dir/cache.txt" || status=1
