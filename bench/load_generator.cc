@@ -29,7 +29,8 @@
 // A model evicted from the server's store between its upload and its stream
 // (NOT_FOUND) is uploaded again, up to 3 times; counted apart.
 // In every scenario a RESOURCE_EXHAUSTED naming the build queue
-// (max_queued_builds) or the parse queue (max_queued_parses) is the server
+// (max_queued_builds), the parse queue (max_queued_parses) or the tree memory
+// of the builds under way ("(cache_bytes): retry later") is the server
 // shedding load: expected, and counted;
 // the worker then backs off for 0.25-1 s, as a client told to retry later.
 // Every outcome is classified expected or unexpected. A sampler thread reads
@@ -134,17 +135,20 @@ class Tally {
     const bool shed = code == grpc::StatusCode::RESOURCE_EXHAUSTED &&
                       (detail.find("max_queued_builds") != std::string::npos ||
                        detail.find("max_queued_parses") != std::string::npos);
-    if (shed) {
-      ++shed_;
+    const bool shed_for_memory = code == grpc::StatusCode::RESOURCE_EXHAUSTED &&
+                                 detail.find("(cache_bytes): retry later") != std::string::npos;
+    if (shed || shed_for_memory) {
+      ++(shed ? shed_ : shed_for_memory_);
       expected = true;
     }
     if (!expected) {
       ++unexpected_;
+      ++unexpected_by_[absl::StrFormat("%s, %s", scenario, CodeName(code))];
       if (examples_.size() < 10) {
         examples_.push_back(absl::StrFormat("%s: code %d: %s", scenario, static_cast<int>(code), detail));
       }
     }
-    return shed;
+    return shed || shed_for_memory;
   }
   void Evicted() {
     absl::MutexLock lock(&mu_);
@@ -170,6 +174,9 @@ class Tally {
     std::printf("| of which RESOURCE_EXHAUSTED for a full build or parse queue (load shed) | %" PRIu64
                 " | |\n",
                 shed_);
+    std::printf("| of which RESOURCE_EXHAUSTED for the tree memory of builds under way (load shed) | %" PRIu64
+                " | |\n",
+                shed_for_memory_);
     std::printf("| model streams that met their model evicted, uploaded again | %" PRIu64 " | |\n", evicted_);
     for (const auto& [scenario, n] : by_scenario_) {
       std::printf("| scenario %s | %" PRIu64 " | |\n", scenario.c_str(), n);
@@ -177,6 +184,9 @@ class Tally {
     std::printf("| completed streams compared with an in-process run | %" PRIu64 " | |\n", checked_);
     std::printf("| of those not byte-identical | %" PRIu64 " | 0 |\n", check_mismatches_);
     std::printf("| unexpected outcomes | %" PRIu64 " | 0 |\n", unexpected_);
+    for (const auto& [what, n] : unexpected_by_) {
+      std::printf("| unexpected: %s | %" PRIu64 " | 0 |\n", what.c_str(), n);
+    }
     std::printf("| samples received | %" PRIu64 " | |\n", samples_.load());
     std::printf("| samples/s (all streams, %.0f s) | %.3g | |\n", seconds, samples_.load() / seconds);
     const double mib = 1024.0 * 1024.0;
@@ -223,7 +233,9 @@ class Tally {
   std::map<std::string, uint64_t> by_scenario_ ABSL_GUARDED_BY(mu_);
   uint64_t completed_ ABSL_GUARDED_BY(mu_) = 0;
   uint64_t shed_ ABSL_GUARDED_BY(mu_) = 0;
+  uint64_t shed_for_memory_ ABSL_GUARDED_BY(mu_) = 0;
   uint64_t evicted_ ABSL_GUARDED_BY(mu_) = 0;
+  std::map<std::string, uint64_t> unexpected_by_ ABSL_GUARDED_BY(mu_);  // "scenario, CODE"
   uint64_t unexpected_ ABSL_GUARDED_BY(mu_) = 0;
   uint64_t checked_ ABSL_GUARDED_BY(mu_) = 0;
   uint64_t check_mismatches_ ABSL_GUARDED_BY(mu_) = 0;
