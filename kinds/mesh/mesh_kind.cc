@@ -140,7 +140,8 @@ absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::
     // A kept tree keeps its mesh alive, also after the parsed-model budget
     // let the mesh go: the tree's cost includes it, so the tree cache's
     // budget bounds what its trees pin (counted twice while both keep it).
-    const uint64_t bytes = tree->stats().bytes + MeshSurfaceBytes(*surface), leaves = tree->leaf_count();
+    const uint64_t bytes = tree->stats().bytes + MeshSurfaceBytes(*surface);
+    const uint64_t leaves = tree->leaf_count();
     return std::make_shared<const TypedTree<MeshCurveTree>>(std::move(tree), bytes, leaves);
   };
   return recipe;
