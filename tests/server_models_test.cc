@@ -286,5 +286,19 @@ TEST(ServerModels, ACachedMeshTreeCountsTheMeshItKeepsAlive) {
   EXPECT_GE(stats.bytes(), mesh_bytes);
 }
 
+// The same for a CAD model: its cached tree counts the model it keeps alive.
+TEST(ServerModels, ACachedCadTreeCountsTheModelItKeepsAlive) {
+  auto step = cad::fixtures::SolidBytes(cad::fixtures::Solid::kSphere, cad::ModelFormat::kStep);
+  ASSERT_TRUE(step.ok()) << step.status();
+  Running r = StartServer(LoopbackOptions());
+  auto info = r.client->UploadModel("step", "sphere.step", *step);
+  ASSERT_TRUE(info.ok()) << info.status();
+  ASSERT_TRUE(SampleStatus(*r.client, Request(info->spec(), 1000)).ok());
+  const auto stats = *r.client->GetCacheStats();
+  ASSERT_EQ(stats.parsed_models(), 1u);
+  ASSERT_GT(stats.parsed_model_bytes(), 0u);
+  EXPECT_GE(stats.bytes(), stats.parsed_model_bytes());
+}
+
 }  // namespace
 }  // namespace sfc

@@ -30,12 +30,18 @@ absl::StatusOr<cad::ModelFormat> CadFormat(ModelFormat format) {
   }
 }
 
-absl::StatusOr<std::shared_ptr<const cad::Model>> LoadCad(const StoredModel& model,
-                                                          LoadedModels* loaded,
-                                                          const std::function<absl::Status()>& caller) {
+// A parsed model and what keeping it costs.
+struct CadParse {
+  std::shared_ptr<const cad::Model> model;
+  uint64_t bytes = 0;
+};
+
+absl::StatusOr<std::shared_ptr<const CadParse>> LoadCad(const StoredModel& model,
+                                                        LoadedModels* loaded,
+                                                        const std::function<absl::Status()>& caller) {
   // The parse owns its inputs: it runs on a parse thread and may outlive the
   // request that started it.
-  return loaded->Get<cad::Model>(
+  return loaded->Get<CadParse>(
       model.Spec(),
       [model](const ParseCheck& check) -> absl::StatusOr<LoadedModels::Parsed> {
         ASSIGN_OR_RETURN(const cad::ModelFormat format, CadFormat(model.format));
@@ -51,7 +57,8 @@ absl::StatusOr<std::shared_ptr<const cad::Model>> LoadCad(const StoredModel& mod
         // threads' allocations make this approximate), at least 4 KiB a face.
         const uint64_t bytes =
             std::max<uint64_t>(after > before ? after - before : 0, 4096 * parsed->faces().size());
-        return LoadedModels::Parsed{std::move(parsed), bytes};
+        return LoadedModels::Parsed{
+            std::make_shared<const CadParse>(CadParse{std::move(parsed), bytes}), bytes};
       },
       caller);
 }
@@ -84,15 +91,19 @@ class CadKind final : public SurfaceKind {
     CurveTreeOptions options = spec.options;
     options.max_leaves = context.limits->max_tree_leaves;
     ASSIGN_OR_RETURN(DensityFromSpec density, MakeDensity(spec.density));
-    ASSIGN_OR_RETURN(std::shared_ptr<const cad::Model> cad_model,
+    ASSIGN_OR_RETURN(std::shared_ptr<const CadParse> parse,
                      LoadCad(*model, context.loaded, context.caller));
     ResolvedSurface out;
     out.key = MakeTreeKey(model->Spec(), density.canonical, options);
-    out.factory.build = [cad_model, density = density.density, options](
+    out.factory.build = [parse, density = density.density, options](
                             int grade, const BuildControl& control) -> TreeFactory::Result {
       ASSIGN_OR_RETURN(std::shared_ptr<const cad::ModelTree> tree,
-                       cad::ModelTree::Build(cad_model, density, options, uint64_t{1} << grade, control));
-      const uint64_t bytes = tree->bytes(), leaves = tree->leaf_count();
+                       cad::ModelTree::Build(parse->model, density, options, uint64_t{1} << grade,
+                                             control));
+      // A kept tree keeps its model alive, also after the parsed-model budget
+      // let the model go: the tree's cost includes it (as a mesh tree's does).
+      const uint64_t bytes = tree->bytes() + parse->bytes;
+      const uint64_t leaves = tree->leaf_count();
       return std::make_shared<const TypedTree<cad::ModelTree>>(std::move(tree), bytes, leaves);
     };
     out.open_cursor = [](const TreeLookup& lookup, Sequence sequence,
@@ -110,9 +121,9 @@ class CadKind final : public SurfaceKind {
 
   absl::StatusOr<std::string> Describe(const StoredModel& model,
                                        const KindContext& context) const override {
-    ASSIGN_OR_RETURN(std::shared_ptr<const cad::Model> cad_model,
+    ASSIGN_OR_RETURN(std::shared_ptr<const CadParse> parse,
                      LoadCad(model, context.loaded, context.caller));
-    return cad::DescribeModel(*cad_model);
+    return cad::DescribeModel(*parse->model);
   }
 };
 
