@@ -138,7 +138,7 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
         "the %s sequence supports at most 2^32 samples", SequenceName(request.sequence)));
   }
   ASSIGN_OR_RETURN(const auto range, ResolveIndexRange(request));
-  if (!Sequence(request.sequence, 1, 0).monotone() &&
+  if (!SequenceIsMonotone(request.sequence) &&
       range.second - range.first > limits_.max_sorted_range) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "the %s sequence is sorted into curve order per request, so a request may cover at most "

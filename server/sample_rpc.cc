@@ -31,7 +31,7 @@ uint64_t StreamWorkingBytes(const SampleRequest& request, const v1::SampleReques
                             int pipeline_depth) {
   const auto range = ResolveIndexRange(request);
   const uint64_t n = range.ok() ? range->second - range->first : 0;
-  const uint64_t sort = Sequence(request.sequence, 1, 0).monotone() ? 0 : 16 * n;
+  const uint64_t sort = SequenceIsMonotone(request.sequence) ? 0 : 16 * n;
   const SampleFields& f = request.fields;
   const uint64_t columns = 5 + (f.normal ? 3 : 0) + (f.density ? 1 : 0) + (f.curve_position ? 1 : 0);
   const uint64_t index_columns = (f.face ? 1 : 0) + (f.triangle ? 1 : 0);

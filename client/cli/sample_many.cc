@@ -282,12 +282,8 @@ Command AddSampleManyCommand(CLI::App& app) {
   cmd->add_option("--manifest", f->manifest,
                   "also write a TSV: name, sha256, seed, samples, output, error (one row per model)");
   cmd->add_flag("--quiet,-q", f->quiet, "no progress bar and no summary (failures still print)");
-  cmd->add_option("--server", f->server,
-                  "HOST:PORT of an sfcsampler-server (default: in-process); each model is uploaded "
-                  "once, only if the server lacks its bytes");
-  cmd->add_option("--token-file", f->token_file, "file with the server's bearer token");
-  cmd->add_flag("--tls", f->tls, "connect with TLS (system roots)");
-  cmd->add_option("--tls-roots", f->tls_roots, "PEM roots to trust for TLS (implies --tls)");
+  // With --server each model is uploaded once, only if the server lacks its bytes.
+  AddConnectionFlags(cmd, &f->connection);
   // The tree and set flags of `sample`, the same for every model (not --surface).
   RequestFlags* r = &f->request;
   cmd->add_option("--density", r->density, "density spec (uniform, gaussian:floor=F, mean:floor=F, expr:...)")
@@ -360,12 +356,7 @@ int RunSampleMany(const SampleManyFlags& flags) {
   options.precision = job.precision;
   // Models run side by side; one model alone may use up to four threads.
   options.generation_threads = jobs > 1 ? 1 : 0;
-  ConnectionFlags connection;
-  connection.server = flags.server;
-  connection.token_file = flags.token_file;
-  connection.tls = flags.tls;
-  connection.tls_roots = flags.tls_roots;
-  const std::unique_ptr<SampleSource> source = OpenSampleSource(connection, options);
+  const std::unique_ptr<SampleSource> source = OpenSampleSource(flags.connection, options);
   if (auto connected = source->Connect(); !connected.ok()) return Usage(std::string(connected.message()));
   job.source = source.get();
 

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "CLI/CLI.hpp"
+#include "client/cli/connection_flags.h"
 #include "request/request_flags.h"
 
 namespace sfc {
@@ -41,10 +42,7 @@ struct SampleManyFlags {
   int jobs = 0;                 // 0: the hardware threads, at most 8
   std::string manifest;         // a TSV of every model's outcome, or ""
   bool quiet = false;
-  std::string server;           // host:port; "" = in-process
-  std::string token_file;       // bearer token for the server
-  bool tls = false;
-  std::string tls_roots;
+  ConnectionFlags connection;   // --server etc.; no --server = in process
   RequestFlags request;         // every model's request but the surface and seed
 };
 

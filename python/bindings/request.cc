@@ -148,7 +148,7 @@ Raises sfcsampler.InvalidArgumentError for malformed values.)doc")
           "the routing key sent as x-surface-key for consistent-hash proxies (request/routing_key.h)")
       .def_property_readonly(
           "monotone",
-          [](const PyRequest& r) { return Sequence(r.request.sequence, 1, 0).monotone(); },
+          [](const PyRequest& r) { return SequenceIsMonotone(r.request.sequence); },
           "whether indices grow along the stream (a broken stream resumes after the last index)")
       .def_property_readonly(
           "index_range",
