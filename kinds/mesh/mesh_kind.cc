@@ -66,13 +66,21 @@ absl::StatusOr<MeshDensityChoice> ParseMeshDensity(const std::string& text) {
   }
   if (catalog.name == "gaussian" || catalog.name == "mean") {
     const double floor = catalog.parameters.at("floor");
+    if (!offset && floor > 0) {
+      // Algorithm version sfcsampler-3 gave |K| + F for this spec on meshes;
+      // max(|K|, F) would give other bytes under the same version.
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "on meshes, %s:floor=F (max(|K|, F), its meaning on other surfaces) waits for the next "
+          "algorithm version; write %s:offset=%g for |K| + F, what sfcsampler-3 gives meshes",
+          catalog.name, catalog.name, floor));
+    }
     out.density = catalog.name == "gaussian" ? GaussianCurvatureMeshDensity(floor, rule)
                                              : MeanCurvatureMeshDensity(floor, rule);
     return out;
   }
   return absl::InvalidArgumentError(absl::StrFormat(
-      "density \"%s\" is not available on meshes; use uniform, gaussian:floor=F, mean:floor=F "
-      "(max(|K|, F), as on every surface), gaussian:offset=F, mean:offset=F (|K| + F), "
+      "density \"%s\" is not available on meshes; use uniform, gaussian, mean, "
+      "gaussian:offset=F, mean:offset=F (|K| + F), "
       "expr:EXPRESSION in x, y, z, or vertex:PROPERTY",
       spec));
 }
