@@ -101,6 +101,7 @@ struct ServerLimits {
   uint64_t stream_memory_bytes = 0;  // streams' working memory
   uint64_t model_budget_bytes = 0;   // uploaded models kept (model_bytes)
   uint64_t parsed_model_budget_bytes = 0;  // parsed models kept (parsed_model_bytes)
+  uint64_t parse_memory_bytes = 0;  // working memory of running parses (0: none set)
   uint32_t max_concurrent_streams = 0;
 };
 
@@ -191,14 +192,15 @@ class Tally {
     std::printf("| samples/s (all streams, %.0f s) | %.3g | |\n", seconds, samples_.load() / seconds);
     const double mib = 1024.0 * 1024.0;
     // The server's memory budgets: trees, streams' working memory, uploaded
-    // models and parsed models.
+    // models (stored and being received), parsed models and parses' working
+    // memory.
     const double budget = limits.budget_bytes + limits.stream_memory_bytes + limits.model_budget_bytes +
-                          limits.parsed_model_budget_bytes;
+                          limits.parsed_model_budget_bytes + limits.parse_memory_bytes;
     std::printf(
-        "| server memory budgets: cache + stream memory + models + parsed models | %.1f + %.1f + %.1f + %.1f = "
-        "%.1f MiB | |\n",
+        "| server memory budgets: cache + stream memory + models + parsed models + parse memory | "
+        "%.1f + %.1f + %.1f + %.1f + %.1f = %.1f MiB | |\n",
         limits.budget_bytes / mib, limits.stream_memory_bytes / mib, limits.model_budget_bytes / mib,
-        limits.parsed_model_budget_bytes / mib, budget / mib);
+        limits.parsed_model_budget_bytes / mib, limits.parse_memory_bytes / mib, budget / mib);
     std::printf("| server peak VmRSS (sampled every 100 ms) | %.1f MiB | <= %.1f MiB |\n", peak_rss / mib,
                 1.2 * budget / mib);
     std::printf("| server VmHWM at the end | %.1f MiB | <= %.1f MiB |\n", hwm / mib, 1.2 * budget / mib);
@@ -701,6 +703,7 @@ int Main(int argc, char** argv) {
   limits.stream_memory_bytes = stats->stream_memory_bytes();
   limits.model_budget_bytes = stats->model_budget_bytes();
   limits.parsed_model_budget_bytes = stats->parsed_model_budget_bytes();
+  limits.parse_memory_bytes = stats->parse_memory_bytes();
   limits.max_concurrent_streams = stats->max_concurrent_streams();
 
   // The in-process reference uses the server's limits, so both accept the

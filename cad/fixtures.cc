@@ -4,10 +4,12 @@
 
 #include <BRepAlgoAPI_Cut.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
+#include <BRepBuilderAPI_Transform.hxx>
 #include <BRepFilletAPI_MakeFillet.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRepPrimAPI_MakeSphere.hxx>
+#include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
 #include <IGESControl_Controller.hxx>
 #include <IGESControl_Writer.hxx>
@@ -16,12 +18,14 @@
 #include <TopExp.hxx>
 #include <TopExp_Explorer.hxx>
 #include <TopoDS.hxx>
+#include <TopoDS_Compound.hxx>
 #include <TopoDS_Edge.hxx>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <gp_Ax2.hxx>
 #include <gp_Pnt.hxx>
+#include <gp_Trsf.hxx>
 #include <sstream>
 
 #include "absl/status/status.h"
@@ -87,7 +91,7 @@ std::string SolidName(Solid solid) {
   return "unknown";
 }
 
-absl::StatusOr<std::string> SolidBytes(Solid solid, ModelFormat format) {
+absl::StatusOr<std::string> SolidBytes(Solid solid, ModelFormat format, int copies) {
   if (format == ModelFormat::kNurbs)
     return absl::InvalidArgumentError("solids are written as STEP or IGES");
   // The writers write files only; a private temporary one, removed after.
@@ -106,7 +110,19 @@ absl::StatusOr<std::string> SolidBytes(Solid solid, ModelFormat format) {
   } remove{path};
   SilenceKernelMessages();
   try {
-    const TopoDS_Shape shape = MakeSolid(solid);
+    TopoDS_Shape shape = MakeSolid(solid);
+    if (copies > 1) {
+      // A row of 20 a line, 10 mm apart past the largest solid.
+      TopoDS_Compound compound;
+      BRep_Builder builder;
+      builder.MakeCompound(compound);
+      for (int i = 0; i < copies; ++i) {
+        gp_Trsf move;
+        move.SetTranslation(gp_Vec((kBoxX + 10) * (i % 20), (kBoxY + 10) * (i / 20), 0));
+        builder.Add(compound, BRepBuilderAPI_Transform(shape, move, /*copy=*/true).Shape());
+      }
+      shape = compound;
+    }
     bool ok = false;
     if (format == ModelFormat::kStep) {
       STEPControl_Writer writer;

@@ -41,9 +41,11 @@ enum class Solid { kSphere, kCylinder, kBoxWithHole, kEdgeOnly };
 // "sphere", "cylinder", "box_with_hole", "edge_only".
 std::string SolidName(Solid solid);
 
-// The solid written as STEP or IGES (ModelFormat::kStep or kIges), as bytes.
-// INVALID_ARGUMENT for kNurbs; INTERNAL if the kernel fails.
-absl::StatusOr<std::string> SolidBytes(Solid solid, ModelFormat format);
+// The solid written as STEP or IGES (ModelFormat::kStep or kIges), as bytes;
+// `copies` > 1 writes that many copies side by side (a large model: 400
+// boxes with a hole make a 7 MB STEP file). INVALID_ARGUMENT for kNurbs;
+// INTERNAL if the kernel fails.
+absl::StatusOr<std::string> SolidBytes(Solid solid, ModelFormat format, int copies = 1);
 
 // The quarter-cylinder NURBS patch in our format (docs/NURBS_FORMAT.md).
 std::string NurbsPatchText();

@@ -294,6 +294,7 @@ absl::StatusOr<v1::ModelInfo> SamplerClient::UploadModel(const std::string& form
   v1::ModelChunk chunk;
   chunk.set_format(format);
   chunk.set_name(name);
+  chunk.set_total_bytes(bytes.size());
   size_t offset = 0;
   do {
     const size_t n = std::min(kChunk, bytes.size() - offset);
@@ -303,6 +304,7 @@ absl::StatusOr<v1::ModelInfo> SamplerClient::UploadModel(const std::string& form
     if (!writer->Write(chunk)) break;
     chunk.clear_format();
     chunk.clear_name();
+    chunk.clear_total_bytes();
   } while (offset < bytes.size());
   writer->WritesDone();
   const grpc::Status status = writer->Finish();

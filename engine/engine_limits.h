@@ -20,8 +20,10 @@ struct EngineLimits {
   // (engine/loaded_models.h): parsed models kept, bytes (LRU past it);
   // parses at once; parses that may wait for a thread; CPU seconds one parse
   // may take (0 = no limit: the CLI's own files); how long a failed parse is
-  // remembered.
+  // remembered; working memory of the parses running at once, estimated
+  // from each file's size before it starts (0 = no limit).
   uint64_t parsed_model_bytes = uint64_t{256} << 20;
+  uint64_t parse_memory_bytes = 0;
   int model_parse_threads = 1;
   int max_queued_parses = 8;
   double model_parse_seconds = 0;

@@ -44,7 +44,8 @@ LoadedModels::~LoadedModels() {
 }
 
 absl::StatusOr<std::shared_ptr<const void>> LoadedModels::GetAny(
-    const std::string& key, ParseFn parse, const std::function<absl::Status()>& caller) {
+    const std::string& key, ParseFn parse, const std::function<absl::Status()>& caller,
+    uint64_t working_bytes) {
   std::shared_ptr<Job> job;
   {
     absl::MutexLock lock(&mu_);
@@ -63,6 +64,13 @@ absl::StatusOr<std::shared_ptr<const void>> LoadedModels::GetAny(
     if (stopping_) return absl::UnavailableError("the server is shutting down");
     if (auto it = pending_.find(key); it != pending_.end()) {
       job = it->second;
+    } else if (options_.working_budget_bytes > 0 && working_bytes > options_.working_budget_bytes) {
+      ++stats_.parses_rejected;
+      return absl::ResourceExhaustedError(absl::StrFormat(
+          "parsing this model needs up to %d bytes of memory (estimated from its size), more than "
+          "this server gives parses (parse_memory_bytes %d); simplify or split the model, or ask "
+          "the operator to raise the limit",
+          working_bytes, options_.working_budget_bytes));
     } else {
       if (queue_.size() >= static_cast<size_t>(std::max(0, options_.max_queued_parses))) {
         ++stats_.parses_rejected;
@@ -73,6 +81,7 @@ absl::StatusOr<std::shared_ptr<const void>> LoadedModels::GetAny(
       job = std::make_shared<Job>();
       job->key = key;
       job->parse = std::move(parse);
+      job->working_bytes = working_bytes;
       pending_.emplace(key, job);
       queue_.push_back(job);
     }
@@ -103,8 +112,13 @@ void LoadedModels::ParserLoop() {
     std::shared_ptr<Job> job;
     {
       absl::MutexLock lock(&mu_);
+      // The next parse in line starts when its working memory fits beside
+      // the running parses' (or nothing runs).
       auto ready = [this]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
-        return stopping_ || !queue_.empty();
+        if (stopping_) return true;
+        if (queue_.empty()) return false;
+        return working_bytes_ == 0 || options_.working_budget_bytes == 0 ||
+               working_bytes_ + queue_.front()->working_bytes <= options_.working_budget_bytes;
       };
       mu_.Await(absl::Condition(&ready));
       if (stopping_) {
@@ -127,6 +141,7 @@ void LoadedModels::ParserLoop() {
         continue;
       }
       ++stats_.parsing;
+      working_bytes_ += job->working_bytes;
     }
     // The parse thread's CPU clock: a parser may call the check from its own
     // helper threads, so it is thread-safe and reads this thread's clock.
@@ -177,6 +192,7 @@ void LoadedModels::ParserLoop() {
     }
     absl::MutexLock lock(&mu_);
     --stats_.parsing;
+    working_bytes_ -= job->working_bytes;
     ++stats_.parses;
     pending_.erase(job->key);
     if (result.ok()) {
@@ -220,6 +236,7 @@ LoadedModelsStats LoadedModels::stats() const {
   s.models = kept_.size();
   s.bytes = kept_.total_cost();
   s.queued = queue_.size();
+  s.working_bytes = working_bytes_;
   return s;
 }
 

@@ -12,6 +12,11 @@
 //  - A failed parse is remembered per key (a model's format + content hash
 //    + whatever changes the parse) for failure_ttl_seconds: the same hostile
 //    file is not parsed again on every request.
+//  - A parse's working memory, estimated by the caller from the file's size
+//    (Get's working_bytes), counts against working_budget_bytes while it
+//    runs: a parse starts only when its estimate fits beside those running
+//    (or none runs), and one whose estimate alone is past the budget is
+//    refused before it is queued.
 //  - Kept parses are counted in bytes (Parsed::bytes) against budget_bytes,
 //    least recently used first out; a parse larger than the budget alone is
 //    returned to its requests but not kept. ForgetModel() drops a model's parses
@@ -44,6 +49,8 @@ struct LoadedModelsOptions {
   // CPU seconds one parse may take (its thread's CPU time); 0 = no budget.
   double parse_seconds = 0;
   double failure_ttl_seconds = 60;  // how long a failed parse is remembered, >= 0
+  // Working memory of the parses running at once, bytes; 0 = no limit.
+  uint64_t working_budget_bytes = 0;
 };
 
 struct LoadedModelsStats {
@@ -58,6 +65,7 @@ struct LoadedModelsStats {
   uint64_t evictions = 0;
   uint64_t parsing = 0;          // running now
   uint64_t queued = 0;           // waiting for a thread now
+  uint64_t working_bytes = 0;    // working memory reserved by running parses, now
 };
 
 // What a parse may ask while it runs: OK to go on, or why to stop
@@ -81,11 +89,13 @@ class LoadedModels {
   // The model under `key`, parsed by `parse` on a parse thread if not kept.
   // `caller` (may be empty) is asked while the request waits; its non-OK
   // status ends the wait with that status (the parse goes on while another
-  // request waits for it). `parse` must own what it uses.
+  // request waits for it). `parse` must own what it uses. `working_bytes`:
+  // the most memory the parse may use at once (an upper estimate).
   template <typename Model>
   absl::StatusOr<std::shared_ptr<const Model>> Get(const std::string& key, ParseFn parse,
-                                                   const std::function<absl::Status()>& caller) {
-    auto any = GetAny(key, std::move(parse), caller);
+                                                   const std::function<absl::Status()>& caller,
+                                                   uint64_t working_bytes) {
+    auto any = GetAny(key, std::move(parse), caller, working_bytes);
     if (!any.ok()) return any.status();
     return std::static_pointer_cast<const Model>(*std::move(any));
   }
@@ -103,6 +113,7 @@ class LoadedModels {
   struct Job {
     std::string key;
     ParseFn parse;
+    uint64_t working_bytes = 0;
     int waiters = 0;  // guarded by mu_
     bool done = false;
     absl::StatusOr<Parsed> result;
@@ -113,7 +124,8 @@ class LoadedModels {
   };
 
   absl::StatusOr<std::shared_ptr<const void>> GetAny(const std::string& key, ParseFn parse,
-                                                     const std::function<absl::Status()>& caller)
+                                                     const std::function<absl::Status()>& caller,
+                                                     uint64_t working_bytes)
       ABSL_LOCKS_EXCLUDED(mu_);
   void ParserLoop() ABSL_LOCKS_EXCLUDED(mu_);
   void Keep(const std::string& key, const Parsed& parsed) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
@@ -126,6 +138,7 @@ class LoadedModels {
   std::unordered_map<std::string, std::shared_ptr<Job>> pending_ ABSL_GUARDED_BY(mu_);
   std::deque<std::shared_ptr<Job>> queue_ ABSL_GUARDED_BY(mu_);
   std::unordered_map<std::string, Failure> failures_ ABSL_GUARDED_BY(mu_);
+  uint64_t working_bytes_ ABSL_GUARDED_BY(mu_) = 0;  // reserved by running parses
   bool stopping_ ABSL_GUARDED_BY(mu_) = false;
   LoadedModelsStats stats_ ABSL_GUARDED_BY(mu_);  // models and bytes: see kept_
   std::vector<std::thread> threads_;  // started in the constructor, joined in the destructor

@@ -30,6 +30,7 @@ SamplingEngine::SamplingEngine(const SurfaceKinds& kinds, EngineLimits limits, T
       loaded_(std::make_unique<LoadedModels>([&limits] {
         LoadedModelsOptions o;
         o.budget_bytes = limits.parsed_model_bytes;
+        o.working_budget_bytes = limits.parse_memory_bytes;
         o.parse_threads = limits.model_parse_threads;
         o.max_queued_parses = limits.max_queued_parses;
         o.parse_seconds = limits.model_parse_seconds;

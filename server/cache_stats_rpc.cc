@@ -55,6 +55,7 @@ grpc::Status SamplerService::GetCacheStats(grpc::ServerContext* context,
     response->set_max_model_bytes(models_->max_model_bytes());
     response->set_model_uploads(m.uploads);
     response->set_model_evictions(m.evictions);
+    response->set_model_upload_bytes(m.upload_bytes);
     const LoadedModelsStats p = engine_.loaded_models().stats();
     const LoadedModelsOptions& po = engine_.loaded_models().options();
     response->set_parsed_models(p.models);
@@ -68,6 +69,8 @@ grpc::Status SamplerService::GetCacheStats(grpc::ServerContext* context,
     response->set_model_parses_running(p.parsing);
     response->set_model_parses_queued(p.queued);
     response->set_max_queued_parses(po.max_queued_parses);
+    response->set_parse_memory_bytes(po.working_budget_bytes);
+    response->set_parse_memory_reserved(p.working_bytes);
   }
   metrics_->CountRequest("GetCacheStats", status.error_code());
   return status;

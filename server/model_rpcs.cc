@@ -19,14 +19,13 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
                                          v1::ModelInfo* response) {
   const auto start = Clock::now();
   grpc::Status status = Admit(*context);
-  std::string name, bytes;
+  std::string name;
   std::optional<ModelFormat> format;
+  // The bytes count against the model budget as they arrive.
+  ModelStore::Upload upload = models_->StartUpload();
   if (status.ok()) {
     v1::ModelChunk chunk;
     bool first = true;
-    // What Put would take: an upload past the store's whole budget is not
-    // read to its end either.
-    const uint64_t max_bytes = std::min(models_->max_model_bytes(), models_->budget_bytes());
     while (status.ok() && reader->Read(&chunk)) {
       if (first) {
         // The name is the client's: escaped and clipped before any message
@@ -40,18 +39,18 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
                                                 Echo(chunk.format())));
         }
         first = false;
+        if (status.ok() && chunk.total_bytes() > 0) {
+          if (absl::Status expected = upload.Expect(chunk.total_bytes()); !expected.ok()) {
+            status = grpc::Status(static_cast<grpc::StatusCode>(expected.code()),
+                                  absl::StrFormat("upload \"%s\": %s", name, expected.message()));
+            break;
+          }
+        }
       }
-      if (bytes.size() + chunk.data().size() > max_bytes) {
-        // Stop reading now: the rest would only be thrown away.
-        models_->CountRejected();
-        status = grpc::Status(
-            grpc::StatusCode::RESOURCE_EXHAUSTED,
-            absl::StrFormat("the model \"%s\" is larger than this server takes (max_model_bytes %d, "
-                            "model budget %d); simplify or split it, or ask the operator to raise "
-                            "the limit",
-                            name, models_->max_model_bytes(), models_->budget_bytes()));
-      } else {
-        bytes += chunk.data();
+      // Past a limit, stop reading now: the rest would only be thrown away.
+      if (absl::Status appended = upload.Append(std::move(*chunk.mutable_data())); !appended.ok()) {
+        status = grpc::Status(static_cast<grpc::StatusCode>(appended.code()),
+                              absl::StrFormat("upload \"%s\": %s", name, appended.message()));
       }
     }
     if (status.ok() && first) {
@@ -60,7 +59,7 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
   }
   if (status.ok()) {
     bool already = false;
-    auto stored = models_->Put(*format, std::move(bytes), name, &already);
+    auto stored = models_->Put(*format, std::move(upload), name, &already);
     if (stored.ok()) {
       ToProto(*stored, already, response);
     } else {

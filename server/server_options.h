@@ -21,8 +21,10 @@ struct ServerOptions {
   EngineLimits limits = [] {
     EngineLimits l;
     l.generation_threads = 2;
-    // A server parses other people's files: each parse gets a CPU budget.
+    // A server parses other people's files: each parse gets a CPU budget,
+    // and the parses running at once a memory budget (a 60 MB STEP file).
     l.model_parse_seconds = 120;
+    l.parse_memory_bytes = uint64_t{2} << 30;
     return l;
   }();
   uint64_t cache_bytes = uint64_t{1} << 30;    // tree cache budget, 1 GiB

@@ -55,6 +55,11 @@ int main(int argc, char** argv) {
   app.add_option("--parsed-model-bytes", o.limits.parsed_model_bytes,
                  "parsed models kept (meshes, CAD models), bytes (LRU eviction)")
       ->capture_default_str();
+  app.add_option("--parse-memory-bytes", o.limits.parse_memory_bytes,
+                 "working memory of the model parses running at once, bytes, estimated from each "
+                 "file's size (about 30 bytes a byte of STEP or IGES, 5-8 of a mesh); a model "
+                 "needing more is RESOURCE_EXHAUSTED (0: no limit)")
+      ->capture_default_str();
   app.add_option("--model-parse-threads", o.limits.model_parse_threads,
                  "model files parsed at once (on threads of their own, not the RPC threads)")
       ->capture_default_str()

@@ -39,17 +39,17 @@ TEST(LoadedModels, KeepsWithinItsByteBudgetLeastRecentlyUsedFirstOut) {
   LoadedModels loaded(o);
   std::atomic<int> parses{0};
   for (const char* key : {"a", "b", "c"}) {
-    ASSERT_TRUE(loaded.Get<int>(key, Returning(100, &parses), nullptr).ok());
+    ASSERT_TRUE(loaded.Get<int>(key, Returning(100, &parses), nullptr, 0).ok());
   }
   EXPECT_EQ(loaded.stats().bytes, 200u);
   EXPECT_EQ(loaded.stats().models, 2u);
   EXPECT_EQ(loaded.stats().evictions, 1u);
-  ASSERT_TRUE(loaded.Get<int>("c", Returning(100, &parses), nullptr).ok());
+  ASSERT_TRUE(loaded.Get<int>("c", Returning(100, &parses), nullptr, 0).ok());
   EXPECT_EQ(parses.load(), 3);  // c was kept
-  ASSERT_TRUE(loaded.Get<int>("a", Returning(100, &parses), nullptr).ok());
+  ASSERT_TRUE(loaded.Get<int>("a", Returning(100, &parses), nullptr, 0).ok());
   EXPECT_EQ(parses.load(), 4);  // a was evicted
   // Larger than the whole budget: returned, not kept.
-  auto big = loaded.Get<int>("big", Returning(1000, &parses), nullptr);
+  auto big = loaded.Get<int>("big", Returning(1000, &parses), nullptr, 0);
   ASSERT_TRUE(big.ok());
   EXPECT_EQ(**big, 7);
   EXPECT_LE(loaded.stats().bytes, 250u);
@@ -65,7 +65,7 @@ TEST(LoadedModels, ConcurrentRequestsShareOneParseAndFailuresAreRemembered) {
   };
   std::vector<std::thread> threads;
   for (int i = 0; i < 8; ++i) {
-    threads.emplace_back([&] { EXPECT_TRUE(loaded.Get<int>("k", slow, nullptr).ok()); });
+    threads.emplace_back([&] { EXPECT_TRUE(loaded.Get<int>("k", slow, nullptr, 0).ok()); });
   }
   for (auto& t : threads) t.join();
   EXPECT_EQ(parses.load(), 1);
@@ -75,12 +75,12 @@ TEST(LoadedModels, ConcurrentRequestsShareOneParseAndFailuresAreRemembered) {
     ++failures;
     return absl::InvalidArgumentError("bad face");
   };
-  EXPECT_EQ(loaded.Get<int>("sha256=ab|x", failing, nullptr).status().message(), "bad face");
-  EXPECT_EQ(loaded.Get<int>("sha256=ab|x", failing, nullptr).status().message(), "bad face");
+  EXPECT_EQ(loaded.Get<int>("sha256=ab|x", failing, nullptr, 0).status().message(), "bad face");
+  EXPECT_EQ(loaded.Get<int>("sha256=ab|x", failing, nullptr, 0).status().message(), "bad face");
   EXPECT_EQ(failures.load(), 1);
   EXPECT_EQ(loaded.stats().failure_hits, 1u);
   loaded.ForgetModel("ab");  // forgets failures too
-  EXPECT_FALSE(loaded.Get<int>("sha256=ab|x", failing, nullptr).ok());
+  EXPECT_FALSE(loaded.Get<int>("sha256=ab|x", failing, nullptr, 0).ok());
   EXPECT_EQ(failures.load(), 2);
 }
 
@@ -89,7 +89,7 @@ TEST(LoadedModels, TheCpuBudgetStopsAParse) {
   o.parse_seconds = 0.2;
   LoadedModels loaded(o);
   std::atomic<bool> started{false};
-  auto s = loaded.Get<int>("spin", Spinning(&started), nullptr);
+  auto s = loaded.Get<int>("spin", Spinning(&started), nullptr, 0);
   EXPECT_EQ(s.status().code(), absl::StatusCode::kResourceExhausted) << s.status();
   EXPECT_NE(s.status().message().find("model_parse_seconds"), std::string::npos);
   EXPECT_EQ(loaded.stats().parses_stopped, 1u);
@@ -103,7 +103,7 @@ TEST(LoadedModels, ACallerLeavesAtOnceAndAParseNobodyWantsStops) {
   std::thread t([&] {
     auto s = loaded.Get<int>("spin", Spinning(&started), [&]() -> absl::Status {
       return leave ? absl::CancelledError("client gone") : absl::OkStatus();
-    });
+    }, 0);
     EXPECT_EQ(s.status().message(), "client gone");
   });
   while (!started) std::this_thread::sleep_for(std::chrono::milliseconds(1));
@@ -127,16 +127,52 @@ TEST(LoadedModels, AFullQueueIsResourceExhausted) {
   auto until_leave = [&]() -> absl::Status {
     return leave ? absl::CancelledError("done") : absl::OkStatus();
   };
-  std::thread running([&] { loaded.Get<int>("a", Spinning(&started), until_leave).IgnoreError(); });
+  std::thread running([&] { loaded.Get<int>("a", Spinning(&started), until_leave, 0).IgnoreError(); });
   while (!started) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  std::thread queued([&] { loaded.Get<int>("b", Spinning(&other), until_leave).IgnoreError(); });
+  std::thread queued([&] { loaded.Get<int>("b", Spinning(&other), until_leave, 0).IgnoreError(); });
   while (loaded.stats().queued < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  auto refused = loaded.Get<int>("c", Spinning(&other), nullptr);
+  auto refused = loaded.Get<int>("c", Spinning(&other), nullptr, 0);
   EXPECT_EQ(refused.status().code(), absl::StatusCode::kResourceExhausted);
   EXPECT_NE(refused.status().message().find("max_queued_parses"), std::string::npos);
   leave = true;
   running.join();
   queued.join();
+}
+
+// Parses' working memory: a parse whose estimate is past the budget is
+// refused before it queues; two whose estimates do not fit together run one
+// after the other even with two parse threads.
+TEST(LoadedModels, ParsesRunOnlyWhileTheirWorkingMemoryFits) {
+  LoadedModelsOptions o;
+  o.parse_threads = 2;
+  o.working_budget_bytes = 1000;
+  LoadedModels loaded(o);
+  std::atomic<int> parses{0};
+  auto refused = loaded.Get<int>("huge", Returning(1, &parses), nullptr, 1001);
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_NE(refused.status().message().find("parse_memory_bytes"), std::string::npos);
+  EXPECT_EQ(parses, 0);
+
+  std::atomic<bool> first_started{false}, second_started{false}, leave{false};
+  auto until_leave = [&]() -> absl::Status {
+    return leave ? absl::CancelledError("done") : absl::OkStatus();
+  };
+  std::thread first([&] { loaded.Get<int>("a", Spinning(&first_started), until_leave, 600).IgnoreError(); });
+  while (!first_started) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  EXPECT_EQ(loaded.stats().working_bytes, 600u);
+  std::thread second([&] { loaded.Get<int>("b", Spinning(&second_started), until_leave, 600).IgnoreError(); });
+  while (loaded.stats().queued < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  EXPECT_FALSE(second_started) << "600 + 600 bytes of parses ran at once on a budget of 1000";
+  leave = true;
+  first.join();
+  second.join();
+  // The abandoned parse stops at its next check and gives its memory back.
+  for (int i = 0; i < 200 && loaded.stats().working_bytes > 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_EQ(loaded.stats().working_bytes, 0u);
+  EXPECT_TRUE(loaded.Get<int>("c", Returning(1, &parses), nullptr, 1000).ok());
 }
 
 }  // namespace

@@ -2,7 +2,10 @@
 #include "server/model_store.h"
 
 #include <fstream>
+#include <optional>
+#include <string>
 
+#include "gmock/gmock.h"
 #include "gtest/gtest.h"
 
 namespace sfc {
@@ -88,6 +91,72 @@ TEST(ModelStore, KeepsNoMoreThanTheBytesItCounts) {
   ASSERT_TRUE(stored.ok()) << stored.status();
   EXPECT_EQ(store.stats().bytes, 1000u);
   EXPECT_LT(stored->bytes->capacity(), 2000u);
+}
+
+// Bytes being received count against the budget with the stored models, so
+// uploads in flight cannot take the server past its budget.
+TEST(ModelStore, UploadsBeingReceivedCountAgainstTheBudget) {
+  ModelStore store(/*budget_bytes=*/300, /*max_model_bytes=*/300);
+  auto stored = store.Put(ModelFormat::kPly, std::string(200, 's'), "stored.ply");
+  ASSERT_TRUE(stored.ok()) << stored.status();
+  std::optional<ModelStore::Upload> first(store.StartUpload());
+  ASSERT_TRUE(first->Append(std::string(150, 'a')).ok());
+  EXPECT_EQ(store.stats().upload_bytes, 150u);
+  // 200 stored + 150 in flight would pass 300: the stored model made room.
+  EXPECT_EQ(store.stats().evictions, 1u);
+  EXPECT_EQ(store.stats().bytes, 0u);
+  EXPECT_EQ(store.Resolve(**ParseModelSpec(stored->Spec())).status().code(), absl::StatusCode::kNotFound);
+
+  ModelStore::Upload second = store.StartUpload();
+  const absl::Status refused = second.Append(std::string(200, 'b'));
+  EXPECT_EQ(refused.code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_THAT(std::string(refused.message()), ::testing::HasSubstr("retry"));
+  EXPECT_EQ(store.stats().upload_bytes, 150u);
+
+  first.reset();  // a client that leaves gives its bytes back
+  EXPECT_EQ(store.stats().upload_bytes, 0u);
+  // Chunks without a declared size are joined at the end, which needs the
+  // bytes twice for a moment: 2 x 200 does not fit 300.
+  ModelStore::Upload undeclared = store.StartUpload();
+  ASSERT_TRUE(undeclared.Append(std::string(100, 'c')).ok());
+  ASSERT_TRUE(undeclared.Append(std::string(100, 'c')).ok());
+  EXPECT_EQ(store.Put(ModelFormat::kPly, std::move(undeclared), "c.ply").status().code(),
+            absl::StatusCode::kResourceExhausted);
+  EXPECT_EQ(store.stats().upload_bytes, 0u);
+  // Declared up front, the same upload is counted once and fits.
+  ModelStore::Upload third = store.StartUpload();
+  ASSERT_TRUE(third.Expect(200).ok());
+  EXPECT_EQ(store.stats().upload_bytes, 200u);
+  ASSERT_TRUE(third.Append(std::string(100, 'c')).ok());
+  ASSERT_TRUE(third.Append(std::string(100, 'c')).ok());
+  auto kept = store.Put(ModelFormat::kPly, std::move(third), "c.ply");
+  ASSERT_TRUE(kept.ok()) << kept.status();
+  EXPECT_EQ(kept->sha256, Sha256Hex(std::string(200, 'c')));
+  EXPECT_EQ(*kept->bytes, std::string(200, 'c'));
+  EXPECT_EQ(kept->bytes->capacity(), 200u);
+  EXPECT_EQ(store.stats().upload_bytes, 0u);
+  EXPECT_EQ(store.stats().bytes, 200u);
+}
+
+// An upload past max_model_bytes is refused at the chunk that passes it, or
+// at once when it declares its size; a declared size must be kept to.
+TEST(ModelStore, RefusesAnUploadAtTheChunkThatPassesTheLimit) {
+  ModelStore store(/*budget_bytes=*/1000, /*max_model_bytes=*/250);
+  ModelStore::Upload upload = store.StartUpload();
+  ASSERT_TRUE(upload.Append(std::string(200, 'a')).ok());
+  EXPECT_EQ(upload.Append(std::string(100, 'a')).code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_EQ(store.stats().rejected, 1u);
+  EXPECT_EQ(upload.size(), 200u);
+  EXPECT_EQ(store.StartUpload().Expect(251).code(), absl::StatusCode::kResourceExhausted);
+
+  ModelStore::Upload more = store.StartUpload();
+  ASSERT_TRUE(more.Expect(10).ok());
+  EXPECT_EQ(more.Append(std::string(11, 'm')).code(), absl::StatusCode::kInvalidArgument);
+  ModelStore::Upload fewer = store.StartUpload();
+  ASSERT_TRUE(fewer.Expect(10).ok());
+  ASSERT_TRUE(fewer.Append(std::string(9, 'f')).ok());
+  EXPECT_EQ(store.Put(ModelFormat::kPly, std::move(fewer), "f.ply").status().code(),
+            absl::StatusCode::kInvalidArgument);
 }
 
 TEST(FileModelSource, ReadsAndHashesAFile) {

@@ -264,6 +264,32 @@ TEST(ServerModels, ParsedModelsAreCountedAndDroppedWithFailedRequestsAndEvictedU
   EXPECT_EQ(stats.parsed_model_bytes(), 0u);
 }
 
+// Parses' working memory follows --parse-memory-bytes: a model whose parse
+// would need more (estimated from its size before parsing) is refused with
+// RESOURCE_EXHAUSTED naming the flag, and a model that fits samples; an
+// upload's bytes are counted as they arrive and none stay held after it.
+TEST(ServerModels, ParseMemoryAndUploadsInFlightFollowTheirBudgets) {
+  ServerOptions options = LoopbackOptions();
+  const std::string small = GridObj(10), large = GridObj(200);
+  // Room for the small grid's parse (1 MiB + 8 bytes a byte), not the large one's.
+  options.limits.parse_memory_bytes = (uint64_t{1} << 20) + 8 * (small.size() + large.size()) / 2;
+  ASSERT_GT((uint64_t{1} << 20) + 8 * large.size(), options.limits.parse_memory_bytes);
+  Running r = StartServer(options);
+  auto info_small = r.client->UploadModel("obj", "small.obj", small);
+  ASSERT_TRUE(info_small.ok()) << info_small.status();
+  EXPECT_TRUE(SampleStatus(*r.client, Request(info_small->spec(), 1000)).ok());
+  auto info_large = r.client->UploadModel("obj", "large.obj", large);
+  ASSERT_TRUE(info_large.ok()) << info_large.status();
+  const absl::Status refused = SampleStatus(*r.client, Request(info_large->spec(), 1000));
+  EXPECT_EQ(refused.code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_NE(refused.message().find("parse_memory_bytes"), std::string::npos) << refused;
+  const auto stats = *r.client->GetCacheStats();
+  EXPECT_EQ(stats.parse_memory_bytes(), options.limits.parse_memory_bytes);
+  EXPECT_EQ(stats.parse_memory_reserved(), 0u);
+  EXPECT_EQ(stats.model_upload_bytes(), 0u);
+  EXPECT_EQ(stats.model_bytes(), small.size() + large.size());
+}
+
 // A cached mesh tree keeps its mesh alive after the parse is dropped (its
 // upload evicted): the tree cache counts the mesh with the tree, so its
 // budget bounds what trees pin (the soak's model phase found RSS past the

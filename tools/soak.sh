@@ -9,13 +9,15 @@
 # tens of MB; hostile uploads that must be refused), and prints its table:
 # outcomes by status code, unexpected outcomes (target 0), samples/s, and the
 # server's peak RSS against the sum of its memory budgets: trees, streams'
-# working memory, uploaded models and parsed models (target: within the sum
-# + 20%). Exits 1 on any unexpected outcome.
+# working memory, uploaded models (stored and being received), parsed models
+# and parses' working memory (target: within the sum + 20%). Exits 1 on any
+# unexpected outcome.
 #   bash tools/soak.sh [SECONDS] [STREAMS]      (defaults 60 and 64)
 # SFC_SOAK_CACHE_BYTES (default 256 MiB) sets the server's cache budget and
 # SFC_SOAK_STREAM_BYTES (default 64 MiB) its streams' working memory;
 # SFC_SOAK_MODEL_BYTES and SFC_SOAK_PARSED_MODEL_BYTES (default 128 MiB each)
-# its uploaded and parsed models; SFC_SOAK_MODEL_SHARE (default 25, 0 = none)
+# its uploaded and parsed models; SFC_SOAK_PARSE_MEMORY_BYTES (default 256
+# MiB) its parses' working memory; SFC_SOAK_MODEL_SHARE (default 25, 0 = none)
 # the percent of workers in the model phase; SFC_SOAK_SERVER_FLAGS adds
 # server flags.
 set -euo pipefail
@@ -26,6 +28,7 @@ cache_bytes="${SFC_SOAK_CACHE_BYTES:-268435456}"
 stream_bytes="${SFC_SOAK_STREAM_BYTES:-67108864}"
 model_bytes="${SFC_SOAK_MODEL_BYTES:-134217728}"
 parsed_model_bytes="${SFC_SOAK_PARSED_MODEL_BYTES:-134217728}"
+parse_memory_bytes="${SFC_SOAK_PARSE_MEMORY_BYTES:-268435456}"
 model_share="${SFC_SOAK_MODEL_SHARE:-25}"
 bash tools/build.sh
 server=build/server/sfcsampler-server
@@ -50,6 +53,11 @@ if "$server" --help 2>&1 | grep -q -- --write-timeout; then flags+=(--write-time
 # parses in well under it).
 if "$server" --help 2>&1 | grep -q -- --parsed-model-bytes; then
   flags+=(--model-bytes "$model_bytes" --parsed-model-bytes "$parsed_model_bytes" --model-parse-seconds 5)
+  # Parses' working memory: the largest good mesh (a 48 MB PLY) reserves
+  # 5 bytes a byte.
+  if "$server" --help 2>&1 | grep -q -- --parse-memory-bytes; then
+    flags+=(--parse-memory-bytes "$parse_memory_bytes")
+  fi
 else
   model_share=0
 fi

@@ -39,6 +39,10 @@ struct CadParse {
 absl::StatusOr<std::shared_ptr<const CadParse>> LoadCad(const StoredModel& model,
                                                         LoadedModels* loaded,
                                                         const std::function<absl::Status()>& caller) {
+  // The parse's peak memory (bench/parse_memory, docs/MODELS.md): 22-26
+  // bytes a byte of a 8-10 MB STEP or IGES file, past the kernel's one-time
+  // ~16 MB; reserved with a margin.
+  const uint64_t working_bytes = (uint64_t{1} << 20) + 30 * model.bytes->size();
   // The parse owns its inputs: it runs on a parse thread and may outlive the
   // request that started it.
   return loaded->Get<CadParse>(
@@ -60,7 +64,7 @@ absl::StatusOr<std::shared_ptr<const CadParse>> LoadCad(const StoredModel& model
         return LoadedModels::Parsed{
             std::make_shared<const CadParse>(CadParse{std::move(parsed), bytes}), bytes};
       },
-      caller);
+      caller, working_bytes);
 }
 
 class CadBatchCursor final : public BatchCursor {

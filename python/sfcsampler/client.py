@@ -180,6 +180,7 @@ class Client:
             for offset in range(0, max(len(local), 1), _UPLOAD_CHUNK):
                 first = offset == 0
                 yield pb.ModelChunk(format=fmt if first else "", name=name if first else "",
+                                    total_bytes=len(local) if first else 0,
                                     data=local[offset:offset + _UPLOAD_CHUNK])
         try:
             return self._stub.UploadModel(chunks(), timeout=self._timeout, metadata=metadata).spec

@@ -1,0 +1,139 @@
+// Measures what parsing a model costs in memory at its peak, against the
+// file's size and against what the parsed model keeps: the figures behind
+// the parse reservations of kinds/cad and kinds/mesh (docs/MODELS.md).
+// Each model is parsed by a fresh process (this program run again with
+// --one), so no memory freed before, by this program or a parse before, hides
+// the parse's peak; the peak is the growth of that process's VmHWM over its
+// VmRSS just before the parse. The kernel's one-time set-up (OpenCASCADE's
+// ~16 MB on its first STEP or IGES) is paid there too: small files show it,
+// large ones their ratio.
+//   parse_memory DIR [LARGE_SUBDIVISIONS] [CAD_COPIES]
+//       writes the soak's models into DIR, and STEP and IGES files of
+//       CAD_COPIES (default 400) boxes with a hole, then measures them all
+//   parse_memory FORMAT:FILE...
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+
+#include "absl/strings/numbers.h"
+#include "bench/soak_models.h"
+#include "cad/fixtures.h"
+#include "cad/load.h"
+#include "mesh/mesh_loader.h"
+#include "mesh/mesh_surface.h"
+
+namespace {
+
+// A field of /proc/self/status in bytes ("VmRSS", "VmHWM").
+uint64_t StatusBytes(const std::string& field) {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind(field + ":", 0) == 0) return std::stoull(line.substr(field.size() + 1)) * 1024;
+  }
+  return 0;
+}
+
+// Parses `spec` (FORMAT:FILE) and prints one row. Runs in a child.
+int Measure(const std::string& spec, bool curvature) {
+  const size_t colon = spec.find(':');
+  const std::string format = spec.substr(0, colon), path = spec.substr(colon + 1);
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string bytes = buffer.str();
+  // Reset the peak to now (Linux: clear_refs 5), then parse.
+  std::ofstream("/proc/self/clear_refs") << "5";
+  const uint64_t before = StatusBytes("VmRSS");
+  std::string what = "ok";
+  if (format == "ply" || format == "obj") {
+    sfc::MeshLoadOptions options;
+    options.format = format == "ply" ? sfc::MeshFormat::kPly : sfc::MeshFormat::kObj;
+    auto mesh = sfc::LoadMesh(bytes, path, options);
+    if (!mesh.ok()) {
+      what = std::string(mesh.status().message()).substr(0, 60);
+    } else {
+      auto surface = sfc::MeshSurface::Create(*std::move(mesh), curvature);
+    }
+  } else {
+    const sfc::cad::ModelFormat f = format == "step"   ? sfc::cad::ModelFormat::kStep
+                                    : format == "iges" ? sfc::cad::ModelFormat::kIges
+                                                       : sfc::cad::ModelFormat::kNurbs;
+    auto model = sfc::cad::Load(f, bytes, path, {});
+    if (!model.ok()) what = std::string(model.status().message()).substr(0, 60);
+  }
+  const uint64_t peak = StatusBytes("VmHWM");
+  const double growth = peak > before ? static_cast<double>(peak - before) : 0.0;
+  std::printf("%-6s %-10s %12zu %12.0f %8.2f  %s\n", format.c_str(), curvature ? "curvature" : "",
+              bytes.size(), growth, growth / static_cast<double>(bytes.size()), what.c_str());
+  std::fflush(stdout);
+  return 0;
+}
+
+// STEP and IGES files of `copies` boxes with a hole side by side, in `dir`.
+bool WriteCadArrays(const std::string& dir, int copies, std::vector<std::string>* specs) {
+  namespace fixtures = sfc::cad::fixtures;
+  for (auto [format, name] : {std::pair{sfc::cad::ModelFormat::kStep, "step"},
+                              std::pair{sfc::cad::ModelFormat::kIges, "iges"}}) {
+    auto bytes = fixtures::SolidBytes(fixtures::Solid::kBoxWithHole, format, copies);
+    if (!bytes.ok()) return false;
+    const std::string path = dir + "/boxes." + name;
+    std::ofstream(path, std::ios::binary) << *bytes;
+    specs->push_back(std::string(name) + ":" + path);
+  }
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc == 4 && std::string(argv[1]) == "--one") return Measure(argv[2], std::string(argv[3]) == "1");
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: parse_memory DIR [LARGE_SUBDIVISIONS] | FORMAT:FILE...\n");
+    return 2;
+  }
+  std::vector<std::string> specs;
+  if (std::string(argv[1]).find(':') == std::string::npos) {
+    int subdivisions = 8;
+    if (argc > 2 && !absl::SimpleAtoi(argv[2], &subdivisions)) return 2;
+    auto models = sfc::SoakModels::Write(argv[1], subdivisions);
+    if (!models.ok()) {
+      std::fprintf(stderr, "%s\n", models.status().ToString().c_str());
+      return 1;
+    }
+    for (const auto& m : models->good()) specs.push_back(m.spec);
+    for (const auto& m : models->large()) specs.push_back(m.spec);
+    int copies = 400;
+    if (argc > 3 && !absl::SimpleAtoi(argv[3], &copies)) return 2;
+    if (!WriteCadArrays(argv[1], copies, &specs)) {
+      std::fprintf(stderr, "could not write the STEP and IGES arrays\n");
+      return 1;
+    }
+  } else {
+    for (int i = 1; i < argc; ++i) specs.push_back(argv[i]);
+  }
+  std::printf("%-6s %-10s %12s %12s %8s  %s\n", "format", "", "file bytes", "peak growth", "ratio",
+              "result");
+  for (const std::string& spec : specs) {
+    for (bool curvature : {false, true}) {
+      const bool mesh = spec.rfind("ply:", 0) == 0 || spec.rfind("obj:", 0) == 0;
+      if (curvature && !mesh) continue;
+      std::fflush(stdout);
+      const pid_t child = fork();
+      if (child == 0) {
+        execl("/proc/self/exe", argv[0], "--one", spec.c_str(), curvature ? "1" : "0", nullptr);
+        _exit(127);
+      }
+      int status = 0;
+      waitpid(child, &status, 0);
+    }
+  }
+  return 0;
+}
