@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 
 namespace sfc {
 
@@ -24,6 +25,10 @@ struct EngineLimits {
   // from each file's size before it starts (0 = no limit).
   uint64_t parsed_model_bytes = uint64_t{256} << 20;
   uint64_t parse_memory_bytes = 0;
+  // A program that reads a CAD file first in a process of its own
+  // (kinds/cad/model_check.h), with model_parse_seconds of CPU; "" = read
+  // in process only (the CLI's own files).
+  std::string model_check_program;
   int model_parse_threads = 1;
   int max_queued_parses = 8;
   double model_parse_seconds = 0;

@@ -5,6 +5,9 @@
 #include <malloc.h>
 #include <signal.h>
 
+#include <unistd.h>
+
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -12,9 +15,40 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/strip.h"
 #include "core/curve_tree.h"
+#include "kinds/registered_kinds.h"
+#include "request/model_spec.h"
 #include "server/memory_trimmer.h"
 #include "server/sampler_server.h"
 #include "spdlog/spdlog.h"
+
+namespace {
+
+// --model-check-program: "none" is "", "auto" the program next to this one
+// (or "" when this build reads no CAD files), a path itself when it can run.
+absl::Status ResolveModelCheckProgram(const std::string& flag, std::string* program) {
+  const bool reads_cad = sfc::RegisteredSurfaceKinds().For(sfc::ModelSpec{sfc::ModelFormat::kStep}) != nullptr;
+  if (flag == "none" || !reads_cad) {
+    *program = "";
+    return absl::OkStatus();
+  }
+  std::string path = flag;
+  if (flag == "auto") {
+    std::error_code error;
+    path = (std::filesystem::read_symlink("/proc/self/exe", error).parent_path() /
+            "sfcsampler-model-check").string();
+  }
+  if (access(path.c_str(), X_OK) != 0) {
+    return absl::FailedPreconditionError(absl::StrFormat(
+        "cannot run the model check program %s; install sfcsampler-model-check next to the server, "
+        "name it with --model-check-program PATH, or pass --model-check-program none to read CAD "
+        "files in process only",
+        path));
+  }
+  *program = path;
+  return absl::OkStatus();
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   // Large buffers (sorted index ranges, batches, messages, tree arrays) come
@@ -122,8 +156,19 @@ int main(int argc, char** argv) {
                  "how often freed heap memory is given back to the system (malloc_trim); 0 = never")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  std::string model_check = "auto";
+  app.add_option("--model-check-program", model_check,
+                 "reads each CAD file first in a process of its own, where a crash or a loop in the "
+                 "CAD kernel costs one request (auto: sfcsampler-model-check next to this program; "
+                 "none: read CAD files in process only)")
+      ->capture_default_str();
   app.add_option("--log-level", log_level, "trace | debug | info | warn | error")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  if (absl::Status found = ResolveModelCheckProgram(model_check, &o.limits.model_check_program);
+      !found.ok()) {
+    std::cerr << "sfcsampler-server: " << found.message() << "\n";
+    return 2;
+  }
 
   spdlog::set_level(spdlog::level::from_str(log_level));
   sfc::MemoryTrimmer trimmer{std::chrono::milliseconds(trim_interval_ms)};

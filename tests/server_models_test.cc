@@ -39,6 +39,14 @@ absl::Status SampleStatus(SamplerClient& client, const SampleRequest& request) {
   return s.status();
 }
 
+// A server as sfcsampler-server runs one: CAD files are read first by the
+// model check program, in a process of its own.
+ServerOptions ModelServerOptions() {
+  ServerOptions options = LoopbackOptions();
+  options.limits.model_check_program = SFC_MODEL_CHECK_PROGRAM;
+  return options;
+}
+
 constexpr char kSquareObj[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
 
 // A 100 000-digit index: the real INVALID_ARGUMENT arrives (not the
@@ -324,6 +332,51 @@ TEST(ServerModels, ACachedCadTreeCountsTheModelItKeepsAlive) {
   ASSERT_EQ(stats.parsed_models(), 1u);
   ASSERT_GT(stats.parsed_model_bytes(), 0u);
   EXPECT_GE(stats.bytes(), stats.parsed_model_bytes());
+}
+
+// An IGES file whose circular arc has a garbled coordinate ("0&"): OpenCASCADE
+// 7.6's shape healing then spins in Geom2d_TrimmedCurve::SetTrim without ever
+// polling the user break (found by iges_fuzzer). In process it would hold a
+// parse thread for good; read first in the model check process, it costs
+// its own request a refusal at the CPU budget, and the next model parses.
+TEST(ServerModels, AFileThatLoopsTheKernelCostsOneRequestNotTheParseThread) {
+  auto iges = cad::fixtures::SolidBytes(cad::fixtures::Solid::kBoxWithHole, cad::ModelFormat::kIges);
+  ASSERT_TRUE(iges.ok()) << iges.status();
+  const std::string arc = "100,0.,0.,0.,5.,0.,5.,0.;";
+  const size_t at = iges->find(arc);
+  ASSERT_NE(at, std::string::npos) << "the fixture's arc moved";
+  std::string looping = *iges;
+  looping.replace(at, arc.size(), "100,0.,0.,0.,5.,0&,5.,0.;");
+  ServerOptions options = ModelServerOptions();
+  options.limits.model_parse_seconds = 1;
+  options.limits.model_parse_threads = 1;
+  Running r = StartServer(options);
+  auto hostile = r.client->UploadModel("iges", "loop.iges", looping);
+  ASSERT_TRUE(hostile.ok()) << hostile.status();
+  const auto start = std::chrono::steady_clock::now();
+  const absl::Status refused = SampleStatus(*r.client, Request(hostile->spec(), 1000));
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(refused.code(), absl::StatusCode::kResourceExhausted) << refused;
+  EXPECT_LT(seconds, 15.0);
+  // The one parse thread is free: a good model parses and samples.
+  auto good = r.client->UploadModel("iges", "box.iges", *iges);
+  ASSERT_TRUE(good.ok()) << good.status();
+  EXPECT_TRUE(SampleStatus(*r.client, Request(good->spec(), 1000)).ok());
+  EXPECT_EQ(r.client->GetCacheStats()->model_parses_running(), 0u);
+}
+
+// The check process reports the loader's own refusals with their codes,
+// and the in-process read of an accepted file gives the same model.
+TEST(ServerModels, TheModelCheckPassesOnTheLoadersOwnErrors) {
+  Running r = StartServer(ModelServerOptions());
+  auto truncated = cad::fixtures::SolidBytes(cad::fixtures::Solid::kSphere, cad::ModelFormat::kStep);
+  ASSERT_TRUE(truncated.ok());
+  truncated->resize(truncated->size() / 2);
+  auto info = r.client->UploadModel("step", "half.step", *truncated);
+  ASSERT_TRUE(info.ok()) << info.status();
+  const absl::Status refused = SampleStatus(*r.client, Request(info->spec(), 1000));
+  EXPECT_EQ(refused.code(), absl::StatusCode::kInvalidArgument) << refused;
+  EXPECT_LT(refused.message().size(), 1100u);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include "base/status_macros.h"
 #include "cad/load.h"
 #include "cad/model_sampler.h"
+#include "kinds/cad/model_check.h"
 #include "catalog/catalog.h"
 
 namespace sfc {
@@ -37,25 +38,33 @@ struct CadParse {
 };
 
 absl::StatusOr<std::shared_ptr<const CadParse>> LoadCad(const StoredModel& model,
-                                                        LoadedModels* loaded,
-                                                        const std::function<absl::Status()>& caller) {
+                                                        const KindContext& context) {
   // The parse's peak memory (bench/parse_memory, docs/MODELS.md): 22-26
   // bytes a byte of a 8-10 MB STEP or IGES file, past the kernel's one-time
   // ~16 MB; reserved with a margin.
   const uint64_t working_bytes = (uint64_t{1} << 20) + 30 * model.bytes->size();
+  ModelCheckLimits check_limits;
+  check_limits.program = context.limits->model_check_program;
+  check_limits.cpu_seconds = context.limits->model_parse_seconds;
+  // The check process's address space: its libraries and the parse's
+  // working memory, twice over.
+  check_limits.memory_bytes = (uint64_t{1} << 30) + 2 * working_bytes;
   // The parse owns its inputs: it runs on a parse thread and may outlive the
   // request that started it.
-  return loaded->Get<CadParse>(
+  return context.loaded->Get<CadParse>(
       model.Spec(),
-      [model](const ParseCheck& check) -> absl::StatusOr<LoadedModels::Parsed> {
+      [model, check_limits](const ParseCheck& check) -> absl::StatusOr<LoadedModels::Parsed> {
         ASSIGN_OR_RETURN(const cad::ModelFormat format, CadFormat(model.format));
+        const std::string name = model.name.empty() ? model.Spec() : model.name;
+        if (!check_limits.program.empty()) {
+          RETURN_IF_ERROR(CheckModelInSubprocess(check_limits, model.format, *model.bytes, name, check));
+        }
         cad::LoadOptions options;
         options.max_bytes = std::max<size_t>(options.max_bytes, model.bytes->size());
         options.check = check;
         const uint64_t before = HeapInUse();
         ASSIGN_OR_RETURN(std::shared_ptr<const cad::Model> parsed,
-                         cad::Load(format, *model.bytes, model.name.empty() ? model.Spec() : model.name,
-                                   options));
+                         cad::Load(format, *model.bytes, name, options));
         const uint64_t after = HeapInUse();
         // What the model holds: the heap's growth across the load (other
         // threads' allocations make this approximate), at least 4 KiB a face.
@@ -64,7 +73,7 @@ absl::StatusOr<std::shared_ptr<const CadParse>> LoadCad(const StoredModel& model
         return LoadedModels::Parsed{
             std::make_shared<const CadParse>(CadParse{std::move(parsed), bytes}), bytes};
       },
-      caller, working_bytes);
+      context.caller, working_bytes);
 }
 
 class CadBatchCursor final : public BatchCursor {
@@ -96,7 +105,7 @@ class CadKind final : public SurfaceKind {
     options.max_leaves = context.limits->max_tree_leaves;
     ASSIGN_OR_RETURN(DensityFromSpec density, MakeDensity(spec.density));
     ASSIGN_OR_RETURN(std::shared_ptr<const CadParse> parse,
-                     LoadCad(*model, context.loaded, context.caller));
+                     LoadCad(*model, context));
     ResolvedSurface out;
     out.key = MakeTreeKey(model->Spec(), density.canonical, options);
     out.factory.build = [parse, density = density.density, options](
@@ -126,7 +135,7 @@ class CadKind final : public SurfaceKind {
   absl::StatusOr<std::string> Describe(const StoredModel& model,
                                        const KindContext& context) const override {
     ASSIGN_OR_RETURN(std::shared_ptr<const CadParse> parse,
-                     LoadCad(model, context.loaded, context.caller));
+                     LoadCad(model, context));
     return cad::DescribeModel(*parse->model);
   }
 };

@@ -1,0 +1,126 @@
+#include "base/subprocess.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/mman.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <thread>
+
+#include "absl/strings/str_cat.h"
+
+extern char** environ;
+
+namespace sfc {
+namespace {
+
+// Closes a descriptor when it leaves scope.
+struct Fd {
+  int fd = -1;
+  ~Fd() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+absl::Status Errno(absl::string_view what) {
+  return absl::InternalError(absl::StrCat(what, ": ", std::strerror(errno)));
+}
+
+// Reads what is available from the non-blocking `fd` into `out`, up to the cap.
+void Drain(int fd, std::string* out) {
+  char buffer[4096];
+  while (true) {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n <= 0) return;
+    const size_t room = kMaxSubprocessOutput - std::min(out->size(), kMaxSubprocessOutput);
+    out->append(buffer, std::min(static_cast<size_t>(n), room));
+  }
+}
+
+}  // namespace
+
+absl::StatusOr<SubprocessResult> RunSubprocess(const std::vector<std::string>& argv,
+                                               absl::string_view input, double wall_seconds,
+                                               const std::function<absl::Status()>& check) {
+  if (argv.empty()) return absl::InvalidArgumentError("no program to run");
+  // The input in an in-memory file: the program reads it at its own pace.
+  Fd in{::memfd_create("sfc-subprocess-input", MFD_CLOEXEC)};
+  if (in.fd < 0) return Errno("memfd_create");
+  for (size_t done = 0; done < input.size();) {
+    const ssize_t n = ::write(in.fd, input.data() + done, input.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return Errno("writing the subprocess's input");
+    }
+    done += static_cast<size_t>(n);
+  }
+  if (::lseek(in.fd, 0, SEEK_SET) != 0) return Errno("lseek");
+  int out_pipe[2];
+  if (::pipe2(out_pipe, O_CLOEXEC | O_NONBLOCK) != 0) return Errno("pipe2");
+  Fd out_read{out_pipe[0]}, out_write{out_pipe[1]};
+  Fd null{::open("/dev/null", O_WRONLY | O_CLOEXEC)};
+  if (null.fd < 0) return Errno("open /dev/null");
+
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, in.fd, 0);
+  posix_spawn_file_actions_adddup2(&actions, out_write.fd, 1);
+  posix_spawn_file_actions_adddup2(&actions, null.fd, 2);
+  // The child starts with default signal handling and no blocked signals,
+  // whatever this process set up.
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t all, none;
+  sigfillset(&all);
+  sigemptyset(&none);
+  posix_spawnattr_setsigdefault(&attributes, &all);
+  posix_spawnattr_setsigmask(&attributes, &none);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETSIGMASK);
+  std::vector<char*> args;
+  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  pid_t pid = 0;
+  const int spawned = posix_spawn(&pid, argv[0].c_str(), &actions, &attributes, args.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attributes);
+  if (spawned != 0) {
+    return absl::InternalError(absl::StrCat("cannot start ", argv[0], ": ", std::strerror(spawned)));
+  }
+  ::close(out_write.fd);
+  out_write.fd = -1;
+
+  SubprocessResult result;
+  const auto start = std::chrono::steady_clock::now();
+  absl::Status stop;
+  int status = 0;
+  while (true) {
+    Drain(out_read.fd, &result.output);
+    const pid_t done = ::waitpid(pid, &status, WNOHANG);
+    if (done == pid) break;
+    if (done < 0 && errno != EINTR) return Errno("waitpid");
+    if (stop.ok() && check) stop = check();
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (stop.ok() && wall_seconds > 0 && elapsed > wall_seconds) result.timed_out = true;
+    if (!stop.ok() || result.timed_out) {
+      ::kill(pid, SIGKILL);
+      while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+      }
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  Drain(out_read.fd, &result.output);
+  if (!stop.ok()) return stop;
+  result.exited = WIFEXITED(status);
+  result.exit_code = result.exited ? WEXITSTATUS(status) : 0;
+  result.signal = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
+  return result;
+}
+
+}  // namespace sfc

@@ -1,0 +1,61 @@
+#include "kinds/cad/model_check.h"
+
+#include <signal.h>
+#include <string.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/strip.h"
+#include "base/echo.h"
+#include "base/subprocess.h"
+
+namespace sfc {
+
+absl::Status CheckModelInSubprocess(const ModelCheckLimits& limits, ModelFormat format,
+                                    const std::string& bytes, const std::string& name,
+                                    const std::function<absl::Status()>& check) {
+  const double wall_seconds = limits.cpu_seconds > 0 ? std::max(10.0, 4 * limits.cpu_seconds) : 0;
+  const std::vector<std::string> argv = {
+      limits.program, std::string(ModelFormatName(format)), name,
+      absl::StrFormat("%d", static_cast<uint64_t>(limits.cpu_seconds + 0.999)),
+      absl::StrFormat("%d", limits.memory_bytes)};
+  absl::StatusOr<SubprocessResult> run = RunSubprocess(argv, bytes, wall_seconds, check);
+  if (!run.ok()) return run.status();
+  absl::string_view line = absl::StripTrailingAsciiWhitespace(run->output);
+  if (run->exited && run->exit_code == 0 && absl::StartsWith(line, "ok ")) return absl::OkStatus();
+  if (run->exited && run->exit_code == 1) {
+    // "CODE MESSAGE": the loader's own refusal.
+    const size_t space = line.find(' ');
+    int code = 0;
+    if (space != absl::string_view::npos && absl::SimpleAtoi(line.substr(0, space), &code) &&
+        code > 0 && code <= static_cast<int>(absl::StatusCode::kUnauthenticated)) {
+      return absl::Status(static_cast<absl::StatusCode>(code), line.substr(space + 1));
+    }
+  }
+  if (run->timed_out) {
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "reading the model took more than %g s and was stopped (the CAD kernel made no progress "
+        "it reports); simplify or re-export the model",
+        wall_seconds));
+  }
+  if (!run->exited && run->signal == SIGXCPU) {
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "reading the model took more than %g s of CPU (the server's model_parse_seconds) and was "
+        "stopped: simplify the model (fewer or simpler faces), or ask the operator to raise the "
+        "limit",
+        limits.cpu_seconds));
+  }
+  if (!run->exited) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the CAD kernel crashed reading this model (signal %d, %s; memory limit %d bytes); it was "
+        "read in a process of its own, so nothing else was affected; fix or re-export the model",
+        run->signal, strsignal(run->signal), limits.memory_bytes));
+  }
+  return absl::InternalError(absl::StrFormat("the model check %s ended with status %d: %s",
+                                             Echo(limits.program), run->exit_code, Echo(line)));
+}
+
+}  // namespace sfc

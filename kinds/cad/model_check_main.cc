@@ -1,0 +1,81 @@
+// sfcsampler-model-check FORMAT NAME CPU_SECONDS MEMORY_BYTES < FILE
+//
+// Reads a CAD model (step, iges or nurbs) from standard input with cad::Load,
+// as the server's parse would, in a process of its own with the given limits
+// (0: none) on its CPU time (RLIMIT_CPU; SIGXCPU past it) and address space
+// (RLIMIT_AS). It dies with its parent. Prints one line and exits:
+//   0  "ok FACES"                   the model loads;
+//   1  "CODE MESSAGE"               cad::Load refused it (an absl status code);
+//   2  "usage ..."                  bad arguments.
+// A crash or a loop inside OpenCASCADE ends this process, not the server
+// (kinds/cad/model_check.h runs it; docs/MODELS.md says why).
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <algorithm>
+#include <exception>
+#include <iostream>
+#include <iterator>
+#include <new>
+#include <string>
+
+#include "absl/strings/numbers.h"
+#include "base/echo.h"
+#include "cad/load.h"
+
+namespace {
+
+void Limit(int resource, uint64_t soft, uint64_t hard) {
+  if (soft == 0) return;
+  rlimit limit{static_cast<rlim_t>(soft), static_cast<rlim_t>(hard)};
+  setrlimit(resource, &limit);
+}
+
+// One line of at most 1 KB (the loader's messages already escape the input).
+int Print(int code, std::string line) {
+  for (char& c : line) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  std::printf("%s\n", sfc::ClipMessage(line, 1024).c_str());
+  std::fflush(stdout);
+  return code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  uint64_t cpu_seconds = 0, memory_bytes = 0;
+  if (argc != 5 || !absl::SimpleAtoi(argv[3], &cpu_seconds) || !absl::SimpleAtoi(argv[4], &memory_bytes)) {
+    return Print(2, "usage: sfcsampler-model-check FORMAT NAME CPU_SECONDS MEMORY_BYTES < FILE");
+  }
+  // Gone with the server: a parse nobody can read the answer of stops.
+  prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (getppid() == 1) return 1;
+  Limit(RLIMIT_CPU, cpu_seconds, cpu_seconds + 1);
+  Limit(RLIMIT_AS, memory_bytes, memory_bytes);
+  rlimit no_core{0, 0};
+  setrlimit(RLIMIT_CORE, &no_core);
+
+  auto format = sfc::cad::ParseModelFormat(argv[1]);
+  if (!format.ok()) return Print(2, "usage: unknown format");
+  try {
+    const std::string bytes{std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>()};
+    sfc::cad::LoadOptions options;
+    options.max_bytes = std::max(options.max_bytes, bytes.size());
+    auto model = sfc::cad::Load(*format, bytes, argv[2], options);
+    if (!model.ok()) {
+      return Print(1, std::to_string(static_cast<int>(model.status().code())) + " " +
+                          std::string(model.status().message()));
+    }
+    return Print(0, "ok " + std::to_string((*model)->faces().size()));
+  } catch (const std::bad_alloc&) {
+    return Print(1, std::to_string(static_cast<int>(absl::StatusCode::kResourceExhausted)) +
+                        " out of memory while reading the model");
+  } catch (const std::exception& e) {
+    return Print(1, std::to_string(static_cast<int>(absl::StatusCode::kInvalidArgument)) +
+                        " reading the model failed: " + e.what());
+  }
+}
