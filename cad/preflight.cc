@@ -1,12 +1,16 @@
 #include "cad/preflight.h"
 
 #include <algorithm>
+#include <string>
+#include <vector>
 
 #include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "base/echo.h"
+#include "base/status_macros.h"
 
 namespace sfc::cad {
 namespace {
@@ -30,6 +34,75 @@ bool ParseHead(absl::string_view record, uint64_t* id, absl::string_view* keywor
   while (j < record.size() && (absl::ascii_isalnum(record[j]) || record[j] == '_')) ++j;
   *keyword = record.substr(0, j);
   return j > 0;
+}
+
+// True when `token` (blanks around it ignored) is an IGES integer or real:
+// [+-]digits[.digits][E|D[+-]digits], or .digits; or empty (a default).
+bool IsIgesNumber(absl::string_view token) {
+  token = absl::StripAsciiWhitespace(token);
+  size_t i = 0;
+  if (i < token.size() && (token[i] == '+' || token[i] == '-')) ++i;
+  size_t digits = 0;
+  while (i < token.size() && absl::ascii_isdigit(token[i])) ++i, ++digits;
+  if (i < token.size() && token[i] == '.') {
+    ++i;
+    while (i < token.size() && absl::ascii_isdigit(token[i])) ++i, ++digits;
+  }
+  if (digits == 0) return token.empty();
+  if (i < token.size() && (token[i] == 'E' || token[i] == 'e' || token[i] == 'D' || token[i] == 'd')) {
+    ++i;
+    if (i < token.size() && (token[i] == '+' || token[i] == '-')) ++i;
+    size_t exponent = 0;
+    while (i < token.size() && absl::ascii_isdigit(token[i])) ++i, ++exponent;
+    if (exponent == 0) return false;
+  }
+  return i == token.size();
+}
+
+// Checks every parameter of the parameter data (columns 1-64 of the P lines,
+// in order, `lines` their line numbers): each is a number, empty, or a
+// Hollerith string nH followed by n characters. OpenCASCADE reads a damaged
+// number such as "0&" without a complaint its transfer heeds, and its shape
+// healing can then loop for good (iges_fuzzer found one).
+absl::Status CheckIgesParameters(absl::string_view data, const std::vector<uint64_t>& lines,
+                                 char parameter_delimiter, char record_delimiter) {
+  size_t i = 0;
+  while (i < data.size()) {
+    size_t j = i;
+    while (j < data.size() && data[j] != parameter_delimiter && data[j] != record_delimiter) ++j;
+    absl::string_view token = data.substr(i, j - i);
+    const absl::string_view stripped = absl::StripLeadingAsciiWhitespace(token);
+    size_t h = 0;
+    while (h < stripped.size() && absl::ascii_isdigit(stripped[h])) ++h;
+    uint64_t length = 0;
+    if (h > 0 && h < stripped.size() && (stripped[h] == 'H' || stripped[h] == 'h') &&
+        absl::SimpleAtoi(stripped.substr(0, h), &length)) {
+      // A Hollerith string: its characters may hold delimiters.
+      const size_t text = static_cast<size_t>(stripped.data() - data.data()) + h + 1;
+      if (length > data.size() - std::min(text, data.size())) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "parameter data line %d: the string '%s' runs past the end of the file",
+            lines[std::min(i / 64, lines.size() - 1)], Echo(stripped, 24)));
+      }
+      j = text + length;
+      const size_t after = j;
+      while (j < data.size() && data[j] == ' ') ++j;
+      if (j < data.size() && data[j] != parameter_delimiter && data[j] != record_delimiter) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "parameter data line %d: a string of %d characters is followed by '%s', not a "
+            "delimiter; the file is damaged (fix or re-export it)",
+            lines[std::min(after / 64, lines.size() - 1)], length, Echo(data.substr(after, 8), 16)));
+      }
+    } else if (!IsIgesNumber(token)) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "parameter data line %d: '%s' is not a number; the file is damaged (fix or re-export it)",
+          lines[std::min(i / 64, lines.size() - 1)], Echo(absl::StripAsciiWhitespace(token), 40)));
+    }
+    i = j + 1;
+    // After a record's end, the rest of its last line is padding (a comment).
+    if (j < data.size() && data[j] == record_delimiter) i = (j / 64 + 1) * 64;
+  }
+  return absl::OkStatus();
 }
 
 }  // namespace
@@ -105,6 +178,8 @@ absl::StatusOr<ModelCensus> PreflightIges(absl::string_view bytes, const Preflig
   ModelCensus census;
   uint64_t line_number = 0;
   bool first_of_entry = true;
+  std::string global, parameters;  // the G lines' columns 1-72, the P lines' 1-64
+  std::vector<uint64_t> parameter_lines;
   size_t start = 0;
   while (start < bytes.size()) {
     size_t end = bytes.find('\n', start);
@@ -123,6 +198,16 @@ absl::StatusOr<ModelCensus> PreflightIges(absl::string_view bytes, const Preflig
           "line %d has %d characters; IGES records have %d columns (max_iges_line), so the file "
           "is broken or not IGES: '%s'",
           line_number, text.size(), limits.max_iges_line, Echo(text, 40)));
+    }
+    if (line.size() >= 73 && line[72] == 'G' && global.size() < (uint64_t{1} << 20)) {
+      absl::StrAppend(&global, line.substr(0, 72));
+    }
+    if (line.size() >= 73 && line[72] == 'P') {
+      // Columns 1-64, blank-padded: a string's count runs across lines.
+      std::string field(line.substr(0, 64));
+      field.resize(64, ' ');
+      parameters += field;
+      parameter_lines.push_back(line_number);
     }
     if (line.size() < 73 || line[72] != 'D') continue;
     // Directory entries take two lines; the first holds the type (columns
@@ -151,6 +236,19 @@ absl::StatusOr<ModelCensus> PreflightIges(absl::string_view bytes, const Preflig
       census.face_ids.push_back(sequence);
     }
   }
+  // The delimiters: the global section's first two fields ("1H," and "1H;"
+  // by default; an empty field keeps the default).
+  char parameter_delimiter = ',', record_delimiter = ';';
+  absl::string_view g = absl::StripLeadingAsciiWhitespace(global);
+  if (absl::StartsWith(g, "1H") && g.size() >= 3) {
+    parameter_delimiter = g[2];
+    g.remove_prefix(3);
+  }
+  if (!g.empty() && g[0] == parameter_delimiter) g.remove_prefix(1);
+  g = absl::StripLeadingAsciiWhitespace(g);
+  if (absl::StartsWith(g, "1H") && g.size() >= 3) record_delimiter = g[2];
+  RETURN_IF_ERROR(CheckIgesParameters(parameters, parameter_lines, parameter_delimiter,
+                                      record_delimiter));
   return census;
 }
 

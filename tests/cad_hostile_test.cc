@@ -106,6 +106,29 @@ TEST(CadHostile, CensusCountsTheFixturesFaces) {
   }
 }
 
+// A damaged number in IGES parameter data ("0&" for a coordinate of the
+// box's arc made OpenCASCADE 7.6 loop for good in its shape healing; found by
+// iges_fuzzer) is refused before the reader runs, naming the line; numbers
+// in the spellings IGES allows pass.
+TEST(CadHostile, DamagedIgesParametersAreRefusedBeforeTheReader) {
+  const std::string& box = Bytes(Solid::kBoxWithHole, ModelFormat::kIges);
+  const std::string arc = "100,0.,0.,0.,5.,0.,5.,0.;";
+  const size_t at = box.find(arc);
+  ASSERT_NE(at, std::string::npos);
+  std::string damaged = box;
+  damaged.replace(at, arc.size(), "100,0.,0.,0.,5.,0&,5.,0.;");
+  ExpectRefused(Load(ModelFormat::kIges, damaged, "arc.iges"), "'0&' is not a number");
+  const uint64_t line = 1 + std::count(box.begin(), box.begin() + at, '\n');
+  ExpectRefused(Load(ModelFormat::kIges, damaged, "arc.iges"), absl::StrCat("line ", line));
+
+  std::string spellings = box;
+  spellings.replace(at, arc.size(), "100,0,-0,.0,5D0,0E0,5.,0;");  // as long as `arc`
+  EXPECT_TRUE(PreflightIges(spellings, PreflightLimits{}).ok());
+  std::string letters = box;
+  letters.replace(at, arc.size(), "100,0.,0.,0.,5.,E5,+5.,0.;");
+  EXPECT_FALSE(PreflightIges(letters, PreflightLimits{}).ok());
+}
+
 // The first STEP record containing `marker` (e.g. "= ADVANCED_FACE("): where
 // the marker is, and the record's entity name "#N"; npos and "" if none.
 struct Entity {
