@@ -112,13 +112,13 @@ void LoadedModels::ParserLoop() {
     std::shared_ptr<Job> job;
     {
       absl::MutexLock lock(&mu_);
-      // The next parse in line starts when its working memory fits beside
+      // The next parse (NextJob) starts when its working memory fits beside
       // the running parses' (or nothing runs).
       auto ready = [this]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
         if (stopping_) return true;
         if (queue_.empty()) return false;
         return working_bytes_ == 0 || options_.working_budget_bytes == 0 ||
-               working_bytes_ + queue_.front()->working_bytes <= options_.working_budget_bytes;
+               working_bytes_ + queue_[NextJob()]->working_bytes <= options_.working_budget_bytes;
       };
       mu_.Await(absl::Condition(&ready));
       if (stopping_) {
@@ -131,8 +131,10 @@ void LoadedModels::ParserLoop() {
         queue_.clear();
         return;
       }
-      job = queue_.front();
-      queue_.pop_front();
+      const size_t next = NextJob();
+      for (size_t i = 0; i < next; ++i) ++queue_[i]->passed_over;
+      job = queue_[next];
+      queue_.erase(queue_.begin() + static_cast<std::ptrdiff_t>(next));
       if (job->waiters == 0) {  // every request left while it was queued
         job->result = absl::CancelledError("no request waits for this model any more");
         job->done = true;
@@ -208,6 +210,15 @@ void LoadedModels::ParserLoop() {
     job->result = std::move(result);
     job->done = true;
   }
+}
+
+size_t LoadedModels::NextJob() const {
+  if (queue_.front()->passed_over >= kMaxPassedOver) return 0;
+  size_t next = 0;
+  for (size_t i = 1; i < queue_.size(); ++i) {
+    if (queue_[i]->working_bytes < queue_[next]->working_bytes) next = i;
+  }
+  return next;
 }
 
 void LoadedModels::Keep(const std::string& key, const Parsed& parsed) {

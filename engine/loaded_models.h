@@ -8,6 +8,10 @@
 //    a CPU budget (thread CPU time, parse_seconds) that its ParseControl
 //    check reports when spent; a parse nobody waits for any more is told to
 //    stop too. The parsers poll the check (CAD: OpenCASCADE's user break).
+//  - Smallest first: of the parses waiting, the one with the least working
+//    memory (which grows with the file's size) starts next, so a small
+//    model does not wait behind large or hostile ones; a parse passed over
+//    kMaxPassedOver times starts next whatever its size.
 //  - One parse per key: requests for a key being parsed wait for that parse.
 //  - A failed parse is remembered per key (a model's format + content hash
 //    + whatever changes the parse) for failure_ttl_seconds: the same hostile
@@ -114,6 +118,7 @@ class LoadedModels {
     std::string key;
     ParseFn parse;
     uint64_t working_bytes = 0;
+    int passed_over = 0;  // guarded by mu_: smaller parses started before it
     int waiters = 0;  // guarded by mu_
     bool done = false;
     absl::StatusOr<Parsed> result;
@@ -129,6 +134,9 @@ class LoadedModels {
       ABSL_LOCKS_EXCLUDED(mu_);
   void ParserLoop() ABSL_LOCKS_EXCLUDED(mu_);
   void Keep(const std::string& key, const Parsed& parsed) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Index in queue_ of the parse to start next. REQUIRES: !queue_.empty().
+  size_t NextJob() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  static constexpr int kMaxPassedOver = 8;
 
   // Constant after construction.
   const LoadedModelsOptions options_;

@@ -3,12 +3,15 @@
 // waits or the CPU budget is spent, and a caller that leaves at once.
 #include "engine/loaded_models.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
+#include "absl/synchronization/mutex.h"
 #include "gtest/gtest.h"
 
 namespace sfc {
@@ -173,6 +176,50 @@ TEST(LoadedModels, ParsesRunOnlyWhileTheirWorkingMemoryFits) {
   }
   EXPECT_EQ(loaded.stats().working_bytes, 0u);
   EXPECT_TRUE(loaded.Get<int>("c", Returning(1, &parses), nullptr, 1000).ok());
+}
+
+// Of the parses waiting, the smallest starts first (a small model does not
+// wait behind large or hostile ones), but none is passed over for good.
+TEST(LoadedModels, SmallParsesStartFirstAndNoneIsPassedOverForGood) {
+  LoadedModelsOptions o;
+  o.parse_threads = 1;
+  o.max_queued_parses = 32;
+  LoadedModels loaded(o);
+  std::atomic<bool> started{false}, leave{false};
+  auto until_leave = [&]() -> absl::Status {
+    return leave ? absl::CancelledError("done") : absl::OkStatus();
+  };
+  std::thread running([&] { loaded.Get<int>("busy", Spinning(&started), until_leave, 1).IgnoreError(); });
+  while (!started) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  absl::Mutex order_mu;
+  std::vector<std::string> order;
+  auto recording = [&](const std::string& name) -> LoadedModels::ParseFn {
+    return [&, name](const ParseCheck&) -> absl::StatusOr<Parsed> {
+      absl::MutexLock lock(&order_mu);
+      order.push_back(name);
+      return Parsed{std::make_shared<const int>(1), 1};
+    };
+  };
+  // Queued while "busy" runs: a large parse, then ten small ones.
+  std::vector<std::thread> waiting;
+  waiting.emplace_back([&] { ASSERT_TRUE(loaded.Get<int>("large", recording("large"), nullptr, 1000).ok()); });
+  while (loaded.stats().queued < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  for (int i = 0; i < 10; ++i) {
+    const std::string name = absl::StrCat("small", i);
+    waiting.emplace_back([&, name] { ASSERT_TRUE(loaded.Get<int>(name, recording(name), nullptr, 10).ok()); });
+    while (loaded.stats().queued < static_cast<uint64_t>(i + 2)) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  }
+  leave = true;
+  running.join();
+  for (std::thread& t : waiting) t.join();
+  ASSERT_EQ(order.size(), 11u);
+  // Eight small ones pass the large one, which then starts: it waited for
+  // at most kMaxPassedOver (8) smaller parses.
+  const size_t large = std::find(order.begin(), order.end(), "large") - order.begin();
+  EXPECT_EQ(large, 8u);
+  EXPECT_EQ(order.front().rfind("small", 0), 0u);
 }
 
 }  // namespace

@@ -45,17 +45,20 @@ flags=(--address 127.0.0.1:0 --health-address "" --metrics-address ""
        --cache-bytes "$cache_bytes" --max-tree-leaves 4194304 --max-count 2000000
        --max-concurrent-streams "$slots" --request-deadline 120 --shutdown-grace 5)
 # A budget for streams' working memory, where this server has one.
-if "$server" --help 2>&1 | grep -q -- --stream-memory-bytes; then flags+=(--stream-memory-bytes "$stream_bytes"); fi
+# The server's flags, read once (grep -q on a pipe would end the writer with
+# SIGPIPE, which pipefail reports as a failure).
+server_help=$("$server" --help 2>&1)
+if grep -q -- --stream-memory-bytes <<< "$server_help"; then flags+=(--stream-memory-bytes "$stream_bytes"); fi
 # A write timeout for stalled readers, where this server has one.
-if "$server" --help 2>&1 | grep -q -- --write-timeout; then flags+=(--write-timeout 5); fi
+if grep -q -- --write-timeout <<< "$server_help"; then flags+=(--write-timeout 5); fi
 # Budgets for uploaded and parsed models, and a parse CPU budget of 5 s (the
 # hostile uploads' quadratic shell is stopped there; the largest good mesh
 # parses in well under it).
-if "$server" --help 2>&1 | grep -q -- --parsed-model-bytes; then
+if grep -q -- --parsed-model-bytes <<< "$server_help"; then
   flags+=(--model-bytes "$model_bytes" --parsed-model-bytes "$parsed_model_bytes" --model-parse-seconds 5)
   # Parses' working memory: the largest good mesh (a 48 MB PLY) reserves
   # 5 bytes a byte.
-  if "$server" --help 2>&1 | grep -q -- --parse-memory-bytes; then
+  if grep -q -- --parse-memory-bytes <<< "$server_help"; then
     flags+=(--parse-memory-bytes "$parse_memory_bytes")
   fi
 else
