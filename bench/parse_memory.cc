@@ -11,6 +11,7 @@
 //       writes the soak's models into DIR, and STEP and IGES files of
 //       CAD_COPIES (default 400) boxes with a hole, then measures them all
 //   parse_memory FORMAT:FILE...
+//   parse_memory --repeat N FORMAT:FILE    (N parses in one process: VmRSS)
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -91,10 +92,33 @@ bool WriteCadArrays(const std::string& dir, int copies, std::vector<std::string>
   return true;
 }
 
+// Parses `spec` `times` times in this process and prints VmRSS every tenth
+// of the way: memory a parse leaves behind shows as growth.
+int Repeat(const std::string& spec, int times) {
+  const size_t colon = spec.find(':');
+  const std::string format = spec.substr(0, colon), path = spec.substr(colon + 1);
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string bytes = buffer.str();
+  auto f = sfc::cad::ParseModelFormat(format);
+  if (!f.ok()) return 2;
+  for (int i = 1; i <= times; ++i) {
+    auto model = sfc::cad::Load(*f, bytes, path, {});
+    if (i % std::max(1, times / 10) == 0) {
+      std::printf("%s: after %d parses (%s) VmRSS %.1f MiB\n", spec.c_str(), i,
+                  model.ok() ? "ok" : "refused", StatusBytes("VmRSS") / 1048576.0);
+      std::fflush(stdout);
+    }
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc == 4 && std::string(argv[1]) == "--one") return Measure(argv[2], std::string(argv[3]) == "1");
+  if (argc == 4 && std::string(argv[1]) == "--repeat") return Repeat(argv[3], std::atoi(argv[2]));
   if (argc < 2) {
     std::fprintf(stderr, "usage: parse_memory DIR [LARGE_SUBDIVISIONS] | FORMAT:FILE...\n");
     return 2;
