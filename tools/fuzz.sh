@@ -77,7 +77,7 @@ done
 
 # One target for `seconds`: libFuzzer stops at its first finding, so it is
 # restarted (keeping the corpus) until the time is used up.
-printf '%-22s %8s %12s %10s %9s %s\n' target seconds executions exec/s findings "restarts (memory accumulated over the run)"
+printf '%-22s %8s %12s %10s %9s %s\n' target seconds executions exec/s findings "restarts (state accumulated over the run)"
 total_findings=0
 for t in "${targets[@]}"; do
   dict=()
@@ -86,13 +86,15 @@ for t in "${targets[@]}"; do
   # handlers turn a fault inside its readers (a null dereference on a broken
   # file) into a Standard_Failure, which Load returns as INVALID_ARGUMENT
   # (cad/internal/kernel_setup.h). ASan and libFuzzer leave SEGV, SIGBUS and
-  # SIGFPE to them there (other ASan checks stay on). The kernel's
+  # SIGFPE to them there (UBSan too; other checks stay on). The kernel's
   # process-wide caches are not leaks: no leak check either.
   asan="${ASAN_OPTIONS:-}"
+  ubsan="${UBSAN_OPTIONS:-}"
   case "$t" in
     step_fuzzer|iges_fuzzer|nurbs_fuzzer)
       dict+=(-detect_leaks=0 -handle_segv=0 -handle_bus=0 -handle_fpe=0)
-      asan="handle_segv=0:handle_sigbus=0:handle_sigfpe=0:detect_leaks=0${asan:+:$asan}" ;;
+      asan="handle_segv=0:handle_sigbus=0:handle_sigfpe=0:detect_leaks=0${asan:+:$asan}"
+      ubsan="handle_segv=0:handle_sigbus=0:handle_sigfpe=0${ubsan:+:$ubsan}" ;;
   esac
   log="$findings_dir/$t/fuzz.log"
   : > "$log"
@@ -103,20 +105,21 @@ for t in "${targets[@]}"; do
     left=$((seconds - ($(date +%s) - start)))
     [ "$left" -gt 0 ] || break
     run_log=$(mktemp)
-    ASAN_OPTIONS="$asan" "$out/fuzz/$t" -max_total_time="$left" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=1024 \
+    ASAN_OPTIONS="$asan" UBSAN_OPTIONS="$ubsan" "$out/fuzz/$t" -max_total_time="$left" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=1024 \
       -print_final_stats=1 "${dict[@]}" -artifact_prefix="$findings_dir/$t/" \
       "$out/corpus/$t" > "$run_log" 2>&1 || true
-    # An out-of-memory stop whose input alone stays within the limit is
-    # memory the run accumulated (OpenCASCADE leaks tens of KB on many broken
-    # files: bench/parse_memory --repeat shows it), not that input's: the
-    # input is replayed alone, and if it passes it is set aside and the run
-    # goes on; only an input that fails alone counts as a finding.
-    for oom in "$findings_dir/$t"/oom-*; do
-      [ -e "$oom" ] || continue
-      if ASAN_OPTIONS="$asan" "$out/fuzz/$t" -rss_limit_mb=2048 -malloc_limit_mb=1024 "${dict[@]}" \
-           "$oom" > /dev/null 2>&1; then
+    # An out-of-memory or timeout stop whose input alone passes is state the
+    # run accumulated, not that input's: OpenCASCADE leaks tens of KB on many
+    # broken files (bench/parse_memory --repeat shows it), and its STEP
+    # reader keeps process-wide state from one file to the next. The input is
+    # replayed alone in a fresh process; if it passes it is set aside (in
+    # accumulated/) and the run goes on; one that fails alone is a finding.
+    for stop in "$findings_dir/$t"/oom-* "$findings_dir/$t"/timeout-*; do
+      [ -e "$stop" ] || continue
+      if ASAN_OPTIONS="$asan" UBSAN_OPTIONS="$ubsan" "$out/fuzz/$t" -timeout=10 -rss_limit_mb=2048 \
+           -malloc_limit_mb=1024 "${dict[@]}" "$stop" > /dev/null 2>&1; then
         mkdir -p "$findings_dir/$t/accumulated"
-        mv "$oom" "$findings_dir/$t/accumulated/"
+        mv "$stop" "$findings_dir/$t/accumulated/"
         restarts=$((restarts + 1))
       fi
     done
