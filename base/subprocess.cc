@@ -1,6 +1,7 @@
 #include "base/subprocess.h"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/mman.h>
@@ -10,7 +11,6 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
-#include <thread>
 
 #include "absl/strings/str_cat.h"
 
@@ -31,13 +31,15 @@ absl::Status Errno(absl::string_view what) {
   return absl::InternalError(absl::StrCat(what, ": ", std::strerror(errno)));
 }
 
-// Reads what is available from the non-blocking `fd` into `out`, up to the cap.
-void Drain(int fd, std::string* out) {
-  char buffer[4096];
+// Reads what is available from the non-blocking `fd` into `out`, up to
+// `max` bytes; past that it reads and drops, and says so in `clipped`.
+void Drain(int fd, size_t max, std::string* out, bool* clipped) {
+  char buffer[65536];
   while (true) {
     const ssize_t n = ::read(fd, buffer, sizeof buffer);
     if (n <= 0) return;
-    const size_t room = kMaxSubprocessOutput - std::min(out->size(), kMaxSubprocessOutput);
+    const size_t room = max - std::min(out->size(), max);
+    if (static_cast<size_t>(n) > room) *clipped = true;
     out->append(buffer, std::min(static_cast<size_t>(n), room));
   }
 }
@@ -45,7 +47,8 @@ void Drain(int fd, std::string* out) {
 }  // namespace
 
 absl::StatusOr<SubprocessResult> RunSubprocess(const std::vector<std::string>& argv,
-                                               absl::string_view input, double wall_seconds,
+                                               absl::string_view input, size_t max_output,
+                                               double wall_seconds,
                                                const std::function<absl::Status()>& check) {
   if (argv.empty()) return absl::InvalidArgumentError("no program to run");
   // The input in an in-memory file: the program reads it at its own pace.
@@ -63,6 +66,7 @@ absl::StatusOr<SubprocessResult> RunSubprocess(const std::vector<std::string>& a
   int out_pipe[2];
   if (::pipe2(out_pipe, O_CLOEXEC | O_NONBLOCK) != 0) return Errno("pipe2");
   Fd out_read{out_pipe[0]}, out_write{out_pipe[1]};
+  ::fcntl(out_read.fd, F_SETPIPE_SZ, 1 << 20);  // fewer wake-ups for large outputs; may fail
   Fd null{::open("/dev/null", O_WRONLY | O_CLOEXEC)};
   if (null.fd < 0) return Errno("open /dev/null");
 
@@ -99,7 +103,7 @@ absl::StatusOr<SubprocessResult> RunSubprocess(const std::vector<std::string>& a
   absl::Status stop;
   int status = 0;
   while (true) {
-    Drain(out_read.fd, &result.output);
+    Drain(out_read.fd, max_output, &result.output, &result.output_clipped);
     const pid_t done = ::waitpid(pid, &status, WNOHANG);
     if (done == pid) break;
     if (done < 0 && errno != EINTR) return Errno("waitpid");
@@ -113,9 +117,11 @@ absl::StatusOr<SubprocessResult> RunSubprocess(const std::vector<std::string>& a
       }
       break;
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    // Wake for output at once, else every 2 ms to look at the process.
+    pollfd ready{out_read.fd, POLLIN, 0};
+    ::poll(&ready, 1, 2);
   }
-  Drain(out_read.fd, &result.output);
+  Drain(out_read.fd, max_output, &result.output, &result.output_clipped);
   if (!stop.ok()) return stop;
   result.exited = WIFEXITED(status);
   result.exit_code = result.exited ? WEXITSTATUS(status) : 0;

@@ -4,7 +4,8 @@
 //
 // The program gets `input` on its standard input (from an in-memory file,
 // so nothing can block on a pipe), its standard output is collected up to
-// kMaxSubprocessOutput bytes, its standard error goes nowhere. The caller's
+// `max_output` bytes (the rest is read and dropped), its standard error goes
+// nowhere. The caller's
 // `check` is asked every few milliseconds while the program runs; when it
 // says to stop, or `wall_seconds` pass, the program is killed (SIGKILL) and
 // the result says why. Limits on the program's own CPU time and memory are
@@ -24,21 +25,21 @@
 
 namespace sfc {
 
-inline constexpr size_t kMaxSubprocessOutput = 64 * 1024;
-
 struct SubprocessResult {
   bool exited = false;  // ended by exit(); else by a signal
   int exit_code = 0;    // when exited
   int signal = 0;       // when not exited
   bool timed_out = false;  // killed at wall_seconds
-  std::string output;   // standard output, at most kMaxSubprocessOutput bytes
+  std::string output;   // standard output, at most max_output bytes
+  bool output_clipped = false;  // it wrote more than max_output
 };
 
 // Runs `argv` (argv[0]: the program's path). INTERNAL when it cannot be
 // started; the check's status when the check stopped it (the program is
 // killed and reaped first). `wall_seconds` <= 0: no wall-clock limit.
 absl::StatusOr<SubprocessResult> RunSubprocess(const std::vector<std::string>& argv,
-                                               absl::string_view input, double wall_seconds,
+                                               absl::string_view input, size_t max_output,
+                                               double wall_seconds,
                                                const std::function<absl::Status()>& check);
 
 }  // namespace sfc

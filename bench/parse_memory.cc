@@ -12,9 +12,11 @@
 //       CAD_COPIES (default 400) boxes with a hole, then measures them all
 //   parse_memory FORMAT:FILE...
 //   parse_memory --repeat N FORMAT:FILE    (N parses in one process: VmRSS)
+//   parse_memory --time-reads FORMAT:FILE  (Load against ReadToBrep + LoadBrep)
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -116,8 +118,37 @@ int Repeat(const std::string& spec, int times) {
 
 }  // namespace
 
+// Times the two ways a model is read: cad::Load in this process, and
+// cad::ReadToBrep (what the model check process does) then cad::LoadBrep
+// (what the server does with its answer).
+int TimeReads(const std::string& spec) {
+  const size_t colon = spec.find(':');
+  const std::string format = spec.substr(0, colon), path = spec.substr(colon + 1);
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string bytes = buffer.str();
+  auto f = sfc::cad::ParseModelFormat(format);
+  if (!f.ok()) return 2;
+  sfc::cad::LoadOptions options;
+  options.max_bytes = bytes.size();
+  auto seconds = [](auto&& work) {
+    const auto start = std::chrono::steady_clock::now();
+    work();
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  std::string brep;
+  const double load = seconds([&] { (void)sfc::cad::Load(*f, bytes, path, options); });
+  const double read = seconds([&] { brep = *sfc::cad::ReadToBrep(*f, bytes, path, options); });
+  const double load_brep = seconds([&] { (void)sfc::cad::LoadBrep(brep, *f, path, options); });
+  std::printf("%s: %zu bytes; Load %.3f s; ReadToBrep %.3f s (%zu bytes of BRep); LoadBrep %.3f s\n",
+              spec.c_str(), bytes.size(), load, read, brep.size(), load_brep);
+  return 0;
+}
+
 int main(int argc, char** argv) {
   if (argc == 4 && std::string(argv[1]) == "--one") return Measure(argv[2], std::string(argv[3]) == "1");
+  if (argc == 3 && std::string(argv[1]) == "--time-reads") return TimeReads(argv[2]);
   if (argc == 4 && std::string(argv[1]) == "--repeat") return Repeat(argv[3], std::atoi(argv[2]));
   if (argc < 2) {
     std::fprintf(stderr, "usage: parse_memory DIR [LARGE_SUBDIVISIONS] | FORMAT:FILE...\n");

@@ -12,6 +12,7 @@
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepGProp.hxx>
 #include <BRepTools.hxx>
+#include <BinTools.hxx>
 #include <GProp_GProps.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <IGESControl_Reader.hxx>
@@ -394,29 +395,28 @@ absl::StatusOr<Face> MakeFace(const TopoDS_Face& face, int index, ModelFormat fo
               std::move(surface), std::move(trim));
 }
 
-// All the kernel work of Load. REQUIRES: g_reader_mutex held; for IGES,
-// `iges_path` holds the bytes.
-absl::StatusOr<std::shared_ptr<const Model>> LoadUnguarded(ModelFormat format,
-                                                           absl::string_view bytes,
-                                                           const ModelCensus& census,
-                                                           const std::string& iges_path,
-                                                           absl::string_view name,
-                                                           const LoadOptions& options) {
-  TopoDS_Shape shape;
+// The file read into one shape by the kernel's reader, with every check of
+// the read. REQUIRES: g_reader_mutex held; for IGES, `iges_path` holds the
+// bytes.
+absl::StatusOr<TopoDS_Shape> ReadShape(ModelFormat format, absl::string_view bytes,
+                                       const ModelCensus& census, const std::string& iges_path,
+                                       absl::string_view name, const LoadOptions& options) {
   switch (format) {
-    case ModelFormat::kStep: {
-      ASSIGN_OR_RETURN(shape, ReadStep(bytes, census, name, options));
-      break;
-    }
-    case ModelFormat::kIges: {
-      ASSIGN_OR_RETURN(shape, ReadIges(iges_path, census, name, options));
-      break;
-    }
-    case ModelFormat::kNurbs: {
-      ASSIGN_OR_RETURN(shape, ReadNurbs(bytes, name));
-      break;
-    }
+    case ModelFormat::kStep:
+      return ReadStep(bytes, census, name, options);
+    case ModelFormat::kIges:
+      return ReadIges(iges_path, census, name, options);
+    case ModelFormat::kNurbs:
+      return ReadNurbs(bytes, name);
   }
+  return absl::InternalError("unknown model format");
+}
+
+// The model of a shape's faces, in the order TopExp::MapShapes finds them.
+absl::StatusOr<std::shared_ptr<const Model>> ModelFromShape(const TopoDS_Shape& shape,
+                                                            ModelFormat format,
+                                                            absl::string_view name,
+                                                            const LoadOptions& options) {
   TopTools_IndexedMapOfShape map;
   if (!shape.IsNull()) TopExp::MapShapes(shape, TopAbs_FACE, map);
   if (map.Extent() == 0) return Invalid(format, name, "empty model: it has no faces");
@@ -430,19 +430,16 @@ absl::StatusOr<std::shared_ptr<const Model>> LoadUnguarded(ModelFormat format,
   return std::make_shared<const Model>(std::string(name), std::move(faces));
 }
 
-// LoadUnguarded with the kernel's exceptions, and the faults it turns into
-// exceptions (cad/internal/kernel_setup.h), as statuses. A fault abandons
-// the frames below without their destructors: it leaks the kernel's objects
-// of this load, nothing else (no lock or file of ours lives below here).
-absl::StatusOr<std::shared_ptr<const Model>> GuardedLoad(ModelFormat format,
-                                                         absl::string_view bytes,
-                                                         const ModelCensus& census,
-                                                         const std::string& iges_path,
-                                                         absl::string_view name,
-                                                         const LoadOptions& options) {
+// `work()` (kernel work returning a StatusOr) with the kernel's exceptions,
+// and the faults it turns into exceptions (cad/internal/kernel_setup.h), as
+// statuses. A fault abandons the frames below without their destructors: it
+// leaks the kernel's objects of this work, nothing else (no lock or file of
+// ours lives below here).
+template <typename Work>
+auto Guarded(ModelFormat format, absl::string_view name, const Work& work) -> decltype(work()) {
   try {
     OCC_CATCH_SIGNALS
-    return LoadUnguarded(format, bytes, census, iges_path, name, options);
+    return work();
   } catch (const Standard_Failure& e) {
     return Invalid(format, name,
                    absl::StrCat("the kernel failed on it: ", Echo(e.GetMessageString()), " (",
@@ -454,6 +451,37 @@ absl::StatusOr<std::shared_ptr<const Model>> GuardedLoad(ModelFormat format,
     return absl::InternalError(
         absl::StrCat(ModelFormatName(format), " file ", name, ": ", Echo(e.what())));
   }
+}
+
+// What Load and ReadToBrep check before the kernel sees the bytes: the size,
+// the framing and the preflight; for IGES, the private file the reader reads.
+struct Prepared {
+  ModelCensus census;
+  TempFile file;
+};
+absl::Status Prepare(ModelFormat format, absl::string_view bytes, absl::string_view name,
+                     const LoadOptions& options, Prepared* prepared) {
+  if (bytes.size() > options.max_bytes) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat(absl::AsciiStrToUpper(ModelFormatName(format)), " file ", name, " has ",
+                     bytes.size(), " bytes, above the limit of ", options.max_bytes, " bytes"));
+  }
+  if (format == ModelFormat::kStep) {
+    RETURN_IF_ERROR(CheckStepFraming(bytes, name));
+    auto step = PreflightStep(bytes, options.preflight);
+    if (!step.ok()) return Invalid(format, name, step.status().message());
+    prepared->census = *std::move(step);
+  }
+  if (format == ModelFormat::kIges) {
+    RETURN_IF_ERROR(CheckIgesFraming(bytes, name));
+    auto iges = PreflightIges(bytes, options.preflight);
+    if (!iges.ok()) return Invalid(format, name, iges.status().message());
+    prepared->census = *std::move(iges);
+    RETURN_IF_ERROR(prepared->file.Write(bytes));  // IGESControl_Reader reads only files
+  }
+  SilenceKernelMessages();
+  ConvertKernelSignals();
+  return absl::OkStatus();
 }
 
 }  // namespace
@@ -483,35 +511,51 @@ absl::StatusOr<std::shared_ptr<const Model>> Load(ModelFormat format, absl::stri
                                                   absl::string_view untrusted_name,
                                                   const LoadOptions& options) {
   const std::string name = Echo(untrusted_name, kMaxNameEcho);
-  if (bytes.size() > options.max_bytes) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat(absl::AsciiStrToUpper(ModelFormatName(format)), " file ", name, " has ",
-                     bytes.size(), " bytes, above the limit of ", options.max_bytes, " bytes"));
-  }
-  // Checks without the kernel first; then our own resources (the temporary
-  // file, the lock) are taken outside GuardedLoad, whose signal guard skips
-  // destructors of the frames between the fault and itself.
-  std::string iges_path;
-  TempFile file;
-  ModelCensus census;
-  if (format == ModelFormat::kStep) {
-    RETURN_IF_ERROR(CheckStepFraming(bytes, name));
-    auto step = PreflightStep(bytes, options.preflight);
-    if (!step.ok()) return Invalid(format, name, step.status().message());
-    census = *std::move(step);
-  }
-  if (format == ModelFormat::kIges) {
-    RETURN_IF_ERROR(CheckIgesFraming(bytes, name));
-    auto iges = PreflightIges(bytes, options.preflight);
-    if (!iges.ok()) return Invalid(format, name, iges.status().message());
-    census = *std::move(iges);
-    RETURN_IF_ERROR(file.Write(bytes));  // IGESControl_Reader reads only files
-    iges_path = file.path();
-  }
+  // Our own resources (the temporary file, the lock) are taken outside
+  // Guarded, whose signal guard skips destructors of the frames between the
+  // fault and itself.
+  Prepared prepared;
+  RETURN_IF_ERROR(Prepare(format, bytes, name, options, &prepared));
+  absl::MutexLock lock(&g_reader_mutex);
+  return Guarded(format, name, [&]() -> absl::StatusOr<std::shared_ptr<const Model>> {
+    ASSIGN_OR_RETURN(TopoDS_Shape shape, ReadShape(format, bytes, prepared.census,
+                                                   prepared.file.path(), name, options));
+    return ModelFromShape(shape, format, name, options);
+  });
+}
+
+absl::StatusOr<std::string> ReadToBrep(ModelFormat format, absl::string_view bytes,
+                                       absl::string_view untrusted_name,
+                                       const LoadOptions& options) {
+  const std::string name = Echo(untrusted_name, kMaxNameEcho);
+  Prepared prepared;
+  RETURN_IF_ERROR(Prepare(format, bytes, name, options, &prepared));
+  absl::MutexLock lock(&g_reader_mutex);
+  return Guarded(format, name, [&]() -> absl::StatusOr<std::string> {
+    ASSIGN_OR_RETURN(TopoDS_Shape shape, ReadShape(format, bytes, prepared.census,
+                                                   prepared.file.path(), name, options));
+    // Every check Load makes of the faces, here, where a fault costs this process.
+    RETURN_IF_ERROR(ModelFromShape(shape, format, name, options).status());
+    std::ostringstream out;
+    BinTools::Write(shape, out, /*theWithTriangles=*/Standard_False, /*theWithNormals=*/Standard_False,
+                    BinTools_FormatVersion_CURRENT);
+    return out.str();
+  });
+}
+
+absl::StatusOr<std::shared_ptr<const Model>> LoadBrep(absl::string_view brep, ModelFormat format,
+                                                      absl::string_view untrusted_name,
+                                                      const LoadOptions& options) {
+  const std::string name = Echo(untrusted_name, kMaxNameEcho);
   SilenceKernelMessages();
   ConvertKernelSignals();
-  absl::MutexLock lock(&g_reader_mutex);
-  return GuardedLoad(format, bytes, census, iges_path, name, options);
+  return Guarded(format, name, [&]() -> absl::StatusOr<std::shared_ptr<const Model>> {
+    std::istringstream in{std::string(brep)};
+    TopoDS_Shape shape;
+    BinTools::Read(shape, in);
+    if (shape.IsNull()) return absl::InternalError(absl::StrCat("the model check's shape of ", name, " could not be read back"));
+    return ModelFromShape(shape, format, name, options);
+  });
 }
 
 }  // namespace sfc::cad

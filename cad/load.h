@@ -15,6 +15,7 @@
 #include <cstddef>
 #include <functional>
 #include <memory>
+#include <string>
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
@@ -68,6 +69,19 @@ struct LoadOptions {
 absl::StatusOr<std::shared_ptr<const Model>> Load(ModelFormat format, absl::string_view bytes,
                                                   absl::string_view name,
                                                   const LoadOptions& options = {});
+
+// Load in two halves, for reading a file in a process of its own
+// (kinds/cad/model_check.h). ReadToBrep does all of Load's reading and
+// checking and returns the model's shape as OpenCASCADE's binary BRep
+// (BinTools); errors as Load's. LoadBrep makes the model of such bytes, as
+// Load would have of the file: the same faces in the same order, the same
+// geometry to the bit. `brep` must come from ReadToBrep (it is not checked
+// as a hostile file would be); `format` and `name` are for messages.
+absl::StatusOr<std::string> ReadToBrep(ModelFormat format, absl::string_view bytes,
+                                       absl::string_view name, const LoadOptions& options = {});
+absl::StatusOr<std::shared_ptr<const Model>> LoadBrep(absl::string_view brep, ModelFormat format,
+                                                      absl::string_view name,
+                                                      const LoadOptions& options = {});
 
 }  // namespace sfc::cad
 

@@ -25,9 +25,9 @@ struct EngineLimits {
   // from each file's size before it starts (0 = no limit).
   uint64_t parsed_model_bytes = uint64_t{256} << 20;
   uint64_t parse_memory_bytes = 0;
-  // A program that reads a CAD file first in a process of its own
-  // (kinds/cad/model_check.h), with model_parse_seconds of CPU; "" = read
-  // in process only (the CLI's own files).
+  // A program that reads each CAD file in a process of its own
+  // (kinds/cad/model_check.h), with model_parse_seconds of CPU, and sends
+  // back its shape; "" = read in this process (the CLI's own files).
   std::string model_check_program;
   int model_parse_threads = 1;
   int max_queued_parses = 8;

@@ -158,9 +158,9 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   std::string model_check = "auto";
   app.add_option("--model-check-program", model_check,
-                 "reads each CAD file first in a process of its own, where a crash or a loop in the "
-                 "CAD kernel costs one request (auto: sfcsampler-model-check next to this program; "
-                 "none: read CAD files in process only)")
+                 "reads each CAD file in a process of its own, where a crash or a loop in the CAD "
+                 "kernel costs one request, and makes the model of the shape it sends back (auto: "
+                 "sfcsampler-model-check next to this program; none: read CAD files in this process)")
       ->capture_default_str();
   app.add_option("--log-level", log_level, "trace | debug | info | warn | error")->capture_default_str();
   CLI11_PARSE(app, argc, argv);

@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <functional>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -39,7 +41,7 @@ absl::Status SampleStatus(SamplerClient& client, const SampleRequest& request) {
   return s.status();
 }
 
-// A server as sfcsampler-server runs one: CAD files are read first by the
+// A server as sfcsampler-server runs one: CAD files are read by the
 // model check program, in a process of its own.
 ServerOptions ModelServerOptions() {
   ServerOptions options = LoopbackOptions();
@@ -373,8 +375,56 @@ TEST(ServerModels, AFileThatLoopedTheKernelIsRefusedAndTheNextModelParses) {
   EXPECT_EQ(r.client->GetCacheStats()->model_parses_running(), 0u);
 }
 
-// The model check process reports the loader's own refusals with their codes,
-// and the in-process read of an accepted file gives the same model.
+// A server reads CAD files in the model check process and makes the model
+// of the BRep it sends back; the samples are the bytes of the model read in
+// process, for every fixture and format, with normals, faces and a density
+// that depends on curvature.
+TEST(ServerModels, ModelsReadInTheCheckProcessGiveTheSameBytesAsInProcess) {
+  Running in_process = StartServer(LoopbackOptions());
+  Running checked = StartServer(ModelServerOptions());
+  std::vector<std::pair<std::string, std::string>> models;  // format, bytes
+  for (auto solid : {cad::fixtures::Solid::kSphere, cad::fixtures::Solid::kCylinder,
+                     cad::fixtures::Solid::kBoxWithHole}) {
+    for (auto format : {cad::ModelFormat::kStep, cad::ModelFormat::kIges}) {
+      auto bytes = cad::fixtures::SolidBytes(solid, format);
+      ASSERT_TRUE(bytes.ok()) << bytes.status();
+      models.emplace_back(format == cad::ModelFormat::kStep ? "step" : "iges", *bytes);
+    }
+  }
+  models.emplace_back("nurbs", cad::fixtures::NurbsPatchText());
+  for (const auto& [format, bytes] : models) {
+    std::vector<double> columns[2];
+    std::vector<uint32_t> faces[2];
+    int side = 0;
+    for (Running* r : {&in_process, &checked}) {
+      auto info = r->client->UploadModel(format, "model." + format, bytes);
+      ASSERT_TRUE(info.ok()) << info.status();
+      SampleRequest request = Request(info->spec(), 5000, 7);
+      request.tree.density = "gaussian:floor=0.1";
+      request.fields.normal = true;
+      request.fields.face = true;
+      auto s = r->client->Sample(request, [&](const v1::StreamHeader&, const SampleBatch& batch) {
+        for (size_t i = 0; i < batch.size(); ++i) {
+          for (const auto* c : {&batch.u, &batch.v, &batch.x, &batch.y, &batch.z, &batch.nx,
+                                &batch.ny, &batch.nz}) {
+            columns[side].push_back((*c)[i]);
+          }
+          faces[side].push_back(batch.face[i]);
+        }
+        return absl::OkStatus();
+      });
+      ASSERT_TRUE(s.ok()) << format << ": " << s.status();
+      ++side;
+    }
+    ASSERT_EQ(faces[0].size(), 5000u) << format;
+    EXPECT_EQ(faces[0], faces[1]) << format;
+    EXPECT_EQ(0, std::memcmp(columns[0].data(), columns[1].data(), columns[0].size() * sizeof(double)))
+        << format << ": the BRep from the check process gave other samples";
+  }
+}
+
+// The model check process passes on the loader's own refusals with their
+// codes, in a message of bounded length.
 TEST(ServerModels, TheModelCheckPassesOnTheLoadersOwnErrors) {
   Running r = StartServer(ModelServerOptions());
   auto truncated = cad::fixtures::SolidBytes(cad::fixtures::Solid::kSphere, cad::ModelFormat::kStep);

@@ -56,15 +56,21 @@ absl::StatusOr<std::shared_ptr<const CadParse>> LoadCad(const StoredModel& model
       [model, check_limits](const ParseCheck& check) -> absl::StatusOr<LoadedModels::Parsed> {
         ASSIGN_OR_RETURN(const cad::ModelFormat format, CadFormat(model.format));
         const std::string name = model.name.empty() ? model.Spec() : model.name;
-        if (!check_limits.program.empty()) {
-          RETURN_IF_ERROR(CheckModelInSubprocess(check_limits, model.format, *model.bytes, name, check));
-        }
         cad::LoadOptions options;
         options.max_bytes = std::max<size_t>(options.max_bytes, model.bytes->size());
         options.check = check;
+        // A server reads the file in the check process and makes the model of
+        // the shape it sends back; the CLI reads the user's own file here.
+        std::string brep;
+        if (!check_limits.program.empty()) {
+          ASSIGN_OR_RETURN(brep, ReadModelInSubprocess(check_limits, model.format, *model.bytes,
+                                                       name, check));
+        }
         const uint64_t before = HeapInUse();
         ASSIGN_OR_RETURN(std::shared_ptr<const cad::Model> parsed,
-                         cad::Load(format, *model.bytes, name, options));
+                         check_limits.program.empty()
+                             ? cad::Load(format, *model.bytes, name, options)
+                             : cad::LoadBrep(brep, format, name, options));
         const uint64_t after = HeapInUse();
         // What the model holds: the heap's growth across the load (other
         // threads' allocations make this approximate), at least 4 KiB a face.

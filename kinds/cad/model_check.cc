@@ -14,18 +14,32 @@
 
 namespace sfc {
 
-absl::Status CheckModelInSubprocess(const ModelCheckLimits& limits, ModelFormat format,
-                                    const std::string& bytes, const std::string& name,
-                                    const std::function<absl::Status()>& check) {
+absl::StatusOr<std::string> ReadModelInSubprocess(const ModelCheckLimits& limits, ModelFormat format,
+                                                  const std::string& bytes, const std::string& name,
+                                                  const std::function<absl::Status()>& check) {
   const double wall_seconds = limits.cpu_seconds > 0 ? std::max(10.0, 4 * limits.cpu_seconds) : 0;
   const std::vector<std::string> argv = {
       limits.program, std::string(ModelFormatName(format)), name,
       absl::StrFormat("%d", static_cast<uint64_t>(limits.cpu_seconds + 0.999)),
       absl::StrFormat("%d", limits.memory_bytes)};
-  absl::StatusOr<SubprocessResult> run = RunSubprocess(argv, bytes, wall_seconds, check);
+  // The answer's size: the BRep of a model is about the size of its file,
+  // at most a few times it.
+  const size_t max_output = std::max<size_t>(size_t{16} << 20, 8 * bytes.size());
+  absl::StatusOr<SubprocessResult> run = RunSubprocess(argv, bytes, max_output, wall_seconds, check);
   if (!run.ok()) return run.status();
-  absl::string_view line = absl::StripTrailingAsciiWhitespace(run->output);
-  if (run->exited && run->exit_code == 0 && absl::StartsWith(line, "ok ")) return absl::OkStatus();
+  const size_t end_of_line = run->output.find('\n');
+  absl::string_view line = absl::StripTrailingAsciiWhitespace(
+      absl::string_view(run->output).substr(0, std::min(end_of_line, size_t{2048})));
+  if (run->exited && run->exit_code == 0 && absl::StartsWith(line, "ok ")) {
+    size_t size = 0;
+    if (end_of_line == std::string::npos || !absl::SimpleAtoi(line.substr(3), &size) ||
+        run->output_clipped || run->output.size() - end_of_line - 1 != size) {
+      return absl::InternalError(absl::StrFormat(
+          "the model check %s sent a malformed answer (%d bytes)", Echo(limits.program),
+          run->output.size()));
+    }
+    return run->output.substr(end_of_line + 1);
+  }
   if (run->exited && run->exit_code == 1) {
     // "CODE MESSAGE": the loader's own refusal.
     const size_t space = line.find(' ');

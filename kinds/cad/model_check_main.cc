@@ -4,7 +4,8 @@
 // as the server's parse would, in a process of its own with the given limits
 // (0: none) on its CPU time (RLIMIT_CPU; SIGXCPU past it) and address space
 // (RLIMIT_AS). It dies with its parent. Prints one line and exits:
-//   0  "ok FACES"                   the model loads;
+//   0  "ok BYTES", then BYTES bytes: the model read, as cad::ReadToBrep's
+//      binary BRep, which the server loads with cad::LoadBrep;
 //   1  "CODE MESSAGE"               cad::Load refused it (an absl status code);
 //   2  "usage ..."                  bad arguments.
 // A crash or a loop inside OpenCASCADE ends this process, not the server
@@ -65,12 +66,15 @@ int main(int argc, char** argv) {
     const std::string bytes{std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>()};
     sfc::cad::LoadOptions options;
     options.max_bytes = std::max(options.max_bytes, bytes.size());
-    auto model = sfc::cad::Load(*format, bytes, argv[2], options);
-    if (!model.ok()) {
-      return Print(1, std::to_string(static_cast<int>(model.status().code())) + " " +
-                          std::string(model.status().message()));
+    auto brep = sfc::cad::ReadToBrep(*format, bytes, argv[2], options);
+    if (!brep.ok()) {
+      return Print(1, std::to_string(static_cast<int>(brep.status().code())) + " " +
+                          std::string(brep.status().message()));
     }
-    return Print(0, "ok " + std::to_string((*model)->faces().size()));
+    std::printf("ok %zu\n", brep->size());
+    std::fwrite(brep->data(), 1, brep->size(), stdout);
+    std::fflush(stdout);
+    return 0;
   } catch (const std::bad_alloc&) {
     return Print(1, std::to_string(static_cast<int>(absl::StatusCode::kResourceExhausted)) +
                         " out of memory while reading the model");
