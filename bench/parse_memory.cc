@@ -44,14 +44,22 @@ uint64_t StatusBytes(const std::string& field) {
   return 0;
 }
 
-// Parses `spec` (FORMAT:FILE) and prints one row. Runs in a child.
-int Measure(const std::string& spec, bool curvature) {
+// The format and bytes of FORMAT:FILE; false when the file cannot be read.
+bool ReadSpec(const std::string& spec, std::string* format, std::string* path, std::string* bytes) {
   const size_t colon = spec.find(':');
-  const std::string format = spec.substr(0, colon), path = spec.substr(colon + 1);
-  std::ifstream in(path, std::ios::binary);
+  *format = spec.substr(0, colon);
+  *path = spec.substr(colon + 1);
+  std::ifstream in(*path, std::ios::binary);
   std::stringstream buffer;
   buffer << in.rdbuf();
-  const std::string bytes = buffer.str();
+  *bytes = buffer.str();
+  return static_cast<bool>(in);
+}
+
+// Parses `spec` (FORMAT:FILE) and prints one row. Runs in a child.
+int Measure(const std::string& spec, bool curvature) {
+  std::string format, path, bytes;
+  if (!ReadSpec(spec, &format, &path, &bytes)) return 1;
   // Reset the peak to now (Linux: clear_refs 5), then parse.
   std::ofstream("/proc/self/clear_refs") << "5";
   const uint64_t before = StatusBytes("VmRSS");
@@ -97,12 +105,8 @@ bool WriteCadArrays(const std::string& dir, int copies, std::vector<std::string>
 // Parses `spec` `times` times in this process and prints VmRSS every tenth
 // of the way: memory a parse leaves behind shows as growth.
 int Repeat(const std::string& spec, int times) {
-  const size_t colon = spec.find(':');
-  const std::string format = spec.substr(0, colon), path = spec.substr(colon + 1);
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  const std::string bytes = buffer.str();
+  std::string format, path, bytes;
+  if (!ReadSpec(spec, &format, &path, &bytes)) return 1;
   auto f = sfc::cad::ParseModelFormat(format);
   if (!f.ok()) return 2;
   for (int i = 1; i <= times; ++i) {
@@ -116,18 +120,12 @@ int Repeat(const std::string& spec, int times) {
   return 0;
 }
 
-}  // namespace
-
 // Times the two ways a model is read: cad::Load in this process, and
 // cad::ReadToBrep (what the model check process does) then cad::LoadBrep
 // (what the server does with its answer).
 int TimeReads(const std::string& spec) {
-  const size_t colon = spec.find(':');
-  const std::string format = spec.substr(0, colon), path = spec.substr(colon + 1);
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  const std::string bytes = buffer.str();
+  std::string format, path, bytes;
+  if (!ReadSpec(spec, &format, &path, &bytes)) return 1;
   auto f = sfc::cad::ParseModelFormat(format);
   if (!f.ok()) return 2;
   sfc::cad::LoadOptions options;
@@ -145,6 +143,8 @@ int TimeReads(const std::string& spec) {
               spec.c_str(), bytes.size(), load, read, brep.size(), load_brep);
   return 0;
 }
+
+}  // namespace
 
 int main(int argc, char** argv) {
   if (argc == 4 && std::string(argv[1]) == "--one") return Measure(argv[2], std::string(argv[3]) == "1");

@@ -507,40 +507,51 @@ absl::string_view ModelFormatName(ModelFormat format) {
   return "unknown";
 }
 
-absl::StatusOr<std::shared_ptr<const Model>> Load(ModelFormat format, absl::string_view bytes,
-                                                  absl::string_view untrusted_name,
-                                                  const LoadOptions& options) {
+namespace {
+
+// Reads `bytes` into a shape with every check, then returns `then(shape)`.
+// Our own resources (the temporary file, the lock) are taken outside
+// Guarded, whose signal guard skips destructors of the frames between the
+// fault and itself.
+template <typename Then>
+auto ReadThen(ModelFormat format, absl::string_view bytes, absl::string_view untrusted_name,
+              const LoadOptions& options, const Then& then)
+    -> decltype(then(TopoDS_Shape(), std::string())) {
   const std::string name = Echo(untrusted_name, kMaxNameEcho);
-  // Our own resources (the temporary file, the lock) are taken outside
-  // Guarded, whose signal guard skips destructors of the frames between the
-  // fault and itself.
   Prepared prepared;
   RETURN_IF_ERROR(Prepare(format, bytes, name, options, &prepared));
   absl::MutexLock lock(&g_reader_mutex);
-  return Guarded(format, name, [&]() -> absl::StatusOr<std::shared_ptr<const Model>> {
+  return Guarded(format, name, [&]() -> decltype(then(TopoDS_Shape(), std::string())) {
     ASSIGN_OR_RETURN(TopoDS_Shape shape, ReadShape(format, bytes, prepared.census,
                                                    prepared.file.path(), name, options));
-    return ModelFromShape(shape, format, name, options);
+    return then(shape, name);
   });
+}
+
+}  // namespace
+
+absl::StatusOr<std::shared_ptr<const Model>> Load(ModelFormat format, absl::string_view bytes,
+                                                  absl::string_view untrusted_name,
+                                                  const LoadOptions& options) {
+  return ReadThen(format, bytes, untrusted_name, options,
+                  [&](const TopoDS_Shape& shape, const std::string& name) {
+                    return ModelFromShape(shape, format, name, options);
+                  });
 }
 
 absl::StatusOr<std::string> ReadToBrep(ModelFormat format, absl::string_view bytes,
                                        absl::string_view untrusted_name,
                                        const LoadOptions& options) {
-  const std::string name = Echo(untrusted_name, kMaxNameEcho);
-  Prepared prepared;
-  RETURN_IF_ERROR(Prepare(format, bytes, name, options, &prepared));
-  absl::MutexLock lock(&g_reader_mutex);
-  return Guarded(format, name, [&]() -> absl::StatusOr<std::string> {
-    ASSIGN_OR_RETURN(TopoDS_Shape shape, ReadShape(format, bytes, prepared.census,
-                                                   prepared.file.path(), name, options));
-    // Every check Load makes of the faces, here, where a fault costs this process.
-    RETURN_IF_ERROR(ModelFromShape(shape, format, name, options).status());
-    std::ostringstream out;
-    BinTools::Write(shape, out, /*theWithTriangles=*/Standard_False, /*theWithNormals=*/Standard_False,
-                    BinTools_FormatVersion_CURRENT);
-    return out.str();
-  });
+  return ReadThen(format, bytes, untrusted_name, options,
+                  [&](const TopoDS_Shape& shape, const std::string& name) -> absl::StatusOr<std::string> {
+                    // Every check Load makes of the faces, here, where a fault
+                    // costs this process.
+                    RETURN_IF_ERROR(ModelFromShape(shape, format, name, options).status());
+                    std::ostringstream out;
+                    BinTools::Write(shape, out, /*theWithTriangles=*/Standard_False,
+                                    /*theWithNormals=*/Standard_False, BinTools_FormatVersion_CURRENT);
+                    return out.str();
+                  });
 }
 
 absl::StatusOr<std::shared_ptr<const Model>> LoadBrep(absl::string_view brep, ModelFormat format,
