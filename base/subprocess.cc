@@ -64,8 +64,11 @@ absl::StatusOr<SubprocessResult> RunSubprocess(const std::vector<std::string>& a
   }
   if (::lseek(in.fd, 0, SEEK_SET) != 0) return Errno("lseek");
   int out_pipe[2];
-  if (::pipe2(out_pipe, O_CLOEXEC | O_NONBLOCK) != 0) return Errno("pipe2");
+  if (::pipe2(out_pipe, O_CLOEXEC) != 0) return Errno("pipe2");
   Fd out_read{out_pipe[0]}, out_write{out_pipe[1]};
+  // Only our end reads without blocking: the program's writes must block
+  // while the pipe is full, not fail.
+  if (::fcntl(out_read.fd, F_SETFL, O_NONBLOCK) != 0) return Errno("fcntl");
   ::fcntl(out_read.fd, F_SETPIPE_SZ, 1 << 20);  // fewer wake-ups for large outputs; may fail
   Fd null{::open("/dev/null", O_WRONLY | O_CLOEXEC)};
   if (null.fd < 0) return Errno("open /dev/null");
