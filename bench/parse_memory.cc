@@ -19,11 +19,10 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <utility>
+#include <optional>
 #include <vector>
-
 
 #include "absl/strings/numbers.h"
 #include "bench/soak_models.h"
@@ -31,6 +30,7 @@
 #include "cad/load.h"
 #include "mesh/mesh_loader.h"
 #include "mesh/mesh_surface.h"
+#include "request/model_spec.h"
 
 namespace {
 
@@ -44,22 +44,27 @@ uint64_t StatusBytes(const std::string& field) {
   return 0;
 }
 
-// The format and bytes of FORMAT:FILE; false when the file cannot be read.
-bool ReadSpec(const std::string& spec, std::string* format, std::string* path, std::string* bytes) {
-  const size_t colon = spec.find(':');
-  *format = spec.substr(0, colon);
-  *path = spec.substr(colon + 1);
-  std::ifstream in(*path, std::ios::binary);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  *bytes = buffer.str();
-  return static_cast<bool>(in);
+// The model FORMAT:FILE names, read as the CLI reads it (request/model_spec.h);
+// prints why not and returns nullopt when it cannot be read.
+std::optional<sfc::StoredModel> ReadSpec(const std::string& spec) {
+  auto parsed = sfc::ParseModelSpec(spec);
+  absl::StatusOr<sfc::StoredModel> model =
+      !parsed.ok()             ? parsed.status()
+      : !parsed->has_value()   ? absl::InvalidArgumentError("not FORMAT:FILE")
+                               : sfc::ReadModelFile(**parsed, uint64_t{1} << 32);
+  if (!model.ok()) {
+    std::fprintf(stderr, "%s: %s\n", spec.c_str(), model.status().ToString().c_str());
+    return std::nullopt;
+  }
+  return *std::move(model);
 }
 
 // Parses `spec` (FORMAT:FILE) and prints one row. Runs in a child.
 int Measure(const std::string& spec, bool curvature) {
-  std::string format, path, bytes;
-  if (!ReadSpec(spec, &format, &path, &bytes)) return 1;
+  const std::optional<sfc::StoredModel> model = ReadSpec(spec);
+  if (!model) return 1;
+  const std::string format(sfc::ModelFormatName(model->format)), &path = model->name;
+  const std::string& bytes = *model->bytes;
   // Reset the peak to now (Linux: clear_refs 5), then parse.
   std::ofstream("/proc/self/clear_refs") << "5";
   const uint64_t before = StatusBytes("VmRSS");
@@ -105,15 +110,17 @@ bool WriteCadArrays(const std::string& dir, int copies, std::vector<std::string>
 // Parses `spec` `times` times in this process and prints VmRSS every tenth
 // of the way: memory a parse leaves behind shows as growth.
 int Repeat(const std::string& spec, int times) {
-  std::string format, path, bytes;
-  if (!ReadSpec(spec, &format, &path, &bytes)) return 1;
+  const std::optional<sfc::StoredModel> model = ReadSpec(spec);
+  if (!model) return 1;
+  const std::string format(sfc::ModelFormatName(model->format)), &path = model->name;
+  const std::string& bytes = *model->bytes;
   auto f = sfc::cad::ParseModelFormat(format);
   if (!f.ok()) return 2;
   for (int i = 1; i <= times; ++i) {
-    auto model = sfc::cad::Load(*f, bytes, path, {});
+    auto loaded = sfc::cad::Load(*f, bytes, path, {});
     if (i % std::max(1, times / 10) == 0) {
       std::printf("%s: after %d parses (%s) VmRSS %.1f MiB\n", spec.c_str(), i,
-                  model.ok() ? "ok" : "refused", StatusBytes("VmRSS") / 1048576.0);
+                  loaded.ok() ? "ok" : "refused", StatusBytes("VmRSS") / 1048576.0);
       std::fflush(stdout);
     }
   }
@@ -124,8 +131,10 @@ int Repeat(const std::string& spec, int times) {
 // cad::ReadToBrep (what the model check process does) then cad::LoadBrep
 // (what the server does with its answer).
 int TimeReads(const std::string& spec) {
-  std::string format, path, bytes;
-  if (!ReadSpec(spec, &format, &path, &bytes)) return 1;
+  const std::optional<sfc::StoredModel> model = ReadSpec(spec);
+  if (!model) return 1;
+  const std::string format(sfc::ModelFormatName(model->format)), &path = model->name;
+  const std::string& bytes = *model->bytes;
   auto f = sfc::cad::ParseModelFormat(format);
   if (!f.ok()) return 2;
   sfc::cad::LoadOptions options;
@@ -135,12 +144,16 @@ int TimeReads(const std::string& spec) {
     work();
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
-  std::string brep;
+  absl::StatusOr<std::string> brep;
   const double load = seconds([&] { (void)sfc::cad::Load(*f, bytes, path, options); });
-  const double read = seconds([&] { brep = *sfc::cad::ReadToBrep(*f, bytes, path, options); });
-  const double load_brep = seconds([&] { (void)sfc::cad::LoadBrep(brep, *f, path, options); });
+  const double read = seconds([&] { brep = sfc::cad::ReadToBrep(*f, bytes, path, options); });
+  if (!brep.ok()) {
+    std::fprintf(stderr, "%s: %s\n", spec.c_str(), brep.status().ToString().c_str());
+    return 1;
+  }
+  const double load_brep = seconds([&] { (void)sfc::cad::LoadBrep(*brep, *f, path, options); });
   std::printf("%s: %zu bytes; Load %.3f s; ReadToBrep %.3f s (%zu bytes of BRep); LoadBrep %.3f s\n",
-              spec.c_str(), bytes.size(), load, read, brep.size(), load_brep);
+              spec.c_str(), bytes.size(), load, read, brep->size(), load_brep);
   return 0;
 }
 

@@ -24,7 +24,6 @@ ModelStore::Upload::Upload(Upload&& other) noexcept
       chunks_(std::move(other.chunks_)),
       whole_(std::move(other.whole_)),
       expected_(other.expected_),
-      expecting_(other.expecting_),
       size_(other.size_),
       held_(other.held_) {
   other.chunks_.clear();
@@ -45,16 +44,15 @@ absl::Status ModelStore::Upload::Expect(uint64_t total_bytes) {
   if (absl::Status held = store_->Hold(total_bytes); !held.ok()) return held;
   held_ += total_bytes;
   expected_ = total_bytes;
-  expecting_ = true;
   whole_.reserve(total_bytes);
   return absl::OkStatus();
 }
 
 absl::Status ModelStore::Upload::Append(std::string chunk) {
-  if (expecting_) {
-    if (size_ + chunk.size() > expected_) {
+  if (expected_) {
+    if (size_ + chunk.size() > *expected_) {
       return absl::InvalidArgumentError(absl::StrFormat(
-          "the upload sent more than the %d bytes it declared (total_bytes)", expected_));
+          "the upload sent more than the %d bytes it declared (total_bytes)", *expected_));
     }
     whole_ += chunk;  // counted by Expect
     size_ += chunk.size();
@@ -72,10 +70,10 @@ absl::Status ModelStore::Upload::Append(std::string chunk) {
 }
 
 absl::StatusOr<std::string> ModelStore::Upload::Join() {
-  if (expecting_) {
-    if (size_ != expected_) {
+  if (expected_) {
+    if (size_ != *expected_) {
       return absl::InvalidArgumentError(absl::StrFormat(
-          "the upload declared %d bytes (total_bytes) and sent %d", expected_, size_));
+          "the upload declared %d bytes (total_bytes) and sent %d", *expected_, size_));
     }
     return std::move(whole_);
   }

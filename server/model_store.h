@@ -16,6 +16,7 @@
 #define SFCSAMPLER_SERVER_MODEL_STORE_H_
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -70,8 +71,7 @@ class ModelStore final : public ModelSource {
     ModelStore* store_;
     std::vector<std::string> chunks_;  // exact sizes: no growth by doubling
     std::string whole_;                // with Expect: reserved at its full size
-    uint64_t expected_ = 0;            // with Expect: the declared size
-    bool expecting_ = false;
+    std::optional<uint64_t> expected_;  // with Expect: the declared size
     uint64_t size_ = 0;
     uint64_t held_ = 0;  // counted against the store's budget now
   };

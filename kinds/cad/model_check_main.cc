@@ -1,12 +1,13 @@
 // sfcsampler-model-check FORMAT NAME CPU_SECONDS MEMORY_BYTES < FILE
 //
-// Reads a CAD model (step, iges or nurbs) from standard input with cad::Load,
-// as the server's parse would, in a process of its own with the given limits
-// (0: none) on its CPU time (RLIMIT_CPU; SIGXCPU past it) and address space
-// (RLIMIT_AS). It dies with its parent. Prints one line and exits:
+// Reads a CAD model (step, iges or nurbs) from standard input with
+// cad::ReadToBrep (every check cad::Load makes), in a process of its own with
+// the given limits (0: none) on its CPU time (RLIMIT_CPU; SIGXCPU past it)
+// and address space (RLIMIT_AS). It dies with its parent. Prints one line
+// and exits:
 //   0  "ok BYTES", then BYTES bytes: the model read, as cad::ReadToBrep's
 //      binary BRep, which the server loads with cad::LoadBrep;
-//   1  "CODE MESSAGE"               cad::Load refused it (an absl status code);
+//   1  "CODE MESSAGE"               the read refused it (an absl status code);
 //   2  "usage ..."                  bad arguments.
 // A crash or a loop inside OpenCASCADE ends this process, not the server
 // (kinds/cad/model_check.h runs it; docs/MODELS.md says why).
@@ -14,8 +15,8 @@
 #include <sys/prctl.h>
 #include <sys/resource.h>
 
-#include <cstdio>
 #include <algorithm>
+#include <cstdio>
 #include <exception>
 #include <iostream>
 #include <iterator>
