@@ -1,6 +1,9 @@
 #include "cad/preflight.h"
 
 #include <algorithm>
+#include <cstdint>
+#include <iterator>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -20,16 +23,27 @@ uint64_t LineOf(absl::string_view bytes, size_t at) {
   return 1 + static_cast<uint64_t>(std::count(bytes.begin(), bytes.begin() + at, '\n'));
 }
 
-// The record's "#N = KEYWORD(" head, when it has one: its number and keyword.
+// `text` without its leading blanks and comments.
+absl::string_view SkipBlanksAndComments(absl::string_view text) {
+  for (;;) {
+    text = absl::StripLeadingAsciiWhitespace(text);
+    if (!absl::StartsWith(text, "/*")) return text;
+    const size_t end = text.find("*/", 2);
+    text = end == absl::string_view::npos ? absl::string_view() : text.substr(end + 2);
+  }
+}
+
+// The record's "#N = KEYWORD(" head, when it has one: its number and
+// keyword. Comments may stand between the tokens.
 bool ParseHead(absl::string_view record, uint64_t* id, absl::string_view* keyword) {
-  record = absl::StripLeadingAsciiWhitespace(record);
+  record = SkipBlanksAndComments(record);
   if (record.empty() || record[0] != '#') return false;
   size_t i = 1;
   while (i < record.size() && absl::ascii_isdigit(record[i])) ++i;
   if (!absl::SimpleAtoi(record.substr(1, i - 1), id)) return false;
-  record = absl::StripLeadingAsciiWhitespace(record.substr(i));
+  record = SkipBlanksAndComments(record.substr(i));
   if (record.empty() || record[0] != '=') return false;
-  record = absl::StripLeadingAsciiWhitespace(record.substr(1));
+  record = SkipBlanksAndComments(record.substr(1));
   size_t j = 0;
   while (j < record.size() && (absl::ascii_isalnum(record[j]) || record[j] == '_')) ++j;
   *keyword = record.substr(0, j);
@@ -105,13 +119,60 @@ absl::Status CheckIgesParameters(absl::string_view data, const std::vector<uint6
   return absl::OkStatus();
 }
 
+// Every entity instance name is defined once, as ISO 10303-21 requires, and
+// fits an int, as the reader keeps it (atoi: a larger one wraps onto
+// another name). OpenCASCADE 7.6 resolves a name defined twice in a second
+// pass (StepData_StepReaderData::SetEntityNumbers) that reads arrays it
+// never initialised: what it does then depends on what earlier allocations
+// left in the heap, from returning at once to looping for good (step_fuzzer
+// found files that read in 0.1 s in a fresh process and never ended after
+// others). A definition is what the reader's lexer takes for one, "#N" then
+// blanks then "=", looked for everywhere, strings and comments included:
+// where the lexer's idea of a string differs from the standard's (it ends
+// one at a control character), a definition hidden in a "string" would
+// otherwise slip through.
+absl::Status CheckEntityNames(absl::string_view bytes) {
+  struct NameAt {
+    uint64_t id;
+    size_t at;
+  };
+  std::vector<NameAt> names;
+  for (size_t i = bytes.find('#'); i != absl::string_view::npos; i = bytes.find('#', i)) {
+    const size_t at = i++;
+    const size_t digits = i;
+    while (i < bytes.size() && absl::ascii_isdigit(bytes[i])) ++i;
+    if (i == digits) continue;
+    size_t j = i;
+    while (j < bytes.size() && (absl::ascii_isspace(bytes[j]) || bytes[j] == '\0')) ++j;
+    if (j == bytes.size() || bytes[j] != '=') continue;
+    const absl::string_view number = bytes.substr(digits, i - digits);
+    uint64_t id = 0;
+    if (!absl::SimpleAtoi(number, &id) || id > uint64_t{std::numeric_limits<int32_t>::max()}) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "the entity name #%s at line %d is out of range (at most #%d); the file is damaged "
+          "(fix or re-export it)",
+          Echo(number, 24), LineOf(bytes, at), std::numeric_limits<int32_t>::max()));
+    }
+    names.push_back({id, at});
+  }
+  std::sort(names.begin(), names.end(), [](const NameAt& a, const NameAt& b) {
+    return a.id != b.id ? a.id < b.id : a.at < b.at;
+  });
+  const auto twice = std::adjacent_find(
+      names.begin(), names.end(), [](const NameAt& a, const NameAt& b) { return a.id == b.id; });
+  if (twice == names.end()) return absl::OkStatus();
+  return absl::InvalidArgumentError(absl::StrFormat(
+      "the entity name #%d is defined twice, at lines %d and %d (strings and comments count); "
+      "names must be unique (fix or re-export the file)",
+      twice->id, LineOf(bytes, twice->at), LineOf(bytes, std::next(twice)->at)));
+}
+
 }  // namespace
 
 absl::StatusOr<ModelCensus> PreflightStep(absl::string_view bytes, const PreflightLimits& limits) {
   ModelCensus census;
   int depth = 0;
   size_t record_start = 0;
-  bool in_data = false;
   for (size_t i = 0; i < bytes.size(); ++i) {
     const char c = bytes[i];
     if (c == '\'') {  // a string: '' is a quote inside it
@@ -151,11 +212,10 @@ absl::StatusOr<ModelCensus> PreflightStep(absl::string_view bytes, const Preflig
       const absl::string_view record =
           absl::StripAsciiWhitespace(bytes.substr(record_start, i - record_start));
       census.longest_record = std::max<uint64_t>(census.longest_record, record.size());
-      if (record == "DATA") in_data = true;
-      if (record == "ENDSEC") in_data = false;
       uint64_t id = 0;
       absl::string_view keyword;
-      if (in_data && ParseHead(record, &id, &keyword)) {
+      // Any record with a "#N =" head is an entity instance, in whichever section.
+      if (ParseHead(record, &id, &keyword)) {
         if (++census.entities > limits.max_entities) {
           return absl::InvalidArgumentError(absl::StrFormat(
               "the file has more than %d entity instances (max_entities); split the model",
@@ -171,6 +231,7 @@ absl::StatusOr<ModelCensus> PreflightStep(absl::string_view bytes, const Preflig
       record_start = i + 1;
     }
   }
+  RETURN_IF_ERROR(CheckEntityNames(bytes));
   return census;
 }
 

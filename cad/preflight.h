@@ -50,10 +50,12 @@ struct ModelCensus {
   std::vector<uint64_t> face_ids;
 };
 
-// STEP (ISO 10303-21): strings and comments are skipped; every record of the
-// DATA section is measured. Faces are ADVANCED_FACE and FACE_SURFACE
-// instances (ORIENTED_FACE only reuses another face). INVALID_ARGUMENT, with
-// the limit's name, where it was hit and what to fix, past a limit.
+// STEP (ISO 10303-21): strings and comments are skipped; every record is
+// measured, and every entity instance name ("#N =") must be defined once and
+// fit an int, as the reader keeps it. Faces are ADVANCED_FACE and
+// FACE_SURFACE instances (ORIENTED_FACE only reuses another face).
+// INVALID_ARGUMENT, with the limit's name (or the names at fault), where it
+// was hit and what to fix.
 absl::StatusOr<ModelCensus> PreflightStep(absl::string_view bytes, const PreflightLimits& limits);
 
 // IGES (fixed 80-column records): line lengths and directory entries. Faces
