@@ -76,7 +76,12 @@ for t in "${targets[@]}"; do
 done
 
 # One target for `seconds`: libFuzzer stops at its first finding, so it is
-# restarted (keeping the corpus) until the time is used up.
+# restarted (keeping the corpus) until the time is used up. It is also
+# restarted every SFC_FUZZ_RUNS_PER_PROCESS executions (default 100 000), as
+# the server starts a fresh check process for every CAD file: OpenCASCADE
+# leaks tens of KB on many broken files, which would otherwise fill the RSS
+# limit within minutes under ASan.
+runs_per_process="${SFC_FUZZ_RUNS_PER_PROCESS:-100000}"
 printf '%-22s %8s %12s %10s %9s %s\n' target seconds executions exec/s findings "restarts (state accumulated over the run)"
 total_findings=0
 for t in "${targets[@]}"; do
@@ -105,7 +110,7 @@ for t in "${targets[@]}"; do
     left=$((seconds - ($(date +%s) - start)))
     [ "$left" -gt 0 ] || break
     run_log=$(mktemp)
-    ASAN_OPTIONS="$asan" UBSAN_OPTIONS="$ubsan" "$out/fuzz/$t" -max_total_time="$left" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=1024 \
+    ASAN_OPTIONS="$asan" UBSAN_OPTIONS="$ubsan" "$out/fuzz/$t" -max_total_time="$left" -runs="$runs_per_process" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=1024 \
       -print_final_stats=1 "${dict[@]}" -artifact_prefix="$findings_dir/$t/" \
       "$out/corpus/$t" > "$run_log" 2>&1 || true
     # An out-of-memory or timeout stop whose input alone passes is state the
