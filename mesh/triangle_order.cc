@@ -12,38 +12,55 @@ struct Item {
   uint32_t t;
 };
 
-double Coordinate(const Vec3& v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
+template <int kAxis>
+double Coordinate(const Vec3& v) {
+  return kAxis == 0 ? v.x : kAxis == 1 ? v.y : v.z;
+}
 
 double Distance2(const Vec3& a, const Vec3& b) {
   const Vec3 d = a - b;
   return Dot(d, d);
 }
 
-// Orders items by their coordinate along `axis`, ties by triangle index.
-bool Before(const Item& a, const Item& b, int axis) {
-  const double ca = Coordinate(a.c, axis), cb = Coordinate(b.c, axis);
+// Orders items by their coordinate along kAxis, ties by triangle index.
+template <int kAxis>
+bool Before(const Item& a, const Item& b) {
+  const double ca = Coordinate<kAxis>(a.c), cb = Coordinate<kAxis>(b.c);
   return ca < cb || (ca == cb && a.t < b.t);
+}
+
+// *x = less ? y : x, without a branch (whether an item is below the pivot is
+// a coin toss the branch predictor loses half the time).
+void Select(bool less, const Item& y, Item* x) {
+  x->c.x = less ? y.c.x : x->c.x;
+  x->c.y = less ? y.c.y : x->c.y;
+  x->c.z = less ? y.c.z : x->c.z;
+  x->area = less ? y.area : x->area;
+  x->t = less ? y.t : x->t;
 }
 
 // Rearranges [begin, end) so that its first m items are the m first in the
 // order Before, and returns m: the most items, in [1, n - 1], whose areas sum
 // to at most `half`. A selection with area weights (expected linear time):
 // [begin, lo) holds items known to be in the first part, with area `below`.
-size_t SplitByArea(Item* begin, Item* end, int axis, double half) {
+// The partition is Lomuto's, its swaps made without branches: the same
+// arrangement, item for item, as the branching form, so the same sums.
+template <int kAxis>
+size_t SplitByArea(Item* begin, Item* end, double half) {
   const size_t n = static_cast<size_t>(end - begin);
   Item *lo = begin, *hi = end;
   double below = 0;
   while (lo < hi) {
     // The median of the first, middle and last items as the pivot, moved to hi - 1.
     Item* mid = lo + (hi - lo) / 2;
-    if (Before(*mid, *lo, axis)) std::swap(*mid, *lo);
-    if (Before(*(hi - 1), *lo, axis)) std::swap(*(hi - 1), *lo);
-    if (Before(*mid, *(hi - 1), axis)) std::swap(*mid, *(hi - 1));
+    if (Before<kAxis>(*mid, *lo)) std::swap(*mid, *lo);
+    if (Before<kAxis>(*(hi - 1), *lo)) std::swap(*(hi - 1), *lo);
+    if (Before<kAxis>(*mid, *(hi - 1))) std::swap(*mid, *(hi - 1));
     const Item pivot = *(hi - 1);
     Item* store = lo;
     double area = 0;
     for (Item* it = lo; it + 1 < hi; ++it) {
-      if (Before(*it, pivot, axis)) {
+      if (Before<kAxis>(*it, pivot)) {
         area += it->area;
         std::swap(*it, *store++);
       }
@@ -58,49 +75,64 @@ size_t SplitByArea(Item* begin, Item* end, int axis, double half) {
   }
   size_t m = static_cast<size_t>(lo - begin);
   if (m == 0) {  // the first item alone holds more than half
-    std::swap(*begin, *std::min_element(begin, end, [axis](const Item& a, const Item& b) {
-      return Before(a, b, axis);
-    }));
+    std::swap(*begin, *std::min_element(begin, end, Before<kAxis>));
     m = 1;
   } else if (m == n) {
-    std::swap(*(end - 1), *std::max_element(begin, end, [axis](const Item& a, const Item& b) {
-      return Before(a, b, axis);
-    }));
+    std::swap(*(end - 1), *std::max_element(begin, end, Before<kAxis>));
     m = n - 1;
   }
   return m;
 }
 
+size_t SplitByArea(Item* begin, Item* end, int axis, double half) {
+  return axis == 0 ? SplitByArea<0>(begin, end, half)
+         : axis == 1 ? SplitByArea<1>(begin, end, half)
+                     : SplitByArea<2>(begin, end, half);
+}
+
+// What Order needs of a run of items, gathered in one pass in the run's
+// arrangement: its centroids' bounding box, its area (summed in that order)
+// and its area-weighted centroid sum.
+struct Summary {
+  Vec3 lo, hi, weighted{0, 0, 0};
+  double area = 0;
+};
+
+Summary Summarize(const Item* begin, const Item* end) {
+  Summary s;
+  s.lo = s.hi = begin->c;
+  for (const Item* it = begin; it != end; ++it) {
+    s.lo = {std::min(s.lo.x, it->c.x), std::min(s.lo.y, it->c.y), std::min(s.lo.z, it->c.z)};
+    s.hi = {std::max(s.hi.x, it->c.x), std::max(s.hi.y, it->c.y), std::max(s.hi.z, it->c.z)};
+    s.weighted = s.weighted + it->c * it->area;
+    s.area += it->area;
+  }
+  return s;
+}
+
 // Appends the items [begin, end) in curve order, starting near `entry`;
-// returns where the order ends (the last centroid).
-Vec3 Order(Item* begin, Item* end, Vec3 entry, std::vector<uint32_t>* out) {
+// returns where the order ends (the last centroid). `run` is
+// Summarize(begin, end): the parent's pass over each half serves both the
+// choice of which half goes first and the half's own split.
+Vec3 Order(Item* begin, Item* end, const Summary& run, Vec3 entry, std::vector<uint32_t>* out) {
   const size_t n = static_cast<size_t>(end - begin);
   if (n == 1) {
     out->push_back(begin->t);
     return begin->c;
   }
-  Vec3 lo = begin->c, hi = begin->c;
-  for (const Item* it = begin; it != end; ++it) {
-    lo = {std::min(lo.x, it->c.x), std::min(lo.y, it->c.y), std::min(lo.z, it->c.z)};
-    hi = {std::max(hi.x, it->c.x), std::max(hi.y, it->c.y), std::max(hi.z, it->c.z)};
-  }
-  const Vec3 extent = hi - lo;
+  const Vec3 extent = run.hi - run.lo;
   const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
-  double total = 0;
-  for (const Item* it = begin; it != end; ++it) total += it->area;
-  const size_t split = SplitByArea(begin, end, axis, total / 2);
+  const size_t split = SplitByArea(begin, end, axis, run.area / 2);
   Item* middle = begin + split;
+  const Summary first = Summarize(begin, middle), second = Summarize(middle, end);
   // The half whose area-weighted centre is nearer the curve's end goes first.
-  auto centre = [](const Item* b, const Item* e) {
-    Vec3 sum{0, 0, 0};
-    double weight = 0;
-    for (const Item* it = b; it != e; ++it) sum = sum + it->c * it->area, weight += it->area;
-    return weight > 0 ? sum * (1 / weight) : b->c;
+  auto centre = [](const Summary& half, const Item* b) {
+    return half.area > 0 ? half.weighted * (1 / half.area) : b->c;
   };
-  if (Distance2(centre(begin, middle), entry) <= Distance2(centre(middle, end), entry)) {
-    return Order(middle, end, Order(begin, middle, entry, out), out);
+  if (Distance2(centre(first, begin), entry) <= Distance2(centre(second, middle), entry)) {
+    return Order(middle, end, second, Order(begin, middle, first, entry, out), out);
   }
-  return Order(begin, middle, Order(middle, end, entry, out), out);
+  return Order(begin, middle, first, Order(middle, end, second, entry, out), out);
 }
 
 }  // namespace
@@ -111,16 +143,14 @@ std::vector<uint32_t> CurveOrderOfTriangles(const std::vector<uint32_t>& triangl
   std::vector<uint32_t> out;
   if (triangles.empty()) return out;
   std::vector<Item> items(triangles.size());
-  Vec3 lo = centroid[triangles[0]];
   for (size_t i = 0; i < triangles.size(); ++i) {
     const uint32_t t = triangles[i];
     items[i] = {centroid[t], area[t], t};
-    lo = {std::min(lo.x, centroid[t].x), std::min(lo.y, centroid[t].y),
-          std::min(lo.z, centroid[t].z)};
   }
   out.reserve(triangles.size());
+  const Summary all = Summarize(items.data(), items.data() + items.size());
   // The curve starts at the low corner of the centroids' bounding box.
-  Order(items.data(), items.data() + items.size(), lo, &out);
+  Order(items.data(), items.data() + items.size(), all, all.lo, &out);
   return out;
 }
 
