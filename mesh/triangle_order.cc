@@ -29,22 +29,12 @@ bool Before(const Item& a, const Item& b) {
   return ca < cb || (ca == cb && a.t < b.t);
 }
 
-// *x = less ? y : x, without a branch (whether an item is below the pivot is
-// a coin toss the branch predictor loses half the time).
-void Select(bool less, const Item& y, Item* x) {
-  x->c.x = less ? y.c.x : x->c.x;
-  x->c.y = less ? y.c.y : x->c.y;
-  x->c.z = less ? y.c.z : x->c.z;
-  x->area = less ? y.area : x->area;
-  x->t = less ? y.t : x->t;
-}
-
 // Rearranges [begin, end) so that its first m items are the m first in the
 // order Before, and returns m: the most items, in [1, n - 1], whose areas sum
 // to at most `half`. A selection with area weights (expected linear time):
 // [begin, lo) holds items known to be in the first part, with area `below`.
-// The partition is Lomuto's, its swaps made without branches: the same
-// arrangement, item for item, as the branching form, so the same sums.
+// The arrangement it leaves decides the order of later sums, so it is part of
+// the curve's definition: change it and meshes' bytes change.
 template <int kAxis>
 size_t SplitByArea(Item* begin, Item* end, double half) {
   const size_t n = static_cast<size_t>(end - begin);
