@@ -110,18 +110,42 @@ for t in "${targets[@]}"; do
     left=$((seconds - ($(date +%s) - start)))
     [ "$left" -gt 0 ] || break
     run_log=$(mktemp)
-    ASAN_OPTIONS="$asan" UBSAN_OPTIONS="$ubsan" "$out/fuzz/$t" -max_total_time="$left" -runs="$runs_per_process" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=1024 \
+    # The target writes each input to last_input before running it
+    # (fuzz/model_fuzz.h), so an input that deadlocks the process is kept.
+    last_input="$findings_dir/$t/.last-input"
+    SFC_FUZZ_LAST_INPUT="$last_input" ASAN_OPTIONS="$asan" UBSAN_OPTIONS="$ubsan" \
+      "$out/fuzz/$t" -max_total_time="$left" -runs="$runs_per_process" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=1024 \
       -print_final_stats=1 "${dict[@]}" -artifact_prefix="$findings_dir/$t/" \
-      "$out/corpus/$t" > "$run_log" 2>&1 || true
-    # An out-of-memory or timeout stop whose input alone passes is state the
-    # run accumulated, not that input's: OpenCASCADE leaks tens of KB on many
-    # broken files (bench/parse_memory --repeat shows it), and its STEP
-    # reader keeps process-wide state from one file to the next. The input is
-    # replayed alone in a fresh process; if it passes it is set aside (in
-    # accumulated/) and the run goes on; one that fails alone is a finding.
-    for stop in "$findings_dir/$t"/oom-* "$findings_dir/$t"/timeout-*; do
+      "$out/corpus/$t" > "$run_log" 2>&1 &
+    pid=$!
+    # Watchdog: a process that used no CPU for 30 s is deadlocked (a fault
+    # inside malloc leaves its lock taken, and libFuzzer's own crash report
+    # then waits on it), which libFuzzer's timeout cannot see. It is killed
+    # and its last input kept as deadlock-SHA1.
+    ticks=-1; idle=0
+    while kill -0 "$pid" 2>/dev/null; do
+      sleep 5
+      now=$(awk '{print $14 + $15}' "/proc/$pid/stat" 2>/dev/null || echo gone)
+      [ "$now" = gone ] && break
+      if [ "$now" = "$ticks" ]; then idle=$((idle + 1)); else idle=0; ticks=$now; fi
+      if [ "$idle" -ge 6 ]; then
+        kill -9 "$pid" 2>/dev/null || true
+        [ -f "$last_input" ] && cp "$last_input" "$findings_dir/$t/deadlock-$(sha1sum < "$last_input" | cut -c1-40)"
+        echo "fuzz: $t deadlocked (no CPU for 30 s); killed, its last input kept" >> "$run_log"
+        break
+      fi
+    done
+    wait "$pid" 2>/dev/null || true
+    # An out-of-memory, timeout or deadlock stop whose input alone passes is
+    # state the run accumulated, not that input's: OpenCASCADE leaks tens of
+    # KB on many broken files (bench/parse_memory --repeat shows it), and its
+    # readers keep process-wide state from one file to the next. The input is
+    # replayed alone in a fresh process (killed after 60 s); if it passes it
+    # is set aside (in accumulated/) and the run goes on; one that fails alone
+    # is a finding.
+    for stop in "$findings_dir/$t"/oom-* "$findings_dir/$t"/timeout-* "$findings_dir/$t"/deadlock-*; do
       [ -e "$stop" ] || continue
-      if ASAN_OPTIONS="$asan" UBSAN_OPTIONS="$ubsan" "$out/fuzz/$t" -timeout=10 -rss_limit_mb=2048 \
+      if ASAN_OPTIONS="$asan" UBSAN_OPTIONS="$ubsan" timeout -s KILL 60 "$out/fuzz/$t" -timeout=10 -rss_limit_mb=2048 \
            -malloc_limit_mb=1024 "${dict[@]}" "$stop" > /dev/null 2>&1; then
         mkdir -p "$findings_dir/$t/accumulated"
         mv "$stop" "$findings_dir/$t/accumulated/"
@@ -138,13 +162,13 @@ for t in "${targets[@]}"; do
   done
   elapsed=$(( $(date +%s) - start ))
   findings=$(find "$findings_dir/$t" -maxdepth 1 -type f \( -name 'crash-*' -o -name 'leak-*' \
-    -o -name 'timeout-*' -o -name 'oom-*' -o -name 'slow-unit-*' \) | wc -l)
+    -o -name 'timeout-*' -o -name 'oom-*' -o -name 'slow-unit-*' -o -name 'deadlock-*' \) | wc -l)
   total_findings=$((total_findings + findings))
   rate=$(awk -v e="$execs" -v s="$elapsed" 'BEGIN {printf "%d", (s > 0 ? e / s : 0)}')
   printf '%-22s %8d %12d %10d %9d %d\n' "$t" "$elapsed" "$execs" "$rate" "$findings" "$restarts"
 done
 if [ "$total_findings" -gt 0 ]; then
   echo "fuzz: $total_findings finding(s); reproducers and logs in $findings_dir/" >&2
-  find "$findings_dir" -maxdepth 2 -type f ! -name fuzz.log >&2
+  find "$findings_dir" -maxdepth 2 -type f ! -name fuzz.log ! -name .last-input >&2
   exit 1
 fi
