@@ -12,22 +12,25 @@ struct Item {
   uint32_t t;
 };
 
-template <int kAxis>
-double Coordinate(const Vec3& v) {
-  return kAxis == 0 ? v.x : kAxis == 1 ? v.y : v.z;
-}
-
 double Distance2(const Vec3& a, const Vec3& b) {
   const Vec3 d = a - b;
   return Dot(d, d);
 }
 
+// The items stay where they are; the recursion arranges indices into them
+// (4 bytes to swap instead of 40).
+using Index = uint32_t;
+
 // Orders items by their coordinate along kAxis, ties by triangle index.
 template <int kAxis>
-bool Before(const Item& a, const Item& b) {
-  const double ca = Coordinate<kAxis>(a.c), cb = Coordinate<kAxis>(b.c);
-  return ca < cb || (ca == cb && a.t < b.t);
-}
+struct Before {
+  const Item* items;
+  bool operator()(Index a, Index b) const {
+    const double ca = Coordinate(items[a].c), cb = Coordinate(items[b].c);
+    return ca < cb || (ca == cb && items[a].t < items[b].t);
+  }
+  static double Coordinate(const Vec3& v) { return kAxis == 0 ? v.x : kAxis == 1 ? v.y : v.z; }
+};
 
 // Rearranges [begin, end) so that its first m items are the m first in the
 // order Before, and returns m: the most items, in [1, n - 1], whose areas sum
@@ -36,28 +39,29 @@ bool Before(const Item& a, const Item& b) {
 // The arrangement it leaves decides the order of later sums, so it is part of
 // the curve's definition: change it and meshes' bytes change.
 template <int kAxis>
-size_t SplitByArea(Item* begin, Item* end, double half) {
+size_t SplitByArea(const Item* items, Index* begin, Index* end, double half) {
+  const Before<kAxis> before{items};
   const size_t n = static_cast<size_t>(end - begin);
-  Item *lo = begin, *hi = end;
+  Index *lo = begin, *hi = end;
   double below = 0;
   while (lo < hi) {
     // The median of the first, middle and last items as the pivot, moved to hi - 1.
-    Item* mid = lo + (hi - lo) / 2;
-    if (Before<kAxis>(*mid, *lo)) std::swap(*mid, *lo);
-    if (Before<kAxis>(*(hi - 1), *lo)) std::swap(*(hi - 1), *lo);
-    if (Before<kAxis>(*mid, *(hi - 1))) std::swap(*mid, *(hi - 1));
-    const Item pivot = *(hi - 1);
-    Item* store = lo;
+    Index* mid = lo + (hi - lo) / 2;
+    if (before(*mid, *lo)) std::swap(*mid, *lo);
+    if (before(*(hi - 1), *lo)) std::swap(*(hi - 1), *lo);
+    if (before(*mid, *(hi - 1))) std::swap(*mid, *(hi - 1));
+    const Index pivot = *(hi - 1);
+    Index* store = lo;
     double area = 0;
-    for (Item* it = lo; it + 1 < hi; ++it) {
-      if (Before<kAxis>(*it, pivot)) {
-        area += it->area;
+    for (Index* it = lo; it + 1 < hi; ++it) {
+      if (before(*it, pivot)) {
+        area += items[*it].area;
         std::swap(*it, *store++);
       }
     }
     std::swap(*store, *(hi - 1));  // the pivot between the smaller and the larger items
-    if (below + area + store->area <= half) {
-      below += area + store->area;
+    if (below + area + items[*store].area <= half) {
+      below += area + items[*store].area;
       lo = store + 1;
     } else {
       hi = store;
@@ -65,19 +69,19 @@ size_t SplitByArea(Item* begin, Item* end, double half) {
   }
   size_t m = static_cast<size_t>(lo - begin);
   if (m == 0) {  // the first item alone holds more than half
-    std::swap(*begin, *std::min_element(begin, end, Before<kAxis>));
+    std::swap(*begin, *std::min_element(begin, end, before));
     m = 1;
   } else if (m == n) {
-    std::swap(*(end - 1), *std::max_element(begin, end, Before<kAxis>));
+    std::swap(*(end - 1), *std::max_element(begin, end, before));
     m = n - 1;
   }
   return m;
 }
 
-size_t SplitByArea(Item* begin, Item* end, int axis, double half) {
-  return axis == 0 ? SplitByArea<0>(begin, end, half)
-         : axis == 1 ? SplitByArea<1>(begin, end, half)
-                     : SplitByArea<2>(begin, end, half);
+size_t SplitByArea(const Item* items, Index* begin, Index* end, int axis, double half) {
+  return axis == 0 ? SplitByArea<0>(items, begin, end, half)
+         : axis == 1 ? SplitByArea<1>(items, begin, end, half)
+                     : SplitByArea<2>(items, begin, end, half);
 }
 
 // What Order needs of a run of items, gathered in one pass in the run's
@@ -88,14 +92,15 @@ struct Summary {
   double area = 0;
 };
 
-Summary Summarize(const Item* begin, const Item* end) {
+Summary Summarize(const Item* items, const Index* begin, const Index* end) {
   Summary s;
-  s.lo = s.hi = begin->c;
-  for (const Item* it = begin; it != end; ++it) {
-    s.lo = {std::min(s.lo.x, it->c.x), std::min(s.lo.y, it->c.y), std::min(s.lo.z, it->c.z)};
-    s.hi = {std::max(s.hi.x, it->c.x), std::max(s.hi.y, it->c.y), std::max(s.hi.z, it->c.z)};
-    s.weighted = s.weighted + it->c * it->area;
-    s.area += it->area;
+  s.lo = s.hi = items[*begin].c;
+  for (const Index* i = begin; i != end; ++i) {
+    const Item& it = items[*i];
+    s.lo = {std::min(s.lo.x, it.c.x), std::min(s.lo.y, it.c.y), std::min(s.lo.z, it.c.z)};
+    s.hi = {std::max(s.hi.x, it.c.x), std::max(s.hi.y, it.c.y), std::max(s.hi.z, it.c.z)};
+    s.weighted = s.weighted + it.c * it.area;
+    s.area += it.area;
   }
   return s;
 }
@@ -104,25 +109,26 @@ Summary Summarize(const Item* begin, const Item* end) {
 // returns where the order ends (the last centroid). `run` is
 // Summarize(begin, end): the parent's pass over each half serves both the
 // choice of which half goes first and the half's own split.
-Vec3 Order(Item* begin, Item* end, const Summary& run, Vec3 entry, std::vector<uint32_t>* out) {
+Vec3 Order(const Item* items, Index* begin, Index* end, const Summary& run, Vec3 entry,
+           std::vector<uint32_t>* out) {
   const size_t n = static_cast<size_t>(end - begin);
   if (n == 1) {
-    out->push_back(begin->t);
-    return begin->c;
+    out->push_back(items[*begin].t);
+    return items[*begin].c;
   }
   const Vec3 extent = run.hi - run.lo;
   const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
-  const size_t split = SplitByArea(begin, end, axis, run.area / 2);
-  Item* middle = begin + split;
-  const Summary first = Summarize(begin, middle), second = Summarize(middle, end);
+  const size_t split = SplitByArea(items, begin, end, axis, run.area / 2);
+  Index* middle = begin + split;
+  const Summary first = Summarize(items, begin, middle), second = Summarize(items, middle, end);
   // The half whose area-weighted centre is nearer the curve's end goes first.
-  auto centre = [](const Summary& half, const Item* b) {
-    return half.area > 0 ? half.weighted * (1 / half.area) : b->c;
+  auto centre = [items](const Summary& half, const Index* b) {
+    return half.area > 0 ? half.weighted * (1 / half.area) : items[*b].c;
   };
   if (Distance2(centre(first, begin), entry) <= Distance2(centre(second, middle), entry)) {
-    return Order(middle, end, second, Order(begin, middle, first, entry, out), out);
+    return Order(items, middle, end, second, Order(items, begin, middle, first, entry, out), out);
   }
-  return Order(begin, middle, first, Order(middle, end, second, entry, out), out);
+  return Order(items, begin, middle, first, Order(items, middle, end, second, entry, out), out);
 }
 
 }  // namespace
@@ -138,9 +144,13 @@ std::vector<uint32_t> CurveOrderOfTriangles(const std::vector<uint32_t>& triangl
     items[i] = {centroid[t], area[t], t};
   }
   out.reserve(triangles.size());
-  const Summary all = Summarize(items.data(), items.data() + items.size());
+  std::vector<Index> arrangement(items.size());
+  for (size_t i = 0; i < items.size(); ++i) arrangement[i] = static_cast<Index>(i);
+  Index* begin = arrangement.data();
+  Index* end = begin + arrangement.size();
+  const Summary all = Summarize(items.data(), begin, end);
   // The curve starts at the low corner of the centroids' bounding box.
-  Order(items.data(), items.data() + items.size(), all, all.lo, &out);
+  Order(items.data(), begin, end, all, all.lo, &out);
   return out;
 }
 
