@@ -4,6 +4,9 @@
 #include <Message_Messenger.hxx>
 #include <Message_Printer.hxx>
 #include <OSD.hxx>
+#include <OSD_SIGBUS.hxx>
+#include <OSD_SIGSEGV.hxx>
+#include <Standard_Failure.hxx>
 #include <signal.h>
 
 #include <memory>
@@ -53,6 +56,13 @@ class AltStack {
 void ConvertKernelSignals() {
   static std::once_flag once;
   std::call_once(once, [] {
+    // The type descriptors a converted fault needs, made now: made first
+    // inside a fault's handling, a second fault there leaves the static's
+    // guard taken, and every later fault waits on it for good (iges_fuzzer
+    // met it, in __cxa_guard_acquire for type_instance<Standard_Failure>).
+    (void)STANDARD_TYPE(Standard_Failure);
+    (void)STANDARD_TYPE(OSD_SIGSEGV);
+    (void)STANDARD_TYPE(OSD_SIGBUS);
     // No floating-point traps: evaluation may produce NaN, which callers check.
     OSD::SetSignal(OSD_SignalMode_SetUnhandled, false);
     // A stack overflow (the kernel recursing through a cycle of references)
