@@ -1,5 +1,7 @@
 """The embedded sampler: the CLI's engine in this process, through pybind11."""
 
+import contextlib
+
 import numpy as np
 
 from sfcsampler import _core, meshes
@@ -55,9 +57,16 @@ class Sampler:
         the same samples as surface="FORMAT:FILE" on a file holding them, with no file."""
         if "surface" in request or "mesh" in request:
             raise TypeError("sample_bytes takes the model as fmt and data, not surface= or mesh=")
+        with self.holding(fmt, data, name) as spec:
+            return self.sample(precision=precision, surface=spec, **request)
+
+    @contextlib.contextmanager
+    def holding(self, fmt, data, name=""):
+        """Holds a model given as its file's bytes while the block runs; yields its spec
+        "FORMAT:sha256=HEX", which requests name it by (HEX: the bytes' SHA-256)."""
         spec = self._engine.hold_model(fmt, data, name)
         try:
-            return self.sample(precision=precision, surface=spec, **request)
+            yield spec
         finally:
             self._engine.release_model(spec)
 

@@ -207,19 +207,23 @@ def sample_one(model, request, base_seed, sampler=None, out_path=None, keep=True
     result = Result(model.name)
     try:
         fmt, data = model.load()
-        result.sha256 = hashlib.sha256(data).hexdigest()
-        result.seed = model_seed(base_seed, result.sha256)
         request = dict(request)
         mesh = fmt in ("obj", "ply")  # the model columns apply to the models that have them
         request["face"] = bool(request.get("face")) and not mesh
         request["triangle"] = bool(request.get("triangle")) and mesh
         if client is not None:
+            result.sha256 = hashlib.sha256(data).hexdigest()
+            result.seed = model_seed(base_seed, result.sha256)
             spec = client._upload_bytes(fmt, data, result.sha256, model.name)
             samples = client.sample(surface=spec, seed=result.seed, **request)
         else:
             from sfcsampler.embedded import Sampler
             sampler = sampler or Sampler(max_trees=0, threads=1)
-            samples = sampler.sample_bytes(fmt, data, model.name, seed=result.seed, **request)
+            # The held model's spec carries the bytes' SHA-256 (hashed once, in C++).
+            with sampler.holding(fmt, data, model.name) as spec:
+                result.sha256 = spec.rsplit("sha256=", 1)[1]
+                result.seed = model_seed(base_seed, result.sha256)
+                samples = sampler.sample(surface=spec, seed=result.seed, **request)
         result.count = len(samples)
         if out_path is not None:
             result.path = out_path
