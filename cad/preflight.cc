@@ -23,13 +23,47 @@ uint64_t LineOf(absl::string_view bytes, size_t at) {
   return 1 + static_cast<uint64_t>(std::count(bytes.begin(), bytes.begin() + at, '\n'));
 }
 
-// `text` without its leading blanks and comments.
+// Where the string that OpenCASCADE's lexer reads from the quote at `at`
+// ends (its closing quote), or npos when the lexer reads no string there: a
+// string runs to the next quote not doubled, through any byte but 0x01-0x08,
+// 0x7f and 0x80 (its rule in StepFile/step.lex).
+size_t LexerStringEnd(absl::string_view bytes, size_t at) {
+  for (size_t i = at + 1; i < bytes.size(); ++i) {
+    const unsigned char c = static_cast<unsigned char>(bytes[i]);
+    if (c == '\'') {
+      if (i + 1 < bytes.size() && bytes[i + 1] == '\'') {
+        ++i;
+        continue;
+      }
+      return i;
+    }
+    if ((c >= 0x01 && c <= 0x08) || c == 0x7f || c == 0x80) return absl::string_view::npos;
+  }
+  return absl::string_view::npos;
+}
+
+// True at the lexer's end-of-exchange token: END-ISO, digits and dashes,
+// then ';', not inside a longer word.
+bool IsEndOfExchange(absl::string_view bytes, size_t at) {
+  if (at > 0 && (absl::ascii_isalnum(bytes[at - 1]) || bytes[at - 1] == '_')) return false;
+  if (!absl::StartsWith(bytes.substr(at), "END-ISO")) return false;
+  size_t i = at + 7;
+  while (i < bytes.size() && (absl::ascii_isdigit(bytes[i]) || bytes[i] == '-')) ++i;
+  return i < bytes.size() && bytes[i] == ';';
+}
+
+// `text` without its leading blanks and comments (a comment ends at the
+// first "*/" outside a string the lexer reads in it).
 absl::string_view SkipBlanksAndComments(absl::string_view text) {
   for (;;) {
     text = absl::StripLeadingAsciiWhitespace(text);
     if (!absl::StartsWith(text, "/*")) return text;
-    const size_t end = text.find("*/", 2);
-    text = end == absl::string_view::npos ? absl::string_view() : text.substr(end + 2);
+    size_t i = 2;
+    while (i < text.size() && !(text[i] == '*' && i + 1 < text.size() && text[i + 1] == '/')) {
+      const size_t end = text[i] == '\'' ? LexerStringEnd(text, i) : absl::string_view::npos;
+      i = end == absl::string_view::npos ? i + 1 : end + 1;
+    }
+    text = i < text.size() ? text.substr(i + 2) : absl::string_view();
   }
 }
 
@@ -173,20 +207,25 @@ absl::StatusOr<ModelCensus> PreflightStep(absl::string_view bytes, const Preflig
   ModelCensus census;
   int depth = 0;
   size_t record_start = 0;
+  bool comment = false;
   for (size_t i = 0; i < bytes.size(); ++i) {
     const char c = bytes[i];
-    if (c == '\'') {  // a string: '' is a quote inside it
-      for (++i; i < bytes.size(); ++i) {
-        if (bytes[i] != '\'') continue;
-        if (i + 1 < bytes.size() && bytes[i + 1] == '\'') {
-          ++i;
-        } else {
-          break;
-        }
-      }
+    // Strings and comments as OpenCASCADE's lexer reads them: a string is
+    // lexed inside a comment too (and can hide its "*/"), and a quote that
+    // starts no string the lexer accepts is a character like any other.
+    if (c == '\'') {
+      const size_t end = LexerStringEnd(bytes, i);
+      if (end != absl::string_view::npos) i = end;
     } else if (c == '/' && i + 1 < bytes.size() && bytes[i + 1] == '*') {
-      const size_t end = bytes.find("*/", i + 2);
-      i = end == absl::string_view::npos ? bytes.size() : end + 1;
+      comment = true;
+      ++i;
+    } else if (c == '*' && i + 1 < bytes.size() && bytes[i + 1] == '/') {
+      comment = false;
+      ++i;
+    } else if (comment) {
+      // Nothing inside a comment counts, but its length.
+    } else if (c == 'E' && IsEndOfExchange(bytes, i)) {
+      break;  // the lexer reads nothing after END-ISO-10303-21;
     } else if (c == '(') {
       if (++depth > limits.max_nesting) {
         return absl::InvalidArgumentError(absl::StrFormat(
@@ -197,7 +236,22 @@ absl::StatusOr<ModelCensus> PreflightStep(absl::string_view bytes, const Preflig
       }
       census.max_nesting = std::max(census.max_nesting, depth);
     } else if (c == ')') {
-      depth = std::max(depth - 1, 0);
+      // The reader's recovery from unbalanced parentheses sent it into the
+      // uninitialised pass of SetEntityNumbers too (step_fuzzer); it refuses
+      // such files anyway, so they are refused here, before it runs.
+      if (depth == 0) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "line %d: a ')' closes no '(' in the record starting '%s'; the file is damaged (fix "
+            "or re-export it)",
+            LineOf(bytes, i), Echo(absl::StripLeadingAsciiWhitespace(bytes.substr(record_start, 40)))));
+      }
+      --depth;
+    } else if (c == ';' && depth > 0) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "line %d: the record starting '%s' ends with %d '(' still open; the file is damaged "
+          "(fix or re-export it)",
+          LineOf(bytes, i), Echo(absl::StripLeadingAsciiWhitespace(bytes.substr(record_start, 40))),
+          depth));
     }
     const size_t length = i + 1 - record_start;
     if (length > limits.max_record_bytes) {
@@ -208,7 +262,7 @@ absl::StatusOr<ModelCensus> PreflightStep(absl::string_view bytes, const Preflig
           Echo(absl::StripLeadingAsciiWhitespace(bytes.substr(record_start, 40))),
           limits.max_record_bytes));
     }
-    if (i < bytes.size() && bytes[i] == ';') {
+    if (i < bytes.size() && bytes[i] == ';' && !comment) {
       const absl::string_view record =
           absl::StripAsciiWhitespace(bytes.substr(record_start, i - record_start));
       census.longest_record = std::max<uint64_t>(census.longest_record, record.size());

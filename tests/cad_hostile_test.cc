@@ -157,6 +157,40 @@ TEST(CadHostile, EntityNamesDefinedTwiceOrOutOfRangeAreRefused) {
   EXPECT_TRUE(PreflightStep(box, PreflightLimits{}).ok());
 }
 
+// Parentheses must balance in every record, counted as OpenCASCADE's lexer
+// reads the file: the reader's recovery from a stray ')' also ran its
+// uninitialised pass for good (step_fuzzer), and it refuses such files anyway.
+TEST(CadHostile, UnbalancedParenthesesAreRefusedAsTheLexerSeesThem) {
+  const std::string& box = Bytes(Solid::kBoxWithHole, ModelFormat::kStep);
+  const std::string point = "#12 = CARTESIAN_POINT('',(0.,0.,0.));";
+  const size_t at = box.find(point);
+  ASSERT_NE(at, std::string::npos);
+  const uint64_t line = 1 + std::count(box.begin(), box.begin() + at, '\n');
+  std::string stray = box;
+  stray.replace(at, point.size(), "#12 = CARTESIAN_POINT('',(0.,0.,0.)));");
+  ExpectRefused(Load(ModelFormat::kStep, stray, "stray.step"),
+                absl::StrCat("line ", line, ": a ')' closes no '('"));
+  std::string open = box;
+  open.replace(at, point.size(), "#12 = CARTESIAN_POINT('',(0.,0.;0.));");
+  ExpectRefused(Load(ModelFormat::kStep, open, "open.step"), "still open");
+
+  const PreflightLimits limits;
+  // A quote followed by a control character starts no string for the lexer,
+  // so the parentheses after it count.
+  const std::string nested = StepWithData(absl::StrCat(
+      "#1 = CARTESIAN_POINT('\x01", std::string(100, '('), "0.", std::string(100, ')'), "');\n"));
+  auto deep = PreflightStep(nested, limits);
+  ASSERT_FALSE(deep.ok());
+  EXPECT_NE(deep.status().message().find("max_nesting"), std::string::npos) << deep.status();
+  // A string inside a comment hides a "*/", as it does for the lexer.
+  auto commented = PreflightStep(
+      StepWithData("/* 'a */ (' */\n#1 = CARTESIAN_POINT('',(0.,0.,0.));\n"), limits);
+  ASSERT_TRUE(commented.ok()) << commented.status();
+  EXPECT_EQ(commented->entities, 1u);
+  // Nothing after the end of the exchange structure is read.
+  EXPECT_TRUE(PreflightStep(box + "trailing (( bytes ;", limits).ok());
+}
+
 // The first STEP record containing `marker` (e.g. "= ADVANCED_FACE("): where
 // the marker is, and the record's entity name "#N"; npos and "" if none.
 struct Entity {
