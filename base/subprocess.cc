@@ -1,5 +1,7 @@
 #include "base/subprocess.h"
 
+#include <filesystem>
+
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
@@ -11,6 +13,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <filesystem>
 
 #include "absl/strings/str_cat.h"
 
@@ -130,6 +133,17 @@ absl::StatusOr<SubprocessResult> RunSubprocess(const std::vector<std::string>& a
   result.exit_code = result.exited ? WEXITSTATUS(status) : 0;
   result.signal = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
   return result;
+}
+
+std::string FindSiblingProgram(const std::string& name) {
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (error) return "";
+  for (const std::filesystem::path& dir : {self.parent_path(), self.parent_path().parent_path() / "server"}) {
+    const std::string path = (dir / name).string();
+    if (access(path.c_str(), X_OK) == 0) return path;
+  }
+  return "";
 }
 
 }  // namespace sfc

@@ -42,6 +42,12 @@ absl::StatusOr<SubprocessResult> RunSubprocess(const std::vector<std::string>& a
                                                double wall_seconds,
                                                const std::function<absl::Status()>& check);
 
+// The path of the helper program `name` installed with this one: next to
+// this process's executable, or in ../server/ beside it (a build tree, where
+// the CLI is in client/ and the server's helpers in server/); "" when neither
+// is executable.
+std::string FindSiblingProgram(const std::string& name);
+
 }  // namespace sfc
 
 #endif  // SFCSAMPLER_BASE_SUBPROCESS_H_

@@ -171,9 +171,9 @@ void LoadedModels::ParserLoop() {
       const double spent = CpuSeconds(cpu_clock) - cpu_start;
       if (now.ok() && options_.parse_seconds > 0 && spent > options_.parse_seconds) {
         now = absl::ResourceExhaustedError(absl::StrFormat(
-            "parsing the model took more than %g s of CPU (the server's model_parse_seconds) and "
-            "was stopped: simplify the model (fewer or simpler faces), or ask the operator to "
-            "raise the limit",
+            "parsing the model took more than %g s of CPU (model_parse_seconds: the server's or "
+            "sample-many's --model-parse-seconds) and was stopped: simplify the model (fewer or "
+            "simpler faces), or raise the limit",
             options_.parse_seconds));
       }
       absl::MutexLock l(&stop_mu);

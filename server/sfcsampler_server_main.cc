@@ -14,6 +14,7 @@
 #include "CLI/CLI.hpp"
 #include "absl/strings/str_format.h"
 #include "absl/strings/strip.h"
+#include "base/subprocess.h"
 #include "core/curve_tree.h"
 #include "kinds/registered_kinds.h"
 #include "request/model_spec.h"
@@ -31,18 +32,13 @@ absl::Status ResolveModelCheckProgram(const std::string& flag, std::string* prog
     *program = "";
     return absl::OkStatus();
   }
-  std::string path = flag;
-  if (flag == "auto") {
-    std::error_code error;
-    path = (std::filesystem::read_symlink("/proc/self/exe", error).parent_path() /
-            "sfcsampler-model-check").string();
-  }
-  if (access(path.c_str(), X_OK) != 0) {
+  const std::string path = flag == "auto" ? sfc::FindSiblingProgram("sfcsampler-model-check") : flag;
+  if (path.empty() || access(path.c_str(), X_OK) != 0) {
     return absl::FailedPreconditionError(absl::StrFormat(
         "cannot run the model check program %s; install sfcsampler-model-check next to the server, "
         "name it with --model-check-program PATH, or pass --model-check-program none to read CAD "
         "files in process only",
-        path));
+        path.empty() ? "sfcsampler-model-check (not next to the server)" : path));
   }
   *program = path;
   return absl::OkStatus();

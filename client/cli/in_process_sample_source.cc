@@ -18,6 +18,8 @@ EngineLimits LimitsFor(const SampleSourceOptions& options) {
       options.generation_threads > 0
           ? options.generation_threads
           : static_cast<int>(std::max(1u, std::min(4u, std::thread::hardware_concurrency())));
+  limits.model_check_program = options.model_check_program;
+  limits.model_parse_seconds = options.model_parse_seconds;
   return limits;
 }
 

@@ -20,6 +20,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/strip.h"
 #include "base/status_macros.h"
+#include "base/subprocess.h"
 #include "client/cli/commands.h"
 #include "client/cli/connection_flags.h"
 #include "client/cli/progress.h"
@@ -282,6 +283,15 @@ Command AddSampleManyCommand(CLI::App& app) {
   cmd->add_option("--manifest", f->manifest,
                   "also write a TSV: name, sha256, seed, samples, output, error (one row per model)");
   cmd->add_flag("--quiet,-q", f->quiet, "no progress bar and no summary (failures still print)");
+  cmd->add_option("--model-check-program", f->model_check_program,
+                  "in process: read each CAD file in this program, a process of its own, so one "
+                  "that crashes or loops the CAD kernel fails alone (auto = sfcsampler-model-check "
+                  "installed with this program, if any; none = in this process)")
+      ->capture_default_str();
+  cmd->add_option("--model-parse-seconds", f->model_parse_seconds,
+                  "in process: CPU seconds one CAD file's read may take in the check program")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   // With --server each model is uploaded once, only if the server lacks its bytes.
   AddConnectionFlags(cmd, &f->connection);
   // The tree and set flags of `sample`, the same for every model (not --surface).
@@ -356,6 +366,16 @@ int RunSampleMany(const SampleManyFlags& flags) {
   options.precision = job.precision;
   // Models run side by side; one model alone may use up to four threads.
   options.generation_threads = jobs > 1 ? 1 : 0;
+  if (flags.model_check_program == "auto") {
+    options.model_check_program = FindSiblingProgram("sfcsampler-model-check");
+  } else if (flags.model_check_program != "none") {
+    if (access(flags.model_check_program.c_str(), X_OK) != 0) {
+      return Usage(absl::StrFormat("--model-check-program %s cannot be run",
+                                   flags.model_check_program));
+    }
+    options.model_check_program = flags.model_check_program;
+  }
+  options.model_parse_seconds = flags.model_parse_seconds;
   const std::unique_ptr<SampleSource> source = OpenSampleSource(flags.connection, options);
   if (auto connected = source->Connect(); !connected.ok()) return Usage(std::string(connected.message()));
   job.source = source.get();

@@ -40,6 +40,11 @@ struct SampleSourceOptions {
   OutputPrecision precision = OutputPrecision::kFloat64;
   // In process: threads filling one batch; 0 = the hardware's, at most 4.
   int generation_threads = 0;
+  // In process: a program that reads each CAD file in a process of its own
+  // (kinds/cad/model_check.h) with model_parse_seconds of CPU (0 = no limit);
+  // "" = read CAD files in this process.
+  std::string model_check_program;
+  double model_parse_seconds = 0;
 };
 
 class SampleSource {

@@ -57,9 +57,9 @@ absl::StatusOr<std::string> ReadModelInSubprocess(const ModelCheckLimits& limits
   }
   if (!run->exited && run->signal == SIGXCPU) {
     return absl::ResourceExhaustedError(absl::StrFormat(
-        "reading the model took more than %g s of CPU (the server's model_parse_seconds) and was "
-        "stopped: simplify the model (fewer or simpler faces), or ask the operator to raise the "
-        "limit",
+        "reading the model took more than %g s of CPU (model_parse_seconds: the server's or "
+        "sample-many's --model-parse-seconds) and was stopped: simplify the model (fewer or "
+        "simpler faces), or raise the limit",
         limits.cpu_seconds));
   }
   if (!run->exited) {

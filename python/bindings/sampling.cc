@@ -157,8 +157,11 @@ class PyJob {
 
 class PyEngine {
  public:
-  PyEngine(size_t max_trees, int threads)
-      : source_(max_trees), engine_(RegisteredSurfaceKinds(), Limits(threads), &source_, &models_) {}
+  PyEngine(size_t max_trees, int threads, const std::string& model_check_program,
+           double model_parse_seconds)
+      : source_(max_trees),
+        engine_(RegisteredSurfaceKinds(),
+                Limits(threads, model_check_program, model_parse_seconds), &source_, &models_) {}
 
   std::string HoldModel(const std::string& format, const py::bytes& data, const std::string& name) {
     const auto parsed = ModelFormatFromName(format);
@@ -200,8 +203,14 @@ class PyEngine {
  private:
   // The CLI's embedded limits (client/cli/in_process_sample_source.cc): the server's
   // defaults, with up to four generation threads.
-  static EngineLimits Limits(int threads) {
+  static EngineLimits Limits(int threads, const std::string& model_check_program,
+                             double model_parse_seconds) {
+    if (model_parse_seconds < 0) {
+      throw StatusException(absl::InvalidArgumentError("model_parse_seconds must be >= 0"));
+    }
     EngineLimits limits;
+    limits.model_check_program = model_check_program;
+    limits.model_parse_seconds = model_parse_seconds;
     limits.generation_threads =
         threads > 0
             ? threads
@@ -241,8 +250,14 @@ max_trees: keep the curve trees of the last this many (surface, density,
   options, grade) combinations, so repeated requests skip the build (0 = build
   every time, as the CLI does).
 threads: threads filling one request's samples (0 = as the CLI: up to 4). The
-  samples do not depend on it.)doc")
-      .def(py::init<size_t, int>(), py::kw_only(), py::arg("max_trees") = 0, py::arg("threads") = 0)
+  samples do not depend on it.
+model_check_program: a program (sfcsampler-model-check) that reads each CAD
+  file in a process of its own, so a file that crashes or loops the CAD kernel,
+  or leaves it broken for the next file, fails alone; "" = read in this process.
+model_parse_seconds: CPU seconds one model's parse may take (0 = no limit).)doc")
+      .def(py::init<size_t, int, const std::string&, double>(), py::kw_only(),
+           py::arg("max_trees") = 0, py::arg("threads") = 0, py::arg("model_check_program") = "",
+           py::arg("model_parse_seconds") = 0.0)
       .def("start", &PyEngine::Start, py::arg("request"), py::kw_only(),
            py::arg("precision") = "float64",
            "Validates the request, builds (or reuses) its tree and opens its job. Raises "

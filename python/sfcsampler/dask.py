@@ -44,7 +44,10 @@ def _sampler():
     with _lock:
         if "embedded" not in _samplers:
             from sfcsampler.embedded import Sampler
-            _samplers["embedded"] = Sampler(max_trees=2, threads=1)
+            # A worker reads many files: each CAD file in a process of its own.
+            _samplers["embedded"] = Sampler(max_trees=2, threads=1,
+                                            model_check_program=many.find_model_check_program(),
+                                            model_parse_seconds=300)
         return _samplers["embedded"]
 
 

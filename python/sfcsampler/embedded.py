@@ -22,12 +22,17 @@ class Sampler:
     options and grade) stay built between calls, so a second request on the
     same surface and count skips the build; `threads` fill one request (0 =
     as the CLI: up to 4; the samples never depend on it). Thread-safe.
+    model_check_program: sfcsampler-model-check's path, to read each CAD file in
+    a process of its own (many.find_model_check_program() finds it); "" = in this
+    process. model_parse_seconds: CPU seconds one model's parse may take (0 = no limit).
 
     The request keywords are `sfcsampler sample`'s flags (see sample()).
     """
 
-    def __init__(self, max_trees=4, threads=0):
-        self._engine = _core.Engine(max_trees=max_trees, threads=threads)
+    def __init__(self, max_trees=4, threads=0, *, model_check_program="", model_parse_seconds=0):
+        self._engine = _core.Engine(max_trees=max_trees, threads=threads,
+                                    model_check_program=model_check_program,
+                                    model_parse_seconds=model_parse_seconds)
 
     def _held(self, request, call):
         """call(parsed request) with a mesh=... argument held in memory as its PLY bytes."""

@@ -19,6 +19,7 @@ import concurrent.futures
 import glob as globlib
 import hashlib
 import os
+import shutil
 import sys
 import threading
 import time
@@ -200,6 +201,21 @@ class Results(list):
         return "\n".join(lines)
 
 
+def find_model_check_program():
+    """sfcsampler-model-check, which reads a CAD file in a process of its own, or "" when it is
+    not installed: $SFCSAMPLER_MODEL_CHECK, else on PATH, else in a build tree beside this
+    package (build/server/ for build/python/sfcsampler/)."""
+    named = os.environ.get("SFCSAMPLER_MODEL_CHECK")
+    if named:
+        return named
+    found = shutil.which("sfcsampler-model-check")
+    if found:
+        return found
+    beside = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, os.pardir, "server",
+                          "sfcsampler-model-check")
+    return os.path.normpath(beside) if os.access(beside, os.X_OK) else ""
+
+
 def sample_one(model, request, base_seed, sampler=None, out_path=None, keep=True, client=None):
     """Samples one Model with its derived seed; never raises for the model's own errors
     (they go into Result.error). `client` samples on a server instead of `sampler`."""
@@ -281,7 +297,7 @@ class _Bar:
 
 
 def sample_many(models, *, seed=1, out_dir=None, keep=None, workers=0, progress=None,
-                server=None, **request):
+                server=None, model_check_program="auto", model_parse_seconds=300, **request):
     """Samples many models, each with its own seed derived from `seed` and its content hash.
 
     models: a folder, a glob ("data/**/*.obj"), a list file, or a model file; or a list of
@@ -292,6 +308,10 @@ def sample_many(models, *, seed=1, out_dir=None, keep=None, workers=0, progress=
       None). workers: models sampled at once (0 = the CPU count, at most 8); each model then
       uses one thread. progress: a progress bar on stderr (None = when it is a terminal).
     server: "host:port" or a Client: sample on a server instead of in this process.
+    model_check_program: in this process, read each CAD file in this program, a process of its
+      own, so a file that crashes or loops the CAD kernel, or leaves it broken for the next,
+      fails alone ("auto": find_model_check_program(), in this process when not installed;
+      "" = in this process); model_parse_seconds: CPU seconds one model's parse may take.
     The other keywords are sample()'s (count, density, normals, ...), the same for every model;
     face=True applies to the CAD models and triangle=True to the meshes. Returns Results (a list of Result, in the models' order); a model that fails
     has its error in Result.error and the others go on. Results.failed, Results.summary().
@@ -310,7 +330,11 @@ def sample_many(models, *, seed=1, out_dir=None, keep=None, workers=0, progress=
     workers = workers or min(8, os.cpu_count() or 1)
     own_client = isinstance(server, str)
     client = Client(server) if own_client else server
-    sampler = None if client is not None else Sampler(max_trees=0, threads=1 if workers > 1 else 0)
+    if model_check_program == "auto":
+        model_check_program = find_model_check_program()
+    sampler = None if client is not None else Sampler(
+        max_trees=0, threads=1 if workers > 1 else 0, model_check_program=model_check_program,
+        model_parse_seconds=model_parse_seconds)
     bar = _Bar(len(items), progress)
     results = Results([None] * len(items))
     try:

@@ -136,6 +136,36 @@ def test_cli_names(folder, tmp_path):
     assert sorted(os.listdir(tmp_path / "p")) == ["sphere.ply.npy", "sphere.step.npy"]
 
 
+def test_cli_a_cad_file_that_holds_the_kernel_fails_alone(folder, tmp_path):
+    # A sphere whose shell lists its face 40 000 times: valid, and some 15 s of
+    # CPU in OpenCASCADE's shell healing. Read in the check program, it is
+    # stopped at --model-parse-seconds and named; the other models go on.
+    text = (folder / "sphere.step").read_text()
+    shell = text.index("CLOSED_SHELL('',(")
+    start = text.index("(", text.index(",", shell))
+    end = text.index(")", start)
+    models = tmp_path / "models"
+    models.mkdir()
+    (models / "hostile.step").write_text(
+        text[:start + 1] + ",".join([text[start + 1:end]] * 40000) + text[end:])
+    shutil.copy(folder / "sphere.step", models / "sphere.step")
+    shutil.copy(folder / "torus.ply", models / "torus.ply")
+    done = run("sample-many", models, "-O", tmp_path / "out", *FLAGS, "--face", "--triangle",
+               "--model-parse-seconds", "1", "-j", "2")
+    assert done.returncode == 1, done.stderr
+    assert "FAILED hostile.step: RESOURCE_EXHAUSTED" in done.stderr and "model_parse_seconds" in done.stderr
+    assert listing(tmp_path / "out") == ["sphere.npy", "torus.npy"]
+    seed = many.model_seed(11, sha(models / "sphere.step"))
+    assert filecmp.cmp(tmp_path / "out" / "sphere.npy",
+                       alone(models / "sphere.step", seed, tmp_path / "alone.npy"), shallow=False)
+    # Python's sample_many finds the same program and stops the same file.
+    assert many.find_model_check_program()
+    results = sfcsampler.sample_many(models, count=3000, seed=11, model_parse_seconds=1, workers=2)
+    by_name = {r.name: r for r in results}
+    assert "RESOURCE_EXHAUSTED" in by_name["hostile.step"].error
+    assert by_name["sphere.step"].ok and by_name["torus.ply"].ok
+
+
 def test_cli_bad_usage(folder, tmp_path):
     empty = run("sample-many", tmp_path / "nothing-*.obj", "-O", tmp_path / "o")
     assert empty.returncode == 2 and "matches no files" in empty.stderr
