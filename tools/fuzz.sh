@@ -136,14 +136,18 @@ for t in "${targets[@]}"; do
       fi
     done
     wait "$pid" 2>/dev/null || true
-    # An out-of-memory, timeout or deadlock stop whose input alone passes is
-    # state the run accumulated, not that input's: OpenCASCADE leaks tens of
-    # KB on many broken files (bench/parse_memory --repeat shows it), and its
-    # readers keep process-wide state from one file to the next. The input is
+    # A stop whose input alone passes is state the run accumulated, not that
+    # input's: OpenCASCADE leaks tens of KB on many broken files
+    # (bench/parse_memory --repeat shows it), its IGES reader keeps state from
+    # one file to the next, and a fault it turns into an exception can leave
+    # the heap or a lock broken for later files (a crash or deadlock then); a
+    # slow unit can also be a fuzzer at nice 19 starved by other work. The
+    # server reads every CAD file in a fresh process. So every stop's input is
     # replayed alone in a fresh process (killed after 60 s); if it passes it
     # is set aside (in accumulated/) and the run goes on; one that fails alone
     # is a finding.
-    for stop in "$findings_dir/$t"/oom-* "$findings_dir/$t"/timeout-* "$findings_dir/$t"/deadlock-*; do
+    for stop in "$findings_dir/$t"/oom-* "$findings_dir/$t"/timeout-* "$findings_dir/$t"/deadlock-* \
+                "$findings_dir/$t"/crash-* "$findings_dir/$t"/slow-unit-*; do
       [ -e "$stop" ] || continue
       if ASAN_OPTIONS="$asan" UBSAN_OPTIONS="$ubsan" timeout -s KILL 60 "$out/fuzz/$t" -timeout=10 -rss_limit_mb=2048 \
            -malloc_limit_mb=1024 "${dict[@]}" "$stop" > /dev/null 2>&1; then
