@@ -157,7 +157,8 @@ for t in "${targets[@]}"; do
       fi
     done
     n=$(sed -n 's/^stat::number_of_executed_units: *//p' "$run_log" | tail -1)
-    [ -n "$n" ] || n=$(grep -o '^#[0-9]*' "$run_log" | tr -d '#' | sort -n | tail -1)
+    # A run killed or aborted before its final stats: its last progress line (or none).
+    [ -n "$n" ] || n=$(grep -o '^#[0-9]*' "$run_log" | tr -d '#' | sort -n | tail -1 || true)
     execs=$((execs + ${n:-0}))
     cat "$run_log" >> "$log"
     rm -f "$run_log"
