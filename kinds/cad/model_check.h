@@ -2,14 +2,16 @@
 // server: OpenCASCADE's readers have loops that never poll the user break
 // (fuzzing found an IGES file that spins forever in Geom2d_TrimmedCurve::
 // SetTrim under ShapeFix_Wire::FixLacking), and a thread cannot be stopped
-// from outside; on broken STEP files the reader leaks, and it keeps state
-// from one file to the next that can slow a later read for minutes (found by
-// step_fuzzer). So the server never runs the readers itself: it reads each
-// file in sfcsampler-model-check (kinds/cad/model_check_main.cc), a process
-// of its own with CPU, memory and wall-clock limits, which sends back the
-// model's shape as binary BRep (cad::ReadToBrep); the server makes the model
-// of that (cad::LoadBrep), the same model Load makes of the file. docs/MODELS.md
-// gives the measured cost.
+// from outside; on broken STEP files the reader leaks; the IGES reader keeps
+// state from one file to the next, and a fault the kernel turns into an
+// exception can leave the heap or a lock broken for later files (found by
+// iges_fuzzer, docs/MODELS.md). So the server (and sample-many, which also
+// reads many files in one process) never runs the readers itself: it reads
+// each file in sfcsampler-model-check (kinds/cad/model_check_main.cc), a
+// process of its own with CPU, memory and wall-clock limits, which sends back
+// the model's shape as binary BRep (cad::ReadToBrep); the caller makes the
+// model of that (cad::LoadBrep), the same model Load makes of the file.
+// docs/MODELS.md gives the measured cost.
 //
 // Thread-safety: thread-safe.
 #ifndef SFCSAMPLER_KINDS_CAD_MODEL_CHECK_H_
