@@ -289,7 +289,8 @@ Command AddSampleManyCommand(CLI::App& app) {
                   "installed with this program, if any; none = in this process)")
       ->capture_default_str();
   cmd->add_option("--model-parse-seconds", f->model_parse_seconds,
-                  "in process: CPU seconds one CAD file's read may take in the check program")
+                  "in process: CPU seconds one model's parse may take (a CAD file's check "
+                  "program is stopped at this limit)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   // With --server each model is uploaded once, only if the server lacks its bytes.
