@@ -1,7 +1,5 @@
 #include "base/subprocess.h"
 
-#include <filesystem>
-
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
@@ -144,6 +142,15 @@ std::string FindSiblingProgram(const std::string& name) {
     if (access(path.c_str(), X_OK) == 0) return path;
   }
   return "";
+}
+
+absl::StatusOr<std::string> ResolveProgramFlag(const std::string& flag, const std::string& name) {
+  if (flag == "none") return std::string();
+  if (flag == "auto") return FindSiblingProgram(name);
+  if (access(flag.c_str(), X_OK) != 0) {
+    return absl::FailedPreconditionError(absl::StrCat("cannot run ", flag, " (", name, ")"));
+  }
+  return flag;
 }
 
 }  // namespace sfc

@@ -48,6 +48,11 @@ absl::StatusOr<SubprocessResult> RunSubprocess(const std::vector<std::string>& a
 // is executable.
 std::string FindSiblingProgram(const std::string& name);
 
+// A helper program named by a flag: "none" is "", "auto" is
+// FindSiblingProgram(name) ("" when it is not installed), anything else a path
+// that must be executable (FAILED_PRECONDITION naming it otherwise).
+absl::StatusOr<std::string> ResolveProgramFlag(const std::string& flag, const std::string& name);
+
 }  // namespace sfc
 
 #endif  // SFCSAMPLER_BASE_SUBPROCESS_H_

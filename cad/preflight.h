@@ -50,8 +50,9 @@ struct ModelCensus {
   std::vector<uint64_t> face_ids;
 };
 
-// STEP (ISO 10303-21): strings and comments are skipped; every record is
-// measured, and every entity instance name ("#N =") must be defined once and
+// STEP (ISO 10303-21): strings and comments are read as OpenCASCADE's lexer
+// reads them and skipped; every record is measured and its parentheses must
+// balance, and every entity instance name ("#N =") must be defined once and
 // fit an int, as the reader keeps it. Faces are ADVANCED_FACE and
 // FACE_SURFACE instances (ORIENTED_FACE only reuses another face).
 // INVALID_ARGUMENT, with the limit's name (or the names at fault), where it

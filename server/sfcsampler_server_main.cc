@@ -32,15 +32,15 @@ absl::Status ResolveModelCheckProgram(const std::string& flag, std::string* prog
     *program = "";
     return absl::OkStatus();
   }
-  const std::string path = flag == "auto" ? sfc::FindSiblingProgram("sfcsampler-model-check") : flag;
-  if (path.empty() || access(path.c_str(), X_OK) != 0) {
+  const absl::StatusOr<std::string> path = sfc::ResolveProgramFlag(flag, "sfcsampler-model-check");
+  if (!path.ok() || path->empty()) {
     return absl::FailedPreconditionError(absl::StrFormat(
         "cannot run the model check program %s; install sfcsampler-model-check next to the server, "
         "name it with --model-check-program PATH, or pass --model-check-program none to read CAD "
         "files in process only",
-        path.empty() ? "sfcsampler-model-check (not next to the server)" : path));
+        path.ok() ? "sfcsampler-model-check (not next to the server)" : flag));
   }
-  *program = path;
+  *program = *path;
   return absl::OkStatus();
 }
 

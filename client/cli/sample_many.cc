@@ -367,15 +367,12 @@ int RunSampleMany(const SampleManyFlags& flags) {
   options.precision = job.precision;
   // Models run side by side; one model alone may use up to four threads.
   options.generation_threads = jobs > 1 ? 1 : 0;
-  if (flags.model_check_program == "auto") {
-    options.model_check_program = FindSiblingProgram("sfcsampler-model-check");
-  } else if (flags.model_check_program != "none") {
-    if (access(flags.model_check_program.c_str(), X_OK) != 0) {
-      return Usage(absl::StrFormat("--model-check-program %s cannot be run",
-                                   flags.model_check_program));
-    }
-    options.model_check_program = flags.model_check_program;
+  const absl::StatusOr<std::string> check_program =
+      ResolveProgramFlag(flags.model_check_program, "sfcsampler-model-check");
+  if (!check_program.ok()) {
+    return Usage(absl::StrFormat("--model-check-program: %s", check_program.status().message()));
   }
+  options.model_check_program = *check_program;
   options.model_parse_seconds = flags.model_parse_seconds;
   const std::unique_ptr<SampleSource> source = OpenSampleSource(flags.connection, options);
   if (auto connected = source->Connect(); !connected.ok()) return Usage(std::string(connected.message()));

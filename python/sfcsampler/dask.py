@@ -47,7 +47,7 @@ def _sampler():
             # A worker reads many files: each CAD file in a process of its own.
             _samplers["embedded"] = Sampler(max_trees=2, threads=1,
                                             model_check_program=many.find_model_check_program(),
-                                            model_parse_seconds=300)
+                                            model_parse_seconds=many.MODEL_PARSE_SECONDS)
         return _samplers["embedded"]
 
 

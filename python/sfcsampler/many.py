@@ -201,6 +201,11 @@ class Results(list):
         return "\n".join(lines)
 
 
+# CPU seconds one model's parse may take in a many-model run (sample-many's
+# --model-parse-seconds default).
+MODEL_PARSE_SECONDS = 300
+
+
 def find_model_check_program():
     """sfcsampler-model-check, which reads a CAD file in a process of its own, or "" when it is
     not installed: $SFCSAMPLER_MODEL_CHECK, else on PATH, else in a build tree beside this
@@ -297,7 +302,8 @@ class _Bar:
 
 
 def sample_many(models, *, seed=1, out_dir=None, keep=None, workers=0, progress=None,
-                server=None, model_check_program="auto", model_parse_seconds=300, **request):
+                server=None, model_check_program="auto", model_parse_seconds=MODEL_PARSE_SECONDS,
+                **request):
     """Samples many models, each with its own seed derived from `seed` and its content hash.
 
     models: a folder, a glob ("data/**/*.obj"), a list file, or a model file; or a list of
