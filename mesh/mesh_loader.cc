@@ -19,6 +19,7 @@
 #include "absl/strings/strip.h"
 #include "base/echo.h"
 #include "base/status_macros.h"
+#include "mesh/plain_ply.h"
 
 namespace sfc {
 namespace {
@@ -326,6 +327,11 @@ absl::Status CheckPlyHeader(absl::string_view bytes, absl::string_view name) {
 
 absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view name,
                                      const MeshLoadOptions& options) {
+  // The plainest binary files (what the Python package writes for arrays)
+  // without the istream (mesh/plain_ply.h); the same mesh.
+  if (std::optional<TriangleMesh> plain = ReadPlainBinaryPly(bytes, name, options.weight_property)) {
+    return *std::move(plain);
+  }
   RETURN_IF_ERROR(CheckPlyHeader(bytes, name));
   std::istringstream in(std::string(bytes), std::ios::in | std::ios::binary);
   CgalPlyReader reader(/*verbose=*/false);

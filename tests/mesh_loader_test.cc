@@ -4,12 +4,16 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <random>
 
+#include "absl/strings/str_format.h"
 #include "gtest/gtest.h"
 #include "mesh/icosphere.h"
 #include "mesh/mesh_loader.h"
 #include "mesh/mesh_writer.h"
+#include "mesh/plain_ply.h"
 #include "tests/mesh_test_util.h"
 
 namespace sfc {
@@ -168,6 +172,98 @@ TEST(MeshLoader, BrokenFilesGetClearErrorsNamingTheFile) {
   ExpectError(load("absent.obj"), StatusCode::kNotFound, "absent.obj", "");
   ExpectError(LoadMesh("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n", "flat.obj"),
               StatusCode::kInvalidArgument, "flat.obj", "degenerate");
+}
+
+// Everything LoadMesh keeps of a mesh, compared exactly.
+void ExpectIdentical(const TriangleMesh& a, const TriangleMesh& b) {
+  ExpectSameMesh(a, b);
+  ASSERT_EQ(a.normals.size(), b.normals.size());
+  for (size_t i = 0; i < a.normals.size(); ++i) ASSERT_EQ(a.normals[i], b.normals[i]) << i;
+  ASSERT_EQ(a.weights.size(), b.weights.size());
+  for (size_t i = 0; i < a.weights.size(); ++i) ASSERT_EQ(a.weights[i], b.weights[i]) << i;
+  EXPECT_EQ(a.stats.faces, b.stats.faces);
+  EXPECT_EQ(a.stats.vertices, b.stats.vertices);
+  EXPECT_EQ(a.stats.degenerate_triangles, b.stats.degenerate_triangles);
+  EXPECT_EQ(a.stats.area, b.stats.area);
+  EXPECT_EQ(a.stats.boundary_edges, b.stats.boundary_edges);
+}
+
+// The direct reader of plain binary PLY (mesh/plain_ply.h) takes the files it
+// claims and makes the mesh CGAL's reader makes of the same values in ASCII
+// (17 digits: exact); every other layout goes to CGAL's reader.
+TEST(MeshLoader, PlainBinaryPlyReadsAsTheGeneralReaderDoes) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> wobble(-0.2, 0.2);
+  for (int trial = 0; trial < 12; ++trial) {
+    SCOPED_TRACE(trial);
+    TriangleMesh mesh = MakeIcosphere(1 + trial % 3, /*with_normals=*/trial % 2 == 0);
+    for (Vec3& p : mesh.positions) p = p * (1 + wobble(rng));
+    if (trial % 3 == 1) {
+      mesh.weights.resize(mesh.positions.size());
+      for (double& w : mesh.weights) w = 1 + wobble(rng);
+    }
+    const std::string weight = trial % 3 == 1 ? "weight" : "";
+    const std::string binary = MeshToPly(mesh, /*binary=*/true, "weight");
+    ASSERT_TRUE(ReadPlainBinaryPly(binary, "m.ply", weight).has_value());
+    auto direct = LoadMesh(binary, "m.ply", {.weight_property = weight});
+    auto general = LoadMesh(MeshToPly(mesh, /*binary=*/false, "weight"), "m.ply",
+                            {.weight_property = weight});
+    ASSERT_TRUE(direct.ok()) << direct.status();
+    ASSERT_TRUE(general.ok()) << general.status();
+    ExpectIdentical(*direct, *general);
+  }
+
+  // float vertex properties, uint indices and comment lines, by hand.
+  const float xyz[4][3] = {{0, 0, 0}, {1.1f, 0, 0}, {0, 1.3f, 0}, {0, 0, 0.7f}};
+  const uint32_t faces[2][3] = {{0, 1, 2}, {0, 2, 3}};
+  std::string plain =
+      "ply\nformat binary_little_endian 1.0\ncomment by hand\nelement vertex 4\n"
+      "property float x\nproperty float y\nproperty float z\nelement face 2\n"
+      "property list uchar uint vertex_indices\nend_header\n";
+  std::string ascii =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 2\nproperty list uchar uint vertex_indices\nend_header\n";
+  for (const auto& v : xyz) {
+    plain.append(reinterpret_cast<const char*>(v), sizeof v);
+    ascii += absl::StrFormat("%.9g %.9g %.9g\n", v[0], v[1], v[2]);
+  }
+  for (const auto& f : faces) {
+    plain.push_back(3);
+    plain.append(reinterpret_cast<const char*>(f), sizeof f);
+    ascii += absl::StrFormat("3 %d %d %d\n", f[0], f[1], f[2]);
+  }
+  ASSERT_TRUE(ReadPlainBinaryPly(plain, "f.ply", "").has_value());
+  auto direct = LoadMesh(plain, "f.ply"), general = LoadMesh(ascii, "f.ply");
+  ASSERT_TRUE(direct.ok()) << direct.status();
+  ASSERT_TRUE(general.ok()) << general.status();
+  ExpectIdentical(*direct, *general);
+
+  // Files the direct reader leaves to CGAL's: each still loads, or fails, as before.
+  const std::string canonical = MeshToPly(MakeIcosphere(1), true);
+  const size_t body = canonical.find("end_header\n") + 11;
+  std::string quad = plain;  // the second face becomes a quad: one more index
+  const size_t second_face = quad.size() - 13;
+  quad[second_face] = 4;
+  quad.insert(second_face + 13, std::string("\x01\x00\x00\x00", 4));
+  std::string out_of_range = canonical;
+  const uint32_t past = 1u << 20;
+  std::memcpy(&out_of_range[canonical.size() - 4], &past, 4);
+  std::string crlf = canonical;
+  crlf.replace(crlf.find("end_header\n"), 11, "end_header\r\n");
+  const std::string bodies[] = {canonical + "x", quad, out_of_range, crlf,
+                                canonical.substr(0, body + 5)};
+  for (const std::string& bytes : bodies) {
+    EXPECT_FALSE(ReadPlainBinaryPly(bytes, "o.ply", "").has_value());
+  }
+  auto polygon = LoadMesh(quad, "quad.ply");
+  ASSERT_TRUE(polygon.ok()) << polygon.status();
+  EXPECT_EQ(polygon->stats.triangulated_polygons, 1u);
+  EXPECT_EQ(polygon->triangles.size(), 3u);
+  ExpectError(LoadMesh(out_of_range, "far.ply"), absl::StatusCode::kInvalidArgument, "far.ply",
+              "vertex index 1048576");
+  EXPECT_FALSE(ReadPlainBinaryPly(canonical, "w.ply", "importance").has_value());
+  ExpectError(LoadMesh(canonical, "w.ply", {.weight_property = "importance"}),
+              absl::StatusCode::kInvalidArgument, "w.ply", "importance");
 }
 
 }  // namespace

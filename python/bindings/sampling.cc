@@ -158,10 +158,12 @@ class PyJob {
 class PyEngine {
  public:
   PyEngine(size_t max_trees, int threads, const std::string& model_check_program,
-           double model_parse_seconds)
+           double model_parse_seconds, uint64_t parsed_model_bytes, int parse_threads)
       : source_(max_trees),
         engine_(RegisteredSurfaceKinds(),
-                Limits(threads, model_check_program, model_parse_seconds), &source_, &models_) {}
+                Limits(threads, model_check_program, model_parse_seconds, parsed_model_bytes,
+                       parse_threads),
+                &source_, &models_) {}
 
   std::string HoldModel(const std::string& format, const py::bytes& data, const std::string& name) {
     const auto parsed = ModelFormatFromName(format);
@@ -204,13 +206,21 @@ class PyEngine {
   // The CLI's embedded limits (client/cli/in_process_sample_source.cc): the server's
   // defaults, with up to four generation threads.
   static EngineLimits Limits(int threads, const std::string& model_check_program,
-                             double model_parse_seconds) {
+                             double model_parse_seconds, uint64_t parsed_model_bytes,
+                             int parse_threads) {
     if (model_parse_seconds < 0) {
       throw StatusException(absl::InvalidArgumentError("model_parse_seconds must be >= 0"));
+    }
+    if (parse_threads < 1 || parse_threads > 64) {
+      throw StatusException(absl::InvalidArgumentError("parse_threads must be in [1, 64]"));
     }
     EngineLimits limits;
     limits.model_check_program = model_check_program;
     limits.model_parse_seconds = model_parse_seconds;
+    limits.parsed_model_bytes = parsed_model_bytes;
+    limits.model_parse_threads = parse_threads;
+    // Calls that share the engine may all wait for a parse at once.
+    limits.max_queued_parses = std::max(limits.max_queued_parses, 2 * parse_threads);
     limits.generation_threads =
         threads > 0
             ? threads
@@ -254,10 +264,16 @@ threads: threads filling one request's samples (0 = as the CLI: up to 4). The
 model_check_program: a program (sfcsampler-model-check) that reads each CAD
   file in a process of its own, so a file that crashes or loops the CAD kernel,
   or leaves it broken for the next file, fails alone; "" = read in this process.
-model_parse_seconds: CPU seconds one model's parse may take (0 = no limit).)doc")
-      .def(py::init<size_t, int, const std::string&, double>(), py::kw_only(),
+model_parse_seconds: CPU seconds one model's parse may take (0 = no limit).
+parsed_model_bytes: parsed models (meshes, CAD shapes) kept for later calls, in
+  bytes, least recently used out first (0 = none: each call parses its model,
+  as a run over many models seen once wants).
+parse_threads: models parsed at once, on the engine's own threads (1 to 64).)doc")
+      .def(py::init<size_t, int, const std::string&, double, uint64_t, int>(), py::kw_only(),
            py::arg("max_trees") = 0, py::arg("threads") = 0, py::arg("model_check_program") = "",
-           py::arg("model_parse_seconds") = 0.0)
+           py::arg("model_parse_seconds") = 0.0,
+           py::arg("parsed_model_bytes") = EngineLimits().parsed_model_bytes,
+           py::arg("parse_threads") = 1)
       .def("start", &PyEngine::Start, py::arg("request"), py::kw_only(),
            py::arg("precision") = "float64",
            "Validates the request, builds (or reuses) its tree and opens its job. Raises "

@@ -25,14 +25,20 @@ class Sampler:
     model_check_program: sfcsampler-model-check's path, to read each CAD file in
     a process of its own (many.find_model_check_program() finds it); "" = in this
     process. model_parse_seconds: CPU seconds one model's parse may take (0 = no limit).
+    parsed_model_bytes: parsed models (meshes, CAD shapes) kept for later calls
+    (default 256 MiB; 0 = none, for models each sampled once); parse_threads:
+    models parsed at once (calls on several threads each wait for their own).
 
     The request keywords are `sfcsampler sample`'s flags (see sample()).
     """
 
-    def __init__(self, max_trees=4, threads=0, *, model_check_program="", model_parse_seconds=0):
+    def __init__(self, max_trees=4, threads=0, *, model_check_program="", model_parse_seconds=0,
+                 parsed_model_bytes=256 << 20, parse_threads=1):
         self._engine = _core.Engine(max_trees=max_trees, threads=threads,
                                     model_check_program=model_check_program,
-                                    model_parse_seconds=model_parse_seconds)
+                                    model_parse_seconds=model_parse_seconds,
+                                    parsed_model_bytes=parsed_model_bytes,
+                                    parse_threads=parse_threads)
 
     def _held(self, request, call):
         """call(parsed request) with a mesh=... argument held in memory as its PLY bytes."""

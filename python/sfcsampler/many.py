@@ -338,9 +338,11 @@ def sample_many(models, *, seed=1, out_dir=None, keep=None, workers=0, progress=
     client = Client(server) if own_client else server
     if model_check_program == "auto":
         model_check_program = find_model_check_program()
+    # Each model is parsed and sampled once: the engine keeps no parsed model (their
+    # memory goes back to the next parse), and every worker has a parse thread.
     sampler = None if client is not None else Sampler(
         max_trees=0, threads=1 if workers > 1 else 0, model_check_program=model_check_program,
-        model_parse_seconds=model_parse_seconds)
+        model_parse_seconds=model_parse_seconds, parsed_model_bytes=0, parse_threads=workers)
     bar = _Bar(len(items), progress)
     results = Results([None] * len(items))
     try:
