@@ -22,9 +22,11 @@ void ForEachEdge(const TriangleMesh& mesh,
                  const std::function<void(uint32_t a, uint32_t b, uint32_t n)>& f) {
   const size_t nv = mesh.positions.size();
   std::vector<uint32_t> start(nv + 1, 0);
+  std::vector<uint8_t> degenerate(mesh.triangles.size());  // tested once, used twice
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) degenerate[t] = IsDegenerateTriangle(mesh, t);
   auto for_each_half = [&](auto&& visit) {
     for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-      if (IsDegenerateTriangle(mesh, t)) continue;
+      if (degenerate[t]) continue;
       const auto& tri = mesh.triangles[t];
       for (int c = 0; c < 3; ++c) {
         const uint32_t a = tri[c], b = tri[(c + 1) % 3];
