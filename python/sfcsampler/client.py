@@ -22,7 +22,7 @@ import numpy as np
 from sfcsampler import _core, _wire, meshes
 from sfcsampler._request import make_request
 from sfcsampler.errors import DataLossError, InvalidArgumentError, from_status
-from sfcsampler.samples import Samples, concatenate, warn_depth_cap
+from sfcsampler.samples import Samples, concatenate, kept_columns, select, warn_depth_cap
 from sfcsampler.v1 import sampler_pb2 as pb
 from sfcsampler.v1 import sampler_pb2_grpc
 
@@ -230,16 +230,19 @@ class Client:
         w.column_encoding = self._encoding
         return w
 
-    def batches(self, *, precision=None, batch_size=None, **request):
+    def batches(self, *, precision=None, batch_size=None, columns=None, **request):
         """Yields the requested samples as Samples, one per message, in curve order.
 
         The keywords are sfcsampler.sample()'s. Resumes after UNAVAILABLE
         (each sample is yielded once); raises sfcsampler.Error subclasses with
         the server's status code and message.
         """
+        kept = kept_columns(columns, request)
         for part in self._stream(precision, batch_size, request):
             if len(part):
-                yield part
+                yield part if kept is None else Samples(
+                    select(part.columns(), kept), part.tree, part.begin, part.end, part.seed,
+                    part.algorithm_version, part.x.dtype, kept)
 
     def _stream(self, precision, batch_size, request):
         """batches(), plus one empty Samples (with the tree) at the end when nothing arrived."""
@@ -330,16 +333,17 @@ class Client:
                               np.float32 if precision == "float32" else np.float64)
             return
 
-    def sample(self, *, precision=None, batch_size=None, **request):
+    def sample(self, *, precision=None, batch_size=None, columns=None, **request):
         """All the requested samples as one Samples: the same values as sfcsampler.sample()."""
+        kept = kept_columns(columns, request)
         precision = precision or self._precision
         parts = list(self._stream(precision, batch_size, request))
         if not parts:
             raise DataLossError(15, "the stream ended without a header or samples")
         last = parts[-1]
-        columns = [p.columns() for p in parts if len(p)]
-        return concatenate(columns, last.tree, last.begin, last.end, last.seed, last.algorithm_version,
-                           np.float32 if precision == "float32" else np.float64)
+        filled = [select(p.columns(), kept) for p in parts if len(p)]
+        return concatenate(filled, last.tree, last.begin, last.end, last.seed, last.algorithm_version,
+                           np.float32 if precision == "float32" else np.float64, kept)
 
     def prepare(self, **request):
         """Builds (or finds in the server's cache) the request's tree; returns its summary."""

@@ -6,7 +6,7 @@ import numpy as np
 
 from sfcsampler import _core, meshes
 from sfcsampler._request import make_request
-from sfcsampler.samples import Samples, warn_depth_cap
+from sfcsampler.samples import Samples, kept_columns, select, warn_depth_cap
 
 _ALL = 1 << 62  # "every remaining sample"
 
@@ -56,20 +56,22 @@ class Sampler:
         warn_depth_cap(job.tree, stacklevel=4)
         return job
 
-    def sample(self, *, precision="float64", **request):
-        """All the requested samples as one Samples (no copy of the filled buffers)."""
+    def sample(self, *, precision="float64", columns=None, **request):
+        """All the requested samples as one Samples (no copy of the filled buffers); only
+        the named columns when `columns` is given (sample())."""
+        kept = kept_columns(columns, request)
         job = self._start(precision, request)
-        columns = job.next(_ALL) or {}
-        return Samples(columns, job.tree, job.begin, job.end, job.seed, _core.ALGORITHM_VERSION,
-                       _dtype(precision))
+        filled = select(job.next(_ALL) or {}, kept)
+        return Samples(filled, job.tree, job.begin, job.end, job.seed, _core.ALGORITHM_VERSION,
+                       _dtype(precision), kept)
 
-    def sample_bytes(self, fmt, data, name="", *, precision="float64", **request):
+    def sample_bytes(self, fmt, data, name="", *, precision="float64", columns=None, **request):
         """sample() of a model given as its file's bytes (fmt: step, iges, nurbs, obj, ply):
         the same samples as surface="FORMAT:FILE" on a file holding them, with no file."""
         if "surface" in request or "mesh" in request:
             raise TypeError("sample_bytes takes the model as fmt and data, not surface= or mesh=")
         with self.holding(fmt, data, name) as spec:
-            return self.sample(precision=precision, surface=spec, **request)
+            return self.sample(precision=precision, columns=columns, surface=spec, **request)
 
     @contextlib.contextmanager
     def holding(self, fmt, data, name=""):
@@ -81,15 +83,16 @@ class Sampler:
         finally:
             self._engine.release_model(spec)
 
-    def batches(self, *, batch_size=65536, precision="float64", **request):
+    def batches(self, *, batch_size=65536, precision="float64", columns=None, **request):
         """Yields the requested samples as Samples of at most batch_size each, in curve order."""
+        kept = kept_columns(columns, request)
         job = self._start(precision, request)
         while True:
-            columns = job.next(batch_size)
-            if columns is None:
+            filled = job.next(batch_size)
+            if filled is None:
                 return
-            yield Samples(columns, job.tree, job.begin, job.end, job.seed, _core.ALGORITHM_VERSION,
-                          _dtype(precision))
+            yield Samples(select(filled, kept), job.tree, job.begin, job.end, job.seed,
+                          _core.ALGORITHM_VERSION, _dtype(precision), kept)
 
     def prepare(self, **request):
         """Builds (or finds) the request's tree, sized for tree_count or count; returns its summary."""
@@ -126,6 +129,9 @@ def sample(*, precision="float64", threads=0, **request):
       normals=False, density_column=False, curve_position=False
       face=False, triangle=False            model columns: CAD face, mesh triangle
       precision="float64"                   or "float32" (half the memory)
+      columns=None                          keep only these columns, e.g. ("x", "y", "z"):
+                                            the others are freed at once (the rest of
+                                            Samples' columns are None); default all
       threads=0                             threads filling the arrays (0 = up to 4)
 
     Returns a sfcsampler.Samples (columns index, u, v, x, y, z, ...). Raises

@@ -232,6 +232,9 @@ def sample_one(model, request, base_seed, sampler=None, out_path=None, keep=True
         mesh = fmt in ("obj", "ply")  # the model columns apply to the models that have them
         request["face"] = bool(request.get("face")) and not mesh
         request["triangle"] = bool(request.get("triangle")) and mesh
+        if request.get("columns") is not None:
+            named = [request["columns"]] if isinstance(request["columns"], str) else request["columns"]
+            request["columns"] = [c for c in named if c != ("triangle" if not mesh else "face")]
         if client is not None:
             result.sha256 = hashlib.sha256(data).hexdigest()
             result.seed = model_seed(base_seed, result.sha256)
@@ -318,8 +321,10 @@ def sample_many(models, *, seed=1, out_dir=None, keep=None, workers=0, progress=
       own, so a file that crashes or loops the CAD kernel, or leaves it broken for the next,
       fails alone ("auto": find_model_check_program(), in this process when not installed;
       "" = in this process); model_parse_seconds: CPU seconds one model's parse may take.
-    The other keywords are sample()'s (count, density, normals, ...), the same for every model;
-    face=True applies to the CAD models and triangle=True to the meshes. Returns Results (a list of Result, in the models' order); a model that fails
+    The other keywords are sample()'s (count, density, normals, columns, ...), the same for
+    every model; face=True applies to the CAD models and triangle=True to the meshes.
+    columns=("x", "y", "z") keeps (and writes) only those columns: the others' memory goes
+    back to the next model at once (written files then hold only those fields). Returns Results (a list of Result, in the models' order); a model that fails
     has its error in Result.error and the others go on. Results.failed, Results.summary().
     """
     from sfcsampler.client import Client

@@ -4,10 +4,40 @@ import warnings
 
 import numpy as np
 
-from sfcsampler.errors import DepthCapWarning
+from sfcsampler.errors import DepthCapWarning, InvalidArgumentError
 
 COLUMNS = ("index", "u", "v", "x", "y", "z", "nx", "ny", "nz", "density", "curve_position", "face",
            "triangle")
+# The request flag that adds each optional column.
+_COLUMN_FLAGS = {"nx": "normals", "ny": "normals", "nz": "normals", "density": "density_column",
+                 "curve_position": "curve_position", "face": "face", "triangle": "triangle"}
+
+
+def kept_columns(columns, request):
+    """The set of column names a `columns=` argument keeps (None: every column the request
+    makes). InvalidArgumentError for an unknown name, or one the request does not make
+    (it names the flag that would)."""
+    if columns is None:
+        return None
+    names = [columns] if isinstance(columns, str) else list(columns)
+    for name in names:
+        if name not in COLUMNS:
+            raise InvalidArgumentError(3, f"columns: unknown column {name!r}; the columns are "
+                                          f"{', '.join(COLUMNS)}")
+        flag = _COLUMN_FLAGS.get(name)
+        if flag and not request.get(flag):
+            raise InvalidArgumentError(3, f"columns: {name!r} needs {flag}=True in the request")
+    if not names:
+        raise InvalidArgumentError(3, "columns: name at least one column")
+    return frozenset(names)
+
+
+def select(columns, kept):
+    """The column dict without the columns `kept` (from kept_columns) leaves out; the arrays
+    dropped are freed at once, so the next request reuses their memory."""
+    if kept is None:
+        return columns
+    return {name: value for name, value in columns.items() if name in kept}
 
 
 class Samples:
@@ -17,15 +47,17 @@ class Samples:
     parameters; x, y, z: the surface point; nx, ny, nz, density,
     curve_position when asked for, else None; face (CAD models) and triangle
     (meshes; u, v are then barycentric) as uint32 when asked for. Float columns are float64, or
-    float32 with precision="float32". `tree` is the curve tree's summary
+    float32 with precision="float32". A column that columns=[...] left out is None. `tree` is the curve tree's summary
     (the wire's TreeInfo fields as a dict); `begin`, `end` the resolved index
     range; `seed` and `algorithm_version` identify the set.
     """
 
-    def __init__(self, columns, tree, begin, end, seed, algorithm_version, dtype=np.float64):
+    def __init__(self, columns, tree, begin, end, seed, algorithm_version, dtype=np.float64,
+                 kept=None):
         for name in COLUMNS:
             value = columns.get(name)
-            if value is None and name in ("index", "u", "v", "x", "y", "z"):
+            if value is None and name in ("index", "u", "v", "x", "y", "z") and (
+                    kept is None or name in kept):
                 value = np.empty(0, dtype=np.uint64 if name == "index" else dtype)
             setattr(self, name, value)
         self.tree = tree
@@ -35,7 +67,11 @@ class Samples:
         self.algorithm_version = algorithm_version
 
     def __len__(self):
-        return len(self.index)
+        for name in COLUMNS:  # index, unless columns= left it out
+            value = getattr(self, name)
+            if value is not None:
+                return len(value)
+        return 0
 
     def __repr__(self):
         present = [c for c in COLUMNS if getattr(self, c) is not None]
@@ -64,7 +100,7 @@ class Samples:
         return {c: getattr(self, c) for c in COLUMNS if getattr(self, c) is not None}
 
 
-def concatenate(parts, tree, begin, end, seed, algorithm_version, dtype):
+def concatenate(parts, tree, begin, end, seed, algorithm_version, dtype, kept=None):
     """One Samples from batches of column dicts (copies each column once)."""
     parts = [p for p in parts if p]
     if len(parts) == 1:
@@ -75,7 +111,7 @@ def concatenate(parts, tree, begin, end, seed, algorithm_version, dtype):
             pieces = [p[name] for p in parts if name in p]
             if pieces:
                 columns[name] = np.concatenate(pieces)
-    return Samples(columns, tree, begin, end, seed, algorithm_version, dtype)
+    return Samples(select(columns, kept), tree, begin, end, seed, algorithm_version, dtype, kept)
 
 
 def warn_depth_cap(tree, stacklevel=3):

@@ -27,6 +27,10 @@ def test_same_numbers_as_cli_and_embedded(server, kwargs, flags):
 
 def test_float32_and_batches(server):
     with sfcsampler.Client(server, batch_size=4096) as client:
+        points = client.sample(surface="torus", count=10000, columns=["x", "y", "z"])
+        assert points.index is None and np.array_equal(
+            points.points, sfcsampler.sample(surface="torus", count=10000).points)
+        assert [p.u for p in client.batches(surface="torus", count=5000, columns="x")] == [None, None]
         parts = list(client.batches(surface="torus", count=10000, precision="float32"))
         assert [len(p) for p in parts] == [4096, 4096, 1808]
         x = np.concatenate([p.x for p in parts])

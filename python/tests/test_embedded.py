@@ -49,6 +49,25 @@ def test_float32_is_the_float64_set_rounded():
     assert np.array_equal(half.index, full.index)
 
 
+def test_columns_keeps_only_the_named_columns_with_the_same_values():
+    full = sfcsampler.sample(surface="torus", count=5000, normals=True)
+    points = sfcsampler.sample(surface="torus", count=5000, normals=True, columns=("x", "y", "z", "nz"))
+    assert len(points) == 5000
+    for name in ("x", "y", "z", "nz"):
+        assert np.array_equal(getattr(points, name), getattr(full, name)), name
+    for name in ("index", "u", "v", "nx", "ny"):
+        assert getattr(points, name) is None, name
+    assert np.array_equal(points.points, full.points)
+    assert list(points.columns()) == ["x", "y", "z", "nz"]
+    parts = list(sfcsampler.batches(surface="torus", count=5000, batch_size=2000, columns="index"))
+    assert [len(p) for p in parts] == [2000, 2000, 1000] and parts[0].x is None
+    assert np.array_equal(np.concatenate([p.index for p in parts]), full.index)
+    with pytest.raises(sfcsampler.InvalidArgumentError, match="unknown column 'w'"):
+        sfcsampler.sample(count=10, columns=["x", "w"])
+    with pytest.raises(sfcsampler.InvalidArgumentError, match="normals=True"):
+        sfcsampler.sample(count=10, columns=["nx"])
+
+
 def test_arrays_own_their_buffers_without_a_copy():
     s = sfcsampler.sample(count=1000)
     # The buffer belongs to a capsule (the C++ vector), not to a NumPy copy.

@@ -220,6 +220,23 @@ def test_python_meshes_in_memory_and_progress(capsys):
         sfcsampler.sample_many(meshes, surface="sphere")
 
 
+def test_python_sample_many_keeps_and_writes_only_the_named_columns(folder, tmp_path):
+    names = [folder / "torus.ply", folder / "sphere.step"]
+    full = sfcsampler.sample_many(names, count=2000, seed=5, triangle=True)
+    some = sfcsampler.sample_many(names, count=2000, seed=5, triangle=True,
+                                  columns=["x", "y", "z", "triangle"])
+    assert not some.failed, some.summary()
+    for a, b in zip(full, some):
+        assert b.samples.index is None and b.samples.u is None and len(b.samples) == 2000
+        assert np.array_equal(a.samples.points, b.samples.points)
+    # The mesh keeps its triangle column; the CAD model has none to keep.
+    assert np.array_equal(some[0].samples.triangle, full[0].samples.triangle)
+    assert some[1].samples.triangle is None
+    written = sfcsampler.sample_many(names, count=2000, seed=5, columns=["x", "y", "z"],
+                                     out_dir=tmp_path)
+    assert np.load(written[0].path).dtype.names == ("x", "y", "z")
+
+
 def test_python_sample_many_over_the_wire(server, folder):
     names = [folder / "torus.ply", folder / "sphere.step", folder / "broken.ply"]
     local = sfcsampler.sample_many(names, count=2000, seed=5)
