@@ -29,7 +29,7 @@ struct EngineLimits {
   // (kinds/cad/model_check.h), with model_parse_seconds of CPU, and sends
   // back its shape; "" = read in this process (the CLI's own files).
   std::string model_check_program;
-  int model_parse_threads = 1;
+  int model_parse_threads = 1;  // 0: on the requests' own threads (embedded only)
   int max_queued_parses = 8;
   double model_parse_seconds = 0;
   double parse_failure_ttl_seconds = 60;

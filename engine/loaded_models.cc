@@ -31,8 +31,7 @@ double CpuSeconds(clockid_t clock) {
 }  // namespace
 
 LoadedModels::LoadedModels(const LoadedModelsOptions& options) : options_(options) {
-  const int threads = std::max(1, options_.parse_threads);
-  for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { ParserLoop(); });
+  for (int i = 0; i < options_.parse_threads; ++i) threads_.emplace_back([this] { ParserLoop(); });
 }
 
 LoadedModels::~LoadedModels() {
@@ -47,6 +46,7 @@ absl::StatusOr<std::shared_ptr<const void>> LoadedModels::GetAny(
     const std::string& key, ParseFn parse, const std::function<absl::Status()>& caller,
     uint64_t working_bytes) {
   std::shared_ptr<Job> job;
+  bool parse_here = false;  // parse_threads == 0: this thread parses
   {
     absl::MutexLock lock(&mu_);
     if (const Parsed* kept = kept_.Touch(key)) {
@@ -71,6 +71,15 @@ absl::StatusOr<std::shared_ptr<const void>> LoadedModels::GetAny(
           "this server gives parses (parse_memory_bytes %d); simplify or split the model, or ask "
           "the operator to raise the limit",
           working_bytes, options_.working_budget_bytes));
+    } else if (options_.parse_threads == 0) {
+      job = std::make_shared<Job>();
+      job->key = key;
+      job->parse = std::move(parse);
+      job->working_bytes = working_bytes;
+      pending_.emplace(key, job);
+      ++stats_.parsing;
+      working_bytes_ += working_bytes;
+      parse_here = true;
     } else {
       if (queue_.size() >= static_cast<size_t>(std::max(0, options_.max_queued_parses))) {
         ++stats_.parses_rejected;
@@ -87,6 +96,7 @@ absl::StatusOr<std::shared_ptr<const void>> LoadedModels::GetAny(
     }
     ++job->waiters;
   }
+  if (parse_here) RunJob(job);
   // Wait in short steps, asking the caller between them.
   while (true) {
     absl::Status wanted = caller ? caller() : absl::OkStatus();
@@ -145,71 +155,75 @@ void LoadedModels::ParserLoop() {
       ++stats_.parsing;
       working_bytes_ += job->working_bytes;
     }
-    // The parse thread's CPU clock: a parser may call the check from its own
-    // helper threads, so it is thread-safe and reads this thread's clock.
-    clockid_t cpu_clock = CLOCK_THREAD_CPUTIME_ID;
-    if (pthread_getcpuclockid(pthread_self(), &cpu_clock) != 0) cpu_clock = CLOCK_THREAD_CPUTIME_ID;
-    const double cpu_start = CpuSeconds(cpu_clock);
-    std::atomic<uint64_t> calls{0};
-    absl::Mutex stop_mu;
-    absl::Status stop;  // sticky once set; guarded by stop_mu
-    const ParseCheck check = [&]() -> absl::Status {
-      // Called often by the parsers: the locks and the clock every 64th time.
-      if ((calls.fetch_add(1, std::memory_order_relaxed) & 63) != 0) {
-        absl::MutexLock l(&stop_mu);
-        return stop;
-      }
-      absl::Status now;
-      {
-        absl::MutexLock lock(&mu_);
-        if (stopping_) {
-          now = absl::UnavailableError("the server is shutting down");
-        } else if (job->waiters == 0) {
-          now = absl::CancelledError("no request waits for this model any more");
-        }
-      }
-      const double spent = CpuSeconds(cpu_clock) - cpu_start;
-      if (now.ok() && options_.parse_seconds > 0 && spent > options_.parse_seconds) {
-        now = absl::ResourceExhaustedError(absl::StrFormat(
-            "parsing the model took more than %g s of CPU (model_parse_seconds: the server's or "
-            "sample-many's --model-parse-seconds) and was stopped: simplify the model (fewer or "
-            "simpler faces), or raise the limit",
-            options_.parse_seconds));
-      }
-      absl::MutexLock l(&stop_mu);
-      if (stop.ok()) stop = now;
-      return stop;
-    };
-    absl::StatusOr<Parsed> result;
-    try {
-      result = job->parse(check);
-    } catch (const std::bad_alloc&) {
-      result = absl::ResourceExhaustedError("out of memory while parsing the model");
-    } catch (const std::exception& e) {
-      result = absl::InternalError(absl::StrFormat("parsing the model failed: %s", e.what()));
-    }
-    {
-      absl::MutexLock l(&stop_mu);
-      if (result.ok() && !stop.ok()) result = stop;  // a parser that ignored the stop
-    }
-    absl::MutexLock lock(&mu_);
-    --stats_.parsing;
-    working_bytes_ -= job->working_bytes;
-    ++stats_.parses;
-    pending_.erase(job->key);
-    if (result.ok()) {
-      Keep(job->key, *result);
-    } else if (result.status().code() == absl::StatusCode::kCancelled ||
-               result.status().code() == absl::StatusCode::kUnavailable) {
-      ++stats_.parses_stopped;  // not the model's fault: the next request parses again
-    } else {
-      if (result.status().code() == absl::StatusCode::kResourceExhausted) ++stats_.parses_stopped;
-      failures_[job->key] = Failure{result.status(), Clock::now()};
-      ++stats_.parse_failures;
-    }
-    job->result = std::move(result);
-    job->done = true;
+    RunJob(job);
   }
+}
+
+void LoadedModels::RunJob(const std::shared_ptr<Job>& job) {
+  // The parse thread's CPU clock: a parser may call the check from its own
+  // helper threads, so it is thread-safe and reads this thread's clock.
+  clockid_t cpu_clock = CLOCK_THREAD_CPUTIME_ID;
+  if (pthread_getcpuclockid(pthread_self(), &cpu_clock) != 0) cpu_clock = CLOCK_THREAD_CPUTIME_ID;
+  const double cpu_start = CpuSeconds(cpu_clock);
+  std::atomic<uint64_t> calls{0};
+  absl::Mutex stop_mu;
+  absl::Status stop;  // sticky once set; guarded by stop_mu
+  const ParseCheck check = [&]() -> absl::Status {
+    // Called often by the parsers: the locks and the clock every 64th time.
+    if ((calls.fetch_add(1, std::memory_order_relaxed) & 63) != 0) {
+      absl::MutexLock l(&stop_mu);
+      return stop;
+    }
+    absl::Status now;
+    {
+      absl::MutexLock lock(&mu_);
+      if (stopping_) {
+        now = absl::UnavailableError("the server is shutting down");
+      } else if (job->waiters == 0) {
+        now = absl::CancelledError("no request waits for this model any more");
+      }
+    }
+    const double spent = CpuSeconds(cpu_clock) - cpu_start;
+    if (now.ok() && options_.parse_seconds > 0 && spent > options_.parse_seconds) {
+      now = absl::ResourceExhaustedError(absl::StrFormat(
+          "parsing the model took more than %g s of CPU (model_parse_seconds: the server's or "
+          "sample-many's --model-parse-seconds) and was stopped: simplify the model (fewer or "
+          "simpler faces), or raise the limit",
+          options_.parse_seconds));
+    }
+    absl::MutexLock l(&stop_mu);
+    if (stop.ok()) stop = now;
+    return stop;
+  };
+  absl::StatusOr<Parsed> result;
+  try {
+    result = job->parse(check);
+  } catch (const std::bad_alloc&) {
+    result = absl::ResourceExhaustedError("out of memory while parsing the model");
+  } catch (const std::exception& e) {
+    result = absl::InternalError(absl::StrFormat("parsing the model failed: %s", e.what()));
+  }
+  {
+    absl::MutexLock l(&stop_mu);
+    if (result.ok() && !stop.ok()) result = stop;  // a parser that ignored the stop
+  }
+  absl::MutexLock lock(&mu_);
+  --stats_.parsing;
+  working_bytes_ -= job->working_bytes;
+  ++stats_.parses;
+  pending_.erase(job->key);
+  if (result.ok()) {
+    Keep(job->key, *result);
+  } else if (result.status().code() == absl::StatusCode::kCancelled ||
+             result.status().code() == absl::StatusCode::kUnavailable) {
+    ++stats_.parses_stopped;  // not the model's fault: the next request parses again
+  } else {
+    if (result.status().code() == absl::StatusCode::kResourceExhausted) ++stats_.parses_stopped;
+    failures_[job->key] = Failure{result.status(), Clock::now()};
+    ++stats_.parse_failures;
+  }
+  job->result = std::move(result);
+  job->done = true;
 }
 
 size_t LoadedModels::NextJob() const {

@@ -1,7 +1,8 @@
 // Parsed models (meshes, CAD models): parsing a model is a build. Parses run
 // on this object's own threads, never on an RPC thread, so a request that
 // waits for one holds no stream slot and no lock; the request waits with its
-// own check (client gone, deadline) and leaves when it says so.
+// own check (client gone, deadline) and leaves when it says so. (An embedded
+// engine may instead parse on its callers' threads: parse_threads = 0.)
 //
 //  - Bounded: at most parse_threads parses at once, at most max_queued_parses
 //    waiting for a thread (past that a miss is RESOURCE_EXHAUSTED), each with
@@ -48,7 +49,11 @@ namespace sfc {
 
 struct LoadedModelsOptions {
   uint64_t budget_bytes = uint64_t{256} << 20;  // parsed models kept; default 256 MiB
-  int parse_threads = 1;                        // parses at once, >= 1
+  // Parses at once, each on a thread of this object's own, >= 1; or 0: each
+  // parse runs on the thread that asked for it (an embedded engine, whose
+  // callers are its own threads: no hand-over, no queue; the CPU budget and
+  // the one-parse-per-key rule hold as before).
+  int parse_threads = 1;
   int max_queued_parses = 8;                    // parses waiting for a thread, >= 0
   // CPU seconds one parse may take (its thread's CPU time); 0 = no budget.
   double parse_seconds = 0;
@@ -133,6 +138,10 @@ class LoadedModels {
                                                      uint64_t working_bytes)
       ABSL_LOCKS_EXCLUDED(mu_);
   void ParserLoop() ABSL_LOCKS_EXCLUDED(mu_);
+  // Runs a started job's parse on this thread and publishes its result.
+  // REQUIRES: the job was taken off the queue (or never queued) and counted in
+  // stats_.parsing and working_bytes_.
+  void RunJob(const std::shared_ptr<Job>& job) ABSL_LOCKS_EXCLUDED(mu_);
   void Keep(const std::string& key, const Parsed& parsed) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   // Index in queue_ of the parse to start next. REQUIRES: !queue_.empty().
   size_t NextJob() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);

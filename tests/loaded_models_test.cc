@@ -98,6 +98,47 @@ TEST(LoadedModels, TheCpuBudgetStopsAParse) {
   EXPECT_EQ(loaded.stats().parses_stopped, 1u);
 }
 
+// parse_threads = 0: each parse runs on the thread that asked for it; the
+// one-parse-per-key rule, remembered failures and the CPU budget still hold.
+TEST(LoadedModels, WithoutParseThreadsTheCallerParsesUnderTheSameRules) {
+  LoadedModelsOptions o;
+  o.parse_threads = 0;
+  o.parse_seconds = 0.2;
+  LoadedModels loaded(o);
+  std::atomic<int> parses{0};
+  absl::Mutex mu;
+  std::vector<std::thread::id> parsed_on;
+  auto slow = [&](const ParseCheck&) -> absl::StatusOr<Parsed> {
+    ++parses;
+    {
+      absl::MutexLock lock(&mu);
+      parsed_on.push_back(std::this_thread::get_id());
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    return Parsed{std::make_shared<const int>(1), 8};
+  };
+  std::vector<std::thread> threads;
+  std::vector<std::thread::id> callers(6);
+  for (int i = 0; i < 6; ++i) {
+    threads.emplace_back([&, i] {
+      callers[i] = std::this_thread::get_id();
+      EXPECT_TRUE(loaded.Get<int>(i < 3 ? "k" : "other", slow, nullptr, 0).ok());
+    });
+  }
+  for (auto& t : threads) t.join();
+  EXPECT_EQ(parses.load(), 2);  // one per key
+  for (const auto& id : parsed_on) {
+    EXPECT_NE(std::find(callers.begin(), callers.end(), id), callers.end());  // a caller's thread
+  }
+  std::atomic<bool> started{false};
+  auto spin = loaded.Get<int>("spin", Spinning(&started), nullptr, 0);
+  EXPECT_EQ(spin.status().code(), absl::StatusCode::kResourceExhausted) << spin.status();
+  EXPECT_EQ(loaded.Get<int>("spin", Spinning(&started), nullptr, 0).status().code(),
+            absl::StatusCode::kResourceExhausted);  // remembered
+  EXPECT_EQ(loaded.stats().failure_hits, 1u);
+  EXPECT_EQ(loaded.stats().parsing, 0u);
+}
+
 TEST(LoadedModels, ACallerLeavesAtOnceAndAParseNobodyWantsStops) {
   LoadedModels loaded;  // no CPU budget: only the callers stop it
   std::atomic<bool> started{false};

@@ -211,8 +211,8 @@ class PyEngine {
     if (model_parse_seconds < 0) {
       throw StatusException(absl::InvalidArgumentError("model_parse_seconds must be >= 0"));
     }
-    if (parse_threads < 1 || parse_threads > 64) {
-      throw StatusException(absl::InvalidArgumentError("parse_threads must be in [1, 64]"));
+    if (parse_threads < 0 || parse_threads > 64) {
+      throw StatusException(absl::InvalidArgumentError("parse_threads must be in [0, 64]"));
     }
     EngineLimits limits;
     limits.model_check_program = model_check_program;
@@ -268,12 +268,13 @@ model_parse_seconds: CPU seconds one model's parse may take (0 = no limit).
 parsed_model_bytes: parsed models (meshes, CAD shapes) kept for later calls, in
   bytes, least recently used out first (0 = none: each call parses its model,
   as a run over many models seen once wants).
-parse_threads: models parsed at once, on the engine's own threads (1 to 64).)doc")
+parse_threads: 0 = each call parses its model on its own thread (no hand-over
+  to another thread); 1 to 64 = models parsed at once on the engine's threads.)doc")
       .def(py::init<size_t, int, const std::string&, double, uint64_t, int>(), py::kw_only(),
            py::arg("max_trees") = 0, py::arg("threads") = 0, py::arg("model_check_program") = "",
            py::arg("model_parse_seconds") = 0.0,
            py::arg("parsed_model_bytes") = EngineLimits().parsed_model_bytes,
-           py::arg("parse_threads") = 1)
+           py::arg("parse_threads") = 0)
       .def("start", &PyEngine::Start, py::arg("request"), py::kw_only(),
            py::arg("precision") = "float64",
            "Validates the request, builds (or reuses) its tree and opens its job. Raises "

@@ -26,14 +26,15 @@ class Sampler:
     a process of its own (many.find_model_check_program() finds it); "" = in this
     process. model_parse_seconds: CPU seconds one model's parse may take (0 = no limit).
     parsed_model_bytes: parsed models (meshes, CAD shapes) kept for later calls
-    (default 256 MiB; 0 = none, for models each sampled once); parse_threads:
-    models parsed at once (calls on several threads each wait for their own).
+    (default 256 MiB; 0 = none, for models each sampled once); parse_threads: 0 =
+    each call parses its model on its own thread (calls on several threads parse
+    at once), N = on N threads of the engine's own.
 
     The request keywords are `sfcsampler sample`'s flags (see sample()).
     """
 
     def __init__(self, max_trees=4, threads=0, *, model_check_program="", model_parse_seconds=0,
-                 parsed_model_bytes=256 << 20, parse_threads=1):
+                 parsed_model_bytes=256 << 20, parse_threads=0):
         self._engine = _core.Engine(max_trees=max_trees, threads=threads,
                                     model_check_program=model_check_program,
                                     model_parse_seconds=model_parse_seconds,

@@ -344,20 +344,25 @@ def sample_many(models, *, seed=1, out_dir=None, keep=None, workers=0, progress=
     if model_check_program == "auto":
         model_check_program = find_model_check_program()
     # Each model is parsed and sampled once: the engine keeps no parsed model (their
-    # memory goes back to the next parse), and every worker has a parse thread.
+    # memory goes back to the next parse), and each worker parses its own models.
     sampler = None if client is not None else Sampler(
         max_trees=0, threads=1 if workers > 1 else 0, model_check_program=model_check_program,
-        model_parse_seconds=model_parse_seconds, parsed_model_bytes=0, parse_threads=workers)
+        model_parse_seconds=model_parse_seconds, parsed_model_bytes=0, parse_threads=0)
     bar = _Bar(len(items), progress)
     results = Results([None] * len(items))
+
+    def run(k):
+        # On a worker thread: this thread waits for all at once, not woken per model
+        # (a wake-up per model costs GIL hand-overs the workers would wait for).
+        results[k] = sample_one(items[k], request, seed, sampler, paths[k], keep, client)
+        bar.step(results[k])
+
     try:
         with concurrent.futures.ThreadPoolExecutor(max_workers=workers) as pool:
-            futures = {pool.submit(sample_one, m, request, seed, sampler, paths[k], keep, client): k
-                       for k, m in enumerate(items)}
-            for future in concurrent.futures.as_completed(futures):
-                result = future.result()
-                results[futures[future]] = result
-                bar.step(result)
+            futures = [pool.submit(run, k) for k in range(len(items))]
+            concurrent.futures.wait(futures)  # one wake-up, when all are done
+            for future in futures:
+                future.result()  # re-raises what sample_one does not catch
     finally:
         bar.close()
         if own_client:
