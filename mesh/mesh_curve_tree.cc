@@ -333,6 +333,36 @@ void InnerPoint(uint64_t bits, int levels, double* x, double* y) {
   for (; levels > 0; --levels, bits >>= 1) kChild[bits & 1].Apply(x, y);
 }
 
+// The maps of ByteMaps() and kChild as columns of two lanes, so that one
+// packed multiply-add step moves both coordinates: lane i computes
+// (a_i1 * x + a_i2 * y) + c_i, the scalar Apply's operations in its order,
+// so the packed and scalar walks agree to the bit (IEEE lanes; no FMA).
+typedef double Lanes __attribute__((vector_size(16)));
+struct PackedAffine {
+  Lanes first, second, offset;  // {a11, a21}, {a12, a22}, {c1, c2}
+  Lanes Apply(Lanes xy) const {
+    const Lanes xx = {xy[0], xy[0]}, yy = {xy[1], xy[1]};
+    return first * xx + second * yy + offset;
+  }
+};
+
+PackedAffine Pack(const Affine& f) {
+  PackedAffine p;
+  p.first = Lanes{f.a11, f.a21};
+  p.second = Lanes{f.a12, f.a22};
+  p.offset = Lanes{f.c1, f.c2};
+  return p;
+}
+
+const std::array<PackedAffine, 256>& PackedByteMaps() {
+  static const std::array<PackedAffine, 256> maps = [] {
+    std::array<PackedAffine, 256> m{};
+    for (int v = 0; v < 256; ++v) m[v] = Pack(ByteMaps()[v]);
+    return m;
+  }();
+  return maps;
+}
+
 constexpr int kLevels = 52;  // all the bits of a sample's fraction t
 
 // The child choices of a uniform cell: the first 52 binary digits of t.
@@ -354,29 +384,31 @@ void MeshCurveTree::DescendMany(size_t n, const Cell* const* cells, const double
   constexpr size_t kMax = 64;
   size_t uniform[kMax];
   uint64_t bits[kMax];
-  double x[kMax], y[kMax];
+  Lanes xy[kMax];
   size_t u = 0;
   for (size_t i = 0; i < n; ++i) {
     if (cells[i]->uniform && u < kMax) {
       uniform[u] = i;
       bits[u] = UniformBits(t[i]);
-      x[u] = y[u] = 1.0 / 3;
+      xy[u] = Lanes{1.0 / 3, 1.0 / 3};
       ++u;
     } else {
       Descend(*cells[i], t[i], &bary[i], &area_position[i]);
     }
   }
-  // The steps of InnerPoint(bits, 52, ...), sample after sample at each step.
-  const auto& maps = ByteMaps();
+  // The steps of InnerPoint(bits, 52, ...), sample after sample at each step,
+  // both coordinates in one packed step.
+  const auto& maps = PackedByteMaps();
   for (int byte = 0; byte < kLevels / 8; ++byte) {
-    for (size_t j = 0; j < u; ++j) maps[(bits[j] >> (8 * byte)) & 255].Apply(&x[j], &y[j]);
+    for (size_t j = 0; j < u; ++j) xy[j] = maps[(bits[j] >> (8 * byte)) & 255].Apply(xy[j]);
   }
+  static const PackedAffine child[2] = {Pack(kChild[0]), Pack(kChild[1])};
   for (int level = kLevels / 8 * 8; level < kLevels; ++level) {
-    for (size_t j = 0; j < u; ++j) kChild[(bits[j] >> level) & 1].Apply(&x[j], &y[j]);
+    for (size_t j = 0; j < u; ++j) xy[j] = child[(bits[j] >> level) & 1].Apply(xy[j]);
   }
   for (size_t j = 0; j < u; ++j) {
     const size_t i = uniform[j];
-    FinishUniform(*cells[i], bits[j], x[j], y[j], &bary[i], &area_position[i]);
+    FinishUniform(*cells[i], bits[j], xy[j][0], xy[j][1], &bary[i], &area_position[i]);
   }
 }
 

@@ -27,7 +27,8 @@ struct Before {
   const Item* items;
   bool operator()(Index a, Index b) const {
     const double ca = Coordinate(items[a].c), cb = Coordinate(items[b].c);
-    return ca < cb || (ca == cb && items[a].t < items[b].t);
+    // Bitwise, not short-circuit: no branch for the partition to mispredict.
+    return (ca < cb) | ((ca == cb) & (items[a].t < items[b].t));
   }
   static double Coordinate(const Vec3& v) { return kAxis == 0 ? v.x : kAxis == 1 ? v.y : v.z; }
 };
@@ -42,6 +43,16 @@ template <int kAxis>
 size_t SplitByArea(const Item* items, Index* begin, Index* end, double half) {
   const Before<kAxis> before{items};
   const size_t n = static_cast<size_t>(end - begin);
+  if (n == 3) {
+    // What the general steps below come to for three items (the median of
+    // three is the pivot; one or two more rounds settle m): the items sorted
+    // by Before, and the first two in the first part when their areas,
+    // added in that order, are at most `half`.
+    if (before(begin[1], begin[0])) std::swap(begin[0], begin[1]);
+    if (before(begin[2], begin[1])) std::swap(begin[1], begin[2]);
+    if (before(begin[1], begin[0])) std::swap(begin[0], begin[1]);
+    return items[begin[0]].area + items[begin[1]].area <= half ? 2 : 1;
+  }
   Index *lo = begin, *hi = end;
   double below = 0;
   while (lo < hi) {
@@ -51,14 +62,22 @@ size_t SplitByArea(const Item* items, Index* begin, Index* end, double half) {
     if (before(*(hi - 1), *lo)) std::swap(*(hi - 1), *lo);
     if (before(*mid, *(hi - 1))) std::swap(*mid, *(hi - 1));
     const Index pivot = *(hi - 1);
+    // Lomuto's partition: each item before the pivot is swapped to `store`.
+    // Written without branches (the comparisons are coin flips to a branch
+    // predictor); it makes the same arrangement as the branching form.
     Index* store = lo;
-    double area = 0;
     for (Index* it = lo; it + 1 < hi; ++it) {
-      if (before(*it, pivot)) {
-        area += items[*it].area;
-        std::swap(*it, *store++);
-      }
+      const Index a = *it, b = *store;
+      const Index smaller = before(a, pivot);
+      const Index keep = smaller - 1;  // all ones when not smaller
+      *store = (a & ~keep) | (b & keep);
+      *it = (b & ~keep) | (a & keep);
+      store += smaller;
     }
+    // The smaller items' area, summed in the order they were found (Lomuto
+    // keeps that order).
+    double area = 0;
+    for (const Index* it = lo; it != store; ++it) area += items[*it].area;
     std::swap(*store, *(hi - 1));  // the pivot between the smaller and the larger items
     if (below + area + items[*store].area <= half) {
       below += area + items[*store].area;

@@ -205,6 +205,25 @@ TEST(MeshSampler, DeterministicAndEqualToRandomAccess) {
   }
 }
 
+// The batch path descends samples together (MeshCurveTree::DescendMany,
+// packed two lanes at a time); random access descends one (Descend). Every
+// sample must agree to the bit, for uniform cells and model-following ones.
+TEST(MeshSampler, EverySampleOfABatchEqualsItsRandomAccess) {
+  const uint64_t n = 30000;
+  for (const auto& density : {UniformMeshDensity(), GaussianCurvatureMeshDensity(0.1)}) {
+    const auto sampler = MakeSampler(Icosphere(3, true), density, n, 11);
+    const Drawn a = Draw(sampler, 0, n);
+    ASSERT_EQ(a.batch.size(), n);
+    for (uint64_t k = 0; k < n; ++k) {
+      const MeshSample s = sampler->At(k);
+      ASSERT_EQ(s.position.x, a.batch.x[k]) << k;
+      ASSERT_EQ(s.position.y, a.batch.y[k]) << k;
+      ASSERT_EQ(s.position.z, a.batch.z[k]) << k;
+      ASSERT_EQ(s.triangle, a.mesh.triangle[k]) << k;
+    }
+  }
+}
+
 TEST(MeshSampler, RangesJoinToTheFullSetAndHaveNoDuplicates) {
   const uint64_t n = 30000;
   const auto sampler = MakeSampler(Icosphere(5), UniformMeshDensity(), n);
