@@ -117,12 +117,16 @@ absl::Status FinalizeMesh(TriangleMesh* mesh) {
         "mesh '%s': all %d triangles are degenerate (no area): nothing to sample", name,
         mesh->triangles.size()));
   }
+  return absl::OkStatus();
+}
+
+void CountEdges(TriangleMesh* mesh) {
+  MeshStats& stats = mesh->stats;
   stats.non_manifold_edges = stats.boundary_edges = 0;
   ForEachEdge(*mesh, [&stats](uint32_t, uint32_t, uint32_t n) {
     if (n == 1) ++stats.boundary_edges;
     if (n > 2) ++stats.non_manifold_edges;
   });
-  return absl::OkStatus();
 }
 
 }  // namespace sfc

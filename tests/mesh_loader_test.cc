@@ -51,6 +51,7 @@ TEST(MeshLoader, IcosphereRoundTripsThroughObjAndBothPlyEncodings) {
     ASSERT_TRUE(loaded.ok()) << loaded.status();
     ExpectSameMesh(sphere, *loaded, std::string(file) == "ico.obj" ? 1e-15 : 0);
     EXPECT_EQ(loaded->stats.degenerate_triangles, 0u);
+    CountEdges(&*loaded);
     EXPECT_EQ(loaded->stats.non_manifold_edges, 0u);
     EXPECT_EQ(loaded->stats.boundary_edges, 0u);  // closed surface
     EXPECT_NEAR(loaded->stats.area, 4 * M_PI, 0.01);
@@ -97,6 +98,7 @@ TEST(MeshLoader, TriangulatesPolygonsAndCountsDegenerateAndNonManifold) {
   EXPECT_EQ(mesh->stats.triangulated_polygons, 1u);
   EXPECT_EQ(mesh->triangles.size(), 5u);
   EXPECT_EQ(mesh->stats.degenerate_triangles, 1u);
+  CountEdges(&*mesh);
   EXPECT_EQ(mesh->stats.non_manifold_edges, 1u);  // edge (1, 2): quad, the tent, the fin
   EXPECT_NEAR(mesh->stats.area, 1 + 0.5 + 0.5, 1e-15);
   const std::string ply =
@@ -185,7 +187,6 @@ void ExpectIdentical(const TriangleMesh& a, const TriangleMesh& b) {
   EXPECT_EQ(a.stats.vertices, b.stats.vertices);
   EXPECT_EQ(a.stats.degenerate_triangles, b.stats.degenerate_triangles);
   EXPECT_EQ(a.stats.area, b.stats.area);
-  EXPECT_EQ(a.stats.boundary_edges, b.stats.boundary_edges);
 }
 
 // The direct reader of plain binary PLY (mesh/plain_ply.h) takes the files it
