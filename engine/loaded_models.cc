@@ -6,6 +6,7 @@
 #include <unistd.h>
 #include <time.h>
 
+#include <algorithm>
 #include <atomic>
 
 #include <exception>
@@ -30,7 +31,12 @@ double CpuSeconds(clockid_t clock) {
 
 }  // namespace
 
-LoadedModels::LoadedModels(const LoadedModelsOptions& options) : options_(options) {
+LoadedModels::LoadedModels(const LoadedModelsOptions& options)
+    : options_([&options] {
+        LoadedModelsOptions o = options;
+        o.parse_threads = std::max(0, o.parse_threads);
+        return o;
+      }()) {
   for (int i = 0; i < options_.parse_threads; ++i) threads_.emplace_back([this] { ParserLoop(); });
 }
 
@@ -96,14 +102,15 @@ absl::StatusOr<std::shared_ptr<const void>> LoadedModels::GetAny(
     }
     ++job->waiters;
   }
-  if (parse_here) RunJob(job);
+  if (parse_here) RunJob(job, caller);
   // Wait in short steps, asking the caller between them.
   while (true) {
     absl::Status wanted = caller ? caller() : absl::OkStatus();
     absl::MutexLock lock(&mu_);
     if (job->done) {
       --job->waiters;
-      if (!job->result.ok()) return job->result.status();
+      // A parse stopped because this request left says why it left.
+      if (!job->result.ok()) return wanted.ok() ? job->result.status() : wanted;
       return job->result->model;
     }
     if (!wanted.ok()) {
@@ -155,11 +162,12 @@ void LoadedModels::ParserLoop() {
       ++stats_.parsing;
       working_bytes_ += job->working_bytes;
     }
-    RunJob(job);
+    RunJob(job, nullptr);
   }
 }
 
-void LoadedModels::RunJob(const std::shared_ptr<Job>& job) {
+void LoadedModels::RunJob(const std::shared_ptr<Job>& job,
+                          const std::function<absl::Status()>& caller) {
   // The parse thread's CPU clock: a parser may call the check from its own
   // helper threads, so it is thread-safe and reads this thread's clock.
   clockid_t cpu_clock = CLOCK_THREAD_CPUTIME_ID;
@@ -183,6 +191,12 @@ void LoadedModels::RunJob(const std::shared_ptr<Job>& job) {
         now = absl::CancelledError("no request waits for this model any more");
       }
     }
+    // Inline, the parsing request's own check too (its deadline, its client).
+    // Stopped for it, the parse is not the model's fault: not remembered.
+    if (now.ok() && caller && !caller().ok()) {
+      now = absl::CancelledError("the request parsing this model left (its deadline passed or "
+                                 "its client went); ask again");
+    }
     const double spent = CpuSeconds(cpu_clock) - cpu_start;
     if (now.ok() && options_.parse_seconds > 0 && spent > options_.parse_seconds) {
       now = absl::ResourceExhaustedError(absl::StrFormat(
@@ -202,6 +216,8 @@ void LoadedModels::RunJob(const std::shared_ptr<Job>& job) {
     result = absl::ResourceExhaustedError("out of memory while parsing the model");
   } catch (const std::exception& e) {
     result = absl::InternalError(absl::StrFormat("parsing the model failed: %s", e.what()));
+  } catch (...) {  // whatever a parser throws, the job ends and its waiters hear of it
+    result = absl::InternalError("parsing the model failed with an unknown exception");
   }
   {
     absl::MutexLock l(&stop_mu);

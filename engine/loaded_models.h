@@ -49,10 +49,11 @@ namespace sfc {
 
 struct LoadedModelsOptions {
   uint64_t budget_bytes = uint64_t{256} << 20;  // parsed models kept; default 256 MiB
-  // Parses at once, each on a thread of this object's own, >= 1; or 0: each
-  // parse runs on the thread that asked for it (an embedded engine, whose
-  // callers are its own threads: no hand-over, no queue; the CPU budget and
-  // the one-parse-per-key rule hold as before).
+  // Parses at once, each on a thread of this object's own, >= 1; or 0 (or
+  // less): each parse runs on the thread that asked for it (an embedded
+  // engine, whose callers are its own threads: no hand-over, no queue). The
+  // CPU budget, the one-parse-per-key rule and the caller's check hold as
+  // before; working_budget_bytes then bounds each parse alone, not their sum.
   int parse_threads = 1;
   int max_queued_parses = 8;                    // parses waiting for a thread, >= 0
   // CPU seconds one parse may take (its thread's CPU time); 0 = no budget.
@@ -141,7 +142,10 @@ class LoadedModels {
   // Runs a started job's parse on this thread and publishes its result.
   // REQUIRES: the job was taken off the queue (or never queued) and counted in
   // stats_.parsing and working_bytes_.
-  void RunJob(const std::shared_ptr<Job>& job) ABSL_LOCKS_EXCLUDED(mu_);
+  // `caller`: the parsing request's own check (parse_threads == 0), asked
+  // with the others; may be empty.
+  void RunJob(const std::shared_ptr<Job>& job, const std::function<absl::Status()>& caller)
+      ABSL_LOCKS_EXCLUDED(mu_);
   void Keep(const std::string& key, const Parsed& parsed) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   // Index in queue_ of the parse to start next. REQUIRES: !queue_.empty().
   size_t NextJob() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);

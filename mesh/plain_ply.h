@@ -17,6 +17,8 @@
 // Anything else (other layouts, damaged files) returns nullopt and goes to
 // the CGAL path, which reads it or gives its error. The mesh is the one the
 // CGAL path makes (same values, triangles and stats), before FinalizeMesh.
+// It does not poll MeshLoadOptions::check: one pass, linear in the bytes
+// (which max_bytes bounds), copying at memory speed.
 //
 // Thread-safety: a pure function.
 #ifndef SFCSAMPLER_MESH_PLAIN_PLY_H_

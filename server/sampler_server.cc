@@ -67,6 +67,10 @@ absl::Status Validate(const ServerOptions& o) {
     return absl::InvalidArgumentError(
         "--max-concurrent-builds must be >= 1, --max-queued-builds and --failure-ttl >= 0");
   }
+  // A server parses on threads of its own, never on its RPC threads.
+  if (o.limits.model_parse_threads < 1) {
+    return absl::InvalidArgumentError("--model-parse-threads must be >= 1");
+  }
   return absl::OkStatus();
 }
 

@@ -137,6 +137,25 @@ TEST(LoadedModels, WithoutParseThreadsTheCallerParsesUnderTheSameRules) {
             absl::StatusCode::kResourceExhausted);  // remembered
   EXPECT_EQ(loaded.stats().failure_hits, 1u);
   EXPECT_EQ(loaded.stats().parsing, 0u);
+
+  // The parsing caller's own check stops its parse, which is not remembered
+  // as the model's failure; a parser's unknown exception ends the job too.
+  LoadedModelsOptions unbounded;
+  unbounded.parse_threads = 0;
+  LoadedModels inline_only(unbounded);
+  const auto start = std::chrono::steady_clock::now();
+  auto deadline = [start]() {
+    return std::chrono::steady_clock::now() - start > std::chrono::milliseconds(100)
+               ? absl::DeadlineExceededError("deadline")
+               : absl::OkStatus();
+  };
+  auto left = inline_only.Get<int>("loops", Spinning(&started), deadline, 0);
+  EXPECT_EQ(left.status().code(), absl::StatusCode::kDeadlineExceeded) << left.status();
+  EXPECT_TRUE(inline_only.Get<int>("loops", Returning(8, &parses), nullptr, 0).ok());
+  auto throwing = [](const ParseCheck&) -> absl::StatusOr<Parsed> { throw 42; };
+  EXPECT_EQ(inline_only.Get<int>("throws", throwing, nullptr, 0).status().code(),
+            absl::StatusCode::kInternal);
+  EXPECT_EQ(inline_only.stats().parsing, 0u);
 }
 
 TEST(LoadedModels, ACallerLeavesAtOnceAndAParseNobodyWantsStops) {

@@ -112,6 +112,7 @@ def sample_many(client, models, *, seed=1, out_dir=None, keep=None, service=None
         if bad in request:
             raise TypeError(f"sample_many takes the models as its second argument, not {bad}=")
     items = many.as_models(models)
+    many.columns_list(request)
     paths = [None] * len(items)
     if out_dir is not None:
         os.makedirs(out_dir, exist_ok=True)

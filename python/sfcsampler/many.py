@@ -28,6 +28,7 @@ import numpy as np
 
 from sfcsampler import meshes
 from sfcsampler.errors import Error
+from sfcsampler.samples import COLUMNS
 
 # File extensions of the model formats (lower case), as the CLI reads them.
 EXTENSIONS = {".step": "step", ".stp": "step", ".iges": "iges", ".igs": "iges", ".nurbs": "nurbs",
@@ -221,6 +222,20 @@ def find_model_check_program():
     return os.path.normpath(beside) if os.access(beside, os.X_OK) else ""
 
 
+def columns_list(request):
+    """Turns request["columns"] (a name or an iterable of names) into a list once, for every
+    model of a run to use; InvalidArgumentError for a name that is no column."""
+    columns = request.get("columns")
+    if columns is None:
+        return
+    request["columns"] = [columns] if isinstance(columns, str) else list(columns)
+    unknown = [c for c in request["columns"] if c not in COLUMNS]
+    if unknown or not request["columns"]:
+        raise meshes.InvalidArgumentError(
+            3, f"columns: {'unknown column ' + repr(unknown[0]) if unknown else 'name at least one column'}; "
+               f"the columns are {', '.join(COLUMNS)}")
+
+
 def sample_one(model, request, base_seed, sampler=None, out_path=None, keep=True, client=None):
     """Samples one Model with its derived seed; never raises for the model's own errors
     (they go into Result.error). `client` samples on a server instead of `sampler`."""
@@ -232,9 +247,13 @@ def sample_one(model, request, base_seed, sampler=None, out_path=None, keep=True
         mesh = fmt in ("obj", "ply")  # the model columns apply to the models that have them
         request["face"] = bool(request.get("face")) and not mesh
         request["triangle"] = bool(request.get("triangle")) and mesh
-        if request.get("columns") is not None:
-            named = [request["columns"]] if isinstance(request["columns"], str) else request["columns"]
-            request["columns"] = [c for c in named if c != ("triangle" if not mesh else "face")]
+        if request.get("columns") is not None:  # a list (sample_many made it one)
+            other = "face" if mesh else "triangle"  # the other kind's column
+            request["columns"] = [c for c in request["columns"] if c != other]
+            if not request["columns"]:
+                raise meshes.InvalidArgumentError(
+                    3, f"columns: this model has no {other!r} column ({other} is for "
+                       f"{'CAD models' if mesh else 'meshes'}); name a column it has")
         if client is not None:
             result.sha256 = hashlib.sha256(data).hexdigest()
             result.seed = model_seed(base_seed, result.sha256)
@@ -333,6 +352,7 @@ def sample_many(models, *, seed=1, out_dir=None, keep=None, workers=0, progress=
         if bad in request:
             raise TypeError(f"sample_many takes the models as its first argument, not {bad}=")
     items = as_models(models)
+    columns_list(request)
     paths = [None] * len(items)
     if out_dir is not None:
         os.makedirs(out_dir, exist_ok=True)

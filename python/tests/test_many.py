@@ -232,9 +232,14 @@ def test_python_sample_many_keeps_and_writes_only_the_named_columns(folder, tmp_
     # The mesh keeps its triangle column; the CAD model has none to keep.
     assert np.array_equal(some[0].samples.triangle, full[0].samples.triangle)
     assert some[1].samples.triangle is None
-    written = sfcsampler.sample_many(names, count=2000, seed=5, columns=["x", "y", "z"],
-                                     out_dir=tmp_path)
-    assert np.load(written[0].path).dtype.names == ("x", "y", "z")
+    written = sfcsampler.sample_many(names, count=2000, seed=5, columns=iter(["x", "y", "z"]),
+                                     out_dir=tmp_path)  # a one-shot iterator serves every model
+    assert not written.failed, written.summary()
+    assert all(np.load(r.path).dtype.names == ("x", "y", "z") for r in written)
+    faces_only = sfcsampler.sample_many(names, count=100, face=True, columns=["face"])
+    assert "no 'face' column" in faces_only[0].error and faces_only[1].ok
+    with pytest.raises(sfcsampler.InvalidArgumentError, match="unknown column 'w'"):
+        sfcsampler.sample_many(names, count=100, columns=["x", "w"])
 
 
 def test_python_sample_many_over_the_wire(server, folder):
