@@ -1,5 +1,6 @@
 #include "client/sample_writer.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cstring>
 #include <vector>
@@ -31,6 +32,53 @@ void AppendBinary(std::string* out, T value) {
   out->append(bytes, sizeof(T));
 }
 
+// The columns a file can hold, in the order of CSV and NPY.
+enum class Col { kIndex, kU, kV, kX, kY, kZ, kNx, kNy, kNz, kDensity, kCurvePosition, kFace,
+                 kTriangle };
+constexpr const char* kColumnNames[] = {"index", "u",  "v",  "x",       "y",
+                                        "z",     "nx", "ny", "nz",      "density",
+                                        "curve_position", "face", "triangle"};
+const char* Name(Col c) { return kColumnNames[static_cast<int>(c)]; }
+bool IsReal(Col c) { return c != Col::kIndex && c != Col::kFace && c != Col::kTriangle; }
+
+// Whether the request's fields make column c.
+bool Made(Col c, const SampleFields& f) {
+  switch (c) {
+    case Col::kNx: case Col::kNy: case Col::kNz: return f.normal;
+    case Col::kDensity: return f.density;
+    case Col::kCurvePosition: return f.curve_position;
+    case Col::kFace: return f.face;
+    case Col::kTriangle: return f.triangle;
+    default: return true;
+  }
+}
+
+// The request flag that makes an optional column.
+const char* FlagOf(Col c) {
+  switch (c) {
+    case Col::kNx: case Col::kNy: case Col::kNz: return "--normals";
+    case Col::kDensity: return "--density-column";
+    case Col::kCurvePosition: return "--curve-position";
+    case Col::kFace: return "--face";
+    default: return "--triangle";
+  }
+}
+
+const std::vector<double>& Real(const SampleBatch& b, Col c) {
+  switch (c) {
+    case Col::kU: return b.u;
+    case Col::kV: return b.v;
+    case Col::kX: return b.x;
+    case Col::kY: return b.y;
+    case Col::kZ: return b.z;
+    case Col::kNx: return b.nx;
+    case Col::kNy: return b.ny;
+    case Col::kNz: return b.nz;
+    case Col::kDensity: return b.density;
+    default: return b.curve_position;
+  }
+}
+
 absl::Status WriteAll(std::FILE* f, const std::string& data) {
   if (std::fwrite(data.data(), 1, data.size(), f) != data.size()) {
     return absl::UnavailableError(absl::StrFormat("writing the output failed: %s", std::strerror(errno)));
@@ -38,11 +86,61 @@ absl::Status WriteAll(std::FILE* f, const std::string& data) {
   return absl::OkStatus();
 }
 
+// The file's columns in its order (CSV and NPY: kColumnNames' order; PLY:
+// x y z, normals, u v index, then the rest), the request's fields filtered by
+// `columns` (empty: all).
+absl::StatusOr<std::vector<Col>> Layout(OutputFormat format, const SampleFields& fields,
+                                        const std::vector<std::string>& columns) {
+  std::vector<Col> order;
+  if (format == OutputFormat::kPlyBinary || format == OutputFormat::kPlyAscii) {
+    order = {Col::kX, Col::kY, Col::kZ, Col::kNx, Col::kNy, Col::kNz, Col::kU,
+             Col::kV, Col::kIndex, Col::kDensity, Col::kCurvePosition, Col::kFace,
+             Col::kTriangle};
+  } else {
+    for (int c = 0; c <= static_cast<int>(Col::kTriangle); ++c) order.push_back(static_cast<Col>(c));
+  }
+  std::vector<bool> wanted(order.size(), columns.empty());
+  for (const std::string& name : columns) {
+    int found = -1;
+    for (int c = 0; c <= static_cast<int>(Col::kTriangle); ++c) {
+      if (name == kColumnNames[c]) found = c;
+    }
+    if (found < 0) {
+      std::string all;
+      for (const char* n : kColumnNames) all += (all.empty() ? "" : ",") + std::string(n);
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "--columns: unknown column \"%s\"; the columns are %s", name.substr(0, 40), all));
+    }
+    const Col c = static_cast<Col>(found);
+    if (!Made(c, fields)) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("--columns: \"%s\" needs %s", name, FlagOf(c)));
+    }
+    wanted[found] = true;
+  }
+  std::vector<Col> layout;
+  for (Col c : order) {
+    if (Made(c, fields) && wanted[static_cast<int>(c)]) layout.push_back(c);
+  }
+  const bool ply = format == OutputFormat::kPlyBinary || format == OutputFormat::kPlyAscii;
+  if (ply && (layout.size() < 3 || layout[0] != Col::kX || layout[1] != Col::kY ||
+              layout[2] != Col::kZ)) {
+    return absl::InvalidArgumentError(
+        "--columns: PLY output needs the x, y and z columns (use CSV or NPY for others)");
+  }
+  return layout;
+}
+
 }  // namespace
 
 SampleWriter::SampleWriter(std::FILE* out, bool owns, OutputFormat format, const SampleFields& fields,
                            OutputPrecision precision)
     : out_(out), owns_(owns), format_(format), fields_(fields), precision_(precision) {}
+
+absl::Status SampleWriter::CheckColumns(OutputFormat format, const SampleFields& fields,
+                                        const std::vector<std::string>& columns) {
+  return Layout(format, fields, columns).status();
+}
 
 void SampleWriter::AppendNumber(std::string* out, double value) const {
   if (precision_ == OutputPrecision::kFloat32) {
@@ -56,15 +154,13 @@ void SampleWriter::AppendNumber(std::string* out, double value) const {
 // Python dict literal padded with spaces and a newline so the data starts at
 // a multiple of 64 bytes (numpy/lib/format.py).
 std::string SampleWriter::NpyHeader(uint64_t count) const {
-  const char* f = precision_ == OutputPrecision::kFloat32 ? "'<f4'" : "'<f8'";
-  std::string descr = "[('index', '<u8')";
-  std::vector<const char*> names = {"u", "v", "x", "y", "z"};
-  if (fields_.normal) names.insert(names.end(), {"nx", "ny", "nz"});
-  if (fields_.density) names.push_back("density");
-  if (fields_.curve_position) names.push_back("curve_position");
-  for (const char* name : names) descr += absl::StrFormat(", ('%s', %s)", name, f);
-  if (fields_.face) descr += ", ('face', '<u4')";
-  if (fields_.triangle) descr += ", ('triangle', '<u4')";
+  const char* real = precision_ == OutputPrecision::kFloat32 ? "'<f4'" : "'<f8'";
+  std::string descr;
+  for (int id : layout_) {
+    const Col c = static_cast<Col>(id);
+    descr += absl::StrFormat("%s('%s', %s)", descr.empty() ? "[" : ", ", Name(c),
+                             c == Col::kIndex ? "'<u8'" : IsReal(c) ? real : "'<u4'");
+  }
   descr += "]";
   std::string dict =
       absl::StrFormat("{'descr': %s, 'fortran_order': False, 'shape': (%d,), }", descr, count);
@@ -85,13 +181,16 @@ SampleWriter::~SampleWriter() {
 
 absl::StatusOr<std::unique_ptr<SampleWriter>> SampleWriter::Open(
     const std::string& path, OutputFormat format, const SampleFields& fields,
-    std::optional<uint64_t> expected_count, OutputPrecision precision) {
+    std::optional<uint64_t> expected_count, OutputPrecision precision,
+    const std::vector<std::string>& columns) {
+  ASSIGN_OR_RETURN(const std::vector<Col> layout, Layout(format, fields, columns));
   std::FILE* f = path == "-" ? stdout : std::fopen(path.c_str(), "wb");
   if (!f) {
     return absl::InvalidArgumentError(
         absl::StrFormat("cannot open \"%s\" for writing: %s", path, std::strerror(errno)));
   }
   auto writer = std::unique_ptr<SampleWriter>(new SampleWriter(f, path != "-", format, fields, precision));
+  for (Col c : layout) writer->layout_.push_back(static_cast<int>(c));
   writer->expected_ = expected_count;
   if (format == OutputFormat::kCsv) {
     RETURN_IF_ERROR(writer->WriteHeader(0));
@@ -109,12 +208,7 @@ absl::StatusOr<std::unique_ptr<SampleWriter>> SampleWriter::Open(
 absl::Status SampleWriter::WriteHeader(uint64_t count) {
   std::string h;
   if (format_ == OutputFormat::kCsv) {
-    h = "index,u,v,x,y,z";
-    if (fields_.normal) h += ",nx,ny,nz";
-    if (fields_.density) h += ",density";
-    if (fields_.curve_position) h += ",curve_position";
-    if (fields_.face) h += ",face";
-    if (fields_.triangle) h += ",triangle";
+    for (int id : layout_) h += (h.empty() ? "" : ",") + std::string(Name(static_cast<Col>(id)));
     h += "\n";
     return WriteAll(out_, h);
   }
@@ -127,18 +221,10 @@ absl::Status SampleWriter::WriteHeader(uint64_t count) {
   h += "comment sfcsampler samples in curve order\n";
   h += absl::StrFormat("element vertex %d\n", count);
   const char* type = precision_ == OutputPrecision::kFloat32 ? "float" : "double";
-  auto property = [&](const char* name) { h += absl::StrFormat("property %s %s\n", type, name); };
-  for (const char* name : {"x", "y", "z"}) property(name);
-  if (fields_.normal) {
-    for (const char* name : {"nx", "ny", "nz"}) property(name);
+  for (int id : layout_) {
+    const Col c = static_cast<Col>(id);
+    h += absl::StrFormat("property %s %s\n", IsReal(c) ? type : "uint", Name(c));
   }
-  property("u");
-  property("v");
-  h += "property uint index\n";
-  if (fields_.density) property("density");
-  if (fields_.curve_position) property("curve_position");
-  if (fields_.face) h += "property uint face\n";
-  if (fields_.triangle) h += "property uint triangle\n";
   h += "end_header\n";
   return WriteAll(out_, h);
 }
@@ -149,33 +235,24 @@ absl::Status SampleWriter::WriteRows(std::FILE* to, const SampleBatch& b) {
     PackBinary(b);
     return WriteAll(to, buffer_);
   }
+  const char separator = format_ == OutputFormat::kCsv ? ',' : ' ';
   for (size_t i = 0; i < b.size(); ++i) {
-    if (format_ == OutputFormat::kCsv) {
-      AppendUint(&buffer_, b.index[i]);
-      for (double d : {b.u[i], b.v[i], b.x[i], b.y[i], b.z[i]}) buffer_ += ',', AppendNumber(&buffer_, d);
-      if (fields_.normal) {
-        for (double d : {b.nx[i], b.ny[i], b.nz[i]}) buffer_ += ',', AppendNumber(&buffer_, d);
+    bool first = true;
+    for (int id : layout_) {
+      const Col c = static_cast<Col>(id);
+      if (!first) buffer_ += separator;
+      first = false;
+      if (c == Col::kIndex) {
+        AppendUint(&buffer_, b.index[i]);
+      } else if (c == Col::kFace) {
+        AppendUint(&buffer_, b.face[i]);
+      } else if (c == Col::kTriangle) {
+        AppendUint(&buffer_, b.triangle[i]);
+      } else {
+        AppendNumber(&buffer_, Real(b, c)[i]);
       }
-      if (fields_.density) buffer_ += ',', AppendNumber(&buffer_, b.density[i]);
-      if (fields_.curve_position) buffer_ += ',', AppendNumber(&buffer_, b.curve_position[i]);
-      if (fields_.face) buffer_ += ',', AppendUint(&buffer_, b.face[i]);
-      if (fields_.triangle) buffer_ += ',', AppendUint(&buffer_, b.triangle[i]);
-      buffer_ += '\n';
-    } else if (format_ == OutputFormat::kPlyAscii) {
-      std::string row;
-      for (double d : {b.x[i], b.y[i], b.z[i]}) AppendNumber(&row, d), row += ' ';
-      if (fields_.normal) {
-        for (double d : {b.nx[i], b.ny[i], b.nz[i]}) AppendNumber(&row, d), row += ' ';
-      }
-      AppendNumber(&row, b.u[i]), row += ' ';
-      AppendNumber(&row, b.v[i]), row += ' ';
-      AppendUint(&row, b.index[i]);
-      if (fields_.density) row += ' ', AppendNumber(&row, b.density[i]);
-      if (fields_.curve_position) row += ' ', AppendNumber(&row, b.curve_position[i]);
-      if (fields_.face) row += ' ', AppendUint(&row, b.face[i]);
-      if (fields_.triangle) row += ' ', AppendUint(&row, b.triangle[i]);
-      buffer_ += row + '\n';
     }
+    buffer_ += '\n';
   }
   return WriteAll(to, buffer_);
 }
@@ -192,17 +269,19 @@ void SampleWriter::PackBinary(const SampleBatch& b) {
     const uint32_t* uint = nullptr;   // face or triangle
   };
   std::vector<Column> columns;
-  const auto add_real = [&](const std::vector<double>& c) { columns.push_back({c.data(), nullptr, nullptr}); };
+  for (int id : layout_) {
+    const Col c = static_cast<Col>(id);
+    if (c == Col::kIndex) {
+      columns.push_back({nullptr, b.index.data(), nullptr});
+    } else if (c == Col::kFace) {
+      columns.push_back({nullptr, nullptr, b.face.data()});
+    } else if (c == Col::kTriangle) {
+      columns.push_back({nullptr, nullptr, b.triangle.data()});
+    } else {
+      columns.push_back({Real(b, c).data(), nullptr, nullptr});
+    }
+  }
   const bool npy = format_ == OutputFormat::kNpy;
-  if (npy) columns.push_back({nullptr, b.index.data(), nullptr});
-  if (npy) add_real(b.u), add_real(b.v);
-  add_real(b.x), add_real(b.y), add_real(b.z);
-  if (fields_.normal) add_real(b.nx), add_real(b.ny), add_real(b.nz);
-  if (!npy) add_real(b.u), add_real(b.v), columns.push_back({nullptr, b.index.data(), nullptr});
-  if (fields_.density) add_real(b.density);
-  if (fields_.curve_position) add_real(b.curve_position);
-  if (fields_.face) columns.push_back({nullptr, nullptr, b.face.data()});
-  if (fields_.triangle) columns.push_back({nullptr, nullptr, b.triangle.data()});
   const size_t index_width = npy ? sizeof(uint64_t) : sizeof(uint32_t);
   size_t record = 0;
   for (const Column& c : columns) record += c.real ? real : c.index ? index_width : sizeof(uint32_t);
@@ -238,7 +317,9 @@ void SampleWriter::PackBinary(const SampleBatch& b) {
 
 absl::Status SampleWriter::Write(const SampleBatch& batch) {
   const bool ply = format_ == OutputFormat::kPlyBinary || format_ == OutputFormat::kPlyAscii;
-  if (ply && !batch.index.empty() && batch.index.back() > UINT32_MAX) {
+  const bool index = std::find(layout_.begin(), layout_.end(), static_cast<int>(Col::kIndex)) !=
+                     layout_.end();
+  if (ply && index && !batch.index.empty() && batch.index.back() > UINT32_MAX) {
     return absl::InvalidArgumentError("PLY stores the sample index as uint32; use CSV for indices >= 2^32");
   }
   RETURN_IF_ERROR(WriteRows(staging_ ? staging_ : out_, batch));

@@ -1,5 +1,5 @@
 // Writes sample batches as CSV, PLY (binary little-endian or ASCII) or NumPy's
-// .npy format.
+// .npy format: every column the request makes, or those --columns names.
 //
 // CSV starts with the header index,u,v,x,y,z, then the optional columns
 // nx,ny,nz, density, curve_position, face, triangle (the last two unsigned
@@ -19,6 +19,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "core/sample_batch.h"
@@ -37,9 +38,17 @@ class SampleWriter {
   // Opens `path` ("-" = stdout). `expected_count` is the exact number of
   // samples when known; PLY output without it is staged in a temporary file
   // so the header can carry the count (likewise NPY).
+  // `columns`: the names of the columns to write (--columns; empty = every
+  // column the fields make), each in the format's own order.
   static absl::StatusOr<std::unique_ptr<SampleWriter>> Open(
       const std::string& path, OutputFormat format, const SampleFields& fields,
-      std::optional<uint64_t> expected_count, OutputPrecision precision = OutputPrecision::kFloat64);
+      std::optional<uint64_t> expected_count, OutputPrecision precision = OutputPrecision::kFloat64,
+      const std::vector<std::string>& columns = {});
+  // Open's check of `columns` alone, before any sampling: INVALID_ARGUMENT
+  // for an unknown name, a column the fields do not make (naming its flag),
+  // or PLY without x, y and z.
+  static absl::Status CheckColumns(OutputFormat format, const SampleFields& fields,
+                                   const std::vector<std::string>& columns);
   ~SampleWriter();
 
   absl::Status Write(const SampleBatch& batch);
@@ -67,6 +76,7 @@ class SampleWriter {
   std::optional<uint64_t> expected_;
   uint64_t written_ = 0;
   std::string buffer_;
+  std::vector<int> layout_;  // the file's columns in its order (sample_writer.cc's Col)
 };
 
 }  // namespace sfc

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "base/status_macros.h"
 #include "client/cli/commands.h"
@@ -24,6 +25,7 @@ struct SampleFlags {
   std::string output = "-";
   size_t batch_size = 0;  // 0: 65536 in-process, the server's choice over the wire
   std::string precision = "float64";
+  std::vector<std::string> columns;  // --columns (empty: every column)
   Verbosity verbosity;
   ConnectionFlags connection;
 };
@@ -48,6 +50,9 @@ int RunSample(const SampleFlags& flags) {
   if (!format.ok()) return Fail(format.status());
   auto precision = ParsePrecision(flags.precision);
   if (!precision.ok()) return Fail(precision.status());
+  if (auto s = SampleWriter::CheckColumns(*format, request->fields, flags.columns); !s.ok()) {
+    return Fail(s);
+  }
   const auto start = std::chrono::steady_clock::now();
   // Float32 output asks a server for float32 columns: half the bytes, and
   // the same file (the writer rounds doubles to floats the same way).
@@ -63,14 +68,15 @@ int RunSample(const SampleFlags& flags) {
       [&](std::optional<uint64_t> expected, const SampleBatch& batch) {
         if (!writer) {
           ASSIGN_OR_RETURN(writer, SampleWriter::Open(flags.output, *format, request->fields,
-                                                      expected, *precision));
+                                                      expected, *precision, flags.columns));
         }
         return writer->Write(batch);
       });
   if (!provenance.ok()) return Fail(provenance.status());
   if (!writer) {  // a region with no samples: still write a valid, empty file
     auto opened =
-        SampleWriter::Open(flags.output, *format, request->fields, std::nullopt, *precision);
+        SampleWriter::Open(flags.output, *format, request->fields, std::nullopt, *precision,
+                           flags.columns);
     if (!opened.ok()) return Fail(opened.status());
     writer = *std::move(opened);
   }
@@ -110,6 +116,11 @@ Command AddSampleCommand(CLI::App& app) {
                    "float64 | float32: width of the float columns (float32 halves the file and the "
                    "wire; values are the float64 ones rounded)")
       ->capture_default_str();
+  sample
+      ->add_option("--columns", flags->columns,
+                   "write only these columns, comma-separated (e.g. x,y,z; default all): index, "
+                   "u, v, x, y, z, nx, ny, nz, density, curve_position, face, triangle")
+      ->delimiter(',');
   sample->add_flag("--quiet,-q", flags->verbosity.quiet,
                    "no summary and no progress on stderr (depth-cap warnings still show)");
   sample->add_flag("--no-warnings", flags->verbosity.no_warnings,

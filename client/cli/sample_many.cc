@@ -173,6 +173,16 @@ absl::Status SampleOne(const Job& job, Outcome* o) {
   flags.face = flags.face && !mesh;
   flags.triangle = flags.triangle && mesh;
   ASSIGN_OR_RETURN(const SampleRequest request, ToSampleRequest(flags));
+  // --columns likewise: the other kind's column is dropped for this model.
+  std::vector<std::string> columns;
+  for (const std::string& c : job.flags->columns) {
+    if (c != (mesh ? "face" : "triangle")) columns.push_back(c);
+  }
+  if (!job.flags->columns.empty() && columns.empty()) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "--columns: this model has no %s column (it is for %s); name a column it has",
+        mesh ? "face" : "triangle", mesh ? "CAD models" : "meshes"));
+  }
   std::error_code error;
   fs::create_directories(fs::path(o->output).parent_path(), error);
   const std::string part = o->output + ".part";
@@ -184,13 +194,15 @@ absl::Status SampleOne(const Job& job, Outcome* o) {
                    [&](std::optional<uint64_t> expected, const SampleBatch& batch) {
                      if (!writer) {
                        ASSIGN_OR_RETURN(writer, SampleWriter::Open(part, job.format, request.fields,
-                                                                   expected, job.precision));
+                                                                   expected, job.precision,
+                                                                   columns));
                      }
                      return writer->Write(batch);
                    })
           .status();
   if (status.ok() && !writer) {  // a region with no samples: still a valid, empty file
-    auto opened = SampleWriter::Open(part, job.format, request.fields, std::nullopt, job.precision);
+    auto opened =
+        SampleWriter::Open(part, job.format, request.fields, std::nullopt, job.precision, columns);
     if (opened.ok()) writer = *std::move(opened);
     status = opened.status();
   }
@@ -277,6 +289,10 @@ Command AddSampleManyCommand(CLI::App& app) {
   cmd->add_option("--format", f->format, "npy | csv | ply")->capture_default_str();
   cmd->add_flag("--ascii", f->ascii, "ASCII PLY instead of binary little-endian");
   cmd->add_option("--precision", f->precision, "float64 | float32")->capture_default_str();
+  cmd->add_option("--columns", f->columns,
+                  "write only these columns, comma-separated (e.g. x,y,z; default all): index, u, "
+                  "v, x, y, z, nx, ny, nz, density, curve_position, face, triangle")
+      ->delimiter(',');
   cmd->add_option("--jobs,-j", f->jobs, "models sampled at once (0 = the hardware threads, at most 8)")
       ->capture_default_str()
       ->check(CLI::Range(0, 256));
@@ -330,7 +346,11 @@ int RunSampleMany(const SampleManyFlags& flags) {
   {  // the shared flags, checked once on a stand-in surface
     RequestFlags probe = flags.request;
     probe.surface = "sphere";
-    if (auto checked = ToSampleRequest(probe); !checked.ok()) return Usage(std::string(checked.status().message()));
+    auto checked = ToSampleRequest(probe);
+    if (!checked.ok()) return Usage(std::string(checked.status().message()));
+    if (auto s = SampleWriter::CheckColumns(job.format, checked->fields, flags.columns); !s.ok()) {
+      return Usage(std::string(s.message()));
+    }
   }
   std::vector<Outcome> outcomes;
   for (const std::string& input : flags.inputs) {

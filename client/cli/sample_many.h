@@ -39,6 +39,7 @@ struct SampleManyFlags {
   std::string format = "npy";  // npy | csv | ply
   bool ascii = false;
   std::string precision = "float64";
+  std::vector<std::string> columns;  // --columns: the columns to write (empty: all)
   int jobs = 0;                 // 0: the hardware threads, at most 8
   std::string manifest;         // a TSV of every model's outcome, or ""
   bool quiet = false;

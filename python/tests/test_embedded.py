@@ -68,6 +68,24 @@ def test_columns_keeps_only_the_named_columns_with_the_same_values():
         sfcsampler.sample(count=10, columns=["nx"])
 
 
+def test_cli_columns_writes_only_those_columns(tmp_path):
+    full = cli_columns("--surface", "torus", "--count", "3000", "--normals")
+    some = cli_columns("--surface", "torus", "--count", "3000", "--normals", "--columns", "nz,x,index")
+    assert list(some) == ["index", "x", "nz"]  # the file's own order, whatever the flag's
+    for name in some:
+        assert np.array_equal(some[name], full[name]), name
+    run_cli("sample", "--surface", "torus", "--count", "3000", "--format", "npy", "--columns", "x,y,z",
+            "-q", "-o", str(tmp_path / "p.npy"))
+    points = np.load(tmp_path / "p.npy")
+    assert points.dtype.names == ("x", "y", "z")
+    assert np.array_equal(points["y"], sfcsampler.sample(surface="torus", count=3000).y)
+    for flags, words in ((["--columns", "x,w"], "unknown column"), (["--columns", "nx"], "--normals"),
+                         (["--columns", "u,v", "--format", "ply"], "x, y and z")):
+        done = subprocess.run([CLI, "sample", "--count", "10", *flags, "-q", "-o", "-"],
+                              capture_output=True, text=True)
+        assert done.returncode != 0 and words in done.stderr, (flags, done.stderr)
+
+
 def test_arrays_own_their_buffers_without_a_copy():
     s = sfcsampler.sample(count=1000)
     # The buffer belongs to a capsule (the C++ vector), not to a NumPy copy.

@@ -236,6 +236,12 @@ def test_python_sample_many_keeps_and_writes_only_the_named_columns(folder, tmp_
                                      out_dir=tmp_path)  # a one-shot iterator serves every model
     assert not written.failed, written.summary()
     assert all(np.load(r.path).dtype.names == ("x", "y", "z") for r in written)
+    # The CLI's --columns writes the same files byte for byte.
+    cli = run("sample-many", folder / "torus.ply", folder / "sphere.step", "-O", tmp_path / "cli",
+              "--count", "2000", "--seed", "5", "--columns", "x,y,z", "-q")
+    assert cli.returncode == 0, cli.stderr
+    for r in written:
+        assert filecmp.cmp(r.path, tmp_path / "cli" / os.path.basename(r.path), shallow=False)
     faces_only = sfcsampler.sample_many(names, count=100, face=True, columns=["face"])
     assert "no 'face' column" in faces_only[0].error and faces_only[1].ok
     with pytest.raises(sfcsampler.InvalidArgumentError, match="unknown column 'w'"):
