@@ -77,17 +77,10 @@ absl::StatusOr<std::shared_ptr<const void>> LoadedModels::GetAny(
           "this server gives parses (parse_memory_bytes %d); simplify or split the model, or ask "
           "the operator to raise the limit",
           working_bytes, options_.working_budget_bytes));
-    } else if (options_.parse_threads == 0) {
-      job = std::make_shared<Job>();
-      job->key = key;
-      job->parse = std::move(parse);
-      job->working_bytes = working_bytes;
-      pending_.emplace(key, job);
-      ++stats_.parsing;
-      working_bytes_ += working_bytes;
-      parse_here = true;
     } else {
-      if (queue_.size() >= static_cast<size_t>(std::max(0, options_.max_queued_parses))) {
+      parse_here = options_.parse_threads == 0;
+      if (!parse_here &&
+          queue_.size() >= static_cast<size_t>(std::max(0, options_.max_queued_parses))) {
         ++stats_.parses_rejected;
         return absl::ResourceExhaustedError(absl::StrFormat(
             "%d model parses are already waiting for a parser (max_queued_parses); retry later",
@@ -98,7 +91,12 @@ absl::StatusOr<std::shared_ptr<const void>> LoadedModels::GetAny(
       job->parse = std::move(parse);
       job->working_bytes = working_bytes;
       pending_.emplace(key, job);
-      queue_.push_back(job);
+      if (parse_here) {  // started at once, as ParserLoop starts a queued one
+        ++stats_.parsing;
+        working_bytes_ += working_bytes;
+      } else {
+        queue_.push_back(job);
+      }
     }
     ++job->waiters;
   }

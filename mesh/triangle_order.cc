@@ -43,11 +43,16 @@ template <int kAxis>
 size_t SplitByArea(const Item* items, Index* begin, Index* end, double half) {
   const Before<kAxis> before{items};
   const size_t n = static_cast<size_t>(end - begin);
+  // What the general steps below come to for two and three items: the items
+  // sorted by Before; two split 1 + 1 whatever the areas, and of three the
+  // first two go to the first part when their areas, added in that order, are
+  // at most `half` (the median of three is the pivot; one or two more rounds
+  // settle m).
+  if (n == 2) {
+    if (before(begin[1], begin[0])) std::swap(begin[0], begin[1]);
+    return 1;
+  }
   if (n == 3) {
-    // What the general steps below come to for three items (the median of
-    // three is the pivot; one or two more rounds settle m): the items sorted
-    // by Before, and the first two in the first part when their areas,
-    // added in that order, are at most `half`.
     if (before(begin[1], begin[0])) std::swap(begin[0], begin[1]);
     if (before(begin[2], begin[1])) std::swap(begin[1], begin[2]);
     if (before(begin[1], begin[0])) std::swap(begin[0], begin[1]);
@@ -124,28 +129,6 @@ Summary Summarize(const Item* items, const Index* begin, const Index* end) {
   return s;
 }
 
-// Order of a run of two items, without the general steps: SplitByArea puts
-// the item first in the order Before first, whatever the areas, and each
-// half's centre is its one item's area-weighted centroid (computed as
-// Summarize and Order do, so the comparison is the same to the bit).
-Vec3 OrderPair(const Item* items, Index a, Index b, int axis, Vec3 entry,
-               std::vector<uint32_t>* out) {
-  const bool a_first = axis == 0 ? Before<0>{items}(a, b)
-                       : axis == 1 ? Before<1>{items}(a, b)
-                                   : Before<2>{items}(a, b);
-  const Item& first = items[a_first ? a : b];
-  const Item& second = items[a_first ? b : a];
-  auto centre = [](const Item& it) {
-    return it.area > 0 ? (Vec3{0, 0, 0} + it.c * it.area) * (1 / it.area) : it.c;
-  };
-  const bool keep = Distance2(centre(first), entry) <= Distance2(centre(second), entry);
-  const Item& head = keep ? first : second;
-  const Item& tail = keep ? second : first;
-  out->push_back(head.t);
-  out->push_back(tail.t);
-  return tail.c;
-}
-
 // Appends the items [begin, end) in curve order, starting near `entry`;
 // returns where the order ends (the last centroid). `run` is
 // Summarize(begin, end): the parent's pass over each half serves both the
@@ -159,7 +142,6 @@ Vec3 Order(const Item* items, Index* begin, Index* end, const Summary& run, Vec3
   }
   const Vec3 extent = run.hi - run.lo;
   const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
-  if (n == 2) return OrderPair(items, begin[0], begin[1], axis, entry, out);
   const size_t split = SplitByArea(items, begin, end, axis, run.area / 2);
   Index* middle = begin + split;
   const Summary first = Summarize(items, begin, middle), second = Summarize(items, middle, end);

@@ -28,7 +28,7 @@ import numpy as np
 
 from sfcsampler import meshes
 from sfcsampler.errors import Error
-from sfcsampler.samples import COLUMNS
+from sfcsampler.samples import column_names
 
 # File extensions of the model formats (lower case), as the CLI reads them.
 EXTENSIONS = {".step": "step", ".stp": "step", ".iges": "iges", ".igs": "iges", ".nurbs": "nurbs",
@@ -223,17 +223,10 @@ def find_model_check_program():
 
 
 def columns_list(request):
-    """Turns request["columns"] (a name or an iterable of names) into a list once, for every
-    model of a run to use; InvalidArgumentError for a name that is no column."""
-    columns = request.get("columns")
-    if columns is None:
-        return
-    request["columns"] = [columns] if isinstance(columns, str) else list(columns)
-    unknown = [c for c in request["columns"] if c not in COLUMNS]
-    if unknown or not request["columns"]:
-        raise meshes.InvalidArgumentError(
-            3, f"columns: {'unknown column ' + repr(unknown[0]) if unknown else 'name at least one column'}; "
-               f"the columns are {', '.join(COLUMNS)}")
+    """Turns request["columns"] into a list once (samples.column_names), for every model of a
+    run to use."""
+    if request.get("columns") is not None:
+        request["columns"] = column_names(request["columns"])
 
 
 def sample_one(model, request, base_seed, sampler=None, out_path=None, keep=True, client=None):

@@ -13,22 +13,30 @@ _COLUMN_FLAGS = {"nx": "normals", "ny": "normals", "nz": "normals", "density": "
                  "curve_position": "curve_position", "face": "face", "triangle": "triangle"}
 
 
+def column_names(columns):
+    """A `columns=` argument (a name or an iterable of names) as a list, read once;
+    InvalidArgumentError for an unknown name or none."""
+    names = [columns] if isinstance(columns, str) else list(columns)
+    for name in names:
+        if name not in COLUMNS:
+            raise InvalidArgumentError(3, f"columns: unknown column {name!r}; the columns are "
+                                          f"{', '.join(COLUMNS)}")
+    if not names:
+        raise InvalidArgumentError(3, "columns: name at least one column")
+    return names
+
+
 def kept_columns(columns, request):
     """The set of column names a `columns=` argument keeps (None: every column the request
     makes). InvalidArgumentError for an unknown name, or one the request does not make
     (it names the flag that would)."""
     if columns is None:
         return None
-    names = [columns] if isinstance(columns, str) else list(columns)
+    names = column_names(columns)
     for name in names:
-        if name not in COLUMNS:
-            raise InvalidArgumentError(3, f"columns: unknown column {name!r}; the columns are "
-                                          f"{', '.join(COLUMNS)}")
         flag = _COLUMN_FLAGS.get(name)
         if flag and not request.get(flag):
             raise InvalidArgumentError(3, f"columns: {name!r} needs {flag}=True in the request")
-    if not names:
-        raise InvalidArgumentError(3, "columns: name at least one column")
     return frozenset(names)
 
 
@@ -101,7 +109,8 @@ class Samples:
 
 
 def concatenate(parts, tree, begin, end, seed, algorithm_version, dtype, kept=None):
-    """One Samples from batches of column dicts (copies each column once)."""
+    """One Samples from batches of column dicts (copies each column once); `kept` as
+    kept_columns() gives it, the parts already holding only those columns."""
     parts = [p for p in parts if p]
     if len(parts) == 1:
         columns = parts[0]
@@ -111,7 +120,7 @@ def concatenate(parts, tree, begin, end, seed, algorithm_version, dtype, kept=No
             pieces = [p[name] for p in parts if name in p]
             if pieces:
                 columns[name] = np.concatenate(pieces)
-    return Samples(select(columns, kept), tree, begin, end, seed, algorithm_version, dtype, kept)
+    return Samples(columns, tree, begin, end, seed, algorithm_version, dtype, kept)
 
 
 def warn_depth_cap(tree, stacklevel=3):
