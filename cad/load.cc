@@ -11,6 +11,7 @@
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepGProp.hxx>
+#include <BRepLib.hxx>
 #include <BRepTools.hxx>
 #include <BinTools.hxx>
 #include <GProp_GProps.hxx>
@@ -37,6 +38,7 @@
 #include <TColStd_Array2OfReal.hxx>
 #include <TColgp_Array2OfPnt.hxx>
 #include <TopExp.hxx>
+#include <TopExp_Explorer.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Face.hxx>
@@ -360,11 +362,29 @@ FaceType TypeOf(GeomAbs_SurfaceType type) {
   }
 }
 
+// The edges of a planar face often carry no p-curve; the kernel then projects
+// the edge's 3D curve onto the plane on every question it is asked about the
+// face (BRep_Tool::CurveOnPlane), which made the trim classifier's answers
+// near the boundary ~20 us each. Storing that same projection on the edge
+// once (BRepLib::BuildPCurveForEdgeOnPlane) leaves every answer as it was. An
+// edge the kernel will not update keeps computing it.
+void StorePlanePcurves(const TopoDS_Face& face) {
+  if (BRepAdaptor_Surface(face, false).GetType() != GeomAbs_Plane) return;
+  for (TopExp_Explorer it(face, TopAbs_EDGE); it.More(); it.Next()) {
+    try {
+      OCC_CATCH_SIGNALS
+      BRepLib::BuildPCurveForEdgeOnPlane(TopoDS::Edge(it.Current()), face);
+    } catch (const Standard_Failure&) {
+    }
+  }
+}
+
 absl::StatusOr<Face> MakeFace(const TopoDS_Face& face, int index, ModelFormat format,
                               absl::string_view name, const LoadOptions& options) {
   auto bad = [&](absl::string_view what) {
     return Invalid(format, name, absl::StrCat("face ", index, " ", what));
   };
+  StorePlanePcurves(face);
   ParameterBox box;
   BRepTools::UVBounds(face, box.u0, box.u1, box.v0, box.v1);
   for (double x : {box.u0, box.u1, box.v0, box.v1}) {

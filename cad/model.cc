@@ -53,6 +53,8 @@ Face::Face(int index, FaceType type, double area, ParameterBox box, bool reverse
 
 bool Face::Contains(double s, double t) const { return trim_->Contains(s, t); }
 
+double Face::Clearance(double s, double t) const { return trim_->Clearance(s, t); }
+
 CellState Face::Classify(double s0, double s1, double t0, double t1) const {
   return trim_->Classify(s0, s1, t0, t1);
 }

@@ -92,8 +92,9 @@ class Face {
 
   // True if the unit-square point (s, t) lies in the trimmed face; points on
   // the trim boundary (within the tolerance) count as inside. Fast away from
-  // the trim: a 128 x 128 grid of Classify() answers, made on first use,
-  // leaves the kernel only the points in cells the boundary may cross.
+  // the trim: a 128 x 128 grid of Classify() answers, made on first use, with
+  // 16 x 16 sub-cells in each cell the boundary may cross, leaves the kernel
+  // only the points within ~1/2048 of the boundary.
   // REQUIRES: (s, t) in [0,1]^2.
   bool Contains(double s, double t) const;
 
@@ -102,6 +103,11 @@ class Face {
   // enclosed in boxes of at most ~1/2048 of the square; a cell that close to
   // the boundary stays kStraddles). REQUIRES: 0 <= s0 <= s1 <= 1, same for t.
   CellState Classify(double s0, double s1, double t0, double t1) const;
+
+  // A lower bound on the distance in the unit square from (s, t) to the trim
+  // curves (with the tolerance): points nearer than it, joined to (s, t) by a
+  // segment, have its Contains() answer. 0 when it cannot tell.
+  double Clearance(double s, double t) const;
 
  private:
   int index_;

@@ -177,11 +177,15 @@ void ModelSampleCursor::KeepInTrim(const ModelTree::Piece& piece, size_t i, Samp
   const double s = b->u[i], t = b->v[i];
   if (!face.trimmed() || face.Contains(s, t)) return;
   // The nearest inside point on growing circles (16 directions each, in a
-  // fixed order), clamped to the square.
+  // fixed order), clamped to the square. A circle within the clearance holds
+  // no inside point (a clamped probe is no farther than r from (s, t)), so it
+  // is skipped without asking.
   constexpr int kDirections = 16;
+  const double clear = face.Clearance(s, t);
   double best_s = s, best_t = t;
   bool found = false;
   for (double r = 1e-9; r <= 2 && !found; r *= 2) {
+    if (r < clear) continue;
     for (int d = 0; d < kDirections && !found; ++d) {
       const math::SinCos a = math::SinCosPi(2.0 * d / kDirections);
       const double cs = std::clamp(s + r * a.cos, 0.0, 1.0);

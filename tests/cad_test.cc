@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -324,6 +325,98 @@ TEST(CadBoxWithHole, RandomCellsOfAllSizesAreClassifiedSafely) {
   EXPECT_GT(decided, 2000);
 }
 
+// The holed faces (top and bottom) of the box, with the plane's affine map:
+// the unit square's point (s, t) is p0 + s fu + t fv (fu, fv orthogonal), so
+// the hole is an exact ellipse in (s, t), a reference the kernel has no part in.
+struct HoledFace {
+  const Face* face;
+  Vec3 p0, fu, fv;
+  // Signed distance in space from the hole's circle, > 0 inside the face.
+  double Beyond(double s, double t) const {
+    const Vec3 p = p0 + fu * s + fv * t;
+    return std::hypot(p.x - fixtures::kBoxX / 2, p.y - fixtures::kBoxY / 2) -
+           fixtures::kHoleRadius;
+  }
+  // The hole's centre in (s, t).
+  double CentreS() const { return Dot(Vec3{fixtures::kBoxX / 2, fixtures::kBoxY / 2, p0.z} - p0, fu) / Dot(fu, fu); }
+  double CentreT() const { return Dot(Vec3{fixtures::kBoxX / 2, fixtures::kBoxY / 2, p0.z} - p0, fv) / Dot(fv, fv); }
+};
+
+std::vector<HoledFace> HoledFaces(const Model& model) {
+  std::vector<HoledFace> out;
+  for (const Face& face : model.faces()) {
+    if (face.type() != FaceType::kPlane || !face.trimmed()) continue;
+    const SurfaceJet jet = face.surface().Jet(0, 0, 1);
+    if (std::abs(jet.fu.z) > 1e-12 || std::abs(jet.fv.z) > 1e-12) continue;  // not horizontal
+    out.push_back({&face, jet.p, jet.fu, jet.fv});
+  }
+  return out;
+}
+
+// Points near the hole, from 1e-6 mm to 4 mm off its circle on either side:
+// Contains matches the exact circle (the fine grid near the trim decides many
+// of them without the kernel).
+TEST(CadBoxWithHole, ContainsMatchesTheExactHoleNearItsEdge) {
+  auto model = LoadOk(Solid::kBoxWithHole, ModelFormat::kStep);
+  ASSERT_NE(model, nullptr);
+  const auto faces = HoledFaces(*model);
+  ASSERT_EQ(faces.size(), 2u);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (const HoledFace& h : faces) {
+    const double cs = h.CentreS(), ct = h.CentreT();
+    int inside = 0, outside = 0;
+    for (int k = 0; k < 20000; ++k) {
+      const double angle = 2 * kPi * unit(rng);
+      const double off = (k % 2 ? 1 : -1) * std::pow(10.0, -6 + 6.6 * unit(rng));  // mm
+      const double r = fixtures::kHoleRadius + off;
+      const double s = cs + r * std::cos(angle) / Norm(h.fu);
+      const double t = ct + r * std::sin(angle) / Norm(h.fv);
+      const double beyond = h.Beyond(s, t);
+      if (std::abs(beyond) < 1e-7) continue;  // within the tolerance: either answer
+      const bool in = h.face->Contains(s, t);
+      ASSERT_EQ(in, beyond > 0) << "face " << h.face->index() << " at (" << s << ", " << t
+                                << "), " << beyond << " mm from the hole";
+      (in ? inside : outside)++;
+    }
+    EXPECT_GT(inside, 9000);
+    EXPECT_GT(outside, 9000);
+  }
+}
+
+// Clearance: every point nearer than it keeps the answer (checked on circles
+// against the exact hole), and it is not uselessly small: at least half the
+// distance to the hole where that is 1e-4 of the square or more.
+TEST(CadBoxWithHole, ClearanceBoundsTheDistanceToTheTrimFromBelow) {
+  auto model = LoadOk(Solid::kBoxWithHole, ModelFormat::kStep);
+  ASSERT_NE(model, nullptr);
+  std::mt19937_64 rng(6);
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (const HoledFace& h : HoledFaces(*model)) {
+    const double cs = h.CentreS(), ct = h.CentreT();
+    const double stretch = std::max(Norm(h.fu), Norm(h.fv));  // mm per unit of the square, at most
+    for (int k = 0; k < 400; ++k) {
+      const double angle = 2 * kPi * unit(rng);
+      const double off = (k % 2 ? 1 : -1) * std::pow(10.0, -5 + 5.5 * unit(rng));  // mm
+      const double r = fixtures::kHoleRadius + off;
+      const double s = cs + r * std::cos(angle) / Norm(h.fu);
+      const double t = ct + r * std::sin(angle) / Norm(h.fv);
+      const double clear = h.face->Clearance(s, t);
+      ASSERT_GE(clear, 0);
+      const bool in = h.Beyond(s, t) > 0;
+      for (int d = 0; d < 32; ++d) {
+        const double qs = s + 0.999 * clear * std::cos(2 * kPi * d / 32);
+        const double qt = t + 0.999 * clear * std::sin(2 * kPi * d / 32);
+        ASSERT_EQ(h.Beyond(qs, qt) > 0, in) << "clearance " << clear << " at (" << s << ", " << t
+                                            << ") reaches across the hole's edge";
+        ASSERT_EQ(h.face->Contains(qs, qt), in);
+      }
+      const double distance = std::abs(h.Beyond(s, t)) / stretch;  // <= the distance in (s, t)
+      if (distance >= 1e-4) EXPECT_GE(clear, 0.5 * distance) << "at (" << s << ", " << t << ")";
+    }
+  }
+}
+
 // Refining a straddling cell ends in cells the boundary boxes leave alone.
 TEST(CadBoxWithHole, StraddlingCellsShrinkToTheBoundary) {
   auto model = LoadOk(Solid::kBoxWithHole, ModelFormat::kStep);
@@ -386,6 +479,51 @@ TEST(CadModel, ConcurrentEvaluationMatchesSerial) {
   for (auto& out : parallel) threads.emplace_back([&] { run(out); });
   for (auto& t : threads) t.join();
   for (const auto& out : parallel) EXPECT_EQ(out, serial);
+}
+
+// The batch calls (one adaptor lease a batch) give Point's and Jet's values
+// bit for bit, on every face type of the fixtures.
+TEST(CadModel, BatchEvaluationEqualsPointByPoint) {
+  std::vector<std::shared_ptr<const Model>> models = {
+      LoadOk(Solid::kBoxWithHole, ModelFormat::kStep), LoadOk(Solid::kSphere, ModelFormat::kStep),
+      LoadOk(Solid::kCylinder, ModelFormat::kIges)};
+  auto patch = Load(ModelFormat::kNurbs, MultiSpanPatch(), "spans.nurbs");
+  ASSERT_TRUE(patch.ok()) << patch.status();
+  models.push_back(*patch);
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (const auto& model : models) {
+    ASSERT_NE(model, nullptr);
+    for (const Face& face : model->faces()) {
+      const Surface& surface = face.surface();
+      std::vector<double> u(200), v(200), x(200), y(200), z(200);
+      for (size_t i = 0; i < u.size(); ++i) u[i] = unit(rng), v[i] = unit(rng);
+      u[0] = 0, v[0] = 1;
+      surface.Points(u.data(), v.data(), u.size(), x.data(), y.data(), z.data());
+      for (size_t i = 0; i < u.size(); ++i) {
+        const Vec3 p = surface.Point(u[i], v[i]);
+        ASSERT_EQ(std::memcmp(&p.x, &x[i], 8) | std::memcmp(&p.y, &y[i], 8) |
+                      std::memcmp(&p.z, &z[i], 8),
+                  0)
+            << model->name() << " face " << face.index() << " sample " << i;
+      }
+      for (int order : {1, 2}) {
+        std::vector<SurfaceJet> grid(7 * 5);
+        surface.JetGrid(u.data(), 7, v.data(), 5, order, grid.data());
+        for (int i = 0; i < 7; ++i) {
+          for (int j = 0; j < 5; ++j) {
+            const SurfaceJet one = surface.Jet(u[i], v[j], order);
+            const SurfaceJet& g = grid[i * 5 + j];
+            for (auto [a, b] : {std::pair{one.p, g.p}, {one.fu, g.fu}, {one.fv, g.fv},
+                                {one.fuu, g.fuu}, {one.fuv, g.fuv}, {one.fvv, g.fvv}}) {
+              ASSERT_EQ(std::memcmp(&a, &b, sizeof(Vec3)), 0)
+                  << model->name() << " face " << face.index() << " order " << order;
+            }
+          }
+        }
+      }
+    }
+  }
 }
 
 TEST(CadModel, LoadingTwiceGivesTheSameFaces) {

@@ -11,11 +11,13 @@
 #include <TopoDS.hxx>
 #include <TopoDS_Edge.hxx>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <gp_Pnt.hxx>
 #include <gp_Pnt2d.hxx>
 #include <gp_Vec.hxx>
 #include <limits>
+#include <queue>
 
 namespace sfc::cad {
 namespace {
@@ -38,17 +40,16 @@ FaceSurface::FaceSurface(const TopoDS_Face& face, const UnitSquareMap& map)
       map_(map),
       adaptors_([face] { return std::make_unique<BRepAdaptor_Surface>(face, true); }) {}
 
-Vec3 FaceSurface::Point(double u, double v) const {
-  auto adaptor = adaptors_.Take();
+Vec3 FaceSurface::PointWith(BRepAdaptor_Surface& adaptor, double u, double v) const {
   try {
-    return ToVec3(adaptor->Value(map_.U(u), map_.V(v)).XYZ());
+    return ToVec3(adaptor.Value(map_.U(u), map_.V(v)).XYZ());
   } catch (const Standard_Failure&) {
     return NotFinite();
   }
 }
 
-SurfaceJet FaceSurface::Jet(double u, double v, int order) const {
-  auto adaptor = adaptors_.Take();
+SurfaceJet FaceSurface::JetWith(BRepAdaptor_Surface& adaptor, double u, double v,
+                                int order) const {
   SurfaceJet jet;
   const double su = map_.DuDs(), sv = map_.DvDt();
   try {
@@ -56,12 +57,12 @@ SurfaceJet FaceSurface::Jet(double u, double v, int order) const {
     gp_Vec du, dv;
     if (order >= 2) {
       gp_Vec duu, dvv, duv;
-      adaptor->D2(map_.U(u), map_.V(v), p, du, dv, duu, dvv, duv);
+      adaptor.D2(map_.U(u), map_.V(v), p, du, dv, duu, dvv, duv);
       jet.fuu = ToVec3(duu.XYZ()) * (su * su);
       jet.fuv = ToVec3(duv.XYZ()) * (su * sv);
       jet.fvv = ToVec3(dvv.XYZ()) * (sv * sv);
     } else {
-      adaptor->D1(map_.U(u), map_.V(v), p, du, dv);
+      adaptor.D1(map_.U(u), map_.V(v), p, du, dv);
     }
     jet.p = ToVec3(p.XYZ());
     jet.fu = ToVec3(du.XYZ()) * su;
@@ -70,6 +71,29 @@ SurfaceJet FaceSurface::Jet(double u, double v, int order) const {
     jet.p = jet.fu = jet.fv = NotFinite();
   }
   return jet;
+}
+
+Vec3 FaceSurface::Point(double u, double v) const { return PointWith(*adaptors_.Take(), u, v); }
+
+SurfaceJet FaceSurface::Jet(double u, double v, int order) const {
+  return JetWith(*adaptors_.Take(), u, v, order);
+}
+
+void FaceSurface::JetGrid(const double* us, int nu, const double* vs, int nv, int order,
+                          SurfaceJet* out) const {
+  auto adaptor = adaptors_.Take();
+  for (int i = 0; i < nu; ++i) {
+    for (int j = 0; j < nv; ++j) out[i * nv + j] = JetWith(*adaptor, us[i], vs[j], order);
+  }
+}
+
+void FaceSurface::Points(const double* u, const double* v, size_t n, double* x, double* y,
+                         double* z) const {
+  auto adaptor = adaptors_.Take();
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 p = PointWith(*adaptor, u[i], v[i]);
+    x[i] = p.x, y[i] = p.y, z[i] = p.z;
+  }
 }
 
 FaceTrim::FaceTrim(const TopoDS_Face& face, const UnitSquareMap& map, double tolerance)
@@ -88,16 +112,8 @@ FaceTrim::FaceTrim(const TopoDS_Face& face, const UnitSquareMap& map, double tol
       continue;
     }
     const Geom2dAdaptor_Curve curve(pcurve);
-    auto box_of = [&](double a, double b) {
-      Bnd_Box2d bnd;
-      BndLib_Add2dCurve::Add(curve, a, b, 0.0, bnd);
-      double umin, vmin, umax, vmax;
-      bnd.Get(umin, vmin, umax, vmax);
-      double s0 = map_.S(umin), s1 = map_.S(umax);
-      if (s0 > s1) std::swap(s0, s1);
-      const double m = tolerance_;
-      return Box2{s0 - m, s1 + m, map_.T(vmin) - m, map_.T(vmax) + m};
-    };
+    const int edge_index = static_cast<int>(pcurves_.size());
+    pcurves_.push_back(pcurve);
     struct Pending {
       int node;
       double a, b;
@@ -105,7 +121,7 @@ FaceTrim::FaceTrim(const TopoDS_Face& face, const UnitSquareMap& map, double tol
     };
     std::vector<Pending> queue;
     roots_.push_back(static_cast<int>(nodes_.size()));
-    nodes_.push_back({box_of(first, last), -1});
+    nodes_.push_back({CurveBox(curve, first, last), -1, edge_index, first, last});
     queue.push_back({roots_.back(), first, last, 0});
     for (size_t q = 0; q < queue.size(); ++q) {
       const Pending p = queue[q];
@@ -115,8 +131,8 @@ FaceTrim::FaceTrim(const TopoDS_Face& face, const UnitSquareMap& map, double tol
       const double mid = 0.5 * (p.a + p.b);
       const int child = static_cast<int>(nodes_.size());
       nodes_[p.node].first_child = child;
-      nodes_.push_back({box_of(p.a, mid), -1});
-      nodes_.push_back({box_of(mid, p.b), -1});
+      nodes_.push_back({CurveBox(curve, p.a, mid), -1, edge_index, p.a, mid});
+      nodes_.push_back({CurveBox(curve, mid, p.b), -1, edge_index, mid, p.b});
       queue.push_back({child, p.a, mid, p.depth + 1});
       queue.push_back({child + 1, mid, p.b, p.depth + 1});
     }
@@ -129,6 +145,78 @@ FaceTrim::FaceTrim(const TopoDS_Face& face, const UnitSquareMap& map, double tol
     auto classifier = classifiers_.Take();
     trimmed_ = classifier->Perform(gp_Pnt2d(map_.U(0.5), map_.V(0.5))) != TopAbs_IN;
   }
+}
+
+Box2 FaceTrim::CurveBox(const Adaptor2d_Curve2d& curve, double a, double b) const {
+  Bnd_Box2d bnd;
+  BndLib_Add2dCurve::Add(curve, a, b, 0.0, bnd);
+  double umin, vmin, umax, vmax;
+  bnd.Get(umin, vmin, umax, vmax);
+  double s0 = map_.S(umin), s1 = map_.S(umax);
+  if (s0 > s1) std::swap(s0, s1);
+  const double m = tolerance_;
+  return Box2{s0 - m, s1 + m, map_.T(vmin) - m, map_.T(vmax) + m};
+}
+
+double FaceTrim::BandS() const {
+  const double du = map_.box.u1 - map_.box.u0, dv = map_.box.v1 - map_.box.v0;
+  return 2 * tolerance_ * std::max(du, dv) / du + 1e-12;
+}
+
+double FaceTrim::BandT() const {
+  const double du = map_.box.u1 - map_.box.u0, dv = map_.box.v1 - map_.box.v0;
+  return 2 * tolerance_ * std::max(du, dv) / dv + 1e-12;
+}
+
+double FaceTrim::Clearance(double s, double t) const {
+  if (!trimmed_ || missing_pcurve_) return 0;
+  const double ms = BandS(), mt = BandT();
+  struct Piece {
+    double distance;
+    Box2 box;
+    int node;  // the hierarchy's node, or -1 for a piece split below a leaf
+    int edge;
+    double a, b;
+    bool operator>(const Piece& o) const { return distance > o.distance; }
+  };
+  auto piece = [&](const Box2& box, int node, int edge, double a, double b) {
+    const Box2 w{box.s0 - ms, box.s1 + ms, box.t0 - mt, box.t1 + mt};
+    const double ds = std::max({w.s0 - s, s - w.s1, 0.0});
+    const double dt = std::max({w.t0 - t, t - w.t1, 0.0});
+    return Piece{std::hypot(ds, dt), w, node, edge, a, b};
+  };
+  auto of_node = [&](int n) {
+    const Node& node = nodes_[n];
+    return piece(node.box, n, node.edge, node.a, node.b);
+  };
+  // Best first: the nearest box is split (the hierarchy's children, then the
+  // kernel's boxes of halves) until it is small against its distance; its
+  // distance then bounds every curve's from below.
+  std::priority_queue<Piece, std::vector<Piece>, std::greater<Piece>> queue;
+  for (int root : roots_) queue.push(of_node(root));
+  constexpr int kMaxSplits = 512;
+  for (int splits = 0; !queue.empty(); ++splits) {
+    const Piece near = queue.top();
+    const double size = std::max(near.box.s1 - near.box.s0, near.box.t1 - near.box.t0);
+    if (size <= 0.25 * near.distance || size < 1e-10 || splits == kMaxSplits) {
+      return near.distance;
+    }
+    queue.pop();
+    if (near.node >= 0 && nodes_[near.node].first_child >= 0) {
+      queue.push(of_node(nodes_[near.node].first_child));
+      queue.push(of_node(nodes_[near.node].first_child + 1));
+      continue;
+    }
+    const Geom2dAdaptor_Curve curve(pcurves_[near.edge]);
+    const double mid = 0.5 * (near.a + near.b);
+    try {
+      queue.push(piece(CurveBox(curve, near.a, mid), -1, near.edge, near.a, mid));
+      queue.push(piece(CurveBox(curve, mid, near.b), -1, near.edge, mid, near.b));
+    } catch (const Standard_Failure&) {
+      return 0;
+    }
+  }
+  return std::numeric_limits<double>::infinity();  // no curve at all
 }
 
 bool FaceTrim::OnBorder(const Box2& box) const {
@@ -152,20 +240,89 @@ bool FaceTrim::CrossesBoundary(const Box2& cell) const {
 
 void FaceTrim::BuildGrid() const {
   grid_.resize(kGridSide * kGridSide);
+  fine_at_.assign(kGridSide * kGridSide, -1);
   for (int i = 0; i < kGridSide; ++i) {
     for (int j = 0; j < kGridSide; ++j) {
       grid_[i * kGridSide + j] = Classify(double(i) / kGridSide, double(i + 1) / kGridSide,
                                           double(j) / kGridSide, double(j + 1) / kGridSide);
+      if (grid_[i * kGridSide + j] == CellState::kStraddles && !missing_pcurve_) {
+        BuildFineGrid(i, j);
+      }
     }
+  }
+}
+
+void FaceTrim::BuildFineGrid(int i, int j) const {
+  constexpr int kSide = kGridSide * kFineSide;
+  constexpr int kCells = kFineSide * kFineSide;
+  const double w = 1.0 / kSide;
+  const double s0 = double(i) / kGridSide, t0 = double(j) / kGridSide;
+  // Every curve box (the hierarchy's leaves, border ones included), widened
+  // by twice the kernel's ON band in each axis (its tolerance is isotropic in
+  // the native parameters), marks the sub-cells it touches.
+  const double ms = BandS(), mt = BandT();
+  const Box2 cell{s0, s0 + 1.0 / kGridSide, t0, t0 + 1.0 / kGridSide};
+  std::array<bool, kCells> marked{};
+  std::vector<int> stack(roots_.begin(), roots_.end());
+  while (!stack.empty()) {
+    const Node& node = nodes_[stack.back()];
+    stack.pop_back();
+    const Box2 b{node.box.s0 - ms, node.box.s1 + ms, node.box.t0 - mt, node.box.t1 + mt};
+    if (!Intersects(b, cell)) continue;
+    if (node.first_child >= 0) {
+      stack.push_back(node.first_child);
+      stack.push_back(node.first_child + 1);
+      continue;
+    }
+    auto first = [w](double lo, double c0) {
+      return std::clamp(static_cast<int>(std::floor((lo - c0) / w)), 0, kFineSide - 1);
+    };
+    auto last = [w](double hi, double c0) {
+      return std::clamp(static_cast<int>(std::floor((hi - c0) / w)), 0, kFineSide - 1);
+    };
+    for (int a = first(b.s0, s0); a <= last(b.s1, s0); ++a) {
+      for (int c = first(b.t0, t0); c <= last(b.t1, t0); ++c) marked[a * kFineSide + c] = true;
+    }
+  }
+  // Unmarked sub-cells joined by a side form a piece no curve enters; one
+  // kernel answer, at the centre of its first sub-cell, holds for all of it.
+  const int32_t at = static_cast<int32_t>(fine_.size());
+  fine_at_[i * kGridSide + j] = at;
+  fine_.resize(fine_.size() + kCells, CellState::kStraddles);
+  std::array<bool, kCells> seen{};
+  std::vector<int> piece;
+  for (int start = 0; start < kCells; ++start) {
+    if (marked[start] || seen[start]) continue;
+    piece.assign(1, start);
+    seen[start] = true;
+    for (size_t q = 0; q < piece.size(); ++q) {
+      const int a = piece[q] / kFineSide, c = piece[q] % kFineSide;
+      const int next[4][2] = {{a - 1, c}, {a + 1, c}, {a, c - 1}, {a, c + 1}};
+      for (const auto& n : next) {
+        if (n[0] < 0 || n[0] >= kFineSide || n[1] < 0 || n[1] >= kFineSide) continue;
+        const int k = n[0] * kFineSide + n[1];
+        if (!marked[k] && !seen[k]) seen[k] = true, piece.push_back(k);
+      }
+    }
+    const CellState state = KernelState(s0 + (start / kFineSide + 0.5) * w,
+                                        t0 + (start % kFineSide + 0.5) * w);
+    for (int k : piece) fine_[at + k] = state;
   }
 }
 
 bool FaceTrim::Contains(double s, double t) const {
   if (!trimmed_) return true;
   std::call_once(grid_once_, [this] { BuildGrid(); });
-  const int i = std::clamp(static_cast<int>(s * kGridSide), 0, kGridSide - 1);
-  const int j = std::clamp(static_cast<int>(t * kGridSide), 0, kGridSide - 1);
-  switch (grid_[i * kGridSide + j]) {
+  // floor(2048 s) / 16 = floor(128 s): both scalings are exact.
+  constexpr int kSide = kGridSide * kFineSide;
+  const int fi = std::clamp(static_cast<int>(s * kSide), 0, kSide - 1);
+  const int fj = std::clamp(static_cast<int>(t * kSide), 0, kSide - 1);
+  const int cell = (fi / kFineSide) * kGridSide + fj / kFineSide;
+  CellState state = grid_[cell];
+  if (state == CellState::kStraddles && fine_at_[cell] >= 0) {
+    state = fine_[fine_at_[cell] + (fi % kFineSide) * kFineSide + fj % kFineSide];
+  }
+  switch (state) {
     case CellState::kInside: return true;
     case CellState::kOutside: return false;
     case CellState::kStraddles: break;
@@ -178,12 +335,10 @@ bool FaceTrim::Contains(double s, double t) const {
   }
 }
 
-CellState FaceTrim::Classify(double s0, double s1, double t0, double t1) const {
-  if (!trimmed_) return CellState::kInside;
-  if (CrossesBoundary({s0, s1, t0, t1})) return CellState::kStraddles;
+CellState FaceTrim::KernelState(double s, double t) const {
   auto classifier = classifiers_.Take();
   try {
-    switch (classifier->Perform(gp_Pnt2d(map_.U(0.5 * (s0 + s1)), map_.V(0.5 * (t0 + t1))))) {
+    switch (classifier->Perform(gp_Pnt2d(map_.U(s), map_.V(t)))) {
       case TopAbs_IN:
         return CellState::kInside;
       case TopAbs_OUT:
@@ -194,6 +349,12 @@ CellState FaceTrim::Classify(double s0, double s1, double t0, double t1) const {
   } catch (const Standard_Failure&) {
     return CellState::kStraddles;
   }
+}
+
+CellState FaceTrim::Classify(double s0, double s1, double t0, double t1) const {
+  if (!trimmed_) return CellState::kInside;
+  if (CrossesBoundary({s0, s1, t0, t1})) return CellState::kStraddles;
+  return KernelState(0.5 * (s0 + s1), 0.5 * (t0 + t1));
 }
 
 }  // namespace sfc::cad

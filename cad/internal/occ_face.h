@@ -12,7 +12,9 @@
 #define SFCSAMPLER_CAD_INTERNAL_OCC_FACE_H_
 
 #include <BRepAdaptor_Surface.hxx>
+#include <Adaptor2d_Curve2d.hxx>
 #include <BRepTopAdaptor_FClass2d.hxx>
+#include <Geom2d_Curve.hxx>
 #include <TopoDS_Face.hxx>
 #include <functional>
 #include <memory>
@@ -101,8 +103,17 @@ class FaceSurface final : public Surface {
 
   Vec3 Point(double u, double v) const override;
   SurfaceJet Jet(double u, double v, int order) const override;
+  // One adaptor lease a call, not one a point; the same values as Point and
+  // Jet, bit for bit.
+  void JetGrid(const double* us, int nu, const double* vs, int nv, int order,
+               SurfaceJet* out) const override;
+  void Points(const double* u, const double* v, size_t n, double* x, double* y,
+              double* z) const override;
 
  private:
+  Vec3 PointWith(BRepAdaptor_Surface& adaptor, double u, double v) const;
+  SurfaceJet JetWith(BRepAdaptor_Surface& adaptor, double u, double v, int order) const;
+
   const TopoDS_Face face_;
   const UnitSquareMap map_;
   mutable LeasePool<BRepAdaptor_Surface> adaptors_;  // thread-safe
@@ -128,20 +139,41 @@ class FaceTrim {
   bool trimmed() const { return trimmed_; }
   bool Contains(double s, double t) const;
   CellState Classify(double s0, double s1, double t0, double t1) const;
+  // A lower bound on the distance from (s, t) to every trim curve widened by
+  // the kernel's ON band: every point closer than it to (s, t), joined to it
+  // by a segment no curve crosses, has the same Contains() answer. Refines
+  // the curves' boxes near the point (a bounded number of kernel box
+  // computations); 0 when it cannot tell.
+  double Clearance(double s, double t) const;
 
   static constexpr double kLeafSize = 1.0 / 2048;
   static constexpr int kMaxDepth = 16;
   // Contains() answers from a kGridSide x kGridSide grid of cells classified
   // once, on first use (Classify: conservative), and asks the kernel only for
-  // points in cells the trim may cross.
+  // points in sub-cells the trim may cross.
   static constexpr int kGridSide = 128;
+  // A grid cell the boundary may cross is split once more into
+  // kFineSide x kFineSide sub-cells (cell width 1/2048, the boxes' size):
+  // sub-cells no curve box (widened by the kernel's tolerance) touches are
+  // flood-filled into connected pieces, and one kernel answer classifies each
+  // piece, since no curve separates its points.
+  static constexpr int kFineSide = 16;
 
  private:
   void BuildGrid() const;
+  void BuildFineGrid(int i, int j) const;
+  CellState KernelState(double s, double t) const;
   struct Node {
     Box2 box;
     int first_child = -1;  // children at first_child, first_child + 1; -1 for a leaf
+    int edge = 0;          // index into pcurves_
+    double a = 0, b = 0;   // the p-curve's parameters the box encloses
   };
+  // The box enclosing the p-curve over [a, b], widened by the tolerance.
+  Box2 CurveBox(const Adaptor2d_Curve2d& curve, double a, double b) const;
+  // The kernel's ON band in unit-square units (twice it, for rounding), per axis.
+  double BandS() const;
+  double BandT() const;
   bool CrossesBoundary(const Box2& cell) const;
   bool OnBorder(const Box2& box) const;
 
@@ -150,11 +182,16 @@ class FaceTrim {
   const double tolerance_;
   std::vector<Node> nodes_;  // every edge's hierarchy; roots listed in roots_
   std::vector<int> roots_;
+  std::vector<Handle(Geom2d_Curve)> pcurves_;  // one per root, read only
   bool missing_pcurve_ = false;  // an edge without a p-curve: every cell near nothing is unknown
   bool trimmed_ = true;
   mutable LeasePool<BRepTopAdaptor_FClass2d> classifiers_;  // thread-safe
   mutable std::once_flag grid_once_;
   mutable std::vector<CellState> grid_;  // row s, column t; filled by BuildGrid
+  // For grid cell k that the boundary may cross, fine_[fine_at_[k] + a *
+  // kFineSide + b] is its sub-cell (a, b); fine_at_[k] = -1 otherwise.
+  mutable std::vector<int32_t> fine_at_;
+  mutable std::vector<CellState> fine_;
 };
 
 }  // namespace sfc::cad
