@@ -33,6 +33,46 @@ bool Intersects(const Box2& a, const Box2& b) {
   return a.s0 <= b.s1 && b.s0 <= a.s1 && a.t0 <= b.t1 && b.t0 <= a.t1;
 }
 
+// Gives every unmarked cell of a side x side grid (row-major) the state of
+// its piece, the unmarked cells joined to it by sides, which `classify(k)`
+// answers for the piece's first cell k; marked cells get kStraddles.
+template <typename Classify>
+void ClassifyPieces(const std::vector<char>& marked, int side, CellState* out,
+                    const Classify& classify) {
+  const int cells = side * side;
+  std::vector<char> seen(cells, 0);
+  std::vector<int> piece;
+  for (int start = 0; start < cells; ++start) {
+    if (marked[start]) out[start] = CellState::kStraddles;
+    if (marked[start] || seen[start]) continue;
+    piece.assign(1, start);
+    seen[start] = 1;
+    for (size_t q = 0; q < piece.size(); ++q) {
+      const int a = piece[q] / side, c = piece[q] % side;
+      const int next[4][2] = {{a - 1, c}, {a + 1, c}, {a, c - 1}, {a, c + 1}};
+      for (const auto& n : next) {
+        if (n[0] < 0 || n[0] >= side || n[1] < 0 || n[1] >= side) continue;
+        const int k = n[0] * side + n[1];
+        if (!marked[k] && !seen[k]) seen[k] = 1, piece.push_back(k);
+      }
+    }
+    const CellState state = classify(start);
+    for (int k : piece) out[k] = state;
+  }
+}
+
+// Marks, in a side x side grid of cells of width w from (s0, t0), the cells
+// the box touches (closed).
+void MarkBox(const Box2& b, double s0, double t0, double w, int side, std::vector<char>* marked) {
+  auto index = [&](double x, double x0) {
+    return std::clamp(static_cast<int>(std::floor((x - x0) / w)), 0, side - 1);
+  };
+  if (b.s1 < s0 || b.s0 > s0 + side * w || b.t1 < t0 || b.t0 > t0 + side * w) return;
+  for (int a = index(b.s0, s0); a <= index(b.s1, s0); ++a) {
+    for (int c = index(b.t0, t0); c <= index(b.t1, t0); ++c) (*marked)[a * side + c] = 1;
+  }
+}
+
 }  // namespace
 
 FaceSurface::FaceSurface(const TopoDS_Face& face, const UnitSquareMap& map)
@@ -239,30 +279,40 @@ bool FaceTrim::CrossesBoundary(const Box2& cell) const {
 }
 
 void FaceTrim::BuildGrid() const {
-  grid_.resize(kGridSide * kGridSide);
-  fine_at_.assign(kGridSide * kGridSide, -1);
-  for (int i = 0; i < kGridSide; ++i) {
-    for (int j = 0; j < kGridSide; ++j) {
-      grid_[i * kGridSide + j] = Classify(double(i) / kGridSide, double(i + 1) / kGridSide,
-                                          double(j) / kGridSide, double(j + 1) / kGridSide);
-      if (grid_[i * kGridSide + j] == CellState::kStraddles && !missing_pcurve_) {
-        BuildFineGrid(i, j);
-      }
-    }
+  constexpr int kCells = kGridSide * kGridSide;
+  grid_.assign(kCells, CellState::kStraddles);
+  fine_at_.assign(kCells, -1);
+  if (missing_pcurve_) return;  // every cell may hold a curve we cannot see
+  // The cells a curve box not on the square's border touches, boxes widened
+  // by the kernel's ON band; the other cells form pieces no curve crosses,
+  // and the kernel's answer at the centre of a piece's first cell holds for
+  // all of it (as Classify, a cell at a time, would answer).
+  const double ms = BandS(), mt = BandT();
+  std::vector<char> marked(kCells, 0);
+  for (const Node& node : nodes_) {
+    if (node.first_child >= 0 || OnBorder(node.box)) continue;
+    MarkBox({node.box.s0 - ms, node.box.s1 + ms, node.box.t0 - mt, node.box.t1 + mt}, 0, 0,
+            1.0 / kGridSide, kGridSide, &marked);
+  }
+  ClassifyPieces(marked, kGridSide, grid_.data(), [&](int k) {
+    return KernelState((k / kGridSide + 0.5) / kGridSide, (k % kGridSide + 0.5) / kGridSide);
+  });
+  for (int k = 0; k < kCells; ++k) {
+    if (grid_[k] == CellState::kStraddles) BuildFineGrid(k / kGridSide, k % kGridSide);
   }
 }
 
 void FaceTrim::BuildFineGrid(int i, int j) const {
-  constexpr int kSide = kGridSide * kFineSide;
   constexpr int kCells = kFineSide * kFineSide;
-  const double w = 1.0 / kSide;
+  const double w = 1.0 / (kGridSide * kFineSide);
   const double s0 = double(i) / kGridSide, t0 = double(j) / kGridSide;
   // Every curve box (the hierarchy's leaves, border ones included), widened
   // by twice the kernel's ON band in each axis (its tolerance is isotropic in
-  // the native parameters), marks the sub-cells it touches.
+  // the native parameters), marks the sub-cells it touches; one kernel answer
+  // classifies each piece of the others.
   const double ms = BandS(), mt = BandT();
   const Box2 cell{s0, s0 + 1.0 / kGridSide, t0, t0 + 1.0 / kGridSide};
-  std::array<bool, kCells> marked{};
+  std::vector<char> marked(kCells, 0);
   std::vector<int> stack(roots_.begin(), roots_.end());
   while (!stack.empty()) {
     const Node& node = nodes_[stack.back()];
@@ -274,40 +324,14 @@ void FaceTrim::BuildFineGrid(int i, int j) const {
       stack.push_back(node.first_child + 1);
       continue;
     }
-    auto first = [w](double lo, double c0) {
-      return std::clamp(static_cast<int>(std::floor((lo - c0) / w)), 0, kFineSide - 1);
-    };
-    auto last = [w](double hi, double c0) {
-      return std::clamp(static_cast<int>(std::floor((hi - c0) / w)), 0, kFineSide - 1);
-    };
-    for (int a = first(b.s0, s0); a <= last(b.s1, s0); ++a) {
-      for (int c = first(b.t0, t0); c <= last(b.t1, t0); ++c) marked[a * kFineSide + c] = true;
-    }
+    MarkBox(b, s0, t0, w, kFineSide, &marked);
   }
-  // Unmarked sub-cells joined by a side form a piece no curve enters; one
-  // kernel answer, at the centre of its first sub-cell, holds for all of it.
   const int32_t at = static_cast<int32_t>(fine_.size());
   fine_at_[i * kGridSide + j] = at;
   fine_.resize(fine_.size() + kCells, CellState::kStraddles);
-  std::array<bool, kCells> seen{};
-  std::vector<int> piece;
-  for (int start = 0; start < kCells; ++start) {
-    if (marked[start] || seen[start]) continue;
-    piece.assign(1, start);
-    seen[start] = true;
-    for (size_t q = 0; q < piece.size(); ++q) {
-      const int a = piece[q] / kFineSide, c = piece[q] % kFineSide;
-      const int next[4][2] = {{a - 1, c}, {a + 1, c}, {a, c - 1}, {a, c + 1}};
-      for (const auto& n : next) {
-        if (n[0] < 0 || n[0] >= kFineSide || n[1] < 0 || n[1] >= kFineSide) continue;
-        const int k = n[0] * kFineSide + n[1];
-        if (!marked[k] && !seen[k]) seen[k] = true, piece.push_back(k);
-      }
-    }
-    const CellState state = KernelState(s0 + (start / kFineSide + 0.5) * w,
-                                        t0 + (start % kFineSide + 0.5) * w);
-    for (int k : piece) fine_[at + k] = state;
-  }
+  ClassifyPieces(marked, kFineSide, fine_.data() + at, [&](int k) {
+    return KernelState(s0 + (k / kFineSide + 0.5) * w, t0 + (k % kFineSide + 0.5) * w);
+  });
 }
 
 bool FaceTrim::Contains(double s, double t) const {

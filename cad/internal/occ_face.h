@@ -149,8 +149,9 @@ class FaceTrim {
   static constexpr double kLeafSize = 1.0 / 2048;
   static constexpr int kMaxDepth = 16;
   // Contains() answers from a kGridSide x kGridSide grid of cells classified
-  // once, on first use (Classify: conservative), and asks the kernel only for
-  // points in sub-cells the trim may cross.
+  // once, on first use: cells no curve box touches form pieces, each
+  // classified by one kernel answer (as Classify would answer each cell), and
+  // asks the kernel only for points in sub-cells the trim may cross.
   static constexpr int kGridSide = 128;
   // A grid cell the boundary may cross is split once more into
   // kFineSide x kFineSide sub-cells (cell width 1/2048, the boxes' size):
