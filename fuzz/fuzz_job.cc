@@ -4,6 +4,9 @@
 #include <cstdio>
 #include <vector>
 
+#include "kinds/registered_kinds.h"
+#include "request/index_range.h"
+
 namespace sfc::fuzz {
 namespace {
 
@@ -45,7 +48,9 @@ EngineLimits SmallLimits() {
 
 void CheckRequest(const SampleRequest& request) {
   static DirectTreeSource* const source = new DirectTreeSource;
-  static const SamplingEngine* const engine = new SamplingEngine(RegisteredSurfaceKinds(), SmallLimits(), source);
+  static FileModelSource* const files = new FileModelSource;
+  static const SamplingEngine* const engine =
+      new SamplingEngine(RegisteredSurfaceKinds(), SmallLimits(), source, files);
 
   const auto range = ResolveIndexRange(request);
   if (!range.ok()) CheckError(range.status(), request);

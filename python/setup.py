@@ -1,7 +1,8 @@
 """Builds sfcsampler._core with the repository's CMake, for pip and python3 -m build.
 
 Where the extension comes from, first match wins:
-  SFCSAMPLER_PREBUILT=DIR          copy DIR/sfcsampler/_core*.so and DIR/sfcsampler/v1
+  SFCSAMPLER_PREBUILT=DIR          copy DIR/sfcsampler/_core*.so, DIR/sfcsampler/v1 and the
+                                   kind modules DIR/sfcsampler/libsfcsampler-*.so
                                    (a configured build's python/ folder; no compiling)
   SFCSAMPLER_CMAKE_BUILD_DIR=DIR   build the target sfcsampler_python in that CMake build
   (neither)                        configure and build the repository in build/cmake
@@ -63,6 +64,12 @@ class CMakeBuild(build_ext):
         os.makedirs(os.path.dirname(target), exist_ok=True)
         shutil.copyfile(cores[0], target)
         os.chmod(target, 0o755)
+        # Kinds built as modules (libsfcsampler-cad.so: CAD models), which
+        # _core loads from its own folder when a request first needs them.
+        for module in glob.glob(os.path.join(package, "libsfcsampler-*.so")):
+            copy = os.path.join(os.path.dirname(target), os.path.basename(module))
+            shutil.copyfile(module, copy)
+            os.chmod(copy, 0o755)
         # The gRPC stubs generated from proto/ at build time: sfcsampler.v1.
         v1 = os.path.join(os.path.dirname(target), "v1")
         os.makedirs(v1, exist_ok=True)

@@ -4,6 +4,8 @@
 #include "engine/surface_kind.h"
 
 #include <algorithm>
+#include <fstream>
+#include <string>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -11,6 +13,7 @@
 #include "engine/sampling_engine.h"
 #include "gtest/gtest.h"
 #include "kinds/formula/formula_kind.h"
+#include "kinds/module_kind.h"
 #include "kinds/registered_kinds.h"
 #include "tests/engine_helpers.h"
 
@@ -107,6 +110,64 @@ TEST(SurfaceKinds, ANewKindIsSampledWithoutChangingTheEngine) {
   r.fields.triangle = true;  // a column the new kind does not fill
   r.tree.surface = "ply:" + WriteTemp("anything.ply", "not a mesh at all");
   EXPECT_EQ(engine.Start(r).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+// The libraries this process has mapped whose path contains `name`.
+int Mapped(const std::string& name) {
+  std::ifstream maps("/proc/self/maps");
+  int count = 0;
+  for (std::string line; std::getline(maps, line);) count += line.find(name) != std::string::npos;
+  return count;
+}
+
+// A kind whose module is missing fails with a clear error naming the file,
+// where it was looked for and what to set; the other kinds still work.
+TEST(ModuleKinds, AMissingModuleIsAClearErrorAndTheOtherKindsWork) {
+  const KindInfo info{"model", "a test kind (nurbs:)", {ModelFormat::kNurbs}};
+  std::vector<std::unique_ptr<const SurfaceKind>> list;
+  list.push_back(MakeFormulaKind());
+  list.push_back(MakeModuleKind(info, "libsfcsampler-nosuch.so", "nosuch_factory"));
+  const SurfaceKinds kinds(std::move(list));
+  DirectTreeSource source;
+  FileModelSource files;
+  SamplingEngine engine(kinds, {}, &source, &files);
+  SampleRequest r;
+  r.count = 100;
+  r.tree.surface = "nurbs:" + WriteTemp("module.nurbs", "sfcsampler-nurbs 1\n");
+  for (int attempt = 0; attempt < 2; ++attempt) {  // the second from the remembered failure
+    const absl::Status status = engine.Start(r).status();
+    ExpectError(status, absl::StatusCode::kFailedPrecondition, "libsfcsampler-nosuch.so");
+    ExpectError(status, absl::StatusCode::kFailedPrecondition, "SFCSAMPLER_LIB_DIR");
+    EXPECT_LE(status.message().size(), 1024u);
+  }
+  r.tree.surface = "torus";
+  EXPECT_EQ(DrawAll(engine, r).size(), 100u);
+}
+
+// The point of the CAD module: sampling formula surfaces maps none of
+// OpenCASCADE's libraries; the first CAD model loads the module, which
+// samples it.
+TEST(ModuleKinds, OpenCascadeIsLoadedOnlyForTheFirstModel) {
+  const SurfaceKinds& kinds = RegisteredSurfaceKinds();
+  if (!kinds.For(ModelSpec{ModelFormat::kNurbs, "x", ""})) GTEST_SKIP() << "a build without CAD";
+  DirectTreeSource source;
+  FileModelSource files;
+  SamplingEngine engine(kinds, {}, &source, &files);
+  SampleRequest r;
+  r.count = 1000;
+  EXPECT_EQ(DrawAll(engine, r).size(), 1000u);
+  EXPECT_EQ(Mapped("libTKernel"), 0) << "a sphere loaded OpenCASCADE";
+  EXPECT_EQ(Mapped("libsfcsampler-cad"), 0);
+  r.tree.surface = "nurbs:" + WriteTemp("sheet.nurbs",
+                                        "sfcsampler-nurbs 1\ndegree 1 1\ncount 2 2\n"
+                                        "knots_u 0 0 1 1\nknots_v 0 0 1 1\npole 0 0 0\n"
+                                        "pole 0 1 0\npole 1 0 0\npole 1 1 0.5\n");
+  r.fields.face = true;
+  const SampleBatch batch = DrawAll(engine, r);
+  EXPECT_EQ(batch.size(), 1000u);
+  EXPECT_EQ(batch.face.size(), 1000u);
+  EXPECT_GT(Mapped("libTKernel"), 0);
+  EXPECT_GT(Mapped("libsfcsampler-cad"), 0);
 }
 
 }  // namespace

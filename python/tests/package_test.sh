@@ -37,6 +37,11 @@ else
   src=$source_dir
 fi
 
+# A build with CAD puts the CAD kind's module in the package (kinds/module_kind.h).
+if [ -z "$prebuilt" ] || [ -e "$prebuilt/sfcsampler/libsfcsampler-cad.so" ]; then
+  export EXPECT_CAD=1
+fi
+
 check_env() {  # VENV LABEL [TESTS]: imports from the environment, runs the tests if TESTS=1
   local venv=$1 label=$2 tests=${3:-1}
   (cd "$work" && "$venv/bin/python" - "$venv" <<'PY'
@@ -47,6 +52,17 @@ for m in (sfcsampler, sfcsampler._core):
     assert os.path.realpath(m.__file__).startswith(venv), m.__file__
 s = sfcsampler.sample(surface="torus", count=12345)
 assert len(s) == 12345
+if os.environ.get("EXPECT_CAD") == "1":
+    # The CAD kind's module travels with the package, and _core loads the
+    # copy next to itself when a request first names a CAD model.
+    import tempfile
+    patch = os.path.join(tempfile.mkdtemp(), "sheet.nurbs")
+    with open(patch, "w") as f:
+        f.write("sfcsampler-nurbs 1\ndegree 1 1\ncount 2 2\nknots_u 0 0 1 1\nknots_v 0 0 1 1\n"
+                "pole 0 0 0\npole 0 1 0\npole 1 0 0\npole 1 1 0.5\n")
+    assert len(sfcsampler.sample(surface="nurbs:" + patch, count=1000)) == 1000
+    loaded = [line.split()[-1] for line in open("/proc/self/maps") if "libsfcsampler-cad" in line]
+    assert loaded and all(os.path.realpath(p).startswith(venv) for p in loaded), loaded
 print("imported", sfcsampler.__file__, "algorithm", sfcsampler.ALGORITHM_VERSION)
 PY
   )
