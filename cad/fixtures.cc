@@ -63,6 +63,11 @@ TopoDS_Shape MakeSolid(Solid solid) {
     }
     case Solid::kEdgeOnly:
       return BRepBuilderAPI_MakeEdge(gp_Pnt(0, 0, 0), gp_Pnt(kBoxX, 0, 0)).Shape();
+    case Solid::kTiltedBoxWithHole: {
+      gp_Trsf turn;
+      turn.SetRotation(gp_Ax1(gp_Pnt(1, 2, 3), gp_Dir(1, 2, 3)), 0.7);
+      return BRepBuilderAPI_Transform(MakeSolid(Solid::kBoxWithHole), turn, /*copy=*/true).Shape();
+    }
   }
   return {};
 }
@@ -87,6 +92,8 @@ std::string SolidName(Solid solid) {
       return "box_with_hole";
     case Solid::kEdgeOnly:
       return "edge_only";
+    case Solid::kTiltedBoxWithHole:
+      return "tilted_box_with_hole";
   }
   return "unknown";
 }

@@ -36,7 +36,10 @@ inline constexpr double kPatchHeight = 3;
 
 // kEdgeOnly is a single straight edge and no face (a model without faces,
 // for the error); WriteAll leaves it out.
-enum class Solid { kSphere, kCylinder, kBoxWithHole, kEdgeOnly };
+// kTiltedBoxWithHole is kBoxWithHole turned by 0.7 rad about (1, 2, 3), its
+// geometry moved (no location): planes and cylinders whose axes are not the
+// coordinate axes.
+enum class Solid { kSphere, kCylinder, kBoxWithHole, kEdgeOnly, kTiltedBoxWithHole };
 
 // "sphere", "cylinder", "box_with_hole", "edge_only".
 std::string SolidName(Solid solid);

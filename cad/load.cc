@@ -401,7 +401,7 @@ absl::StatusOr<Face> MakeFace(const TopoDS_Face& face, int index, ModelFormat fo
   const Vec3 centroid{c.X(), c.Y(), c.Z()};
   if (!std::isfinite(area) || !IsFinite(centroid))
     return bad("has a non-finite area (NaN or infinite geometry)");
-  auto surface = std::make_shared<FaceSurface>(face, map);
+  auto surface = std::make_shared<FaceSurface>(face, map, options.closed_forms);
   for (double s : {0.0, 0.5, 1.0}) {
     for (double t : {0.0, 0.5, 1.0}) {
       if (!IsFinite(surface->Point(s, t)))

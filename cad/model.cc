@@ -55,6 +55,11 @@ bool Face::Contains(double s, double t) const { return trim_->Contains(s, t); }
 
 double Face::Clearance(double s, double t) const { return trim_->Clearance(s, t); }
 
+bool Face::closed_form() const {
+  const auto* face = dynamic_cast<const FaceSurface*>(surface_.get());
+  return face && face->closed_form();
+}
+
 CellState Face::Classify(double s0, double s1, double t0, double t1) const {
   return trim_->Classify(s0, s1, t0, t1);
 }

@@ -75,34 +75,54 @@ void MarkBox(const Box2& b, double s0, double t0, double w, int side, std::vecto
 
 }  // namespace
 
-FaceSurface::FaceSurface(const TopoDS_Face& face, const UnitSquareMap& map)
+FaceSurface::FaceSurface(const TopoDS_Face& face, const UnitSquareMap& map, bool closed_form)
     : face_(face),
       map_(map),
+      closed_(closed_form ? ClosedForm::Extract(BRepAdaptor_Surface(face, true)) : std::nullopt),
       adaptors_([face] { return std::make_unique<BRepAdaptor_Surface>(face, true); }) {}
 
-Vec3 FaceSurface::PointWith(BRepAdaptor_Surface& adaptor, double u, double v) const {
+Vec3 FaceSurface::PointWith(BRepAdaptor_Surface* adaptor, double u, double v) const {
+  if (closed_) {
+    double d[6][3];
+    closed_->Evaluate(map_.U(u), map_.V(v), 0, d);
+    return {d[0][0], d[0][1], d[0][2]};
+  }
   try {
-    return ToVec3(adaptor.Value(map_.U(u), map_.V(v)).XYZ());
+    return ToVec3(adaptor->Value(map_.U(u), map_.V(v)).XYZ());
   } catch (const Standard_Failure&) {
     return NotFinite();
   }
 }
 
-SurfaceJet FaceSurface::JetWith(BRepAdaptor_Surface& adaptor, double u, double v,
+SurfaceJet FaceSurface::JetWith(BRepAdaptor_Surface* adaptor, double u, double v,
                                 int order) const {
   SurfaceJet jet;
   const double su = map_.DuDs(), sv = map_.DvDt();
+  auto vec = [](const double d[3]) { return Vec3{d[0], d[1], d[2]}; };
+  if (closed_) {
+    double d[6][3];
+    closed_->Evaluate(map_.U(u), map_.V(v), order >= 2 ? 2 : 1, d);
+    jet.p = vec(d[0]);
+    jet.fu = vec(d[1]) * su;
+    jet.fv = vec(d[2]) * sv;
+    if (order >= 2) {
+      jet.fuu = vec(d[3]) * (su * su);
+      jet.fuv = vec(d[5]) * (su * sv);
+      jet.fvv = vec(d[4]) * (sv * sv);
+    }
+    return jet;
+  }
   try {
     gp_Pnt p;
     gp_Vec du, dv;
     if (order >= 2) {
       gp_Vec duu, dvv, duv;
-      adaptor.D2(map_.U(u), map_.V(v), p, du, dv, duu, dvv, duv);
+      adaptor->D2(map_.U(u), map_.V(v), p, du, dv, duu, dvv, duv);
       jet.fuu = ToVec3(duu.XYZ()) * (su * su);
       jet.fuv = ToVec3(duv.XYZ()) * (su * sv);
       jet.fvv = ToVec3(dvv.XYZ()) * (sv * sv);
     } else {
-      adaptor.D1(map_.U(u), map_.V(v), p, du, dv);
+      adaptor->D1(map_.U(u), map_.V(v), p, du, dv);
     }
     jet.p = ToVec3(p.XYZ());
     jet.fu = ToVec3(du.XYZ()) * su;
@@ -113,27 +133,37 @@ SurfaceJet FaceSurface::JetWith(BRepAdaptor_Surface& adaptor, double u, double v
   return jet;
 }
 
-Vec3 FaceSurface::Point(double u, double v) const { return PointWith(*adaptors_.Take(), u, v); }
+Vec3 FaceSurface::Point(double u, double v) const {
+  if (closed_) return PointWith(nullptr, u, v);
+  return PointWith(&*adaptors_.Take(), u, v);
+}
 
 SurfaceJet FaceSurface::Jet(double u, double v, int order) const {
-  return JetWith(*adaptors_.Take(), u, v, order);
+  if (closed_) return JetWith(nullptr, u, v, order);
+  return JetWith(&*adaptors_.Take(), u, v, order);
 }
 
 void FaceSurface::JetGrid(const double* us, int nu, const double* vs, int nv, int order,
                           SurfaceJet* out) const {
-  auto adaptor = adaptors_.Take();
-  for (int i = 0; i < nu; ++i) {
-    for (int j = 0; j < nv; ++j) out[i * nv + j] = JetWith(*adaptor, us[i], vs[j], order);
-  }
+  auto fill = [&](BRepAdaptor_Surface* adaptor) {
+    for (int i = 0; i < nu; ++i) {
+      for (int j = 0; j < nv; ++j) out[i * nv + j] = JetWith(adaptor, us[i], vs[j], order);
+    }
+  };
+  if (closed_) return fill(nullptr);
+  fill(&*adaptors_.Take());
 }
 
 void FaceSurface::Points(const double* u, const double* v, size_t n, double* x, double* y,
                          double* z) const {
-  auto adaptor = adaptors_.Take();
-  for (size_t i = 0; i < n; ++i) {
-    const Vec3 p = PointWith(*adaptor, u[i], v[i]);
-    x[i] = p.x, y[i] = p.y, z[i] = p.z;
-  }
+  auto fill = [&](BRepAdaptor_Surface* adaptor) {
+    for (size_t i = 0; i < n; ++i) {
+      const Vec3 p = PointWith(adaptor, u[i], v[i]);
+      x[i] = p.x, y[i] = p.y, z[i] = p.z;
+    }
+  };
+  if (closed_) return fill(nullptr);
+  fill(&*adaptors_.Take());
 }
 
 FaceTrim::FaceTrim(const TopoDS_Face& face, const UnitSquareMap& map, double tolerance)

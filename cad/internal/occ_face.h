@@ -19,10 +19,12 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 #include "absl/base/thread_annotations.h"
 #include "absl/synchronization/mutex.h"
+#include "cad/internal/closed_form.h"
 #include "cad/model.h"
 #include "core/surface.h"
 
@@ -99,7 +101,8 @@ struct UnitSquareMap {
 // non-finite result (core/surface.h's contract).
 class FaceSurface final : public Surface {
  public:
-  FaceSurface(const TopoDS_Face& face, const UnitSquareMap& map);
+  // `closed_form`: evaluate from the closed form when the face has one.
+  FaceSurface(const TopoDS_Face& face, const UnitSquareMap& map, bool closed_form = true);
 
   Vec3 Point(double u, double v) const override;
   SurfaceJet Jet(double u, double v, int order) const override;
@@ -110,12 +113,19 @@ class FaceSurface final : public Surface {
   void Points(const double* u, const double* v, size_t n, double* x, double* y,
               double* z) const override;
 
+  // True when the face is evaluated from its closed form (ClosedForm), not
+  // through the kernel's adaptors.
+  bool closed_form() const { return closed_.has_value(); }
+
  private:
-  Vec3 PointWith(BRepAdaptor_Surface& adaptor, double u, double v) const;
-  SurfaceJet JetWith(BRepAdaptor_Surface& adaptor, double u, double v, int order) const;
+  // Through the closed form when there is one (`adaptor` unused: may be
+  // null), else through `adaptor`.
+  Vec3 PointWith(BRepAdaptor_Surface* adaptor, double u, double v) const;
+  SurfaceJet JetWith(BRepAdaptor_Surface* adaptor, double u, double v, int order) const;
 
   const TopoDS_Face face_;
   const UnitSquareMap map_;
+  std::optional<ClosedForm> closed_;
   mutable LeasePool<BRepAdaptor_Surface> adaptors_;  // thread-safe
 };
 

@@ -1,0 +1,143 @@
+#include "cad/internal/closed_form.h"
+
+#include <Standard_Failure.hxx>
+#include <gp_Ax3.hxx>
+#include <gp_Cylinder.hxx>
+#include <gp_Pln.hxx>
+#include <gp_Sphere.hxx>
+
+#include <cmath>
+#include <cstring>
+
+namespace sfc::cad {
+namespace {
+
+void Set(double out[3], const gp_XYZ& v) { out[0] = v.X(), out[1] = v.Y(), out[2] = v.Z(); }
+
+void Place(const gp_Ax3& position, ClosedForm* form) {
+  Set(form->o, position.Location().XYZ());
+  Set(form->x, position.XDirection().XYZ());
+  Set(form->y, position.YDirection().XYZ());
+  Set(form->z, position.Direction().XYZ());
+}
+
+bool SameBits(const double a[3], const gp_XYZ& b) {
+  const double c[3] = {b.X(), b.Y(), b.Z()};
+  return std::memcmp(a, c, sizeof(c)) == 0;
+}
+
+}  // namespace
+
+// Each formula is the one ElSLib (OpenCASCADE 7.6) evaluates for the type
+// and order: PlaneD0/D1, CylinderD0/D1/D2, SphereD0/D1/D2.
+void ClosedForm::Evaluate(double u, double v, int order, double d[][3]) const {
+  switch (type) {
+    case Type::kPlane:
+      for (int k = 0; k < 3; ++k) d[0][k] = u * x[k] + v * y[k] + o[k];
+      if (order >= 1) {
+        for (int k = 0; k < 3; ++k) d[1][k] = x[k], d[2][k] = y[k];
+      }
+      if (order >= 2) {
+        for (int k = 0; k < 3; ++k) d[3][k] = d[4][k] = d[5][k] = 0.0;
+      }
+      return;
+    case Type::kCylinder: {
+      const double a1 = radius * std::cos(u), a2 = radius * std::sin(u);
+      if (order < 2) {
+        for (int k = 0; k < 3; ++k) d[0][k] = a1 * x[k] + a2 * y[k] + v * z[k] + o[k];
+      } else {
+        for (int k = 0; k < 3; ++k) {
+          const double som = a1 * x[k] + a2 * y[k];
+          d[0][k] = som + v * z[k] + o[k];
+          d[3][k] = -som;
+          d[4][k] = d[5][k] = 0.0;
+        }
+      }
+      if (order >= 1) {
+        for (int k = 0; k < 3; ++k) d[1][k] = -a2 * x[k] + a1 * y[k], d[2][k] = z[k];
+      }
+      return;
+    }
+    case Type::kSphere: {
+      if (order == 0) {
+        const double r = radius * std::cos(v), a3 = radius * std::sin(v);
+        const double a1 = r * std::cos(u), a2 = r * std::sin(u);
+        for (int k = 0; k < 3; ++k) d[0][k] = a1 * x[k] + a2 * y[k] + a3 * z[k] + o[k];
+        return;
+      }
+      const double cu = std::cos(u), su = std::sin(u);
+      const double r1 = radius * std::cos(v), r2 = radius * std::sin(v);
+      const double a1 = r1 * cu, a2 = r1 * su, a3 = r2 * cu, a4 = r2 * su;
+      for (int k = 0; k < 3; ++k) {
+        if (order == 1) {
+          d[0][k] = a1 * x[k] + a2 * y[k] + r2 * z[k] + o[k];
+        } else {
+          const double som = a1 * x[k] + a2 * y[k], r2z = r2 * z[k];
+          d[0][k] = som + r2z + o[k];
+          d[3][k] = -som;
+          d[4][k] = -som - r2z;
+          d[5][k] = a4 * x[k] - a3 * y[k];
+        }
+        d[1][k] = -a2 * x[k] + a1 * y[k];
+        d[2][k] = -a3 * x[k] - a4 * y[k] + r1 * z[k];
+      }
+      return;
+    }
+  }
+}
+
+std::optional<ClosedForm> ClosedForm::Extract(const BRepAdaptor_Surface& adaptor) {
+  if (adaptor.Trsf().Form() != gp_Identity) return std::nullopt;
+  ClosedForm form;
+  try {
+    const GeomAdaptor_Surface& local = adaptor.Surface();
+    switch (local.GetType()) {
+      case GeomAbs_Plane:
+        form.type = Type::kPlane;
+        Place(local.Plane().Position(), &form);
+        break;
+      case GeomAbs_Cylinder:
+        form.type = Type::kCylinder;
+        Place(local.Cylinder().Position(), &form);
+        form.radius = local.Cylinder().Radius();
+        break;
+      case GeomAbs_Sphere:
+        form.type = Type::kSphere;
+        Place(local.Sphere().Position(), &form);
+        form.radius = local.Sphere().Radius();
+        break;
+      default:
+        return std::nullopt;
+    }
+    // The kernel's values on a grid of its parameter box, and well outside
+    // it, for every order, bit for bit.
+    const double u0 = adaptor.FirstUParameter(), u1 = adaptor.LastUParameter();
+    const double v0 = adaptor.FirstVParameter(), v1 = adaptor.LastVParameter();
+    for (int i = 0; i <= 8; ++i) {
+      for (int j = 0; j <= 8; ++j) {
+        const double u = u0 + (u1 - u0) * (i * 0.1371 + 0.0113) - 0.05 * (u1 - u0);
+        const double v = v0 + (v1 - v0) * (j * 0.1297 + 0.0171) - 0.05 * (v1 - v0);
+        double d[6][3];
+        gp_Pnt p;
+        gp_Vec du, dv, duu, dvv, duv;
+        form.Evaluate(u, v, 0, d);
+        adaptor.D0(u, v, p);
+        if (!SameBits(d[0], p.XYZ())) return std::nullopt;
+        form.Evaluate(u, v, 1, d);
+        adaptor.D1(u, v, p, du, dv);
+        if (!SameBits(d[0], p.XYZ()) || !SameBits(d[1], du.XYZ()) || !SameBits(d[2], dv.XYZ()))
+          return std::nullopt;
+        form.Evaluate(u, v, 2, d);
+        adaptor.D2(u, v, p, du, dv, duu, dvv, duv);
+        if (!SameBits(d[0], p.XYZ()) || !SameBits(d[1], du.XYZ()) || !SameBits(d[2], dv.XYZ()) ||
+            !SameBits(d[3], duu.XYZ()) || !SameBits(d[4], dvv.XYZ()) || !SameBits(d[5], duv.XYZ()))
+          return std::nullopt;
+      }
+    }
+  } catch (const Standard_Failure&) {
+    return std::nullopt;
+  }
+  return form;
+}
+
+}  // namespace sfc::cad
