@@ -7,6 +7,7 @@
 #include <BRepBuilderAPI_Transform.hxx>
 #include <BRepFilletAPI_MakeFillet.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeCone.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRepPrimAPI_MakeSphere.hxx>
 #include <BRep_Builder.hxx>
@@ -37,6 +38,13 @@
 namespace sfc::cad::fixtures {
 namespace {
 
+// `shape` turned by 0.7 rad about (1, 2, 3), its geometry moved (no location).
+TopoDS_Shape Tilted(const TopoDS_Shape& shape) {
+  gp_Trsf turn;
+  turn.SetRotation(gp_Ax1(gp_Pnt(1, 2, 3), gp_Dir(1, 2, 3)), 0.7);
+  return BRepBuilderAPI_Transform(shape, turn, /*copy=*/true).Shape();
+}
+
 TopoDS_Shape MakeSolid(Solid solid) {
   switch (solid) {
     case Solid::kSphere:
@@ -63,10 +71,19 @@ TopoDS_Shape MakeSolid(Solid solid) {
     }
     case Solid::kEdgeOnly:
       return BRepBuilderAPI_MakeEdge(gp_Pnt(0, 0, 0), gp_Pnt(kBoxX, 0, 0)).Shape();
-    case Solid::kTiltedBoxWithHole: {
-      gp_Trsf turn;
-      turn.SetRotation(gp_Ax1(gp_Pnt(1, 2, 3), gp_Dir(1, 2, 3)), 0.7);
-      return BRepBuilderAPI_Transform(MakeSolid(Solid::kBoxWithHole), turn, /*copy=*/true).Shape();
+    case Solid::kTiltedBoxWithHole:
+      return Tilted(MakeSolid(Solid::kBoxWithHole));
+    case Solid::kTiltedConeAndTorus: {
+      // The base's circular edge rounded: the round between the cone and the
+      // base's plane is a piece of a torus.
+      const TopoDS_Shape cone = BRepPrimAPI_MakeCone(10, 4, 15).Shape();
+      BRepFilletAPI_MakeFillet fillet(cone);
+      for (TopExp_Explorer it(cone, TopAbs_EDGE); it.More(); it.Next()) {
+        const TopoDS_Edge& edge = TopoDS::Edge(it.Current());
+        if (!BRep_Tool::Degenerated(edge) && BRep_Tool::Pnt(TopExp::FirstVertex(edge)).Z() == 0)
+          fillet.Add(2, edge);
+      }
+      return Tilted(fillet.Shape());
     }
   }
   return {};
@@ -94,6 +111,8 @@ std::string SolidName(Solid solid) {
       return "edge_only";
     case Solid::kTiltedBoxWithHole:
       return "tilted_box_with_hole";
+    case Solid::kTiltedConeAndTorus:
+      return "tilted_cone_and_torus";
   }
   return "unknown";
 }

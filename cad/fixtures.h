@@ -39,7 +39,12 @@ inline constexpr double kPatchHeight = 3;
 // kTiltedBoxWithHole is kBoxWithHole turned by 0.7 rad about (1, 2, 3), its
 // geometry moved (no location): planes and cylinders whose axes are not the
 // coordinate axes.
-enum class Solid { kSphere, kCylinder, kBoxWithHole, kEdgeOnly, kTiltedBoxWithHole };
+// kTiltedConeAndTorus is a truncated cone (radii 10 and 4, height 15) whose
+// base edge is rounded (radius 2: a piece of a torus), turned the same way:
+// cones and tori.
+enum class Solid {
+  kSphere, kCylinder, kBoxWithHole, kEdgeOnly, kTiltedBoxWithHole, kTiltedConeAndTorus
+};
 
 // "sphere", "cylinder", "box_with_hole", "edge_only".
 std::string SolidName(Solid solid);

@@ -38,10 +38,10 @@ struct LoadOptions {
   // box's larger side (points this close to a trim curve count as inside).
   // Default 1e-9.
   double trim_tolerance = 1e-9;
-  // Planes, cylinders and spheres without a transformation are evaluated
-  // from their closed forms (Face::closed_form(): the same bits as the
-  // kernel, checked at load); false evaluates every face through the kernel,
-  // to compare the two.
+  // Planes, cylinders, cones, spheres and tori without a transformation are
+  // evaluated from their closed forms (Face::closed_form(): the same bits as
+  // the kernel, checked at load); false evaluates every face through the
+  // kernel, to compare the two.
   bool closed_forms = true;
   // What the kernel's readers are spared (cad/preflight.h).
   PreflightLimits preflight;

@@ -89,9 +89,9 @@ class Face {
   // with the kernel's exact first and second derivatives.
   const Surface& surface() const { return *surface_; }
   // True when the surface is evaluated from its closed form (a plane,
-  // cylinder or sphere without a transformation: the kernel's arithmetic
-  // without its adaptors, checked bit for bit against them at load), false
-  // when through the kernel.
+  // cylinder, cone, sphere or torus without a transformation: the kernel's
+  // arithmetic without its adaptors, checked bit for bit against them at
+  // load), false when through the kernel.
   bool closed_form() const;
   std::shared_ptr<const Surface> shared_surface() const { return surface_; }
 

@@ -526,7 +526,7 @@ TEST(CadModel, BatchEvaluationEqualsPointByPoint) {
   }
 }
 
-// Planes, cylinders and spheres are evaluated from their closed forms, with
+// Planes, cylinders, cones, spheres and tori are evaluated from their closed forms, with
 // the kernel's values bit for bit: each fixture loaded with and without
 // closed forms gives the same points and derivatives at random parameters
 // (inside the square and on its edges).
@@ -534,8 +534,8 @@ TEST(CadModel, ClosedFormsGiveTheKernelsBits) {
   std::mt19937_64 rng(9);
   std::uniform_real_distribution<double> unit(0, 1);
   int closed = 0;
-  for (Solid solid :
-       {Solid::kBoxWithHole, Solid::kTiltedBoxWithHole, Solid::kSphere, Solid::kCylinder}) {
+  for (Solid solid : {Solid::kBoxWithHole, Solid::kTiltedBoxWithHole, Solid::kSphere,
+                      Solid::kCylinder, Solid::kTiltedConeAndTorus}) {
     for (ModelFormat format : {ModelFormat::kStep, ModelFormat::kIges}) {
       auto fast = LoadOk(solid, format);
       LoadOptions options;
@@ -549,8 +549,12 @@ TEST(CadModel, ClosedFormsGiveTheKernelsBits) {
         const Face& b = (*kernel)->faces()[f];
         EXPECT_FALSE(b.closed_form());
         const bool elementary = a.type() == FaceType::kPlane || a.type() == FaceType::kCylinder ||
-                                a.type() == FaceType::kSphere;
-        if (format == ModelFormat::kStep) EXPECT_EQ(a.closed_form(), elementary) << f;
+                                a.type() == FaceType::kCone || a.type() == FaceType::kSphere ||
+                                a.type() == FaceType::kTorus;
+        if (format == ModelFormat::kStep) {
+          EXPECT_EQ(a.closed_form(), elementary)
+              << fixtures::SolidName(solid) << " face " << f << " " << FaceTypeName(a.type());
+        }
         closed += a.closed_form();
         for (int k = 0; k < 3000; ++k) {
           const double s = k < 4 ? double(k / 2) : unit(rng), t = k < 4 ? double(k % 2) : unit(rng);
@@ -568,7 +572,15 @@ TEST(CadModel, ClosedFormsGiveTheKernelsBits) {
       }
     }
   }
-  EXPECT_GE(closed, 18) << "both boxes' eight faces and the sphere's, at least, in STEP";
+  EXPECT_GE(closed, 22) << "both boxes' eight faces, the sphere's, the cone's three and the "
+                          "torus's, at least, in STEP";
+  auto cone = LoadOk(Solid::kTiltedConeAndTorus, ModelFormat::kStep);
+  ASSERT_NE(cone, nullptr);
+  std::map<FaceType, int> types;
+  for (const Face& face : cone->faces()) types[face.type()] += face.closed_form();
+  EXPECT_GE(types[FaceType::kCone], 1);
+  EXPECT_GE(types[FaceType::kTorus], 1);
+  EXPECT_GE(types[FaceType::kPlane], 2);
 }
 
 TEST(CadModel, LoadingTwiceGivesTheSameFaces) {

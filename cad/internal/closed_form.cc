@@ -2,10 +2,13 @@
 
 #include <Standard_Failure.hxx>
 #include <gp_Ax3.hxx>
+#include <gp_Cone.hxx>
 #include <gp_Cylinder.hxx>
 #include <gp_Pln.hxx>
 #include <gp_Sphere.hxx>
+#include <gp_Torus.hxx>
 
+#include <cfloat>
 #include <cmath>
 #include <cstring>
 
@@ -29,7 +32,8 @@ bool SameBits(const double a[3], const gp_XYZ& b) {
 }  // namespace
 
 // Each formula is the one ElSLib (OpenCASCADE 7.6) evaluates for the type
-// and order: PlaneD0/D1, CylinderD0/D1/D2, SphereD0/D1/D2.
+// and order: PlaneD0/D1, CylinderD0/D1/D2, ConeD0/D1/D2, SphereD0/D1/D2,
+// TorusD0/D1/D2 (with its rounding of tiny terms to zero).
 void ClosedForm::Evaluate(double u, double v, int order, double d[][3]) const {
   switch (type) {
     case Type::kPlane:
@@ -55,6 +59,61 @@ void ClosedForm::Evaluate(double u, double v, int order, double d[][3]) const {
       }
       if (order >= 1) {
         for (int k = 0; k < 3; ++k) d[1][k] = -a2 * x[k] + a1 * y[k], d[2][k] = z[k];
+      }
+      return;
+    }
+    case Type::kCone: {
+      if (order == 0) {
+        const double r = radius + v * std::sin(angle), a3 = v * std::cos(angle);
+        const double a1 = r * std::cos(u), a2 = r * std::sin(u);
+        for (int k = 0; k < 3; ++k) d[0][k] = a1 * x[k] + a2 * y[k] + a3 * z[k] + o[k];
+        return;
+      }
+      const double cu = std::cos(u), su = std::sin(u);
+      const double ca = std::cos(angle), sa = std::sin(angle);
+      const double r = radius + v * sa, a3 = v * ca;
+      const double a1 = r * cu, a2 = r * su, r1 = sa * cu, r2 = sa * su;
+      for (int k = 0; k < 3; ++k) {
+        if (order == 1) {
+          d[0][k] = a1 * x[k] + a2 * y[k] + a3 * z[k] + o[k];
+        } else {
+          const double som = a1 * x[k] + a2 * y[k];
+          d[0][k] = som + a3 * z[k] + o[k];
+          d[3][k] = -som;
+          d[4][k] = 0.0;
+          d[5][k] = -r2 * x[k] + r1 * y[k];
+        }
+        d[1][k] = -a2 * x[k] + a1 * y[k];
+        d[2][k] = r1 * x[k] + r2 * y[k] + ca * z[k];
+      }
+      return;
+    }
+    case Type::kTorus: {
+      const double eps = 10. * (minor + radius) * DBL_EPSILON;
+      auto tiny = [eps](double a) { return std::abs(a) <= eps ? 0. : a; };
+      if (order == 0) {
+        const double r = radius + minor * std::cos(v), a3 = tiny(minor * std::sin(v));
+        const double a1 = tiny(r * std::cos(u)), a2 = tiny(r * std::sin(u));
+        for (int k = 0; k < 3; ++k) d[0][k] = a1 * x[k] + a2 * y[k] + a3 * z[k] + o[k];
+        return;
+      }
+      const double cu = std::cos(u), su = std::sin(u);
+      const double r1 = minor * std::cos(v), r2 = minor * std::sin(v);
+      const double r = radius + r1;
+      const double a1 = tiny(r * cu), a2 = tiny(r * su), a3 = tiny(r2 * cu), a4 = tiny(r2 * su);
+      for (int k = 0; k < 3; ++k) {
+        if (order == 1) {
+          d[0][k] = a1 * x[k] + a2 * y[k] + r2 * z[k] + o[k];
+        } else {
+          const double a5 = tiny(r1 * cu), a6 = tiny(r1 * su);
+          const double som = a1 * x[k] + a2 * y[k], r2z = r2 * z[k];
+          d[0][k] = som + r2z + o[k];
+          d[3][k] = -som;
+          d[4][k] = -a5 * x[k] - a6 * y[k] - r2z;
+          d[5][k] = a4 * x[k] - a3 * y[k];
+        }
+        d[1][k] = -a2 * x[k] + a1 * y[k];
+        d[2][k] = -a3 * x[k] - a4 * y[k] + r1 * z[k];
       }
       return;
     }
@@ -101,10 +160,22 @@ std::optional<ClosedForm> ClosedForm::Extract(const BRepAdaptor_Surface& adaptor
         Place(local.Cylinder().Position(), &form);
         form.radius = local.Cylinder().Radius();
         break;
+      case GeomAbs_Cone:
+        form.type = Type::kCone;
+        Place(local.Cone().Position(), &form);
+        form.radius = local.Cone().RefRadius();
+        form.angle = local.Cone().SemiAngle();
+        break;
       case GeomAbs_Sphere:
         form.type = Type::kSphere;
         Place(local.Sphere().Position(), &form);
         form.radius = local.Sphere().Radius();
+        break;
+      case GeomAbs_Torus:
+        form.type = Type::kTorus;
+        Place(local.Torus().Position(), &form);
+        form.radius = local.Torus().MajorRadius();
+        form.minor = local.Torus().MinorRadius();
         break;
       default:
         return std::nullopt;

@@ -1,4 +1,4 @@
-// Internal to cad/: a face's plane, cylinder or sphere evaluated from its
+// Internal to cad/: a face's plane, cylinder, cone, sphere or torus evaluated from its
 // closed form, without the kernel's adaptors (no lease, no virtual calls):
 // issue 20's "the face's analytic form extracted once into a plain
 // evaluator". The arithmetic is the kernel's own (OpenCASCADE 7.6's ElSLib
@@ -16,19 +16,20 @@
 namespace sfc::cad {
 
 struct ClosedForm {
-  enum class Type { kPlane, kCylinder, kSphere };
+  enum class Type { kPlane, kCylinder, kCone, kSphere, kTorus };
   Type type = Type::kPlane;
-  // The surface's placement (location; x, y and main directions) and radius.
+  // The surface's placement (location; x, y and main directions), radius (a
+  // torus's major one), a cone's semi-angle and a torus's minor radius.
   double o[3], x[3], y[3], z[3];
-  double radius = 0;
+  double radius = 0, angle = 0, minor = 0;
 
   // In the kernel's native parameters (U, V); d[0] is the point, d[1], d[2]
   // the first derivatives (U, V), d[3], d[4], d[5] the second (UU, VV, UV),
   // as BRepAdaptor_Surface::D0, D1 and D2 give them for `order` 0, 1, 2.
   void Evaluate(double u, double v, int order, double d[][3]) const;
 
-  // The closed form of `adaptor`'s surface, if it is a plane, cylinder or
-  // sphere without a transformation (identity location) and evaluates as the
+  // The closed form of `adaptor`'s surface, if it is a plane, cylinder, cone,
+  // sphere or torus without a transformation (identity location) and evaluates as the
   // kernel does at every checked point, for every order; nullopt otherwise.
   static std::optional<ClosedForm> Extract(const BRepAdaptor_Surface& adaptor);
 };
