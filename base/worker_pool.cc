@@ -14,11 +14,19 @@ struct WorkerPool::Loop {
   int done = 0;  // guarded by mu
 };
 
+namespace {
+std::atomic<WorkerPool*> g_shared_from{nullptr};  // set by ShareFrom
+}  // namespace
+
 WorkerPool& WorkerPool::Shared() {
-  static WorkerPool* const pool = new WorkerPool(
-      std::clamp(static_cast<int>(std::thread::hardware_concurrency()) - 1, 1, 63));
+  static WorkerPool* const pool =
+      g_shared_from.load() ? g_shared_from.load()
+                           : new WorkerPool(std::clamp(
+                                 static_cast<int>(std::thread::hardware_concurrency()) - 1, 1, 63));
   return *pool;
 }
+
+void WorkerPool::ShareFrom(WorkerPool* pool) { g_shared_from.store(pool); }
 
 WorkerPool::WorkerPool(int workers) {
   for (int i = 0; i < workers; ++i) threads_.emplace_back([this] { Work(); });

@@ -26,6 +26,10 @@ class WorkerPool {
  public:
   // The process's pool: hardware threads - 1 workers (at least 1, at most 63).
   static WorkerPool& Shared();
+  // For a kind module (kinds/module_kind.h), which has its own copy of this
+  // code: makes its Shared() the program's pool, so a process keeps one
+  // pool. Call before the module's first Shared(); `pool` outlives it.
+  static void ShareFrom(WorkerPool* pool);
 
   explicit WorkerPool(int workers);
   ~WorkerPool();

@@ -4,6 +4,13 @@
 
 #include <BRepAlgoAPI_Cut.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakeWire.hxx>
+#include <GeomAPI_Interpolate.hxx>
+#include <Geom_BSplineCurve.hxx>
+#include <TColgp_HArray1OfPnt.hxx>
+#include <TopoDS_Wire.hxx>
+#include <gp_Pln.hxx>
 #include <BRepBuilderAPI_Transform.hxx>
 #include <BRepFilletAPI_MakeFillet.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
@@ -45,6 +52,20 @@ TopoDS_Shape Tilted(const TopoDS_Shape& shape) {
   return BRepBuilderAPI_Transform(shape, turn, /*copy=*/true).Shape();
 }
 
+// kSplineHolePlate's hole: a periodic cubic B-spline through 40 points of
+// r = 10 + 3 sin 7a.
+Handle(Geom_BSplineCurve) SplineHole() {
+  const int n = 40;
+  Handle(TColgp_HArray1OfPnt) points = new TColgp_HArray1OfPnt(1, n);
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * M_PI * i / n, r = 10 + 3 * std::sin(7 * a);
+    points->SetValue(i + 1, gp_Pnt(r * std::cos(a), r * std::sin(a), 0));
+  }
+  GeomAPI_Interpolate interpolate(points, /*periodic=*/true, 1e-9);
+  interpolate.Perform();
+  return interpolate.Curve();
+}
+
 TopoDS_Shape MakeSolid(Solid solid) {
   switch (solid) {
     case Solid::kSphere:
@@ -73,6 +94,14 @@ TopoDS_Shape MakeSolid(Solid solid) {
       return BRepBuilderAPI_MakeEdge(gp_Pnt(0, 0, 0), gp_Pnt(kBoxX, 0, 0)).Shape();
     case Solid::kTiltedBoxWithHole:
       return Tilted(MakeSolid(Solid::kBoxWithHole));
+    case Solid::kSplineHolePlate: {
+      const gp_Pln plane(gp_Pnt(0, 0, 0), gp::DZ());
+      BRepBuilderAPI_MakeFace face(plane, -20, 20, -20, 20);
+      TopoDS_Wire hole = BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(SplineHole()).Edge());
+      hole.Reverse();
+      face.Add(hole);
+      return face.Shape();
+    }
     case Solid::kTiltedConeAndTorus: {
       // The base's circular edge rounded: the round between the cone and the
       // base's plane is a piece of a torus.
@@ -113,6 +142,8 @@ std::string SolidName(Solid solid) {
       return "tilted_box_with_hole";
     case Solid::kTiltedConeAndTorus:
       return "tilted_cone_and_torus";
+    case Solid::kSplineHolePlate:
+      return "spline_hole_plate";
   }
   return "unknown";
 }
@@ -187,6 +218,17 @@ std::string NurbsPatchText() {
     }
   }
   return text;
+}
+
+std::vector<std::pair<double, double>> SplineHolePoints(int n) {
+  const Handle(Geom_BSplineCurve) curve = SplineHole();
+  const double a = curve->FirstParameter(), b = curve->LastParameter();
+  std::vector<std::pair<double, double>> out;
+  for (int i = 0; i < n; ++i) {
+    const gp_Pnt p = curve->Value(a + (b - a) * i / n);
+    out.emplace_back(p.X(), p.Y());
+  }
+  return out;
 }
 
 absl::StatusOr<std::vector<std::string>> WriteAll(const std::string& dir) {

@@ -9,6 +9,7 @@
 #define SFCSAMPLER_CAD_FIXTURES_H_
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -42,9 +43,17 @@ inline constexpr double kPatchHeight = 3;
 // kTiltedConeAndTorus is a truncated cone (radii 10 and 4, height 15) whose
 // base edge is rounded (radius 2: a piece of a torus), turned the same way:
 // cones and tori.
+// kSplineHolePlate is one planar face, the square [-20, 20]^2 at z = 0, with
+// a hole bounded by a periodic cubic B-spline through 40 points of the wavy
+// circle r = 10 + 3 sin 7a: a trim that is neither a line nor a circle.
 enum class Solid {
-  kSphere, kCylinder, kBoxWithHole, kEdgeOnly, kTiltedBoxWithHole, kTiltedConeAndTorus
+  kSphere, kCylinder, kBoxWithHole, kEdgeOnly, kTiltedBoxWithHole, kTiltedConeAndTorus,
+  kSplineHolePlate
 };
+
+// Points along kSplineHolePlate's hole (x, y), `n` of them evenly in its
+// parameter, from the same curve.
+std::vector<std::pair<double, double>> SplineHolePoints(int n);
 
 // "sphere", "cylinder", "box_with_hole", "edge_only".
 std::string SolidName(Solid solid);

@@ -1,6 +1,7 @@
 #include "kinds/module_kind.h"
 
 #include <dlfcn.h>
+#include <link.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -12,22 +13,33 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "base/echo.h"
+#include "base/worker_pool.h"
 #include "core/sample_batch.h"
 #include "request/sample_request.h"
 
 namespace sfc {
 namespace {
 
-// The folder of the binary (executable or shared object) holding this code.
+// The folder of the binary (executable or shared object) holding this code,
+// from the dynamic linker's map: a shared object's path as it was loaded, the
+// executable's from /proc/self/exe (its map entry has no name). Never a
+// path relative to the working directory.
 std::optional<std::filesystem::path> OwnFolder() {
   Dl_info info;
-  if (dladdr(reinterpret_cast<void*>(&KindModuleAbi), &info) == 0 || !info.dli_fname) {
+  struct link_map* map = nullptr;
+  if (dladdr1(reinterpret_cast<void*>(&KindModuleAbi), &info, reinterpret_cast<void**>(&map),
+              RTLD_DL_LINKMAP) == 0 ||
+      map == nullptr) {
     return std::nullopt;
   }
   std::error_code error;
-  const auto path = std::filesystem::canonical(info.dli_fname, error);
+  const std::filesystem::path path =
+      map->l_name && map->l_name[0] ? std::filesystem::path(map->l_name)
+                                    : std::filesystem::read_symlink("/proc/self/exe", error);
+  if (error || !path.is_absolute()) return std::nullopt;
+  const auto real = std::filesystem::canonical(path, error);
   if (error) return std::nullopt;
-  return path.parent_path();
+  return real.parent_path();
 }
 
 std::vector<std::filesystem::path> Candidates(const std::string& file) {
@@ -91,13 +103,13 @@ class ModuleKind final : public SurfaceKind {
         return Refused(path, Echo(why ? why : "dlopen failed", kMaxNameEcho));
       }
       auto abi = reinterpret_cast<const char* (*)()>(dlsym(handle, "sfcsampler_kind_module_abi"));
-      auto make = reinterpret_cast<SurfaceKind* (*)()>(dlsym(handle, factory_.c_str()));
+      auto make = reinterpret_cast<SurfaceKind* (*)(WorkerPool*)>(dlsym(handle, factory_.c_str()));
       if (!abi || !make) return Refused(path, "it lacks the kind module's entry points");
       if (KindModuleAbi() != abi()) {
         return Refused(path, absl::StrCat("it is from another build (", Echo(abi()),
                                           ", this program is ", KindModuleAbi(), ")"));
       }
-      kind_.reset(make());
+      kind_.reset(make(&WorkerPool::Shared()));  // one pool for the process
       if (!kind_) return Refused(path, "its factory made no kind");
       return absl::OkStatus();
     }
@@ -132,7 +144,7 @@ std::unique_ptr<const SurfaceKind> MakeModuleKind(const KindInfo& info, std::str
 }
 
 std::string KindModuleAbi() {
-  return absl::StrCat(kAlgorithmVersion, "/gcc", __GNUC__, ".", __GNUC_MINOR__, "/",
+  return absl::StrCat(kAlgorithmVersion, "/", SFC_BUILD_ID, "/",
                       sizeof(TreeSpec), ".", sizeof(KindContext), ".", sizeof(ResolvedSurface),
                       ".", sizeof(CursorSpec), ".", sizeof(KindInfo), ".", sizeof(StoredModel),
                       ".", sizeof(SampleBatch), ".", sizeof(EngineLimits), ".",

@@ -12,7 +12,8 @@
 //      folder, where _core.so is);
 //   3. that folder's ../lib/sfcsampler/ (an installed bin/ next to lib/);
 //   4. the build tree's lib/sfcsampler/ (compiled in).
-// It exports `factory` (extern "C" SurfaceKind* ()) and
+// It exports `factory` (extern "C" SurfaceKind* (WorkerPool* the program's
+// pool, which the module's cursors then share: base/worker_pool.h) and
 // sfcsampler_kind_module_abi (extern "C" const char* ()), which must equal
 // KindModuleAbi(): a module of another build is refused.
 //
@@ -35,8 +36,8 @@ std::unique_ptr<const SurfaceKind> MakeModuleKind(const KindInfo& info, std::str
                                                   std::string factory);
 
 // The stamp a kind module and its host compare: the algorithm version, the
-// compiler and the sizes of the types that cross between them, from the
-// same headers on both sides.
+// build tree's identity (a random id made when the tree is first
+// configured) and the sizes of the types that cross between them.
 std::string KindModuleAbi();
 
 }  // namespace sfc

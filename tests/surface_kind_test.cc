@@ -14,6 +14,7 @@
 #include "gtest/gtest.h"
 #include "kinds/formula/formula_kind.h"
 #include "kinds/module_kind.h"
+#include "base/worker_pool.h"
 #include "kinds/registered_kinds.h"
 #include "tests/engine_helpers.h"
 
@@ -168,6 +169,45 @@ TEST(ModuleKinds, OpenCascadeIsLoadedOnlyForTheFirstModel) {
   EXPECT_EQ(batch.face.size(), 1000u);
   EXPECT_GT(Mapped("libTKernel"), 0);
   EXPECT_GT(Mapped("libsfcsampler-cad"), 0);
+}
+
+int Threads() {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);) {
+    if (line.rfind("Threads:", 0) == 0) return std::stoi(line.substr(8));
+  }
+  return -1;
+}
+
+// The module's cursors run on the program's worker pool (base/worker_pool.h:
+// one pool a process), not on a second pool of their own copy's.
+TEST(ModuleKinds, TheModuleSharesTheProgramsWorkerPool) {
+  const SurfaceKinds& kinds = RegisteredSurfaceKinds();
+  if (!kinds.For(ModelSpec{ModelFormat::kNurbs, "x", ""})) GTEST_SKIP() << "a build without CAD";
+  DirectTreeSource source;
+  FileModelSource files;
+  EngineLimits limits;
+  limits.generation_threads = 4;
+  limits.model_parse_threads = 0;  // the model parsed on this thread: no parse thread either
+  SamplingEngine engine(kinds, limits, &source, &files);
+  WorkerPool::Shared();  // the program's pool, started
+  const int threads = Threads();
+  SampleRequest r;
+  r.count = 400000;
+  r.tree.surface = "nurbs:" + WriteTemp("pool.nurbs",
+                                        "sfcsampler-nurbs 1\ndegree 1 1\ncount 2 2\n"
+                                        "knots_u 0 0 1 1\nknots_v 0 0 1 1\npole 0 0 0\n"
+                                        "pole 0 1 0\npole 1 0 0\npole 1 1 0.5\n");
+  auto job = engine.Start(r);
+  ASSERT_TRUE(job.ok()) << job.status();
+  SampleBatch all;
+  while (true) {  // in batches large enough to be filled in parallel
+    auto n = job->cursor->Next(r.count, &all);
+    ASSERT_TRUE(n.ok()) << n.status();
+    if (*n == 0) break;
+  }
+  EXPECT_EQ(all.size(), r.count);
+  EXPECT_EQ(Threads(), threads) << "the CAD module started threads of its own";
 }
 
 }  // namespace

@@ -36,14 +36,14 @@ bool Intersects(const Box2& a, const Box2& b) {
 // Gives every unmarked cell of a side x side grid (row-major) the state of
 // its piece, the unmarked cells joined to it by sides, which `classify(k)`
 // answers for the piece's first cell k; marked cells get kStraddles.
-template <typename Classify>
-void ClassifyPieces(const std::vector<char>& marked, int side, CellState* out,
+template <typename State, typename Classify>
+void ClassifyPieces(const std::vector<char>& marked, int side, State* out,
                     const Classify& classify) {
   const int cells = side * side;
   std::vector<char> seen(cells, 0);
   std::vector<int> piece;
   for (int start = 0; start < cells; ++start) {
-    if (marked[start]) out[start] = CellState::kStraddles;
+    if (marked[start]) out[start] = static_cast<State>(CellState::kStraddles);
     if (marked[start] || seen[start]) continue;
     piece.assign(1, start);
     seen[start] = 1;
@@ -56,7 +56,7 @@ void ClassifyPieces(const std::vector<char>& marked, int side, CellState* out,
         if (!marked[k] && !seen[k]) seen[k] = 1, piece.push_back(k);
       }
     }
-    const CellState state = classify(start);
+    const State state = static_cast<State>(classify(start));
     for (int k : piece) out[k] = state;
   }
 }
@@ -182,6 +182,8 @@ FaceTrim::FaceTrim(const TopoDS_Face& face, const UnitSquareMap& map, double tol
       continue;
     }
     const Geom2dAdaptor_Curve curve(pcurve);
+    lines_and_circles_ = lines_and_circles_ && (curve.GetType() == GeomAbs_Line ||
+                                                curve.GetType() == GeomAbs_Circle);
     const int edge_index = static_cast<int>(pcurves_.size());
     pcurves_.push_back(pcurve);
     struct Pending {
@@ -239,7 +241,7 @@ double FaceTrim::BandT() const {
 }
 
 double FaceTrim::Clearance(double s, double t) const {
-  if (!trimmed_ || missing_pcurve_) return 0;
+  if (!trimmed_ || missing_pcurve_ || !lines_and_circles_) return 0;
   const double ms = BandS(), mt = BandT();
   struct Piece {
     double distance;
@@ -313,6 +315,14 @@ void FaceTrim::BuildGrid() const {
   grid_.assign(kCells, CellState::kStraddles);
   fine_at_.assign(kCells, -1);
   if (missing_pcurve_) return;  // every cell may hold a curve we cannot see
+  if (!lines_and_circles_) {
+    for (int k = 0; k < kCells; ++k) {
+      const int i = k / kGridSide, j = k % kGridSide;
+      grid_[k] = Classify(double(i) / kGridSide, double(i + 1) / kGridSide, double(j) / kGridSide,
+                          double(j + 1) / kGridSide);
+    }
+    return;
+  }
   // The cells a curve box not on the square's border touches, boxes widened
   // by the kernel's ON band; the other cells form pieces no curve crosses,
   // and the kernel's answer at the centre of a piece's first cell holds for
@@ -327,8 +337,11 @@ void FaceTrim::BuildGrid() const {
   ClassifyPieces(marked, kGridSide, grid_.data(), [&](int k) {
     return KernelState((k / kGridSide + 0.5) / kGridSide, (k % kGridSide + 0.5) / kGridSide);
   });
-  for (int k = 0; k < kCells; ++k) {
-    if (grid_[k] == CellState::kStraddles) BuildFineGrid(k / kGridSide, k % kGridSide);
+  int fine_cells = 0;
+  for (int k = 0; k < kCells && fine_cells < kMaxFineCells; ++k) {
+    if (grid_[k] != CellState::kStraddles) continue;
+    BuildFineGrid(k / kGridSide, k % kGridSide);
+    ++fine_cells;
   }
 }
 
@@ -358,7 +371,7 @@ void FaceTrim::BuildFineGrid(int i, int j) const {
   }
   const int32_t at = static_cast<int32_t>(fine_.size());
   fine_at_[i * kGridSide + j] = at;
-  fine_.resize(fine_.size() + kCells, CellState::kStraddles);
+  fine_.resize(fine_.size() + kCells, static_cast<uint8_t>(CellState::kStraddles));
   ClassifyPieces(marked, kFineSide, fine_.data() + at, [&](int k) {
     return KernelState(s0 + (k / kFineSide + 0.5) * w, t0 + (k % kFineSide + 0.5) * w);
   });
@@ -374,7 +387,8 @@ bool FaceTrim::Contains(double s, double t) const {
   const int cell = (fi / kFineSide) * kGridSide + fj / kFineSide;
   CellState state = grid_[cell];
   if (state == CellState::kStraddles && fine_at_[cell] >= 0) {
-    state = fine_[fine_at_[cell] + (fi % kFineSide) * kFineSide + fj % kFineSide];
+    state = static_cast<CellState>(
+        fine_[fine_at_[cell] + (fi % kFineSide) * kFineSide + fj % kFineSide]);
   }
   switch (state) {
     case CellState::kInside: return true;

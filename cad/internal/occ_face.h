@@ -165,10 +165,22 @@ class FaceTrim {
   static constexpr int kGridSide = 128;
   // A grid cell the boundary may cross is split once more into
   // kFineSide x kFineSide sub-cells (cell width 1/2048, the boxes' size):
-  // sub-cells no curve box (widened by the kernel's tolerance) touches are
+  // sub-cells no curve box (widened by the kernel's ON band) touches are
   // flood-filled into connected pieces, and one kernel answer classifies each
   // piece, since no curve separates its points.
+  //
+  // Pieces (of cells and of sub-cells) and Clearance() rely on the kernel
+  // answering the truth away from the curves, which holds where its polygon's
+  // error allowance is exact: trims of lines and circles (the allowance is
+  // measured at chord midpoints, where a circle's arc is farthest). On any
+  // other trim (B-splines, ellipses, ...) the kernel can be wrong a few
+  // sub-cells from the curve, and one wrong answer would spread over a piece;
+  // those faces classify each cell at its centre and ask the kernel for
+  // every point in the cells a curve may cross, as before pieces existed.
   static constexpr int kFineSide = 16;
+  // At most this many cells get sub-cells (256 bytes each); past it the
+  // kernel answers the rest point by point.
+  static constexpr int kMaxFineCells = 4096;
 
  private:
   void BuildGrid() const;
@@ -195,6 +207,7 @@ class FaceTrim {
   std::vector<int> roots_;
   std::vector<Handle(Geom2d_Curve)> pcurves_;  // one per root, read only
   bool missing_pcurve_ = false;  // an edge without a p-curve: every cell near nothing is unknown
+  bool lines_and_circles_ = true;  // every p-curve is a line or a circle (see kFineSide)
   bool trimmed_ = true;
   mutable LeasePool<BRepTopAdaptor_FClass2d> classifiers_;  // thread-safe
   mutable std::once_flag grid_once_;
@@ -202,7 +215,7 @@ class FaceTrim {
   // For grid cell k that the boundary may cross, fine_[fine_at_[k] + a *
   // kFineSide + b] is its sub-cell (a, b); fine_at_[k] = -1 otherwise.
   mutable std::vector<int32_t> fine_at_;
-  mutable std::vector<CellState> fine_;
+  mutable std::vector<uint8_t> fine_;  // CellState values
 };
 
 }  // namespace sfc::cad

@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_format.h"
 #include "base/status_macros.h"
+#include "base/worker_pool.h"
 #include "cad/load.h"
 #include "cad/model_sampler.h"
 #include "kinds/cad/cad_kind.h"
@@ -155,5 +156,8 @@ const char* sfcsampler_kind_module_abi() {
   static const std::string* const abi = new std::string(sfc::KindModuleAbi());
   return abi->c_str();
 }
-sfc::SurfaceKind* sfcsampler_make_cad_kind() { return new sfc::CadKind(); }
+sfc::SurfaceKind* sfcsampler_make_cad_kind(sfc::WorkerPool* pool) {
+  sfc::WorkerPool::ShareFrom(pool);
+  return new sfc::CadKind();
+}
 }
