@@ -19,6 +19,8 @@
 //
 // Errors from Resolve and Describe when the module cannot be used:
 // FAILED_PRECONDITION naming the file, where it was looked for and what to set.
+// The first file found is the one used (one that fails to load ends the
+// search), and a failed load is remembered for the life of the process.
 //
 // Thread-safety: as every kind, immutable after the first load; the load is
 // once for all threads.
