@@ -538,7 +538,8 @@ TEST(CadModel, ConcurrentEvaluationMatchesSerial) {
 TEST(CadModel, BatchEvaluationEqualsPointByPoint) {
   std::vector<std::shared_ptr<const Model>> models = {
       LoadOk(Solid::kBoxWithHole, ModelFormat::kStep), LoadOk(Solid::kSphere, ModelFormat::kStep),
-      LoadOk(Solid::kCylinder, ModelFormat::kIges)};
+      LoadOk(Solid::kCylinder, ModelFormat::kIges),
+      LoadOk(Solid::kTiltedConeAndTorus, ModelFormat::kStep)};
   auto patch = Load(ModelFormat::kNurbs, MultiSpanPatch(), "spans.nurbs");
   ASSERT_TRUE(patch.ok()) << patch.status();
   models.push_back(*patch);

@@ -35,6 +35,11 @@ bool SameBits(const double a[3], const gp_XYZ& b) {
 // and order: PlaneD0/D1, CylinderD0/D1/D2, ConeD0/D1/D2, SphereD0/D1/D2,
 // TorusD0/D1/D2 (with its rounding of tiny terms to zero).
 void ClosedForm::Evaluate(double u, double v, int order, double d[][3]) const {
+  EvaluateWith(u, v, TurnsInU() ? TrigOf(u) : Trig{}, TurnsInV() ? TrigOf(v) : Trig{}, order, d);
+}
+
+void ClosedForm::EvaluateWith(double u, double v, const Trig& tu, const Trig& tv, int order,
+                              double d[][3]) const {
   switch (type) {
     case Type::kPlane:
       for (int k = 0; k < 3; ++k) d[0][k] = u * x[k] + v * y[k] + o[k];
@@ -46,7 +51,7 @@ void ClosedForm::Evaluate(double u, double v, int order, double d[][3]) const {
       }
       return;
     case Type::kCylinder: {
-      const double a1 = radius * std::cos(u), a2 = radius * std::sin(u);
+      const double a1 = radius * tu.cos, a2 = radius * tu.sin;
       if (order < 2) {
         for (int k = 0; k < 3; ++k) d[0][k] = a1 * x[k] + a2 * y[k] + v * z[k] + o[k];
       } else {
@@ -64,13 +69,13 @@ void ClosedForm::Evaluate(double u, double v, int order, double d[][3]) const {
     }
     case Type::kCone: {
       if (order == 0) {
-        const double r = radius + v * std::sin(angle), a3 = v * std::cos(angle);
-        const double a1 = r * std::cos(u), a2 = r * std::sin(u);
+        const double r = radius + v * sin_angle, a3 = v * cos_angle;
+        const double a1 = r * tu.cos, a2 = r * tu.sin;
         for (int k = 0; k < 3; ++k) d[0][k] = a1 * x[k] + a2 * y[k] + a3 * z[k] + o[k];
         return;
       }
-      const double cu = std::cos(u), su = std::sin(u);
-      const double ca = std::cos(angle), sa = std::sin(angle);
+      const double cu = tu.cos, su = tu.sin;
+      const double ca = cos_angle, sa = sin_angle;
       const double r = radius + v * sa, a3 = v * ca;
       const double a1 = r * cu, a2 = r * su, r1 = sa * cu, r2 = sa * su;
       for (int k = 0; k < 3; ++k) {
@@ -92,13 +97,13 @@ void ClosedForm::Evaluate(double u, double v, int order, double d[][3]) const {
       const double eps = 10. * (minor + radius) * DBL_EPSILON;
       auto tiny = [eps](double a) { return std::abs(a) <= eps ? 0. : a; };
       if (order == 0) {
-        const double r = radius + minor * std::cos(v), a3 = tiny(minor * std::sin(v));
-        const double a1 = tiny(r * std::cos(u)), a2 = tiny(r * std::sin(u));
+        const double r = radius + minor * tv.cos, a3 = tiny(minor * tv.sin);
+        const double a1 = tiny(r * tu.cos), a2 = tiny(r * tu.sin);
         for (int k = 0; k < 3; ++k) d[0][k] = a1 * x[k] + a2 * y[k] + a3 * z[k] + o[k];
         return;
       }
-      const double cu = std::cos(u), su = std::sin(u);
-      const double r1 = minor * std::cos(v), r2 = minor * std::sin(v);
+      const double cu = tu.cos, su = tu.sin;
+      const double r1 = minor * tv.cos, r2 = minor * tv.sin;
       const double r = radius + r1;
       const double a1 = tiny(r * cu), a2 = tiny(r * su), a3 = tiny(r2 * cu), a4 = tiny(r2 * su);
       for (int k = 0; k < 3; ++k) {
@@ -119,13 +124,13 @@ void ClosedForm::Evaluate(double u, double v, int order, double d[][3]) const {
     }
     case Type::kSphere: {
       if (order == 0) {
-        const double r = radius * std::cos(v), a3 = radius * std::sin(v);
-        const double a1 = r * std::cos(u), a2 = r * std::sin(u);
+        const double r = radius * tv.cos, a3 = radius * tv.sin;
+        const double a1 = r * tu.cos, a2 = r * tu.sin;
         for (int k = 0; k < 3; ++k) d[0][k] = a1 * x[k] + a2 * y[k] + a3 * z[k] + o[k];
         return;
       }
-      const double cu = std::cos(u), su = std::sin(u);
-      const double r1 = radius * std::cos(v), r2 = radius * std::sin(v);
+      const double cu = tu.cos, su = tu.sin;
+      const double r1 = radius * tv.cos, r2 = radius * tv.sin;
       const double a1 = r1 * cu, a2 = r1 * su, a3 = r2 * cu, a4 = r2 * su;
       for (int k = 0; k < 3; ++k) {
         if (order == 1) {
@@ -165,6 +170,8 @@ std::optional<ClosedForm> ClosedForm::Extract(const BRepAdaptor_Surface& adaptor
         Place(local.Cone().Position(), &form);
         form.radius = local.Cone().RefRadius();
         form.angle = local.Cone().SemiAngle();
+        form.sin_angle = std::sin(form.angle);
+        form.cos_angle = std::cos(form.angle);
         break;
       case GeomAbs_Sphere:
         form.type = Type::kSphere;

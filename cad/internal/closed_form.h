@@ -11,6 +11,7 @@
 
 #include <BRepAdaptor_Surface.hxx>
 
+#include <cmath>
 #include <optional>
 
 namespace sfc::cad {
@@ -23,10 +24,28 @@ struct ClosedForm {
   double o[3], x[3], y[3], z[3];
   double radius = 0, angle = 0, minor = 0;
 
+  double sin_angle = 0, cos_angle = 0;  // of a cone's semi-angle
+
   // In the kernel's native parameters (U, V); d[0] is the point, d[1], d[2]
   // the first derivatives (U, V), d[3], d[4], d[5] the second (UU, VV, UV),
   // as BRepAdaptor_Surface::D0, D1 and D2 give them for `order` 0, 1, 2.
   void Evaluate(double u, double v, int order, double d[][3]) const;
+
+  // The cosine and sine of a parameter, as the kernel's formulas take them
+  // (glibc's cos and sin): computed once for a row or column of a grid, they
+  // give the same values as Evaluate computes point by point.
+  struct Trig {
+    double cos, sin;
+  };
+  static Trig TrigOf(double a) { return {std::cos(a), std::sin(a)}; }
+  // Whether the formulas take TrigOf(u) (every type but the plane) and
+  // TrigOf(v) (the sphere and the torus).
+  bool TurnsInU() const { return type != Type::kPlane; }
+  bool TurnsInV() const { return type == Type::kSphere || type == Type::kTorus; }
+  // Evaluate with tu = TrigOf(u) and tv = TrigOf(v) given (either unused,
+  // and may be anything, when the type does not take it).
+  void EvaluateWith(double u, double v, const Trig& tu, const Trig& tv, int order,
+                    double d[][3]) const;
 
   // The closed form of `adaptor`'s surface, if it is a plane, cylinder, cone,
   // sphere or torus without a transformation (identity location) and evaluates as the

@@ -96,22 +96,13 @@ Vec3 FaceSurface::PointWith(BRepAdaptor_Surface* adaptor, double u, double v) co
 
 SurfaceJet FaceSurface::JetWith(BRepAdaptor_Surface* adaptor, double u, double v,
                                 int order) const {
+  if (closed_) {
+    const double nu = map_.U(u), nv = map_.V(v);
+    return ClosedJet(nu, nv, closed_->TurnsInU() ? ClosedForm::TrigOf(nu) : ClosedForm::Trig{},
+                     closed_->TurnsInV() ? ClosedForm::TrigOf(nv) : ClosedForm::Trig{}, order);
+  }
   SurfaceJet jet;
   const double su = map_.DuDs(), sv = map_.DvDt();
-  auto vec = [](const double d[3]) { return Vec3{d[0], d[1], d[2]}; };
-  if (closed_) {
-    double d[6][3];
-    closed_->Evaluate(map_.U(u), map_.V(v), order >= 2 ? 2 : 1, d);
-    jet.p = vec(d[0]);
-    jet.fu = vec(d[1]) * su;
-    jet.fv = vec(d[2]) * sv;
-    if (order >= 2) {
-      jet.fuu = vec(d[3]) * (su * su);
-      jet.fuv = vec(d[5]) * (su * sv);
-      jet.fvv = vec(d[4]) * (sv * sv);
-    }
-    return jet;
-  }
   try {
     gp_Pnt p;
     gp_Vec du, dv;
@@ -133,6 +124,24 @@ SurfaceJet FaceSurface::JetWith(BRepAdaptor_Surface* adaptor, double u, double v
   return jet;
 }
 
+SurfaceJet FaceSurface::ClosedJet(double u, double v, const ClosedForm::Trig& tu,
+                                  const ClosedForm::Trig& tv, int order) const {
+  double d[6][3];
+  closed_->EvaluateWith(u, v, tu, tv, order >= 2 ? 2 : 1, d);
+  auto vec = [](const double* e) { return Vec3{e[0], e[1], e[2]}; };
+  const double su = map_.DuDs(), sv = map_.DvDt();
+  SurfaceJet jet;
+  jet.p = vec(d[0]);
+  jet.fu = vec(d[1]) * su;
+  jet.fv = vec(d[2]) * sv;
+  if (order >= 2) {
+    jet.fuu = vec(d[3]) * (su * su);
+    jet.fuv = vec(d[5]) * (su * sv);
+    jet.fvv = vec(d[4]) * (sv * sv);
+  }
+  return jet;
+}
+
 Vec3 FaceSurface::Point(double u, double v) const {
   if (closed_) return PointWith(nullptr, u, v);
   return PointWith(&*adaptors_.Take(), u, v);
@@ -145,6 +154,18 @@ SurfaceJet FaceSurface::Jet(double u, double v, int order) const {
 
 void FaceSurface::JetGrid(const double* us, int nu, const double* vs, int nv, int order,
                           SurfaceJet* out) const {
+  if (closed_) {
+    // The cosines and sines once a row and once a column, not once a point:
+    // the same values, so the same bits.
+    std::vector<ClosedForm::Trig> tv(nv);
+    for (int j = 0; j < nv && closed_->TurnsInV(); ++j) tv[j] = ClosedForm::TrigOf(map_.V(vs[j]));
+    for (int i = 0; i < nu; ++i) {
+      const double u = map_.U(us[i]);
+      const ClosedForm::Trig tu = closed_->TurnsInU() ? ClosedForm::TrigOf(u) : ClosedForm::Trig{};
+      for (int j = 0; j < nv; ++j) out[i * nv + j] = ClosedJet(u, map_.V(vs[j]), tu, tv[j], order);
+    }
+    return;
+  }
   auto fill = [&](BRepAdaptor_Surface* adaptor) {
     for (int i = 0; i < nu; ++i) {
       for (int j = 0; j < nv; ++j) out[i * nv + j] = JetWith(adaptor, us[i], vs[j], order);

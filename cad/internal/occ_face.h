@@ -122,6 +122,9 @@ class FaceSurface final : public Surface {
   // null), else through `adaptor`.
   Vec3 PointWith(BRepAdaptor_Surface* adaptor, double u, double v) const;
   SurfaceJet JetWith(BRepAdaptor_Surface* adaptor, double u, double v, int order) const;
+  // The jet from the closed form at native (u, v), with their cosines and sines.
+  SurfaceJet ClosedJet(double u, double v, const ClosedForm::Trig& tu, const ClosedForm::Trig& tv,
+                       int order) const;
 
   const TopoDS_Face face_;
   const UnitSquareMap map_;
