@@ -19,10 +19,11 @@ std::atomic<WorkerPool*> g_shared_from{nullptr};  // set by ShareFrom
 }  // namespace
 
 WorkerPool& WorkerPool::Shared() {
-  static WorkerPool* const pool =
-      g_shared_from.load() ? g_shared_from.load()
-                           : new WorkerPool(std::clamp(
-                                 static_cast<int>(std::thread::hardware_concurrency()) - 1, 1, 63));
+  static WorkerPool* const pool = [] {
+    if (WorkerPool* shared = g_shared_from.load()) return shared;
+    return new WorkerPool(
+        std::clamp(static_cast<int>(std::thread::hardware_concurrency()) - 1, 1, 63));
+  }();
   return *pool;
 }
 

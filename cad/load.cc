@@ -401,14 +401,15 @@ absl::StatusOr<Face> MakeFace(const TopoDS_Face& face, int index, ModelFormat fo
   const Vec3 centroid{c.X(), c.Y(), c.Z()};
   if (!std::isfinite(area) || !IsFinite(centroid))
     return bad("has a non-finite area (NaN or infinite geometry)");
-  auto surface = std::make_shared<FaceSurface>(face, map, options.closed_forms);
+  const BRepAdaptor_Surface adaptor(face, true);
+  auto surface = std::make_shared<FaceSurface>(
+      face, map, options.closed_forms ? ClosedForm::Extract(adaptor) : std::nullopt);
   for (double s : {0.0, 0.5, 1.0}) {
     for (double t : {0.0, 0.5, 1.0}) {
       if (!IsFinite(surface->Point(s, t)))
         return bad("has non-finite points (NaN or infinite coordinates)");
     }
   }
-  const BRepAdaptor_Surface adaptor(face, true);
   auto trim = std::make_shared<FaceTrim>(face, map, options.trim_tolerance);
   const bool trimmed = trim->trimmed();  // before `trim` is moved from
   return Face(index, TypeOf(adaptor.GetType()), area, box, reversed, centroid, trimmed,

@@ -121,10 +121,10 @@ class ModuleKind final : public SurfaceKind {
   }
 
   absl::Status Refused(const std::filesystem::path& path, const std::string& why) const {
-    return absl::FailedPreconditionError(ClipMessage(
-        absl::StrCat(std::string(info_.what), " needs the module ", path.string(), ", which cannot be used: ",
-                     why),
-        kMaxMessage));
+    return absl::FailedPreconditionError(
+        ClipMessage(absl::StrCat(std::string(info_.what), " needs the module ", path.string(),
+                                 ", which cannot be used: ", why),
+                    kMaxMessage));
   }
 
   static constexpr size_t kMaxMessage = 900;

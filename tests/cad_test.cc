@@ -337,9 +337,14 @@ struct HoledFace {
     return std::hypot(p.x - fixtures::kBoxX / 2, p.y - fixtures::kBoxY / 2) -
            fixtures::kHoleRadius;
   }
-  // The hole's centre in (s, t).
-  double CentreS() const { return Dot(Vec3{fixtures::kBoxX / 2, fixtures::kBoxY / 2, p0.z} - p0, fu) / Dot(fu, fu); }
-  double CentreT() const { return Dot(Vec3{fixtures::kBoxX / 2, fixtures::kBoxY / 2, p0.z} - p0, fv) / Dot(fv, fv); }
+  // The unit-square point `off` mm beyond the hole's circle (inside the
+  // face for off > 0) at `angle` about its centre.
+  std::pair<double, double> AtOffset(double off, double angle) const {
+    const Vec3 centre = Vec3{fixtures::kBoxX / 2, fixtures::kBoxY / 2, p0.z} - p0;
+    const double r = fixtures::kHoleRadius + off;
+    return {Dot(centre, fu) / Dot(fu, fu) + r * std::cos(angle) / Norm(fu),
+            Dot(centre, fv) / Dot(fv, fv) + r * std::sin(angle) / Norm(fv)};
+  }
 };
 
 std::vector<HoledFace> HoledFaces(const Model& model) {
@@ -364,14 +369,11 @@ TEST(CadBoxWithHole, ContainsMatchesTheExactHoleNearItsEdge) {
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> unit(0, 1);
   for (const HoledFace& h : faces) {
-    const double cs = h.CentreS(), ct = h.CentreT();
     int inside = 0, outside = 0;
     for (int k = 0; k < 20000; ++k) {
       const double angle = 2 * kPi * unit(rng);
       const double off = (k % 2 ? 1 : -1) * std::pow(10.0, -6 + 6.6 * unit(rng));  // mm
-      const double r = fixtures::kHoleRadius + off;
-      const double s = cs + r * std::cos(angle) / Norm(h.fu);
-      const double t = ct + r * std::sin(angle) / Norm(h.fv);
+      const auto [s, t] = h.AtOffset(off, angle);
       const double beyond = h.Beyond(s, t);
       if (std::abs(beyond) < 1e-7) continue;  // within the tolerance: either answer
       const bool in = h.face->Contains(s, t);
@@ -393,14 +395,11 @@ TEST(CadBoxWithHole, ClearanceBoundsTheDistanceToTheTrimFromBelow) {
   std::mt19937_64 rng(6);
   std::uniform_real_distribution<double> unit(0, 1);
   for (const HoledFace& h : HoledFaces(*model)) {
-    const double cs = h.CentreS(), ct = h.CentreT();
     const double stretch = std::max(Norm(h.fu), Norm(h.fv));  // mm per unit of the square, at most
     for (int k = 0; k < 400; ++k) {
       const double angle = 2 * kPi * unit(rng);
       const double off = (k % 2 ? 1 : -1) * std::pow(10.0, -5 + 5.5 * unit(rng));  // mm
-      const double r = fixtures::kHoleRadius + off;
-      const double s = cs + r * std::cos(angle) / Norm(h.fu);
-      const double t = ct + r * std::sin(angle) / Norm(h.fv);
+      const auto [s, t] = h.AtOffset(off, angle);
       const double clear = h.face->Clearance(s, t);
       ASSERT_GE(clear, 0);
       const bool in = h.Beyond(s, t) > 0;

@@ -113,6 +113,11 @@ TEST(SurfaceKinds, ANewKindIsSampledWithoutChangingTheEngine) {
   EXPECT_EQ(engine.Start(r).status().code(), absl::StatusCode::kInvalidArgument);
 }
 
+// A bilinear NURBS patch: the smallest CAD model, written without OpenCASCADE.
+constexpr char kSheetNurbs[] =
+    "sfcsampler-nurbs 1\ndegree 1 1\ncount 2 2\nknots_u 0 0 1 1\nknots_v 0 0 1 1\n"
+    "pole 0 0 0\npole 0 1 0\npole 1 0 0\npole 1 1 0.5\n";
+
 // The libraries this process has mapped whose path contains `name`.
 int Mapped(const std::string& name) {
   std::ifstream maps("/proc/self/maps");
@@ -159,10 +164,7 @@ TEST(ModuleKinds, OpenCascadeIsLoadedOnlyForTheFirstModel) {
   EXPECT_EQ(DrawAll(engine, r).size(), 1000u);
   EXPECT_EQ(Mapped("libTKernel"), 0) << "a sphere loaded OpenCASCADE";
   EXPECT_EQ(Mapped("libsfcsampler-cad"), 0);
-  r.tree.surface = "nurbs:" + WriteTemp("sheet.nurbs",
-                                        "sfcsampler-nurbs 1\ndegree 1 1\ncount 2 2\n"
-                                        "knots_u 0 0 1 1\nknots_v 0 0 1 1\npole 0 0 0\n"
-                                        "pole 0 1 0\npole 1 0 0\npole 1 1 0.5\n");
+  r.tree.surface = "nurbs:" + WriteTemp("sheet.nurbs", kSheetNurbs);
   r.fields.face = true;
   const SampleBatch batch = DrawAll(engine, r);
   EXPECT_EQ(batch.size(), 1000u);
@@ -194,10 +196,7 @@ TEST(ModuleKinds, TheModuleSharesTheProgramsWorkerPool) {
   const int threads = Threads();
   SampleRequest r;
   r.count = 400000;
-  r.tree.surface = "nurbs:" + WriteTemp("pool.nurbs",
-                                        "sfcsampler-nurbs 1\ndegree 1 1\ncount 2 2\n"
-                                        "knots_u 0 0 1 1\nknots_v 0 0 1 1\npole 0 0 0\n"
-                                        "pole 0 1 0\npole 1 0 0\npole 1 1 0.5\n");
+  r.tree.surface = "nurbs:" + WriteTemp("pool.nurbs", kSheetNurbs);
   auto job = engine.Start(r);
   ASSERT_TRUE(job.ok()) << job.status();
   SampleBatch all;

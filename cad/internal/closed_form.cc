@@ -24,9 +24,20 @@ void Place(const gp_Ax3& position, ClosedForm* form) {
   Set(form->z, position.Direction().XYZ());
 }
 
-bool SameBits(const double a[3], const gp_XYZ& b) {
-  const double c[3] = {b.X(), b.Y(), b.Z()};
-  return std::memcmp(a, c, sizeof(c)) == 0;
+// The kernel's D0, D1 or D2 (`order`) at (u, v), laid out as Evaluate's.
+void KernelAt(const BRepAdaptor_Surface& adaptor, double u, double v, int order,
+              double d[][3]) {
+  gp_Pnt p;
+  gp_Vec du, dv, duu, dvv, duv;
+  if (order == 0) adaptor.D0(u, v, p);
+  if (order == 1) adaptor.D1(u, v, p, du, dv);
+  if (order == 2) adaptor.D2(u, v, p, du, dv, duu, dvv, duv);
+  Set(d[0], p.XYZ());
+  Set(d[1], du.XYZ());
+  Set(d[2], dv.XYZ());
+  Set(d[3], duu.XYZ());
+  Set(d[4], dvv.XYZ());
+  Set(d[5], duv.XYZ());
 }
 
 }  // namespace
@@ -35,7 +46,7 @@ bool SameBits(const double a[3], const gp_XYZ& b) {
 // and order: PlaneD0/D1, CylinderD0/D1/D2, ConeD0/D1/D2, SphereD0/D1/D2,
 // TorusD0/D1/D2 (with its rounding of tiny terms to zero).
 void ClosedForm::Evaluate(double u, double v, int order, double d[][3]) const {
-  EvaluateWith(u, v, TurnsInU() ? TrigOf(u) : Trig{}, TurnsInV() ? TrigOf(v) : Trig{}, order, d);
+  EvaluateWith(u, v, TrigU(u), TrigV(v), order, d);
 }
 
 void ClosedForm::EvaluateWith(double u, double v, const Trig& tu, const Trig& tv, int order,
@@ -169,9 +180,8 @@ std::optional<ClosedForm> ClosedForm::Extract(const BRepAdaptor_Surface& adaptor
         form.type = Type::kCone;
         Place(local.Cone().Position(), &form);
         form.radius = local.Cone().RefRadius();
-        form.angle = local.Cone().SemiAngle();
-        form.sin_angle = std::sin(form.angle);
-        form.cos_angle = std::cos(form.angle);
+        form.sin_angle = std::sin(local.Cone().SemiAngle());
+        form.cos_angle = std::cos(local.Cone().SemiAngle());
         break;
       case GeomAbs_Sphere:
         form.type = Type::kSphere;
@@ -195,21 +205,13 @@ std::optional<ClosedForm> ClosedForm::Extract(const BRepAdaptor_Surface& adaptor
       for (int j = 0; j <= 8; ++j) {
         const double u = u0 + (u1 - u0) * (i * 0.1371 + 0.0113) - 0.05 * (u1 - u0);
         const double v = v0 + (v1 - v0) * (j * 0.1297 + 0.0171) - 0.05 * (v1 - v0);
-        double d[6][3];
-        gp_Pnt p;
-        gp_Vec du, dv, duu, dvv, duv;
-        form.Evaluate(u, v, 0, d);
-        adaptor.D0(u, v, p);
-        if (!SameBits(d[0], p.XYZ())) return std::nullopt;
-        form.Evaluate(u, v, 1, d);
-        adaptor.D1(u, v, p, du, dv);
-        if (!SameBits(d[0], p.XYZ()) || !SameBits(d[1], du.XYZ()) || !SameBits(d[2], dv.XYZ()))
-          return std::nullopt;
-        form.Evaluate(u, v, 2, d);
-        adaptor.D2(u, v, p, du, dv, duu, dvv, duv);
-        if (!SameBits(d[0], p.XYZ()) || !SameBits(d[1], du.XYZ()) || !SameBits(d[2], dv.XYZ()) ||
-            !SameBits(d[3], duu.XYZ()) || !SameBits(d[4], dvv.XYZ()) || !SameBits(d[5], duv.XYZ()))
-          return std::nullopt;
+        for (int order = 0; order <= 2; ++order) {
+          double ours[6][3], theirs[6][3];
+          form.Evaluate(u, v, order, ours);
+          KernelAt(adaptor, u, v, order, theirs);
+          const int rows = order == 0 ? 1 : order == 1 ? 3 : 6;
+          if (std::memcmp(ours, theirs, rows * sizeof(ours[0])) != 0) return std::nullopt;
+        }
       }
     }
   } catch (const Standard_Failure&) {

@@ -1,5 +1,5 @@
-// Internal to cad/: a face's plane, cylinder, cone, sphere or torus evaluated from its
-// closed form, without the kernel's adaptors (no lease, no virtual calls):
+// Internal to cad/: a face's plane, cylinder, cone, sphere or torus
+// evaluated from its closed form, without the kernel's adaptors (no lease, no virtual calls):
 // issue 20's "the face's analytic form extracted once into a plain
 // evaluator". The arithmetic is the kernel's own (OpenCASCADE 7.6's ElSLib
 // formulas, the same operations in the same order, glibc's sin and cos), so
@@ -20,11 +20,10 @@ struct ClosedForm {
   enum class Type { kPlane, kCylinder, kCone, kSphere, kTorus };
   Type type = Type::kPlane;
   // The surface's placement (location; x, y and main directions), radius (a
-  // torus's major one), a cone's semi-angle and a torus's minor radius.
+  // torus's major one), a torus's minor radius and the sine and cosine of a
+  // cone's semi-angle.
   double o[3], x[3], y[3], z[3];
-  double radius = 0, angle = 0, minor = 0;
-
-  double sin_angle = 0, cos_angle = 0;  // of a cone's semi-angle
+  double radius = 0, minor = 0, sin_angle = 0, cos_angle = 0;
 
   // In the kernel's native parameters (U, V); d[0] is the point, d[1], d[2]
   // the first derivatives (U, V), d[3], d[4], d[5] the second (UU, VV, UV),
@@ -38,18 +37,20 @@ struct ClosedForm {
     double cos, sin;
   };
   static Trig TrigOf(double a) { return {std::cos(a), std::sin(a)}; }
-  // Whether the formulas take TrigOf(u) (every type but the plane) and
-  // TrigOf(v) (the sphere and the torus).
-  bool TurnsInU() const { return type != Type::kPlane; }
-  bool TurnsInV() const { return type == Type::kSphere || type == Type::kTorus; }
-  // Evaluate with tu = TrigOf(u) and tv = TrigOf(v) given (either unused,
-  // and may be anything, when the type does not take it).
+  // TrigOf(u) and TrigOf(v) when the type's formulas take them (u: every
+  // type but the plane; v: the sphere and the torus), else nothing computed.
+  Trig TrigU(double u) const { return type != Type::kPlane ? TrigOf(u) : Trig{}; }
+  Trig TrigV(double v) const {
+    return type == Type::kSphere || type == Type::kTorus ? TrigOf(v) : Trig{};
+  }
+  // Evaluate with tu = TrigU(u) and tv = TrigV(v) given.
   void EvaluateWith(double u, double v, const Trig& tu, const Trig& tv, int order,
                     double d[][3]) const;
 
   // The closed form of `adaptor`'s surface, if it is a plane, cylinder, cone,
-  // sphere or torus without a transformation (identity location) and evaluates as the
-  // kernel does at every checked point, for every order; nullopt otherwise.
+  // sphere or torus without a transformation (identity location) and
+  // evaluates as the kernel does at every checked point, for every order;
+  // nullopt otherwise.
   static std::optional<ClosedForm> Extract(const BRepAdaptor_Surface& adaptor);
 };
 

@@ -11,7 +11,6 @@
 #include <TopoDS.hxx>
 #include <TopoDS_Edge.hxx>
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <gp_Pnt.hxx>
 #include <gp_Pnt2d.hxx>
@@ -75,32 +74,23 @@ void MarkBox(const Box2& b, double s0, double t0, double w, int side, std::vecto
 
 }  // namespace
 
-FaceSurface::FaceSurface(const TopoDS_Face& face, const UnitSquareMap& map, bool closed_form)
+FaceSurface::FaceSurface(const TopoDS_Face& face, const UnitSquareMap& map,
+                         std::optional<ClosedForm> closed)
     : face_(face),
       map_(map),
-      closed_(closed_form ? ClosedForm::Extract(BRepAdaptor_Surface(face, true)) : std::nullopt),
+      closed_(std::move(closed)),
       adaptors_([face] { return std::make_unique<BRepAdaptor_Surface>(face, true); }) {}
 
-Vec3 FaceSurface::PointWith(BRepAdaptor_Surface* adaptor, double u, double v) const {
-  if (closed_) {
-    double d[6][3];
-    closed_->Evaluate(map_.U(u), map_.V(v), 0, d);
-    return {d[0][0], d[0][1], d[0][2]};
-  }
+Vec3 FaceSurface::KernelPoint(BRepAdaptor_Surface& adaptor, double u, double v) const {
   try {
-    return ToVec3(adaptor->Value(map_.U(u), map_.V(v)).XYZ());
+    return ToVec3(adaptor.Value(map_.U(u), map_.V(v)).XYZ());
   } catch (const Standard_Failure&) {
     return NotFinite();
   }
 }
 
-SurfaceJet FaceSurface::JetWith(BRepAdaptor_Surface* adaptor, double u, double v,
-                                int order) const {
-  if (closed_) {
-    const double nu = map_.U(u), nv = map_.V(v);
-    return ClosedJet(nu, nv, closed_->TurnsInU() ? ClosedForm::TrigOf(nu) : ClosedForm::Trig{},
-                     closed_->TurnsInV() ? ClosedForm::TrigOf(nv) : ClosedForm::Trig{}, order);
-  }
+SurfaceJet FaceSurface::KernelJet(BRepAdaptor_Surface& adaptor, double u, double v,
+                                  int order) const {
   SurfaceJet jet;
   const double su = map_.DuDs(), sv = map_.DvDt();
   try {
@@ -108,12 +98,12 @@ SurfaceJet FaceSurface::JetWith(BRepAdaptor_Surface* adaptor, double u, double v
     gp_Vec du, dv;
     if (order >= 2) {
       gp_Vec duu, dvv, duv;
-      adaptor->D2(map_.U(u), map_.V(v), p, du, dv, duu, dvv, duv);
+      adaptor.D2(map_.U(u), map_.V(v), p, du, dv, duu, dvv, duv);
       jet.fuu = ToVec3(duu.XYZ()) * (su * su);
       jet.fuv = ToVec3(duv.XYZ()) * (su * sv);
       jet.fvv = ToVec3(dvv.XYZ()) * (sv * sv);
     } else {
-      adaptor->D1(map_.U(u), map_.V(v), p, du, dv);
+      adaptor.D1(map_.U(u), map_.V(v), p, du, dv);
     }
     jet.p = ToVec3(p.XYZ());
     jet.fu = ToVec3(du.XYZ()) * su;
@@ -122,6 +112,12 @@ SurfaceJet FaceSurface::JetWith(BRepAdaptor_Surface* adaptor, double u, double v
     jet.p = jet.fu = jet.fv = NotFinite();
   }
   return jet;
+}
+
+Vec3 FaceSurface::ClosedPoint(double u, double v) const {
+  double d[6][3];
+  closed_->Evaluate(map_.U(u), map_.V(v), 0, d);
+  return {d[0][0], d[0][1], d[0][2]};
 }
 
 SurfaceJet FaceSurface::ClosedJet(double u, double v, const ClosedForm::Trig& tu,
@@ -143,48 +139,46 @@ SurfaceJet FaceSurface::ClosedJet(double u, double v, const ClosedForm::Trig& tu
 }
 
 Vec3 FaceSurface::Point(double u, double v) const {
-  if (closed_) return PointWith(nullptr, u, v);
-  return PointWith(&*adaptors_.Take(), u, v);
+  return closed_ ? ClosedPoint(u, v) : KernelPoint(*adaptors_.Take(), u, v);
 }
 
 SurfaceJet FaceSurface::Jet(double u, double v, int order) const {
-  if (closed_) return JetWith(nullptr, u, v, order);
-  return JetWith(&*adaptors_.Take(), u, v, order);
+  if (!closed_) return KernelJet(*adaptors_.Take(), u, v, order);
+  const double nu = map_.U(u), nv = map_.V(v);
+  return ClosedJet(nu, nv, closed_->TrigU(nu), closed_->TrigV(nv), order);
 }
 
 void FaceSurface::JetGrid(const double* us, int nu, const double* vs, int nv, int order,
                           SurfaceJet* out) const {
-  if (closed_) {
-    // The cosines and sines once a row and once a column, not once a point:
-    // the same values, so the same bits.
-    std::vector<ClosedForm::Trig> tv(nv);
-    for (int j = 0; j < nv && closed_->TurnsInV(); ++j) tv[j] = ClosedForm::TrigOf(map_.V(vs[j]));
+  if (!closed_) {
+    auto adaptor = adaptors_.Take();
     for (int i = 0; i < nu; ++i) {
-      const double u = map_.U(us[i]);
-      const ClosedForm::Trig tu = closed_->TurnsInU() ? ClosedForm::TrigOf(u) : ClosedForm::Trig{};
-      for (int j = 0; j < nv; ++j) out[i * nv + j] = ClosedJet(u, map_.V(vs[j]), tu, tv[j], order);
+      for (int j = 0; j < nv; ++j) out[i * nv + j] = KernelJet(*adaptor, us[i], vs[j], order);
     }
     return;
   }
-  auto fill = [&](BRepAdaptor_Surface* adaptor) {
-    for (int i = 0; i < nu; ++i) {
-      for (int j = 0; j < nv; ++j) out[i * nv + j] = JetWith(adaptor, us[i], vs[j], order);
-    }
-  };
-  if (closed_) return fill(nullptr);
-  fill(&*adaptors_.Take());
+  // The cosines and sines once a row and once a column, not once a point:
+  // the same values, so the same bits.
+  std::vector<ClosedForm::Trig> tv(nv);
+  for (int j = 0; j < nv; ++j) tv[j] = closed_->TrigV(map_.V(vs[j]));
+  for (int i = 0; i < nu; ++i) {
+    const double u = map_.U(us[i]);
+    const ClosedForm::Trig tu = closed_->TrigU(u);
+    for (int j = 0; j < nv; ++j) out[i * nv + j] = ClosedJet(u, map_.V(vs[j]), tu, tv[j], order);
+  }
 }
 
 void FaceSurface::Points(const double* u, const double* v, size_t n, double* x, double* y,
                          double* z) const {
-  auto fill = [&](BRepAdaptor_Surface* adaptor) {
+  auto fill = [&](auto point) {
     for (size_t i = 0; i < n; ++i) {
-      const Vec3 p = PointWith(adaptor, u[i], v[i]);
+      const Vec3 p = point(u[i], v[i]);
       x[i] = p.x, y[i] = p.y, z[i] = p.z;
     }
   };
-  if (closed_) return fill(nullptr);
-  fill(&*adaptors_.Take());
+  if (closed_) return fill([this](double s, double t) { return ClosedPoint(s, t); });
+  auto adaptor = adaptors_.Take();
+  fill([&](double s, double t) { return KernelPoint(*adaptor, s, t); });
 }
 
 FaceTrim::FaceTrim(const TopoDS_Face& face, const UnitSquareMap& map, double tolerance)

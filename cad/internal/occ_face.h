@@ -101,8 +101,10 @@ struct UnitSquareMap {
 // non-finite result (core/surface.h's contract).
 class FaceSurface final : public Surface {
  public:
-  // `closed_form`: evaluate from the closed form when the face has one.
-  FaceSurface(const TopoDS_Face& face, const UnitSquareMap& map, bool closed_form = true);
+  // `closed`: the face's closed form (ClosedForm::Extract), evaluated instead
+  // of the kernel; nullopt: the kernel evaluates.
+  FaceSurface(const TopoDS_Face& face, const UnitSquareMap& map,
+              std::optional<ClosedForm> closed);
 
   Vec3 Point(double u, double v) const override;
   SurfaceJet Jet(double u, double v, int order) const override;
@@ -118,11 +120,12 @@ class FaceSurface final : public Surface {
   bool closed_form() const { return closed_.has_value(); }
 
  private:
-  // Through the closed form when there is one (`adaptor` unused: may be
-  // null), else through `adaptor`.
-  Vec3 PointWith(BRepAdaptor_Surface* adaptor, double u, double v) const;
-  SurfaceJet JetWith(BRepAdaptor_Surface* adaptor, double u, double v, int order) const;
-  // The jet from the closed form at native (u, v), with their cosines and sines.
+  // Through the kernel's `adaptor`, at unit-square (u, v).
+  Vec3 KernelPoint(BRepAdaptor_Surface& adaptor, double u, double v) const;
+  SurfaceJet KernelJet(BRepAdaptor_Surface& adaptor, double u, double v, int order) const;
+  // From the closed form: the point at unit-square (u, v); the jet at native
+  // (u, v), with their cosines and sines.
+  Vec3 ClosedPoint(double u, double v) const;
   SurfaceJet ClosedJet(double u, double v, const ClosedForm::Trig& tu, const ClosedForm::Trig& tv,
                        int order) const;
 
