@@ -120,6 +120,19 @@ with open(sys.argv[2], 'wb') as f:
 """
 
 
+def same_file(a, b):
+    """Fails unless the two PLY files declare the same properties and have
+    the same body size: the row compares writing the same file."""
+    def layout(path):
+        with open(path, "rb") as f:
+            head = f.read(4096)
+        end = head.index(b"end_header\n") + len(b"end_header\n")
+        lines = [l for l in head[:end].split(b"\n") if not l.startswith(b"comment")]
+        return lines, os.path.getsize(path) - end
+    if layout(a) != layout(b):
+        raise SystemExit(f"row 3 compares different files: {layout(a)} against {layout(b)}")
+
+
 def row_cold_cli(n=4_000_000):
     with tempfile.TemporaryDirectory() as tmp:
         script = os.path.join(tmp, "numpy_ply.py")
@@ -127,8 +140,9 @@ def row_cold_cli(n=4_000_000):
             f.write(NUMPY_PLY)
         ours, theirs = paired(
             lambda: run([f"{BUILD}/client/sfcsampler", "sample", "-n", str(n), "-q", "--format", "ply",
-                         "-o", os.path.join(tmp, "a.ply")]),
+                         "--columns", "x,y,z", "-o", os.path.join(tmp, "a.ply")]),
             lambda: run([sys.executable, script, str(n), os.path.join(tmp, "b.ply")]))
+        same_file(os.path.join(tmp, "a.ply"), os.path.join(tmp, "b.ply"))
     return [(f"3. cold CLI, {n / 1e6:.0f} M sphere samples to a binary PLY file, 5 paired runs",
              f"median {statistics.median(ours):.2f} s ({min(ours):.2f}-{max(ours):.2f})",
              f"numpy script {min(theirs):.2f}-{max(theirs):.2f} s",
