@@ -142,6 +142,27 @@ absl::Status SampleWriter::CheckColumns(OutputFormat format, const SampleFields&
   return Layout(format, fields, columns).status();
 }
 
+SampleFields SampleWriter::SourceFields(SampleFields fields, const std::vector<std::string>& columns) {
+  if (columns.empty()) return fields;
+  auto named = [&](std::initializer_list<const char*> names) {
+    for (const char* name : names) {
+      if (std::find(columns.begin(), columns.end(), name) != columns.end()) return true;
+    }
+    return false;
+  };
+  fields.uv = named({"u", "v"});
+  fields.xyz = named({"x", "y", "z"});
+  fields.normal = fields.normal && named({"nx", "ny", "nz"});
+  fields.density = fields.density && named({"density"});
+  fields.curve_position = fields.curve_position && named({"curve_position"});
+  fields.face = fields.face && named({"face"});
+  fields.triangle = fields.triangle && named({"triangle"});
+  if (!fields.uv && !fields.xyz && !fields.normal && !fields.density && !fields.curve_position) {
+    fields.uv = true;
+  }
+  return fields;
+}
+
 void SampleWriter::AppendNumber(std::string* out, double value) const {
   if (precision_ == OutputPrecision::kFloat32) {
     AppendShortest(out, static_cast<float>(value));

@@ -49,6 +49,12 @@ class SampleWriter {
   // or PLY without x, y and z.
   static absl::Status CheckColumns(OutputFormat format, const SampleFields& fields,
                                    const std::vector<std::string>& columns);
+  // The fields to ask a sample source for when only `columns` are written
+  // (empty: `fields` unchanged): what no named column needs is left off,
+  // u v and x y z included, so it is neither made nor sent. If nothing else
+  // would remain, u and v stay (the wire needs one value column).
+  // REQUIRES: CheckColumns(format, fields, columns) passed.
+  static SampleFields SourceFields(SampleFields fields, const std::vector<std::string>& columns);
   ~SampleWriter();
 
   absl::Status Write(const SampleBatch& batch);

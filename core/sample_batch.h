@@ -8,8 +8,12 @@
 
 namespace sfc {
 
-// Optional per-sample columns.
+// Optional per-sample columns. The engine always fills u, v, x, y and z;
+// `uv` and `xyz` say whether they travel on the wire (a client that writes
+// only some columns leaves the others off; proto/convert.h).
 struct SampleFields {
+  bool uv = true;               // u, v
+  bool xyz = true;              // x, y, z
   bool normal = false;          // unit normal (nx, ny, nz)
   bool density = false;         // delta at the sample
   bool curve_position = false;  // position along the parameter-space curve, in [0,1)
@@ -51,6 +55,16 @@ struct SampleBatch {
     }
   }
   void Append(const SampleBatch& other) { AppendFrom(other, 0, other.size()); }
+  // Keeps the first n samples of every column longer than n.
+  void Truncate(size_t n) {
+    for (auto* c : {&u, &v, &x, &y, &z, &nx, &ny, &nz, &density, &curve_position}) {
+      if (c->size() > n) c->resize(n);
+    }
+    for (auto* c : {&face, &triangle}) {
+      if (c->size() > n) c->resize(n);
+    }
+    if (index.size() > n) index.resize(n);
+  }
   void Clear() {
     for (auto* c : {&u, &v, &x, &y, &z, &nx, &ny, &nz, &density, &curve_position}) c->clear();
     index.clear(), face.clear(), triangle.clear();

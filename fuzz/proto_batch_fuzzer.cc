@@ -21,11 +21,14 @@ namespace {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   sfc::v1::SampleResponse response;
   if (!response.ParseFromArray(data, static_cast<int>(size))) return 0;
-  for (int mask = 0; mask < 8; ++mask) {
+  for (int mask = 0; mask < 32; ++mask) {
     sfc::SampleFields fields;
     fields.normal = mask & 1;
     fields.density = mask & 2;
     fields.curve_position = mask & 4;
+    fields.uv = !(mask & 8);
+    fields.xyz = !(mask & 16);
+    if (sfc::WireValueColumns(fields) == 0) continue;  // the server refuses such a request
     sfc::SampleBatch batch;
     const absl::Status status = sfc::AppendFromProto(response.batch(), fields, &batch);
     if (!status.ok()) {
@@ -35,9 +38,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       continue;
     }
     const size_t n = batch.size();
-    if (batch.u.size() != n || batch.v.size() != n || batch.x.size() != n || batch.y.size() != n ||
-        batch.z.size() != n) {
-      Fail("an accepted batch has a column of another length than its indices");
+    const size_t uv = fields.uv ? n : 0, xyz = fields.xyz ? n : 0;
+    if (batch.u.size() != uv || batch.v.size() != uv || batch.x.size() != xyz ||
+        batch.y.size() != xyz || batch.z.size() != xyz) {
+      Fail("an accepted batch has a column of another length than its indices, or one not asked for");
     }
     if (fields.normal && (batch.nx.size() != n || batch.ny.size() != n || batch.nz.size() != n)) {
       Fail("an accepted batch lacks a requested normal column");

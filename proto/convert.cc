@@ -23,11 +23,15 @@ void Put(const std::vector<double>& from, Column* to) {
 
 template <typename Columns>
 void PutColumns(const SampleBatch& b, const SampleFields& fields, Columns* c) {
-  Put(b.u, c->mutable_u());
-  Put(b.v, c->mutable_v());
-  Put(b.x, c->mutable_x());
-  Put(b.y, c->mutable_y());
-  Put(b.z, c->mutable_z());
+  if (fields.uv) {
+    Put(b.u, c->mutable_u());
+    Put(b.v, c->mutable_v());
+  }
+  if (fields.xyz) {
+    Put(b.x, c->mutable_x());
+    Put(b.y, c->mutable_y());
+    Put(b.z, c->mutable_z());
+  }
   if (fields.normal) {
     Put(b.nx, c->mutable_nx());
     Put(b.ny, c->mutable_ny());
@@ -84,11 +88,15 @@ void PutRaw(const std::vector<double>& from, std::string* to) {
 
 template <typename T>
 void PutRawColumns(const SampleBatch& b, const SampleFields& fields, v1::RawColumns* c) {
-  PutRaw<T>(b.u, c->mutable_u());
-  PutRaw<T>(b.v, c->mutable_v());
-  PutRaw<T>(b.x, c->mutable_x());
-  PutRaw<T>(b.y, c->mutable_y());
-  PutRaw<T>(b.z, c->mutable_z());
+  if (fields.uv) {
+    PutRaw<T>(b.u, c->mutable_u());
+    PutRaw<T>(b.v, c->mutable_v());
+  }
+  if (fields.xyz) {
+    PutRaw<T>(b.x, c->mutable_x());
+    PutRaw<T>(b.y, c->mutable_y());
+    PutRaw<T>(b.z, c->mutable_z());
+  }
   if (fields.normal) {
     PutRaw<T>(b.nx, c->mutable_nx());
     PutRaw<T>(b.ny, c->mutable_ny());
@@ -125,11 +133,15 @@ absl::Status TakeRaw(const char* name, const std::string& from, size_t n, std::v
 
 template <typename T>
 absl::Status TakeRawColumns(const v1::RawColumns& c, const SampleFields& fields, size_t n, SampleBatch* b) {
-  RETURN_IF_ERROR(TakeRaw<T>("u", c.u(), n, &b->u));
-  RETURN_IF_ERROR(TakeRaw<T>("v", c.v(), n, &b->v));
-  RETURN_IF_ERROR(TakeRaw<T>("x", c.x(), n, &b->x));
-  RETURN_IF_ERROR(TakeRaw<T>("y", c.y(), n, &b->y));
-  RETURN_IF_ERROR(TakeRaw<T>("z", c.z(), n, &b->z));
+  if (fields.uv) {
+    RETURN_IF_ERROR(TakeRaw<T>("u", c.u(), n, &b->u));
+    RETURN_IF_ERROR(TakeRaw<T>("v", c.v(), n, &b->v));
+  }
+  if (fields.xyz) {
+    RETURN_IF_ERROR(TakeRaw<T>("x", c.x(), n, &b->x));
+    RETURN_IF_ERROR(TakeRaw<T>("y", c.y(), n, &b->y));
+    RETURN_IF_ERROR(TakeRaw<T>("z", c.z(), n, &b->z));
+  }
   if (fields.normal) {
     RETURN_IF_ERROR(TakeRaw<T>("nx", c.nx(), n, &b->nx));
     RETURN_IF_ERROR(TakeRaw<T>("ny", c.ny(), n, &b->ny));
@@ -171,11 +183,15 @@ absl::Status Take(const char* name, const Column& from, size_t n, std::vector<do
 
 template <typename Columns>
 absl::Status TakeColumns(const Columns& c, const SampleFields& fields, size_t n, SampleBatch* b) {
-  RETURN_IF_ERROR(Take("u", c.u(), n, &b->u));
-  RETURN_IF_ERROR(Take("v", c.v(), n, &b->v));
-  RETURN_IF_ERROR(Take("x", c.x(), n, &b->x));
-  RETURN_IF_ERROR(Take("y", c.y(), n, &b->y));
-  RETURN_IF_ERROR(Take("z", c.z(), n, &b->z));
+  if (fields.uv) {
+    RETURN_IF_ERROR(Take("u", c.u(), n, &b->u));
+    RETURN_IF_ERROR(Take("v", c.v(), n, &b->v));
+  }
+  if (fields.xyz) {
+    RETURN_IF_ERROR(Take("x", c.x(), n, &b->x));
+    RETURN_IF_ERROR(Take("y", c.y(), n, &b->y));
+    RETURN_IF_ERROR(Take("z", c.z(), n, &b->z));
+  }
   if (fields.normal) {
     RETURN_IF_ERROR(Take("nx", c.nx(), n, &b->nx));
     RETURN_IF_ERROR(Take("ny", c.ny(), n, &b->ny));
@@ -271,6 +287,13 @@ absl::StatusOr<SampleRequest> FromProto(const v1::SampleRequest& p) {
   r.fields.curve_position = p.curve_position();
   r.fields.face = p.face();
   r.fields.triangle = p.triangle();
+  r.fields.uv = !p.omit_uv();
+  r.fields.xyz = !p.omit_xyz();
+  if (WireValueColumns(r.fields) == 0) {
+    return absl::InvalidArgumentError(
+        "omit_uv and omit_xyz leave no value column: keep u v or x y z, or ask for normals, density "
+        "or curve_position");
+  }
   return r;
 }
 
@@ -304,6 +327,8 @@ v1::SampleRequest ToProto(const SampleRequest& r) {
   p.set_curve_position(r.fields.curve_position);
   p.set_face(r.fields.face);
   p.set_triangle(r.fields.triangle);
+  p.set_omit_uv(!r.fields.uv);
+  p.set_omit_xyz(!r.fields.xyz);
   return p;
 }
 
@@ -335,10 +360,14 @@ void ToProto(const SampleBatch& b, const SampleFields& fields, v1::Precision pre
   if (fields.triangle) PutIndexColumn(b.triangle, out->mutable_triangle());
 }
 
+size_t WireValueColumns(const SampleFields& fields) {
+  return (fields.uv ? 2 : 0) + (fields.xyz ? 3 : 0) + (fields.normal ? 3 : 0) + (fields.density ? 1 : 0) +
+         (fields.curve_position ? 1 : 0);
+}
+
 uint32_t MaxSamplesPerMessage(const SampleFields& fields, v1::Precision precision,
                               bool indices_listed, size_t reserved_bytes, size_t max_message_bytes) {
-  const size_t columns = 5 + (fields.normal ? 3 : 0) + (fields.density ? 1 : 0) +
-                         (fields.curve_position ? 1 : 0);
+  const size_t columns = WireValueColumns(fields);
   const size_t width = precision == v1::PRECISION_FLOAT32 ? sizeof(float) : sizeof(double);
   const size_t index_columns = (fields.face ? 1 : 0) + (fields.triangle ? 1 : 0);
   const size_t per_sample = columns * width + index_columns * sizeof(uint32_t) +
@@ -357,6 +386,9 @@ absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fiel
     return absl::DataLossError(absl::StrFormat("a batch has %d indices for %d samples", in.index_size(), n));
   }
   if (n == 0) return absl::OkStatus();
+  if (WireValueColumns(fields) == 0) {
+    return absl::InvalidArgumentError("the request leaves no value column on the wire");
+  }
   if (!in.has_f64() && !in.has_f32() && !in.has_raw()) return absl::DataLossError("a batch has no columns");
   const bool raw32 = in.has_raw() && in.raw().precision() == v1::PRECISION_FLOAT32;
   if (in.has_raw() && !raw32 && in.raw().precision() != v1::PRECISION_FLOAT64) {
@@ -364,33 +396,29 @@ absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fiel
                                                in.raw().precision()));
   }
   // `size` is just a number on the wire; only the columns bound what it may
-  // make us allocate, so check them before appending any index.
+  // make us allocate. So the value columns come first (each is checked
+  // before it is appended), the indices last; on an error everything
+  // appended is taken back.
+  const size_t old = out->size();
+  absl::Status status;
   if (in.has_raw()) {
-    const size_t width = raw32 ? sizeof(float) : sizeof(double);
-    if (in.raw().u().size() != n * width) {
-      return absl::DataLossError(absl::StrFormat(
-          "a batch's raw column u has %d bytes for %d samples of %d bytes", in.raw().u().size(), n, width));
-    }
-  } else if (const size_t u_values = in.has_f64() ? in.f64().u_size() : in.f32().u_size(); u_values != n) {
-    return absl::DataLossError(
-        absl::StrFormat("a batch's column u has %d values for %d samples", u_values, n));
+    status = raw32 ? TakeRawColumns<float>(in.raw(), fields, n, out)
+                   : TakeRawColumns<double>(in.raw(), fields, n, out);
+  } else {
+    status = in.has_f64() ? TakeColumns(in.f64(), fields, n, out) : TakeColumns(in.f32(), fields, n, out);
+  }
+  if (status.ok() && fields.face) status = TakeIndexColumn("face", in.face(), n, &out->face);
+  if (status.ok() && fields.triangle) status = TakeIndexColumn("triangle", in.triangle(), n, &out->triangle);
+  if (!status.ok()) {
+    out->Truncate(old);
+    return status;
   }
   if (in.index_size() == 0) {
-    const size_t old = out->index.size();
     out->index.resize(old + n);
     for (size_t i = 0; i < n; ++i) out->index[old + i] = in.first_index() + i;
   } else {
     out->index.insert(out->index.end(), in.index().begin(), in.index().end());
   }
-  if (in.has_raw()) {
-    RETURN_IF_ERROR(raw32 ? TakeRawColumns<float>(in.raw(), fields, n, out)
-                          : TakeRawColumns<double>(in.raw(), fields, n, out));
-  } else {
-    RETURN_IF_ERROR(in.has_f64() ? TakeColumns(in.f64(), fields, n, out)
-                                  : TakeColumns(in.f32(), fields, n, out));
-  }
-  if (fields.face) RETURN_IF_ERROR(TakeIndexColumn("face", in.face(), n, &out->face));
-  if (fields.triangle) RETURN_IF_ERROR(TakeIndexColumn("triangle", in.triangle(), n, &out->triangle));
   return absl::OkStatus();
 }
 

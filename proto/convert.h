@@ -30,6 +30,10 @@ v1::SampleRequest ToProto(const SampleRequest& request);
 // message reused for the next batch allocates nothing.
 void ToProto(const SampleBatch& batch, const SampleFields& fields, v1::Precision precision,
              v1::SampleBatch* out, v1::ColumnEncoding encoding = v1::COLUMN_ENCODING_PACKED);
+// The float columns a batch carries on the wire for `fields` (u v, x y z,
+// normals, density, curve_position; SampleFields::uv and ::xyz leave the
+// first two off).
+size_t WireValueColumns(const SampleFields& fields);
 // The largest number of samples one SampleResponse may carry so that it
 // serialises to at most `max_message_bytes`, given the requested columns,
 // precision, whether the batch lists its indices (regions and sequences not
@@ -39,8 +43,10 @@ uint32_t MaxSamplesPerMessage(const SampleFields& fields, v1::Precision precisio
                               bool indices_listed, size_t reserved_bytes, size_t max_message_bytes);
 
 // Appends the samples of `in` to `out`, whichever encoding and precision it
-// uses (a raw column is one memcpy on little-endian hosts). DATA_LOSS when a
-// column has the wrong length or a requested column is missing.
+// uses (a raw column is one memcpy on little-endian hosts); columns `fields`
+// does not ask for are ignored. DATA_LOSS when a column has the wrong length
+// or a requested column is missing, and then nothing is appended;
+// INVALID_ARGUMENT when `fields` leaves no value column.
 absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fields, SampleBatch* out);
 
 // The longest status message the server sends, in bytes; longer ones are

@@ -34,13 +34,14 @@ uint64_t StreamWorkingBytes(const SampleRequest& request, const v1::SampleReques
   const uint64_t sort = SequenceIsMonotone(request.sequence) ? 0 : 16 * n;
   const SampleFields& f = request.fields;
   const uint64_t columns = 5 + (f.normal ? 3 : 0) + (f.density ? 1 : 0) + (f.curve_position ? 1 : 0);
+  const uint64_t wire_columns = WireValueColumns(f);
   const uint64_t index_columns = (f.face ? 1 : 0) + (f.triangle ? 1 : 0);
   const uint64_t width = wire.precision() == v1::PRECISION_FLOAT32 ? 4 : 8;
   // The messages the stream holds, plus the serialized copy gRPC keeps of the
   // one being written until the transport has sent it.
   const uint64_t messages = (pipeline_depth <= 0 ? 1 : static_cast<uint64_t>(pipeline_depth) + 2) + 1;
   const uint64_t per_sample =
-      (8 + 8 * columns + 4 * index_columns) + messages * (8 + width * columns + 4 * index_columns);
+      (8 + 8 * columns + 4 * index_columns) + messages * (8 + width * wire_columns + 4 * index_columns);
   const uint64_t batch = wire.batch_size() != 0 ? wire.batch_size() : kDefaultBatchSize;
   return sort + per_sample * std::min(n, batch);
 }

@@ -269,5 +269,92 @@ TEST(FromProto, AnUnknownColumnEncodingIsInvalidArgument) {
   EXPECT_EQ(FromProto(request).status().code(), absl::StatusCode::kInvalidArgument);
 }
 
+// SampleFields::uv and ::xyz leave columns off the wire; a batch from a
+// server that predates them still carries every column, and the client
+// keeps only what it asked for. Every subset, both encodings and precisions.
+TEST(WireColumns, OnlyTheAskedForColumnsTravelAndArrive) {
+  const SampleBatch sent = EveryColumn(50, 5, true);
+  for (int mask = 0; mask < 8; ++mask) {
+    SampleFields fields;
+    fields.uv = mask & 1;
+    fields.xyz = mask & 2;
+    fields.normal = mask & 4;
+    if (WireValueColumns(fields) == 0) continue;
+    for (auto encoding : {v1::COLUMN_ENCODING_PACKED, v1::COLUMN_ENCODING_RAW}) {
+      for (auto precision : {v1::PRECISION_FLOAT64, v1::PRECISION_FLOAT32}) {
+        v1::SampleBatch narrow, old_server;
+        ToProto(sent, fields, precision, &narrow, encoding);
+        SampleFields everything = fields;
+        everything.uv = everything.xyz = everything.normal = true;
+        ToProto(sent, everything, precision, &old_server, encoding);
+        EXPECT_LT(narrow.ByteSizeLong(), old_server.ByteSizeLong() + (mask == 7 ? 1 : 0));
+        for (const v1::SampleBatch* wire : {&narrow, &old_server}) {
+          SampleBatch got;
+          ASSERT_TRUE(AppendFromProto(*wire, fields, &got).ok()) << mask;
+          EXPECT_EQ(got.index, sent.index);
+          EXPECT_EQ(got.u.size(), fields.uv ? sent.size() : 0u);
+          EXPECT_EQ(got.x.size(), fields.xyz ? sent.size() : 0u);
+          EXPECT_EQ(got.nx.size(), fields.normal ? sent.size() : 0u);
+          EXPECT_TRUE(got.density.empty());
+        }
+        // The message's size follows the columns it carries.
+        const size_t width = precision == v1::PRECISION_FLOAT32 ? 4 : 8;
+        EXPECT_GE(narrow.ByteSizeLong(), WireValueColumns(fields) * width * sent.size());
+        EXPECT_LT(narrow.ByteSizeLong(), (WireValueColumns(fields) * width + 1) * sent.size() + 100);
+      }
+    }
+  }
+}
+
+TEST(WireColumns, AMessageOfTheMostThatFitWithoutUvFitsTheCapAndHoldsMore) {
+  SampleFields all, positions;
+  positions.uv = false;
+  for (auto precision : {v1::PRECISION_FLOAT64, v1::PRECISION_FLOAT32}) {
+    const size_t cap = 1 << 16;
+    const uint32_t n = MaxSamplesPerMessage(positions, precision, true, 0, cap);
+    EXPECT_GT(n, MaxSamplesPerMessage(all, precision, true, 0, cap) * 4 / 3);  // 48 or 28 bytes a sample against 32 or 20
+    const SampleBatch b = EveryColumn(n, 13, false);
+    v1::SampleResponse response;
+    ToProto(b, positions, precision, response.mutable_batch(), v1::COLUMN_ENCODING_RAW);
+    EXPECT_LE(response.ByteSizeLong(), cap);
+  }
+}
+
+// A column that fails after others were appended takes them back: the
+// batch holds exactly what it held before.
+TEST(WireColumns, ALateBadColumnLeavesTheBatchAsItWas) {
+  const SampleFields fields = AllFields();
+  const SampleBatch first = EveryColumn(7, 1, true);
+  v1::SampleBatch good, bad;
+  ToProto(first, fields, v1::PRECISION_FLOAT64, &good, v1::COLUMN_ENCODING_RAW);
+  ToProto(EveryColumn(9, 2, true), fields, v1::PRECISION_FLOAT64, &bad, v1::COLUMN_ENCODING_RAW);
+  bad.mutable_triangle()->RemoveLast();
+  SampleBatch got;
+  ASSERT_TRUE(AppendFromProto(good, fields, &got).ok());
+  EXPECT_EQ(AppendFromProto(bad, fields, &got).code(), absl::StatusCode::kDataLoss);
+  EXPECT_EQ(got.index, first.index);
+  for (auto column : kValueColumns) EXPECT_EQ((got.*column).size(), first.size());
+  EXPECT_EQ(got.face, first.face);
+  EXPECT_EQ(got.triangle.size(), first.size());
+}
+
+TEST(WireColumns, ARequestLeavingNoValueColumnIsInvalidArgumentAndTheFlagsRoundTrip) {
+  v1::SampleRequest request;
+  request.set_count(10);
+  request.set_omit_uv(true);
+  request.set_omit_xyz(true);
+  const auto refused = FromProto(request);
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(refused.status().message().find("no value column"), std::string::npos);
+  request.set_density(true);
+  const auto accepted = FromProto(request);
+  ASSERT_TRUE(accepted.ok()) << accepted.status();
+  EXPECT_FALSE(accepted->fields.uv || accepted->fields.xyz);
+  const v1::SampleRequest back = ToProto(*accepted);
+  EXPECT_TRUE(back.omit_uv() && back.omit_xyz() && back.density());
+  request.set_omit_uv(false);
+  EXPECT_TRUE(FromProto(request)->fields.uv);
+}
+
 }  // namespace
 }  // namespace sfc

@@ -488,6 +488,80 @@ TEST(Server, AStockClientReceivesEveryColumnWithinItsDefaultMessageLimit) {
   ExpectStatus(Fetch(*client, all).status(), absl::StatusCode::kInvalidArgument, "max_message_bytes");
 }
 
+// Columns a client leaves off (omit_uv, omit_xyz) do not travel, the
+// others are the full stream's, and a request that leaves no value column is
+// refused.
+TEST(Server, ColumnsLeftOffDoNotTravelAndTheRestAreTheFullStreams) {
+  Running r = StartServer(LoopbackOptions());
+  auto channel = grpc::CreateChannel("127.0.0.1:" + std::to_string(r.server->port()),
+                                     grpc::InsecureChannelCredentials());
+  auto stub = v1::Sampler::NewStub(channel);
+  auto stream = [&](bool omit_uv, bool omit_xyz, bool normals, size_t* bytes, grpc::Status* status) {
+    v1::SampleRequest request;
+    request.mutable_tree()->set_surface("torus");
+    request.set_count(20000);
+    request.set_batch_size(5000);
+    request.set_precision(v1::PRECISION_FLOAT32);
+    request.set_column_encoding(v1::COLUMN_ENCODING_RAW);
+    request.set_normals(normals);
+    request.set_omit_uv(omit_uv);
+    request.set_omit_xyz(omit_xyz);
+    grpc::ClientContext context;
+    auto reader = stub->Sample(&context, request);
+    v1::SampleResponse response;
+    std::vector<v1::RawColumns> columns;
+    *bytes = 0;
+    while (reader->Read(&response)) {
+      *bytes += response.batch().ByteSizeLong();
+      columns.push_back(response.batch().raw());
+    }
+    *status = reader->Finish();
+    return columns;
+  };
+  size_t all_bytes = 0, xyz_bytes = 0, normal_bytes = 0, none_bytes = 0;
+  grpc::Status status;
+  const auto all = stream(false, false, true, &all_bytes, &status);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  const auto xyz = stream(true, false, false, &xyz_bytes, &status);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  const auto normals = stream(true, true, true, &normal_bytes, &status);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(all.size(), 4u);
+  ASSERT_EQ(xyz.size(), all.size());
+  ASSERT_EQ(normals.size(), all.size());
+  for (size_t i = 0; i < all.size(); ++i) {
+    EXPECT_TRUE(xyz[i].u().empty() && xyz[i].v().empty() && xyz[i].nx().empty());
+    EXPECT_EQ(xyz[i].x(), all[i].x());
+    EXPECT_EQ(xyz[i].z(), all[i].z());
+    EXPECT_TRUE(normals[i].u().empty() && normals[i].x().empty() && normals[i].z().empty());
+    EXPECT_EQ(normals[i].nx(), all[i].nx());
+    EXPECT_EQ(normals[i].nz(), all[i].nz());
+  }
+  // 8 columns of 4 bytes against 3: the bytes follow the columns sent.
+  EXPECT_LT(xyz_bytes, all_bytes * 3 / 8 + 1000);
+  EXPECT_LT(normal_bytes, all_bytes * 3 / 8 + 1000);
+
+  stream(true, true, false, &none_bytes, &status);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(status.error_message().find("no value column"), std::string::npos) << status.error_message();
+}
+
+// The C++ client asks for what SampleFields keeps and gets exactly that.
+TEST(Server, TheClientReceivesOnlyTheColumnsItAskedFor) {
+  Running r = StartServer(LoopbackOptions());
+  SampleRequest full = Request("torus", 3000);
+  SampleRequest positions = full;
+  positions.fields.uv = false;
+  auto a = Fetch(*r.client, full);
+  auto b = Fetch(*r.client, positions);
+  ASSERT_TRUE(a.ok() && b.ok()) << a.status() << b.status();
+  EXPECT_TRUE(b->u.empty() && b->v.empty());
+  EXPECT_EQ(b->index, a->index);
+  EXPECT_EQ(b->x, a->x);
+  EXPECT_EQ(b->y, a->y);
+  EXPECT_EQ(b->z, a->z);
+}
+
 TEST(Server, EveryBadInputGetsItsStatusCode) {
   ServerOptions options = LoopbackOptions();
   options.limits.max_count = 1'000'000;

@@ -172,7 +172,7 @@ absl::Status SampleOne(const Job& job, Outcome* o) {
   const bool mesh = format == "obj" || format == "ply";
   flags.face = flags.face && !mesh;
   flags.triangle = flags.triangle && mesh;
-  ASSIGN_OR_RETURN(const SampleRequest request, ToSampleRequest(flags));
+  ASSIGN_OR_RETURN(SampleRequest request, ToSampleRequest(flags));
   // --columns likewise: the other kind's column is dropped for this model.
   std::vector<std::string> columns;
   for (const std::string& c : job.flags->columns) {
@@ -183,6 +183,7 @@ absl::Status SampleOne(const Job& job, Outcome* o) {
         "--columns: this model has no %s column (it is for %s); name a column it has",
         mesh ? "face" : "triangle", mesh ? "CAD models" : "meshes"));
   }
+  request.fields = SampleWriter::SourceFields(request.fields, columns);  // neither made nor sent
   std::error_code error;
   fs::create_directories(fs::path(o->output).parent_path(), error);
   const std::string part = o->output + ".part";

@@ -69,6 +69,23 @@ def _error(rpc_error, suffix=""):
     return from_status(code.value[0], (rpc_error.details() or str(code)) + suffix)
 
 
+def _wire_columns(req, kept):
+    """The columns to ask the server for: those the request makes, less what `kept`
+    (kept_columns()) leaves out; u and v stay when no other value column would (the
+    wire needs one)."""
+    made = [name for name, on in (("u", 1), ("v", 1), ("x", 1), ("y", 1), ("z", 1),
+                                  ("nx", req.normals), ("ny", req.normals), ("nz", req.normals),
+                                  ("density", req.density_column),
+                                  ("curve_position", req.curve_position),
+                                  ("face", req.face), ("triangle", req.triangle)) if on]
+    if kept is None:
+        return made
+    sent = [name for name in made if name in kept]
+    if not any(name in sent for name in made if name not in ("face", "triangle")):
+        sent = ["u", "v"] + sent
+    return sent
+
+
 class Client:
     """A connection to an sfcsampler-server.
 
@@ -201,7 +218,7 @@ class Client:
                 request = dict(request, surface=uploaded)
         return request
 
-    def _wire_request(self, request, precision, batch_size, begin_end):
+    def _wire_request(self, request, precision, batch_size, begin_end, sent):
         w = pb.SampleRequest()
         _tree_spec(request, w.tree)
         w.sequence = _SEQUENCES[request.sequence]
@@ -220,11 +237,13 @@ class Client:
         elif region is not None:
             b = w.box
             b.min_x, b.min_y, b.min_z, b.max_x, b.max_y, b.max_z = region[1:]
-        w.normals = request.normals
-        w.density = request.density_column
-        w.curve_position = request.curve_position
-        w.face = request.face
-        w.triangle = request.triangle
+        w.normals = any(c in sent for c in ("nx", "ny", "nz"))
+        w.density = "density" in sent
+        w.curve_position = "curve_position" in sent
+        w.face = "face" in sent
+        w.triangle = "triangle" in sent
+        w.omit_uv = "u" not in sent and "v" not in sent
+        w.omit_xyz = not any(c in sent for c in ("x", "y", "z"))
         w.precision = _PRECISIONS[precision]
         w.batch_size = batch_size
         w.column_encoding = self._encoding
@@ -238,24 +257,19 @@ class Client:
         the server's status code and message.
         """
         kept = kept_columns(columns, request)
-        for part in self._stream(precision, batch_size, request):
+        for part in self._stream(precision, batch_size, request, kept):
             if len(part):
-                yield part if kept is None else Samples(
-                    select(part.columns(), kept), part.tree, part.begin, part.end, part.seed,
-                    part.algorithm_version, part.x.dtype, kept)
+                yield part
 
-    def _stream(self, precision, batch_size, request):
-        """batches(), plus one empty Samples (with the tree) at the end when nothing arrived."""
+    def _stream(self, precision, batch_size, request, kept=None):
+        """batches(), plus one empty Samples (with the tree) at the end when nothing arrived.
+        Columns `kept` (kept_columns()) leaves out are not sent."""
         precision = precision or self._precision
         if precision not in _PRECISIONS:
             raise InvalidArgumentError(3, "precision must be float64 or float32")
         batch_size = batch_size or self._batch_size
         req = make_request(self._with_model(request))
-        requested = [name for name, on in (("u", 1), ("v", 1), ("x", 1), ("y", 1), ("z", 1),
-                                           ("nx", req.normals), ("ny", req.normals),
-                                           ("nz", req.normals), ("density", req.density_column),
-                                           ("curve_position", req.curve_position),
-                                           ("face", req.face), ("triangle", req.triangle)) if on]
+        requested = _wire_columns(req, kept)
         range_end = req.index_range[1]
         metadata = self._metadata(_routing_key(req))
         first = None          # the first stream's header
@@ -266,7 +280,7 @@ class Client:
         resume_range = None   # monotone resumes ask for the rest of the range
         backoff = self._resume_backoff
         for attempt in range(self._max_resumes + 1):
-            call = self._sample_rpc(self._wire_request(req, precision, batch_size, resume_range),
+            call = self._sample_rpc(self._wire_request(req, precision, batch_size, resume_range, requested),
                                     timeout=self._timeout, metadata=metadata)
             this_stream = 0
             try:
@@ -296,9 +310,9 @@ class Client:
                         continue
                     received += n
                     last_index = int(columns["index"][-1])
-                    yield Samples(columns, tree, first.begin, first.end, first.seed,
+                    yield Samples(select(columns, kept), tree, first.begin, first.end, first.seed,
                                   first.algorithm_version,
-                                  np.float32 if precision == "float32" else np.float64)
+                                  np.float32 if precision == "float32" else np.float64, kept)
             except grpc.RpcError as e:
                 details = e.details() or ""
                 # Behind a proxy, the replica after a dead one lacks the model:
@@ -330,18 +344,18 @@ class Client:
                 raise DataLossError(15, f"expected {first.expected_samples} samples, received {received}")
             if received == 0 and first is not None:  # e.g. a region with no samples
                 yield Samples({}, tree, first.begin, first.end, first.seed, first.algorithm_version,
-                              np.float32 if precision == "float32" else np.float64)
+                              np.float32 if precision == "float32" else np.float64, kept)
             return
 
     def sample(self, *, precision=None, batch_size=None, columns=None, **request):
         """All the requested samples as one Samples: the same values as sfcsampler.sample()."""
         kept = kept_columns(columns, request)
         precision = precision or self._precision
-        parts = list(self._stream(precision, batch_size, request))
+        parts = list(self._stream(precision, batch_size, request, kept))
         if not parts:
             raise DataLossError(15, "the stream ended without a header or samples")
         last = parts[-1]
-        filled = [select(p.columns(), kept) for p in parts if len(p)]
+        filled = [p.columns() for p in parts if len(p)]
         return concatenate(filled, last.tree, last.begin, last.end, last.seed, last.algorithm_version,
                            np.float32 if precision == "float32" else np.float64, kept)
 

@@ -54,6 +54,57 @@ def test_raw_and_packed_columns_decode_to_the_embedded_arrays(server, precision)
             assert got.tobytes() == column.tobytes(), (encoding, name)
 
 
+class _CountingCall:
+    """A streaming call that adds the bytes of each message it yields to `total`."""
+
+    def __init__(self, call, total):
+        self._call, self._total = call, total
+
+    def __iter__(self):
+        for raw in self._call:
+            self._total[0] += len(raw)
+            yield raw
+
+    def __getattr__(self, name):
+        return getattr(self._call, name)
+
+
+@pytest.mark.parametrize("encoding", ["raw", "packed"])
+def test_columns_left_out_are_not_sent(server, encoding):
+    kwargs = dict(surface="torus", density="gaussian:floor=0.1", count=20000, seed=2, normals=True,
+                  density_column=True)
+    embedded = sfcsampler.sample(**kwargs)
+    sent = {}
+    for columns in (None, ("x", "y", "z"), ("nz",), ("index",), ("u", "density")):
+        with sfcsampler.Client(server, batch_size=5000, encoding=encoding) as client:
+            total = [0]
+            rpc = client._sample_rpc
+            client._sample_rpc = lambda *a, **k: _CountingCall(rpc(*a, **k), total)
+            remote = client.sample(columns=columns, **kwargs)
+            parts = list(client.batches(columns=columns, **kwargs))
+        sent[columns] = total[0] / 2  # each request streamed once by sample(), once by batches()
+        kept = embedded.columns() if columns is None else {c: embedded.columns()[c] for c in columns}
+        assert set(remote.columns()) == set(kept), columns
+        for name, column in kept.items():
+            assert getattr(remote, name).tobytes() == column.tobytes(), (columns, name)
+            joined = np.concatenate([getattr(p, name) for p in parts])
+            assert joined.tobytes() == column.tobytes(), (columns, name)
+    # u v x y z nx ny nz density: 9 float64 columns; the bytes follow the columns sent
+    # (index alone still needs one value column: u and v travel).
+    full = sent[None]
+    assert sent[("x", "y", "z")] < full * 3.2 / 9
+    assert sent[("nz",)] < full * 3.2 / 9
+    assert sent[("index",)] < full * 2.2 / 9
+    assert sent[("u", "density")] < full * 3.2 / 9
+
+
+@pytest.mark.parametrize("columns", ["x,y,z", "nz,x,index", "index", "u,density"])
+def test_cli_columns_over_the_wire_write_the_in_process_file(server, columns):
+    flags = ("sample", "--surface", "torus", "--density", "gaussian:floor=0.1", "--count", "3000",
+             "--normals", "--density-column", "--columns", columns, "--format", "npy", "-q", "-o", "-")
+    assert run_cli(*flags, "--server", server) == run_cli(*flags)
+
+
 def test_empty_region(server):
     with sfcsampler.Client(server) as client:
         s = client.sample(surface="sphere", count=1000, region="box:5,5,5,6,6,6")
