@@ -3,7 +3,8 @@
 // draw every sample) and the leaves for N samples of the STEP box with a
 // fillet and a hole and of the STEP sphere, each next to the built-in sphere
 // measured in the same loop. Prints a Markdown table; not a ctest.
-//   taskset -c 0 ./build/bench/model_benchmark [count=1000000] [repeats=3]
+//   taskset -c 0 ./build/bench/model_benchmark [count=1000000] [repeats=3] [only=NAME]
+// (only: run just the models whose name contains NAME, e.g. "box" to profile it)
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -66,6 +67,7 @@ double Median(std::vector<double> v) {
 int main(int argc, char** argv) {
   const uint64_t count = argc > 1 ? std::strtoull(argv[1], nullptr, 10) : 1000000;
   const int repeats = argc > 2 ? std::atoi(argv[2]) : 3;
+  const std::string only = argc > 3 ? argv[3] : "";
   const std::string dir = "/tmp/sfc_model_bench_" + std::to_string(::getpid());
   std::system(("mkdir -p " + dir).c_str());
   auto written = sfc::cad::fixtures::WriteAll(dir);
@@ -83,6 +85,7 @@ int main(int argc, char** argv) {
   std::printf("| surface | cold s | leaves | built-in sphere cold s | its leaves | time ratio |\n");
   std::printf("|---|---:|---:|---:|---:|---:|\n");
   for (const auto& [name, spec] : models) {
+    if (name.find(only) == std::string::npos) continue;
     std::vector<double> model_s, sphere_s;
     Run m, s;
     for (int i = 0; i < repeats; ++i) {

@@ -229,12 +229,19 @@ absl::StatusOr<size_t> ModelSampleCursor::Next(size_t max, SampleBatch* batch) {
     if (fields_.curve_position) {
       for (double& c : scratch_.curve_position) c = (piece_ + c) / pieces;
     }
-    for (size_t i = 0; i < n; ++i) {
-      const Vec3 p{scratch_.x[i], scratch_.y[i], scratch_.z[i]};
-      if (!region_.Contains(scratch_.u[i], scratch_.v[i], p)) continue;
-      batch->AppendFrom(scratch_, i, i + 1);
-      if (fields_.face) batch->face.push_back(static_cast<uint32_t>(piece.face));
-      ++got;
+    // The samples inside the region, appended a run of consecutive ones at a time.
+    for (size_t i = 0; i < n;) {
+      size_t j = i;
+      while (j < n && region_.Contains(scratch_.u[j], scratch_.v[j],
+                                       Vec3{scratch_.x[j], scratch_.y[j], scratch_.z[j]})) {
+        ++j;
+      }
+      if (j > i) {
+        batch->AppendFrom(scratch_, i, j);
+        if (fields_.face) batch->face.insert(batch->face.end(), j - i, static_cast<uint32_t>(piece.face));
+        got += j - i;
+      }
+      i = j + 1;  // j is outside the region, or n
     }
   }
   return got;

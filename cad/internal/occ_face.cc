@@ -120,22 +120,22 @@ Vec3 FaceSurface::ClosedPoint(double u, double v) const {
   return {d[0][0], d[0][1], d[0][2]};
 }
 
-SurfaceJet FaceSurface::ClosedJet(double u, double v, const ClosedForm::Trig& tu,
-                                  const ClosedForm::Trig& tv, int order) const {
+void FaceSurface::ClosedJet(double u, double v, const ClosedForm::Trig& tu,
+                            const ClosedForm::Trig& tv, int order, SurfaceJet* jet) const {
   double d[6][3];
   closed_->EvaluateWith(u, v, tu, tv, order >= 2 ? 2 : 1, d);
   auto vec = [](const double* e) { return Vec3{e[0], e[1], e[2]}; };
   const double su = map_.DuDs(), sv = map_.DvDt();
-  SurfaceJet jet;
-  jet.p = vec(d[0]);
-  jet.fu = vec(d[1]) * su;
-  jet.fv = vec(d[2]) * sv;
+  jet->p = vec(d[0]);
+  jet->fu = vec(d[1]) * su;
+  jet->fv = vec(d[2]) * sv;
   if (order >= 2) {
-    jet.fuu = vec(d[3]) * (su * su);
-    jet.fuv = vec(d[5]) * (su * sv);
-    jet.fvv = vec(d[4]) * (sv * sv);
+    jet->fuu = vec(d[3]) * (su * su);
+    jet->fuv = vec(d[5]) * (su * sv);
+    jet->fvv = vec(d[4]) * (sv * sv);
+  } else {
+    jet->fuu = jet->fuv = jet->fvv = Vec3{};
   }
-  return jet;
 }
 
 Vec3 FaceSurface::Point(double u, double v) const {
@@ -145,7 +145,9 @@ Vec3 FaceSurface::Point(double u, double v) const {
 SurfaceJet FaceSurface::Jet(double u, double v, int order) const {
   if (!closed_) return KernelJet(*adaptors_.Take(), u, v, order);
   const double nu = map_.U(u), nv = map_.V(v);
-  return ClosedJet(nu, nv, closed_->TrigU(nu), closed_->TrigV(nv), order);
+  SurfaceJet jet;
+  ClosedJet(nu, nv, closed_->TrigU(nu), closed_->TrigV(nv), order, &jet);
+  return jet;
 }
 
 void FaceSurface::JetGrid(const double* us, int nu, const double* vs, int nv, int order,
@@ -159,12 +161,15 @@ void FaceSurface::JetGrid(const double* us, int nu, const double* vs, int nv, in
   }
   // The cosines and sines once a row and once a column, not once a point:
   // the same values, so the same bits.
-  std::vector<ClosedForm::Trig> tv(nv);
+  // The tree build asks for 3 x 3 grids: no allocation for those.
+  ClosedForm::Trig on_stack[16];
+  std::vector<ClosedForm::Trig> on_heap(nv > 16 ? nv : 0);
+  ClosedForm::Trig* tv = nv > 16 ? on_heap.data() : on_stack;
   for (int j = 0; j < nv; ++j) tv[j] = closed_->TrigV(map_.V(vs[j]));
   for (int i = 0; i < nu; ++i) {
     const double u = map_.U(us[i]);
     const ClosedForm::Trig tu = closed_->TrigU(u);
-    for (int j = 0; j < nv; ++j) out[i * nv + j] = ClosedJet(u, map_.V(vs[j]), tu, tv[j], order);
+    for (int j = 0; j < nv; ++j) ClosedJet(u, map_.V(vs[j]), tu, tv[j], order, &out[i * nv + j]);
   }
 }
 

@@ -124,10 +124,12 @@ class FaceSurface final : public Surface {
   Vec3 KernelPoint(BRepAdaptor_Surface& adaptor, double u, double v) const;
   SurfaceJet KernelJet(BRepAdaptor_Surface& adaptor, double u, double v, int order) const;
   // From the closed form: the point at unit-square (u, v); the jet at native
-  // (u, v), with their cosines and sines.
+  // (u, v), with their cosines and sines, written into `jet` (every field:
+  // the second derivatives zero below order 2). Written in place, since a
+  // returned jet copied into a grid stalled on store forwarding.
   Vec3 ClosedPoint(double u, double v) const;
-  SurfaceJet ClosedJet(double u, double v, const ClosedForm::Trig& tu, const ClosedForm::Trig& tv,
-                       int order) const;
+  void ClosedJet(double u, double v, const ClosedForm::Trig& tu, const ClosedForm::Trig& tv,
+                 int order, SurfaceJet* jet) const;
 
   const TopoDS_Face face_;
   const UnitSquareMap map_;
