@@ -155,8 +155,8 @@ SampleFields SampleWriter::SourceFields(SampleFields fields, const std::vector<s
   fields.normal = fields.normal && named({"nx", "ny", "nz"});
   fields.density = fields.density && named({"density"});
   fields.curve_position = fields.curve_position && named({"curve_position"});
-  fields.face = fields.face && named({"face"});
-  fields.triangle = fields.triangle && named({"triangle"});
+  // face and triangle stay as asked: the engine refuses them on a surface
+  // without faces or triangles, whatever the file keeps.
   if (!fields.uv && !fields.xyz && !fields.normal && !fields.density && !fields.curve_position) {
     fields.uv = true;
   }

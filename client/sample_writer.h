@@ -50,9 +50,10 @@ class SampleWriter {
   static absl::Status CheckColumns(OutputFormat format, const SampleFields& fields,
                                    const std::vector<std::string>& columns);
   // The fields to ask a sample source for when only `columns` are written
-  // (empty: `fields` unchanged): what no named column needs is left off,
-  // u v and x y z included, so it is neither made nor sent. If nothing else
-  // would remain, u and v stay (the wire needs one value column).
+  // (empty: `fields` unchanged): the float columns no named column needs are
+  // left off, u v and x y z included, so they are neither made nor sent. If
+  // no float column would remain, u and v stay (the wire needs one). face and
+  // triangle stay as asked, so a surface without them is still refused.
   // REQUIRES: CheckColumns(format, fields, columns) passed.
   static SampleFields SourceFields(SampleFields fields, const std::vector<std::string>& columns);
   ~SampleWriter();

@@ -112,20 +112,22 @@ def _batch(buf, requested):
             model_columns.setdefault(name, []).append(np.frombuffer(value, dtype="<u4"))
     for name, parts in model_columns.items():
         columns[name] = np.concatenate(parts) if len(parts) > 1 else parts[0].copy()
-    if index:
-        index = np.concatenate(index) if len(index) > 1 else index[0].copy()
-        if len(index) != size:
-            raise DataLossError(15, f"a batch has {len(index)} indices for {size} samples")
-    else:
-        index = np.arange(first_index, first_index + size, dtype=np.uint64)
-    out = {"index": index}
+    # `size` is just a number on the wire: the columns, checked first, bound what it may make
+    # us allocate (the request always has one).
+    out = {}
     for name in requested:
         column = columns.get(name)
         if size and (column is None or len(column) != size):
             raise DataLossError(15, f"a batch of {size} samples has a bad or missing {name} column")
         if column is not None:
             out[name] = column
-    return out
+    if index:
+        index = np.concatenate(index) if len(index) > 1 else index[0].copy()
+        if len(index) != size:
+            raise DataLossError(15, f"a batch has {len(index)} indices for {size} samples")
+    else:
+        index = np.arange(first_index, first_index + size, dtype=np.uint64)
+    return {"index": index, **out}
 
 
 def decode_response(raw, requested):

@@ -70,8 +70,8 @@ def _error(rpc_error, suffix=""):
 
 
 def _wire_columns(req, kept):
-    """The columns to ask the server for: those the request makes, less what `kept`
-    (kept_columns()) leaves out; u and v stay when no other value column would (the
+    """The columns to ask the server for: those the request makes, less the float columns
+    `kept` (kept_columns()) leaves out; u and v stay when no other float column would (the
     wire needs one)."""
     made = [name for name, on in (("u", 1), ("v", 1), ("x", 1), ("y", 1), ("z", 1),
                                   ("nx", req.normals), ("ny", req.normals), ("nz", req.normals),
@@ -80,7 +80,9 @@ def _wire_columns(req, kept):
                                   ("face", req.face), ("triangle", req.triangle)) if on]
     if kept is None:
         return made
-    sent = [name for name in made if name in kept]
+    # face and triangle stay as asked: the server refuses them on a surface without faces or
+    # triangles, as sfcsampler.sample() does, whatever columns= keeps.
+    sent = [name for name in made if name in kept or name in ("face", "triangle")]
     if not any(name in sent for name in made if name not in ("face", "triangle")):
         sent = ["u", "v"] + sent
     return sent

@@ -105,6 +105,38 @@ def test_cli_columns_over_the_wire_write_the_in_process_file(server, columns):
     assert run_cli(*flags, "--server", server) == run_cli(*flags)
 
 
+def test_a_model_column_is_refused_on_a_surface_without_it_whatever_columns_keeps(server):
+    # Leaving face or triangle out of the file must not skip the check that the surface has it.
+    for flag in ("--face", "--triangle"):
+        for where in ((), ("--server", server)):
+            done = subprocess.run([CLI, "sample", "--surface", "sphere", "--count", "10", flag,
+                                   "--columns", "x,y,z", "-q", "-o", "-", *where], capture_output=True)
+            assert done.returncode != 0 and b"INVALID_ARGUMENT" in done.stderr, (flag, where)
+    with sfcsampler.Client(server) as client:
+        for flag in ("face", "triangle"):
+            with pytest.raises(sfcsampler.InvalidArgumentError):
+                client.sample(surface="sphere", count=10, columns=("x",), **{flag: True})
+            with pytest.raises(sfcsampler.InvalidArgumentError):
+                sfcsampler.sample(surface="sphere", count=10, columns=("x",), **{flag: True})
+
+
+def test_a_batch_claiming_more_samples_than_its_columns_hold_is_refused_before_allocating():
+    from sfcsampler import _wire
+    from sfcsampler.v1 import sampler_pb2 as pb
+    import tracemalloc
+    response = pb.SampleResponse()
+    response.batch.size = 100_000_000  # 800 MB of indices, were they made first
+    response.batch.f64.u.append(0.5)
+    tracemalloc.start()  # numpy reports its arrays to tracemalloc
+    try:
+        with pytest.raises(sfcsampler.DataLossError):
+            _wire.decode_response(response.SerializeToString(), ["u", "v", "x", "y", "z"])
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 10_000_000
+
+
 def test_empty_region(server):
     with sfcsampler.Client(server) as client:
         s = client.sample(surface="sphere", count=1000, region="box:5,5,5,6,6,6")
