@@ -55,16 +55,6 @@ struct SampleBatch {
     }
   }
   void Append(const SampleBatch& other) { AppendFrom(other, 0, other.size()); }
-  // Keeps the first n samples of every column longer than n.
-  void Truncate(size_t n) {
-    for (auto* c : {&u, &v, &x, &y, &z, &nx, &ny, &nz, &density, &curve_position}) {
-      if (c->size() > n) c->resize(n);
-    }
-    for (auto* c : {&face, &triangle}) {
-      if (c->size() > n) c->resize(n);
-    }
-    if (index.size() > n) index.resize(n);
-  }
   void Clear() {
     for (auto* c : {&u, &v, &x, &y, &z, &nx, &ny, &nz, &density, &curve_position}) c->clear();
     index.clear(), face.clear(), triangle.clear();

@@ -204,6 +204,28 @@ absl::Status TakeColumns(const Columns& c, const SampleFields& fields, size_t n,
   return absl::OkStatus();
 }
 
+// Every column's length in a batch, to take back a partial append.
+struct ColumnLengths {
+  size_t index, values[10], face, triangle;
+};
+
+constexpr std::vector<double> SampleBatch::*kValueColumns[10] = {
+    &SampleBatch::u,  &SampleBatch::v,  &SampleBatch::x,  &SampleBatch::y,       &SampleBatch::z,
+    &SampleBatch::nx, &SampleBatch::ny, &SampleBatch::nz, &SampleBatch::density, &SampleBatch::curve_position};
+
+ColumnLengths LengthsOf(const SampleBatch& b) {
+  ColumnLengths l;
+  l.index = b.index.size(), l.face = b.face.size(), l.triangle = b.triangle.size();
+  for (int c = 0; c < 10; ++c) l.values[c] = (b.*kValueColumns[c]).size();
+  return l;
+}
+
+// Shortens every column of `b` back to `l` (each is at least that long).
+void ShortenTo(const ColumnLengths& l, SampleBatch* b) {
+  b->index.resize(l.index), b->face.resize(l.face), b->triangle.resize(l.triangle);
+  for (int c = 0; c < 10; ++c) (b->*kValueColumns[c]).resize(l.values[c]);
+}
+
 }  // namespace
 
 absl::StatusOr<TreeSpec> FromProto(const v1::TreeSpec& p) {
@@ -399,6 +421,7 @@ absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fiel
   // make us allocate. So the value columns come first (each is checked
   // before it is appended), the indices last; on an error everything
   // appended is taken back.
+  const ColumnLengths before = LengthsOf(*out);
   const size_t old = out->size();
   absl::Status status;
   if (in.has_raw()) {
@@ -410,7 +433,7 @@ absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fiel
   if (status.ok() && fields.face) status = TakeIndexColumn("face", in.face(), n, &out->face);
   if (status.ok() && fields.triangle) status = TakeIndexColumn("triangle", in.triangle(), n, &out->triangle);
   if (!status.ok()) {
-    out->Truncate(old);
+    ShortenTo(before, out);
     return status;
   }
   if (in.index_size() == 0) {

@@ -338,6 +338,27 @@ TEST(WireColumns, ALateBadColumnLeavesTheBatchAsItWas) {
   EXPECT_EQ(got.triangle.size(), first.size());
 }
 
+// Found by tools/fuzz.sh (proto_batch_fuzzer): a batch whose columns have
+// different lengths (here x y z only, the normals then asked for) is also
+// left as it was; each column goes back to its own length.
+TEST(WireColumns, ALateBadColumnLeavesColumnsOfOtherLengthsAsTheyWere) {
+  SampleFields fields;
+  fields.uv = false;
+  fields.normal = true;
+  v1::SampleBatch bad;
+  ToProto(EveryColumn(2, 4, true), fields, v1::PRECISION_FLOAT64, &bad);
+  bad.mutable_f64()->add_ny(1.0);  // 3 values for 2 samples
+  SampleBatch got;
+  got.index = {0};
+  got.x = got.y = got.z = {0.5};
+  const SampleBatch before = got;
+  EXPECT_EQ(AppendFromProto(bad, fields, &got).code(), absl::StatusCode::kDataLoss);
+  EXPECT_EQ(got.index, before.index);
+  EXPECT_EQ(got.x, before.x);
+  EXPECT_EQ(got.z, before.z);
+  EXPECT_TRUE(got.nx.empty() && got.ny.empty() && got.u.empty());
+}
+
 TEST(WireColumns, ARequestLeavingNoValueColumnIsInvalidArgumentAndTheFlagsRoundTrip) {
   v1::SampleRequest request;
   request.set_count(10);
