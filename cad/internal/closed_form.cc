@@ -161,6 +161,23 @@ void ClosedForm::EvaluateWith(double u, double v, const Trig& tu, const Trig& tv
   }
 }
 
+void ClosedForm::Points(const double* u, const double* v, size_t n, double* px, double* py,
+                        double* pz) const {
+  if (type == Type::kPlane) {  // EvaluateWith's plane, order 0
+    for (size_t i = 0; i < n; ++i) {
+      px[i] = u[i] * x[0] + v[i] * y[0] + o[0];
+      py[i] = u[i] * x[1] + v[i] * y[1] + o[1];
+      pz[i] = u[i] * x[2] + v[i] * y[2] + o[2];
+    }
+    return;
+  }
+  for (size_t i = 0; i < n; ++i) {
+    double d[6][3];
+    Evaluate(u[i], v[i], 0, d);
+    px[i] = d[0][0], py[i] = d[0][1], pz[i] = d[0][2];
+  }
+}
+
 std::optional<ClosedForm> ClosedForm::Extract(const BRepAdaptor_Surface& adaptor) {
   if (adaptor.Trsf().Form() != gp_Identity) return std::nullopt;
   ClosedForm form;

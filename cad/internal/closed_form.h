@@ -43,6 +43,10 @@ struct ClosedForm {
   Trig TrigV(double v) const {
     return type == Type::kSphere || type == Type::kTorus ? TrigOf(v) : Trig{};
   }
+  // Evaluate's points (order 0) at native (u[i], v[i]) for i < n, into x, y
+  // and z; a plane's in one loop the compiler vectorises (the same
+  // operations, so the same bits).
+  void Points(const double* u, const double* v, size_t n, double* x, double* y, double* z) const;
   // Evaluate with tu = TrigU(u) and tv = TrigV(v) given.
   void EvaluateWith(double u, double v, const Trig& tu, const Trig& tv, int order,
                     double d[][3]) const;

@@ -181,7 +181,17 @@ void FaceSurface::Points(const double* u, const double* v, size_t n, double* x, 
       x[i] = p.x, y[i] = p.y, z[i] = p.z;
     }
   };
-  if (closed_) return fill([this](double s, double t) { return ClosedPoint(s, t); });
+  if (closed_) {
+    // Native parameters a chunk at a time, then the closed form's loop.
+    constexpr size_t kChunk = 256;
+    double nu[kChunk], nv[kChunk];
+    for (size_t b = 0; b < n; b += kChunk) {
+      const size_t m = std::min(kChunk, n - b);
+      for (size_t i = 0; i < m; ++i) nu[i] = map_.U(u[b + i]), nv[i] = map_.V(v[b + i]);
+      closed_->Points(nu, nv, m, x + b, y + b, z + b);
+    }
+    return;
+  }
   auto adaptor = adaptors_.Take();
   fill([&](double s, double t) { return KernelPoint(*adaptor, s, t); });
 }
