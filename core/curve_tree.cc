@@ -231,18 +231,19 @@ class CurveTree::Builder {
 
   // AssessSubdivision: the largest distance from f(centre) to f at the 4
   // corners and 4 edge midpoints of the cell.
+  // The 9 points in one Points call (Point's bits, one dispatch).
   absl::StatusOr<double> CellSpread(double u0, double v0, double h) const {
-    const Vec3 c = surface_.Point(u0 + h / 2, v0 + h / 2);
-    double spread = 0;
+    double us[9], vs[9], x[9], y[9], z[9];
     for (int i = 0; i <= 2; ++i) {
-      for (int j = 0; j <= 2; ++j) {
-        const double u = u0 + i * (h / 2), v = v0 + j * (h / 2);
-        const Vec3 p = (i == 1 && j == 1) ? c : surface_.Point(u, v);
-        if (!IsFinite(p)) {
-          return SurfaceNotFiniteError(u, v);
-        }
-        spread = std::max(spread, Norm(p - c));
-      }
+      for (int j = 0; j <= 2; ++j) us[3 * i + j] = u0 + i * (h / 2), vs[3 * i + j] = v0 + j * (h / 2);
+    }
+    surface_.Points(us, vs, 9, x, y, z);
+    const Vec3 c{x[4], y[4], z[4]};
+    double spread = 0;
+    for (int k = 0; k < 9; ++k) {
+      const Vec3 p{x[k], y[k], z[k]};
+      if (!IsFinite(p)) return SurfaceNotFiniteError(us[k], vs[k]);
+      spread = std::max(spread, Norm(p - c));
     }
     return spread;
   }
