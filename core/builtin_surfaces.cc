@@ -35,6 +35,33 @@ void SinCosPoints(const double* u, const double* v, size_t n, Scale scale_u, Sca
 double Same(double x) { return x; }
 double Twice(double x) { return 2 * x; }
 
+// A jet grid of a surface whose jet needs sin and cos of pi scale_u(u) and
+// pi scale_v(v): each row's and column's once, in one batch call
+// (math::SinCosPi's values, the same as point by point), then
+// jet(s_u, c_u, s_v, c_v, &out[i * nv + j]) in place. Grids wider than 16
+// go point by point (Surface::JetGrid).
+template <typename Scale, typename Jet>
+void SinCosGrid(const double* us, int nu, Scale scale_u, const double* vs, int nv, Scale scale_v,
+                SurfaceJet* out, Jet jet) {
+  constexpr int kMax = 16;
+  double x[2 * kMax], s[2 * kMax], c[2 * kMax];  // the u's, then the v's: one batch
+  if (nu > kMax || nv > kMax) {
+    for (int i = 0; i < nu; ++i) {
+      for (int j = 0; j < nv; ++j) {
+        const math::SinCos p = math::SinCosPi(scale_u(us[i])), q = math::SinCosPi(scale_v(vs[j]));
+        jet(p.sin, p.cos, q.sin, q.cos, &out[i * nv + j]);
+      }
+    }
+    return;
+  }
+  for (int i = 0; i < nu; ++i) x[i] = scale_u(us[i]);
+  for (int j = 0; j < nv; ++j) x[nu + j] = scale_v(vs[j]);
+  math::SinCosPi(x, nu + nv, s, c);
+  for (int i = 0; i < nu; ++i) {
+    for (int j = 0; j < nv; ++j) jet(s[i], c[i], s[nu + j], c[nu + j], &out[i * nv + j]);
+  }
+}
+
 class Plane final : public Surface {
  public:
   void Points(const double* u, const double* v, size_t n, double* x, double* y,
@@ -75,32 +102,31 @@ class Sphere final : public Surface {
   }
   SurfaceJet Jet(double u, double v, int order) const override {
     const math::SinCos t = math::SinCosPi(u), p = math::SinCosPi(2 * v);
-    return JetFrom(t.sin, t.cos, p.sin, p.cos, order);
+    SurfaceJet j;
+    JetFrom(t.sin, t.cos, p.sin, p.cos, order, &j);
+    return j;
   }
   void JetGrid(const double* us, int nu, const double* vs, int nv, int order,
                SurfaceJet* out) const override {
-    math::SinCos p[9];
-    if (nv > 9) return Surface::JetGrid(us, nu, vs, nv, order, out);
-    for (int j = 0; j < nv; ++j) p[j] = math::SinCosPi(2 * vs[j]);
-    for (int i = 0; i < nu; ++i) {
-      const math::SinCos t = math::SinCosPi(us[i]);
-      for (int j = 0; j < nv; ++j) out[i * nv + j] = JetFrom(t.sin, t.cos, p[j].sin, p[j].cos, order);
-    }
+    SinCosGrid(us, nu, Same, vs, nv, Twice, out, [&](double st, double ct, double sp, double cp, SurfaceJet* j) {
+      JetFrom(st, ct, sp, cp, order, j);
+    });
   }
 
  private:
-  // The jet from sin and cos of theta = pi u and phi = 2 pi v.
-  SurfaceJet JetFrom(double st, double ct, double sp, double cp, int order) const {
-    SurfaceJet j;
-    j.p = {r_ * st * cp, r_ * st * sp, r_ * ct};
-    j.fu = Vec3{ct * cp, ct * sp, -st} * (kPi * r_);
-    j.fv = Vec3{-st * sp, st * cp, 0} * (2 * kPi * r_);
+  // The jet from sin and cos of theta = pi u and phi = 2 pi v, into `j`
+  // (every field).
+  void JetFrom(double st, double ct, double sp, double cp, int order, SurfaceJet* j) const {
+    j->p = {r_ * st * cp, r_ * st * sp, r_ * ct};
+    j->fu = Vec3{ct * cp, ct * sp, -st} * (kPi * r_);
+    j->fv = Vec3{-st * sp, st * cp, 0} * (2 * kPi * r_);
     if (order >= 2) {
-      j.fuu = j.p * (-kPi * kPi);
-      j.fuv = Vec3{-ct * sp, ct * cp, 0} * (2 * kPi * kPi * r_);
-      j.fvv = Vec3{st * cp, st * sp, 0} * (-4 * kPi * kPi * r_);
+      j->fuu = j->p * (-kPi * kPi);
+      j->fuv = Vec3{-ct * sp, ct * cp, 0} * (2 * kPi * kPi * r_);
+      j->fvv = Vec3{st * cp, st * sp, 0} * (-4 * kPi * kPi * r_);
+    } else {
+      j->fuu = j->fuv = j->fvv = Vec3{};
     }
-    return j;
   }
 
   const double r_;
@@ -129,22 +155,35 @@ class Torus final : public Surface {
   }
   SurfaceJet Jet(double u, double v, int order) const override {
     const math::SinCos a = math::SinCosPi(2 * u), b = math::SinCosPi(2 * v);
-    const double sa = a.sin, ca = a.cos, sb = b.sin, cb = b.cos;
-    const double w = big_r_ + r_ * cb;
-    const double k = 2 * kPi;
     SurfaceJet j;
-    j.p = {w * ca, w * sa, r_ * sb};
-    j.fu = Vec3{-w * sa, w * ca, 0} * k;
-    j.fv = Vec3{-r_ * sb * ca, -r_ * sb * sa, r_ * cb} * k;
-    if (order >= 2) {
-      j.fuu = Vec3{-w * ca, -w * sa, 0} * (k * k);
-      j.fuv = Vec3{r_ * sb * sa, -r_ * sb * ca, 0} * (k * k);
-      j.fvv = Vec3{-r_ * cb * ca, -r_ * cb * sa, -r_ * sb} * (k * k);
-    }
+    JetFrom(a.sin, a.cos, b.sin, b.cos, order, &j);
     return j;
+  }
+  void JetGrid(const double* us, int nu, const double* vs, int nv, int order,
+               SurfaceJet* out) const override {
+    SinCosGrid(us, nu, Twice, vs, nv, Twice, out, [&](double sa, double ca, double sb, double cb, SurfaceJet* j) {
+      JetFrom(sa, ca, sb, cb, order, j);
+    });
   }
 
  private:
+  // The jet from sin and cos of a = 2 pi u and b = 2 pi v, into `j` (every
+  // field).
+  void JetFrom(double sa, double ca, double sb, double cb, int order, SurfaceJet* j) const {
+    const double w = big_r_ + r_ * cb;
+    const double k = 2 * kPi;
+    j->p = {w * ca, w * sa, r_ * sb};
+    j->fu = Vec3{-w * sa, w * ca, 0} * k;
+    j->fv = Vec3{-r_ * sb * ca, -r_ * sb * sa, r_ * cb} * k;
+    if (order >= 2) {
+      j->fuu = Vec3{-w * ca, -w * sa, 0} * (k * k);
+      j->fuv = Vec3{r_ * sb * sa, -r_ * sb * ca, 0} * (k * k);
+      j->fvv = Vec3{-r_ * cb * ca, -r_ * cb * sa, -r_ * sb} * (k * k);
+    } else {
+      j->fuu = j->fuv = j->fvv = Vec3{};
+    }
+  }
+
   const double big_r_, r_;
 };
 

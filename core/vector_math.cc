@@ -1,5 +1,6 @@
 #include "core/vector_math.h"
 
+#include <algorithm>
 #include <emmintrin.h>
 #include <cstdlib>
 #include <sleef.h>
@@ -26,14 +27,22 @@ VectorPath Detect() {
   return widest;
 }
 
-// Whole vectors of `width` by `body`, the tail through the scalar reference.
+// Whole vectors of `width` by `body`; a tail of two or more values as one
+// more vector, padded with zeros (each lane's value is its own, so the same
+// bits), a single value through the scalar reference.
 template <typename Body>
 void Batched(const double* x, size_t n, double* s, double* c, size_t width, Body body) {
-  const size_t whole = n / width * width;
+  const size_t whole = n / width * width, tail = n - whole;
   body(x, whole, s, c);
-  for (size_t i = whole; i < n; ++i) {
-    const SinCos r = SinCosPi(x[i]);
-    s[i] = r.sin, c[i] = r.cos;
+  if (tail >= 2) {
+    double xp[8] = {}, sp[8], cp[8];
+    std::copy(x + whole, x + n, xp);
+    body(xp, width, sp, cp);
+    std::copy(sp, sp + tail, s + whole);
+    std::copy(cp, cp + tail, c + whole);
+  } else if (tail == 1) {
+    const SinCos r = SinCosPi(x[whole]);
+    s[whole] = r.sin, c[whole] = r.cos;
   }
 }
 
