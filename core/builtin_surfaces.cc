@@ -39,7 +39,7 @@ double Twice(double x) { return 2 * x; }
 // pi scale_v(v): each row's and column's once, in one batch call
 // (math::SinCosPi's values, the same as point by point), then
 // jet(s_u, c_u, s_v, c_v, &out[i * nv + j]) in place. Grids wider than 16
-// go point by point (Surface::JetGrid).
+// take each node's values one by one (the same values).
 template <typename Scale, typename Jet>
 void SinCosGrid(const double* us, int nu, Scale scale_u, const double* vs, int nv, Scale scale_v,
                 SurfaceJet* out, Jet jet) {

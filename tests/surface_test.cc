@@ -70,6 +70,39 @@ TEST(BuiltinSurfaces, OtherJetsAreExact) {
 
 // The batch call is Point, bit for bit, on every built-in (including the
 // superellipsoid's singular lines, where both give the same infinities).
+// JetGrid is Jet at every node, in every bit of every field (the tree build
+// uses the grid; Jet is the reference): every grid size from 1 x 1 to
+// 17 x 17 (short batches' padded tails, and the point-by-point fallback
+// past 16), orders 1 and 2, every built-in.
+TEST(BuiltinSurfaces, JetGridIsJetBitForBit) {
+  std::vector<std::unique_ptr<Surface>> surfaces;
+  surfaces.push_back(MakePlane());
+  surfaces.push_back(MakeSphere(1.5));
+  surfaces.push_back(MakeTorus(1, 0.3));
+  surfaces.push_back(MakeEightSurface());
+  surfaces.push_back(MakeMonkeySaddle());
+  surfaces.push_back(MakeWhitneyUmbrella());
+  surfaces.push_back(MakeSuperellipsoid(1.0 / 3, false));
+  surfaces.push_back(MakeSuperellipsoid(0.5, true));
+  for (const auto& surface : surfaces) {
+    for (int n = 1; n <= 17; ++n) {
+      std::vector<double> us(n), vs(n);
+      for (int i = 0; i < n; ++i) us[i] = (i + 0.37) / (n + 1), vs[i] = (n - i + 0.11) / (n + 2);
+      for (int order : {1, 2}) {
+        std::vector<SurfaceJet> grid(n * n);
+        surface->JetGrid(us.data(), n, vs.data(), n, order, grid.data());
+        for (int i = 0; i < n; ++i) {
+          for (int j = 0; j < n; ++j) {
+            const SurfaceJet want = surface->Jet(us[i], vs[j], order);
+            ASSERT_EQ(std::memcmp(&grid[i * n + j], &want, sizeof want), 0)
+                << "n = " << n << " order " << order << " at (" << us[i] << ", " << vs[j] << ")";
+          }
+        }
+      }
+    }
+  }
+}
+
 TEST(BuiltinSurfaces, PointsIsPointBitForBit) {
   std::vector<std::unique_ptr<Surface>> surfaces;
   surfaces.push_back(MakePlane());

@@ -1,7 +1,7 @@
 // Every vector path of core/vector_math.h that this CPU runs gives the scalar
 // reference's bits, over arguments the samplers use ([0, 2]: pi u and 2 pi v)
-// and beyond, with the tails a batch leaves to the scalar path; and the
-// values are sin and cos of pi x.
+// and beyond, with every tail a batch leaves (one padded vector, or a single
+// value through the scalar path); and the values are sin and cos of pi x.
 #include "core/vector_math.h"
 
 #include <cmath>
@@ -56,7 +56,6 @@ TEST(VectorMath, EveryPathGivesTheScalarBits) {
   }
 }
 
-// The one-value sin, cos and pow give SLEEF's portable scalar bits.
 // Short batches (a tree build's 3 x 3 grids) end in a tail of 1 to 7
 // values, computed as one more zero-padded vector: every length, from every
 // start, on every path gives the scalar bits.
@@ -78,6 +77,7 @@ TEST(VectorMath, EveryShortBatchGivesTheScalarBits) {
   }
 }
 
+// The one-value sin, cos and pow give SLEEF's portable scalar bits.
 TEST(VectorMath, OneValueFunctionsGiveThePortableBits) {
   for (double x : Arguments()) {
     const SinCos r = SinCosOf(x);
