@@ -230,8 +230,8 @@ class CurveTree::Builder {
   }
 
   // AssessSubdivision: the largest distance from f(centre) to f at the 4
-  // corners and 4 edge midpoints of the cell.
-  // The 9 points in one Points call (Point's bits, one dispatch).
+  // corners and 4 edge midpoints of the cell, the 9 points from one Points
+  // call (Point's bits, one dispatch).
   absl::StatusOr<double> CellSpread(double u0, double v0, double h) const {
     double us[9], vs[9], x[9], y[9], z[9];
     for (int i = 0; i <= 2; ++i) {

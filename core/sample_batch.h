@@ -3,6 +3,7 @@
 #ifndef SFCSAMPLER_CORE_SAMPLE_BATCH_H_
 #define SFCSAMPLER_CORE_SAMPLE_BATCH_H_
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -33,15 +34,21 @@ struct SampleBatch {
 
   size_t size() const { return index.size(); }
 
+  // The float columns as members: u v x y z nx ny nz density curve_position.
+  using ValueColumn = std::vector<double> SampleBatch::*;
+  static const std::array<ValueColumn, 10>& ValueColumns() {
+    static constexpr std::array<ValueColumn, 10> kColumns = {
+        &SampleBatch::u,  &SampleBatch::v,  &SampleBatch::x,  &SampleBatch::y,       &SampleBatch::z,
+        &SampleBatch::nx, &SampleBatch::ny, &SampleBatch::nz, &SampleBatch::density, &SampleBatch::curve_position};
+    return kColumns;
+  }
+
   // Appends samples [begin, end) of `other`, with whichever optional columns
   // `other` has. REQUIRES: begin <= end <= other.size(), and this batch has the
   // same optional columns (or is empty).
   void AppendFrom(const SampleBatch& other, size_t begin, size_t end) {
     index.insert(index.end(), other.index.begin() + begin, other.index.begin() + end);
-    std::vector<double> SampleBatch::*const columns[] = {
-        &SampleBatch::u,  &SampleBatch::v,  &SampleBatch::x,  &SampleBatch::y,       &SampleBatch::z,
-        &SampleBatch::nx, &SampleBatch::ny, &SampleBatch::nz, &SampleBatch::density, &SampleBatch::curve_position};
-    for (auto column : columns) {
+    for (ValueColumn column : ValueColumns()) {
       const std::vector<double>& from = other.*column;
       if (from.empty()) continue;
       std::vector<double>& to = this->*column;
@@ -56,7 +63,7 @@ struct SampleBatch {
   }
   void Append(const SampleBatch& other) { AppendFrom(other, 0, other.size()); }
   void Clear() {
-    for (auto* c : {&u, &v, &x, &y, &z, &nx, &ny, &nz, &density, &curve_position}) c->clear();
+    for (ValueColumn column : ValueColumns()) (this->*column).clear();
     index.clear(), face.clear(), triangle.clear();
   }
 };

@@ -3,6 +3,7 @@
 #include "base/echo.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -206,24 +207,20 @@ absl::Status TakeColumns(const Columns& c, const SampleFields& fields, size_t n,
 
 // Every column's length in a batch, to take back a partial append.
 struct ColumnLengths {
-  size_t index, values[10], face, triangle;
+  size_t index, face, triangle;
+  std::array<size_t, 10> values;  // SampleBatch::ValueColumns()' order
 };
 
-constexpr std::vector<double> SampleBatch::*kValueColumns[10] = {
-    &SampleBatch::u,  &SampleBatch::v,  &SampleBatch::x,  &SampleBatch::y,       &SampleBatch::z,
-    &SampleBatch::nx, &SampleBatch::ny, &SampleBatch::nz, &SampleBatch::density, &SampleBatch::curve_position};
-
 ColumnLengths LengthsOf(const SampleBatch& b) {
-  ColumnLengths l;
-  l.index = b.index.size(), l.face = b.face.size(), l.triangle = b.triangle.size();
-  for (int c = 0; c < 10; ++c) l.values[c] = (b.*kValueColumns[c]).size();
+  ColumnLengths l{b.index.size(), b.face.size(), b.triangle.size(), {}};
+  for (size_t c = 0; c < l.values.size(); ++c) l.values[c] = (b.*SampleBatch::ValueColumns()[c]).size();
   return l;
 }
 
 // Shortens every column of `b` back to `l` (each is at least that long).
 void ShortenTo(const ColumnLengths& l, SampleBatch* b) {
   b->index.resize(l.index), b->face.resize(l.face), b->triangle.resize(l.triangle);
-  for (int c = 0; c < 10; ++c) (b->*kValueColumns[c]).resize(l.values[c]);
+  for (size_t c = 0; c < l.values.size(); ++c) (b->*SampleBatch::ValueColumns()[c]).resize(l.values[c]);
 }
 
 }  // namespace
@@ -422,7 +419,6 @@ absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fiel
   // before it is appended), the indices last; on an error everything
   // appended is taken back.
   const ColumnLengths before = LengthsOf(*out);
-  const size_t old = out->size();
   absl::Status status;
   if (in.has_raw()) {
     status = raw32 ? TakeRawColumns<float>(in.raw(), fields, n, out)
@@ -437,8 +433,8 @@ absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fiel
     return status;
   }
   if (in.index_size() == 0) {
-    out->index.resize(old + n);
-    for (size_t i = 0; i < n; ++i) out->index[old + i] = in.first_index() + i;
+    out->index.resize(before.index + n);
+    for (size_t i = 0; i < n; ++i) out->index[before.index + i] = in.first_index() + i;
   } else {
     out->index.insert(out->index.end(), in.index().begin(), in.index().end());
   }

@@ -33,8 +33,9 @@ uint64_t StreamWorkingBytes(const SampleRequest& request, const v1::SampleReques
   const uint64_t n = range.ok() ? range->second - range->first : 0;
   const uint64_t sort = SequenceIsMonotone(request.sequence) ? 0 : 16 * n;
   const SampleFields& f = request.fields;
-  const uint64_t columns = 5 + (f.normal ? 3 : 0) + (f.density ? 1 : 0) + (f.curve_position ? 1 : 0);
-  const uint64_t wire_columns = WireValueColumns(f);
+  SampleFields made = f;  // the engine makes u v x y z whatever the wire carries
+  made.uv = made.xyz = true;
+  const uint64_t columns = WireValueColumns(made), wire_columns = WireValueColumns(f);
   const uint64_t index_columns = (f.face ? 1 : 0) + (f.triangle ? 1 : 0);
   const uint64_t width = wire.precision() == v1::PRECISION_FLOAT32 ? 4 : 8;
   // The messages the stream holds, plus the serialized copy gRPC keeps of the

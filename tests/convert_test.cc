@@ -3,6 +3,7 @@
 // allocates for it.
 #include "proto/convert.h"
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -99,10 +100,7 @@ TEST(MaxSamplesPerMessage, AMessageOfThatManySamplesWithModelColumnsFitsTheCap) 
   EXPECT_LE(response.ByteSizeLong(), cap);
 }
 
-std::vector<double> SampleBatch::*const kValueColumns[] = {
-    &SampleBatch::u,  &SampleBatch::v,  &SampleBatch::x,       &SampleBatch::y,
-    &SampleBatch::z,  &SampleBatch::nx, &SampleBatch::ny,      &SampleBatch::nz,
-    &SampleBatch::density, &SampleBatch::curve_position};
+const std::array<SampleBatch::ValueColumn, 10>& kValueColumns = SampleBatch::ValueColumns();
 
 uint64_t Bits(double d) {
   uint64_t b;

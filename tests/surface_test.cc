@@ -68,13 +68,7 @@ TEST(BuiltinSurfaces, OtherJetsAreExact) {
   ExpectJetMatchesDifferences(*MakeWhitneyUmbrella());
 }
 
-// The batch call is Point, bit for bit, on every built-in (including the
-// superellipsoid's singular lines, where both give the same infinities).
-// JetGrid is Jet at every node, in every bit of every field (the tree build
-// uses the grid; Jet is the reference): every grid size from 1 x 1 to
-// 17 x 17 (short batches' padded tails, and the point-by-point fallback
-// past 16), orders 1 and 2, every built-in.
-TEST(BuiltinSurfaces, JetGridIsJetBitForBit) {
+std::vector<std::unique_ptr<Surface>> EveryBuiltin() {
   std::vector<std::unique_ptr<Surface>> surfaces;
   surfaces.push_back(MakePlane());
   surfaces.push_back(MakeSphere(1.5));
@@ -84,6 +78,15 @@ TEST(BuiltinSurfaces, JetGridIsJetBitForBit) {
   surfaces.push_back(MakeWhitneyUmbrella());
   surfaces.push_back(MakeSuperellipsoid(1.0 / 3, false));
   surfaces.push_back(MakeSuperellipsoid(0.5, true));
+  return surfaces;
+}
+
+// JetGrid is Jet at every node, in every bit of every field (the tree build
+// uses the grid; Jet is the reference): every grid size from 1 x 1 to
+// 17 x 17 (short batches' padded tails, and the point-by-point fallback
+// past 16), orders 1 and 2, every built-in.
+TEST(BuiltinSurfaces, JetGridIsJetBitForBit) {
+  const std::vector<std::unique_ptr<Surface>> surfaces = EveryBuiltin();
   for (const auto& surface : surfaces) {
     for (int n = 1; n <= 17; ++n) {
       std::vector<double> us(n), vs(n);
@@ -103,16 +106,10 @@ TEST(BuiltinSurfaces, JetGridIsJetBitForBit) {
   }
 }
 
+// The batch call is Point, bit for bit, on every built-in (including the
+// superellipsoid's singular lines, where both give the same infinities).
 TEST(BuiltinSurfaces, PointsIsPointBitForBit) {
-  std::vector<std::unique_ptr<Surface>> surfaces;
-  surfaces.push_back(MakePlane());
-  surfaces.push_back(MakeSphere(1.5));
-  surfaces.push_back(MakeTorus(1, 0.3));
-  surfaces.push_back(MakeEightSurface());
-  surfaces.push_back(MakeMonkeySaddle());
-  surfaces.push_back(MakeWhitneyUmbrella());
-  surfaces.push_back(MakeSuperellipsoid(1.0 / 3, false));
-  surfaces.push_back(MakeSuperellipsoid(0.5, true));
+  const std::vector<std::unique_ptr<Surface>> surfaces = EveryBuiltin();
   std::vector<double> u, v;
   for (int i = 0; i <= 40; ++i) {
     for (int j = 0; j <= 40; ++j) u.push_back(i / 40.0), v.push_back(j / 40.0);

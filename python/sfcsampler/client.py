@@ -82,8 +82,9 @@ def _wire_columns(req, kept):
         return made
     # face and triangle stay as asked: the server refuses them on a surface without faces or
     # triangles, as sfcsampler.sample() does, whatever columns= keeps.
-    sent = [name for name in made if name in kept or name in ("face", "triangle")]
-    if not any(name in sent for name in made if name not in ("face", "triangle")):
+    model = ("face", "triangle")
+    sent = [name for name in made if name in kept or name in model]
+    if all(name in model for name in sent):
         sent = ["u", "v"] + sent
     return sent
 
