@@ -3,6 +3,17 @@
 #include <unistd.h>
 
 #include <BRepAlgoAPI_Cut.hxx>
+#include <BRepBuilderAPI_MakeVertex.hxx>
+#include <BRepClass_FaceClassifier.hxx>
+#include <BRepExtrema_DistShapeShape.hxx>
+#include <BRepTools.hxx>
+#include <ElCLib.hxx>
+#include <GeomAPI_ProjectPointOnSurf.hxx>
+#include <Geom_Surface.hxx>
+#include <Precision.hxx>
+#include <IGESControl_Reader.hxx>
+#include <STEPControl_Reader.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakeWire.hxx>
@@ -28,8 +39,10 @@
 #include <TopoDS.hxx>
 #include <TopoDS_Compound.hxx>
 #include <TopoDS_Edge.hxx>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <fstream>
 #include <gp_Ax2.hxx>
 #include <gp_Pnt.hxx>
@@ -199,6 +212,134 @@ absl::StatusOr<std::string> SolidBytes(Solid solid, ModelFormat format, int copi
         absl::StrCat("the kernel failed writing ", SolidName(solid), ": ", e.GetMessageString()));
   }
   return ReadBack(path);
+}
+
+std::string CollinearFacesStep(int collinear, bool with_square) {
+  std::string data;
+  int id = 0;
+  auto add = [&](const std::string& record) {
+    absl::StrAppend(&data, "#", ++id, " = ", record, ";\n");
+    return id;
+  };
+  auto point = [&](double x, double y) {
+    return add(absl::StrFormat("CARTESIAN_POINT('',(%.17g,%.17g,0.))", x, y));
+  };
+  const int origin = point(0, 0);
+  const int z = add("DIRECTION('',(0.,0.,1.))");
+  const int x = add("DIRECTION('',(1.,0.,0.))");
+  const int axes = add(absl::StrFormat("AXIS2_PLACEMENT_3D('',#%d,#%d,#%d)", origin, z, x));
+  const int plane = add(absl::StrFormat("PLANE('',#%d)", axes));
+  auto references = [](const std::vector<int>& ids) {
+    std::string list;
+    for (int i : ids) absl::StrAppend(&list, list.empty() ? "#" : ",#", i);
+    return list;
+  };
+  std::vector<int> faces;
+  auto face = [&](const std::vector<int>& points) {
+    const int loop = add(absl::StrFormat("POLY_LOOP('',(%s))", references(points)));
+    const int bound = add(absl::StrFormat("FACE_OUTER_BOUND('',#%d,.T.)", loop));
+    faces.push_back(add(absl::StrFormat("FACE_SURFACE('',(#%d),#%d,.T.)", bound, plane)));
+  };
+  for (int k = 0; k < collinear; ++k) {
+    const double a = (k + 1) / std::sqrt(2.0), step = 0.5 / std::sqrt(3.0);
+    face({point(a, a), point(a + step, a + step), point(a + 2 * step, a + 2 * step)});
+  }
+  if (with_square) {
+    face({point(kSquareX, 0), point(kSquareX + 1, 0), point(kSquareX + 1, 1), point(kSquareX, 1)});
+  }
+  // The faces in an open shell of a surface model, and the product around
+  // it that the reader takes as its root.
+  const int shell = add(absl::StrFormat("OPEN_SHELL('',(%s))", references(faces)));
+  const int surface_model = add(absl::StrFormat("SHELL_BASED_SURFACE_MODEL('',(#%d))", shell));
+  const int mm = add("( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) )");
+  const int radian = add("( NAMED_UNIT(*) PLANE_ANGLE_UNIT() SI_UNIT($,.RADIAN.) )");
+  const int steradian = add("( NAMED_UNIT(*) SI_UNIT($,.STERADIAN.) SOLID_ANGLE_UNIT() )");
+  const int uncertainty = add(absl::StrFormat(
+      "UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE(1.E-07),#%d,'distance_accuracy_value','')", mm));
+  const int context = add(absl::StrFormat(
+      "( GEOMETRIC_REPRESENTATION_CONTEXT(3) GLOBAL_UNCERTAINTY_ASSIGNED_CONTEXT((#%d)) "
+      "GLOBAL_UNIT_ASSIGNED_CONTEXT((#%d,#%d,#%d)) REPRESENTATION_CONTEXT('','') )",
+      uncertainty, mm, radian, steradian));
+  const int representation = add(absl::StrFormat(
+      "MANIFOLD_SURFACE_SHAPE_REPRESENTATION('',(#%d,#%d),#%d)", axes, surface_model, context));
+  const int application =
+      add("APPLICATION_CONTEXT('core data for automotive mechanical design processes')");
+  const int product_context = add(absl::StrFormat("PRODUCT_CONTEXT('',#%d,'mechanical')", application));
+  const int product = add(absl::StrFormat("PRODUCT('collinear','collinear','',(#%d))", product_context));
+  const int formation = add(absl::StrFormat("PRODUCT_DEFINITION_FORMATION('','',#%d)", product));
+  const int definition_context =
+      add(absl::StrFormat("PRODUCT_DEFINITION_CONTEXT('part definition',#%d,'design')", application));
+  const int definition = add(
+      absl::StrFormat("PRODUCT_DEFINITION('design','',#%d,#%d)", formation, definition_context));
+  const int shape = add(absl::StrFormat("PRODUCT_DEFINITION_SHAPE('','',#%d)", definition));
+  add(absl::StrFormat("SHAPE_DEFINITION_REPRESENTATION(#%d,#%d)", shape, representation));
+  return absl::StrCat(
+      "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION((''),'2;1');\n"
+      "FILE_NAME('','',(''),(''),'','','');\n"
+      "FILE_SCHEMA(('AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }'));\nENDSEC;\nDATA;\n",
+      data, "ENDSEC;\nEND-ISO-10303-21;\n");
+}
+
+absl::StatusOr<double> MaxDistanceToFaces(const std::string& bytes, ModelFormat format,
+                                          const std::vector<PointOnFace>& points) {
+  TopoDS_Shape shape;
+  if (format == ModelFormat::kStep) {
+    STEPControl_Reader reader;
+    std::istringstream in(bytes);
+    if (reader.ReadStream("points.step", in) != IFSelect_RetDone) {
+      return absl::InvalidArgumentError("the STEP reader refused the file");
+    }
+    reader.TransferRoots();
+    shape = reader.OneShape();
+  } else if (format == ModelFormat::kIges) {
+    const std::string path = std::filesystem::temp_directory_path() /
+                             absl::StrCat("sfc_distance_", getpid(), ".iges");
+    std::ofstream(path, std::ios::binary) << bytes;
+    IGESControl_Reader reader;
+    const bool read = reader.ReadFile(path.c_str()) == IFSelect_RetDone;
+    std::filesystem::remove(path);
+    if (!read) return absl::InvalidArgumentError("the IGES reader refused the file");
+    reader.TransferRoots();
+    shape = reader.OneShape();
+  } else {
+    return absl::InvalidArgumentError("STEP or IGES only");
+  }
+  TopTools_IndexedMapOfShape faces;
+  TopExp::MapShapes(shape, TopAbs_FACE, faces);
+  double worst = 0;
+  for (const PointOnFace& p : points) {
+    if (p.face < 0 || p.face >= faces.Extent()) {
+      return absl::InvalidArgumentError(absl::StrCat("face ", p.face, " is not in the file"));
+    }
+    // The nearest foot on the face's surface that the kernel's face
+    // classifier puts inside the face, parameters taken into the face's
+    // period first; else (no such foot) the distance to the face's boundary
+    // by BRepExtrema (which on its own misses feet at another period).
+    const TopoDS_Face& face = TopoDS::Face(faces(p.face + 1));
+    const gp_Pnt point(p.x, p.y, p.z);
+    const Handle(Geom_Surface) surface = BRep_Tool::Surface(face);
+    double u0, u1, v0, v1;
+    BRepTools::UVBounds(face, u0, u1, v0, v1);
+    GeomAPI_ProjectPointOnSurf feet(point, surface);
+    double best = std::numeric_limits<double>::infinity();
+    for (int i = 1; feet.IsDone() && i <= feet.NbPoints(); ++i) {
+      double u, v;
+      feet.Parameters(i, u, v);
+      if (surface->IsUPeriodic()) u = ElCLib::InPeriod(u, u0, u0 + surface->UPeriod());
+      if (surface->IsVPeriodic()) v = ElCLib::InPeriod(v, v0, v0 + surface->VPeriod());
+      BRepClass_FaceClassifier inside(face, gp_Pnt2d(u, v), Precision::PConfusion());
+      if (inside.State() == TopAbs_IN || inside.State() == TopAbs_ON) {
+        best = std::min(best, feet.Distance(i));
+      }
+    }
+    if (!std::isfinite(best)) {
+      BRepExtrema_DistShapeShape distance(BRepBuilderAPI_MakeVertex(point).Vertex(), face);
+      if (!distance.IsDone()) return absl::InternalError("BRepExtrema found no distance");
+      best = distance.Value();
+    }
+    worst = std::max(worst, best);
+  }
+  return worst;
 }
 
 std::string NurbsPatchText() {

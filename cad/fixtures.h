@@ -67,6 +67,32 @@ absl::StatusOr<std::string> SolidBytes(Solid solid, ModelFormat format, int copi
 // The quarter-cylinder NURBS patch in our format (docs/NURBS_FORMAT.md).
 std::string NurbsPatchText();
 
+// A hand-written STEP of planar FACE_SURFACEs on z = 0 in one open shell
+// (issue 37): `collinear` faces each bounded by a POLY_LOOP of three
+// collinear points on the line x = y (no area; the k-th starts at
+// (k+1)/sqrt(2) and is 1/sqrt(3) long), then, when `with_square`, the unit
+// square [kSquareX, kSquareX + 1] x [0, 1] (area 1). 10^5 collinear faces
+// make a 30 MB file that keeps the kernel busy for minutes: the hostile
+// parse of the isolation tests.
+inline constexpr double kSquareX = 2.5;
+std::string CollinearFacesStep(int collinear, bool with_square);
+
+// A point with the index of the face it claims to lie on.
+struct PointOnFace {
+  int face = 0;  // in the file's order (Face::index())
+  double x = 0, y = 0, z = 0;
+};
+
+// The largest distance from a point to its trimmed face, measured
+// independently of the sampler: the STEP or IGES `bytes` read again by the
+// kernel's reader, faces in TopExp::MapShapes order; the nearest foot on the
+// face's surface (GeomAPI_ProjectPointOnSurf) that the kernel's own face
+// classifier (BRepClass_FaceClassifier, not the one the sampler uses) puts
+// inside, else BRepExtrema's distance to the face. No evaluation, trim or
+// closed form of ours. INVALID_ARGUMENT for a face index out of range.
+absl::StatusOr<double> MaxDistanceToFaces(const std::string& bytes, ModelFormat format,
+                                          const std::vector<PointOnFace>& points);
+
 // Writes every fixture into `dir` (which must exist): sphere.step,
 // sphere.iges, cylinder.step, ..., box_with_hole.iges, quarter_cylinder.nurbs.
 // Returns the paths written.

@@ -9,11 +9,13 @@
 #include <unistd.h>
 
 #include <BRepAdaptor_Surface.hxx>
+#include <BRepBndLib.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepGProp.hxx>
 #include <BRepLib.hxx>
 #include <BRepTools.hxx>
 #include <BinTools.hxx>
+#include <Bnd_Box.hxx>
 #include <GProp_GProps.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <IGESControl_Reader.hxx>
@@ -43,6 +45,7 @@
 #include <TopoDS.hxx>
 #include <TopoDS_Face.hxx>
 #include <TopoDS_Shape.hxx>
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -396,9 +399,9 @@ absl::StatusOr<Face> MakeFace(const TopoDS_Face& face, int index, ModelFormat fo
   const UnitSquareMap map{box, reversed};
   GProp_GProps props;
   BRepGProp::SurfaceProperties(face, props);
-  const double area = std::abs(props.Mass());
+  double area = std::abs(props.Mass());
   const gp_Pnt c = props.CentreOfMass();
-  const Vec3 centroid{c.X(), c.Y(), c.Z()};
+  Vec3 centroid{c.X(), c.Y(), c.Z()};
   if (!std::isfinite(area) || !IsFinite(centroid))
     return bad("has a non-finite area (NaN or infinite geometry)");
   const BRepAdaptor_Surface adaptor(face, true);
@@ -409,6 +412,22 @@ absl::StatusOr<Face> MakeFace(const TopoDS_Face& face, int index, ModelFormat fo
       if (!IsFinite(surface->Point(s, t)))
         return bad("has non-finite points (NaN or infinite coordinates)");
     }
+  }
+  // A face thinner on average than the kernel's own tolerance has no area:
+  // its integral is rounding noise (a loop of collinear points gives ~1e-16)
+  // and its trim cannot be classified, so it takes no samples (Face::area()
+  // 0) and its noisy centre of mass is not used (the bounding box's centre).
+  Bnd_Box bounds;
+  BRepBndLib::Add(face, bounds, /*useTriangulation=*/Standard_False);
+  const double diagonal = bounds.IsVoid() ? 0 : std::sqrt(bounds.SquareExtent());
+  if (!(area > Precision::Confusion() * diagonal)) {
+    area = 0;
+    if (!bounds.IsVoid()) {
+      double x0, y0, z0, x1, y1, z1;
+      bounds.Get(x0, y0, z0, x1, y1, z1);
+      centroid = {0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (z0 + z1)};
+    }
+    if (!IsFinite(centroid)) centroid = surface->Point(0.5, 0.5);
   }
   auto trim = std::make_shared<FaceTrim>(face, map, options.trim_tolerance);
   const bool trimmed = trim->trimmed();  // before `trim` is moved from
@@ -443,10 +462,23 @@ absl::StatusOr<std::shared_ptr<const Model>> ModelFromShape(const TopoDS_Shape& 
   if (map.Extent() == 0) return Invalid(format, name, "empty model: it has no faces");
   std::vector<Face> faces;
   faces.reserve(map.Extent());
+  bool any_area = false;
   for (int i = 1; i <= map.Extent(); ++i) {
     RETURN_IF_ERROR(Checked(options));
     ASSIGN_OR_RETURN(Face face, MakeFace(TopoDS::Face(map(i)), i - 1, format, name, options));
+    any_area = any_area || face.area() > 0;
     faces.push_back(std::move(face));
+  }
+  if (!any_area) {
+    constexpr size_t kNamed = 8;
+    std::string named;
+    for (size_t i = 0; i < std::min(faces.size(), kNamed); ++i) absl::StrAppend(&named, i ? ", " : "", i);
+    if (faces.size() > kNamed) absl::StrAppend(&named, ", ...");
+    return Invalid(format, name,
+                   absl::StrCat("has no face with area: its ", faces.size(), " faces (", named,
+                                ") are thinner than the kernel's tolerance (",
+                                Precision::Confusion(),
+                                " model units); a degenerate or collapsed model? fix or re-export it"));
   }
   return std::make_shared<const Model>(std::string(name), std::move(faces));
 }

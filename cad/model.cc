@@ -66,12 +66,21 @@ CellState Face::Classify(double s0, double s1, double t0, double t1) const {
 
 Model::Model(std::string name, std::vector<Face> faces)
     : name_(std::move(name)), faces_(std::move(faces)) {
+  // Faces with area in the Hilbert order of their centroids; faces without
+  // (no samples) after them in file order, so they move no other face.
   std::vector<Vec3> centroids;
+  std::vector<int> with_area, without;
   for (const Face& face : faces_) {
     total_area_ += face.area();
-    centroids.push_back(face.centroid());
+    if (face.area() > 0) {
+      with_area.push_back(face.index());
+      centroids.push_back(face.centroid());
+    } else {
+      without.push_back(face.index());
+    }
   }
-  curve_order_ = HilbertOrder(centroids);
+  for (int i : HilbertOrder(centroids)) curve_order_.push_back(with_area[i]);
+  curve_order_.insert(curve_order_.end(), without.begin(), without.end());
 }
 
 std::string DescribeModel(const Model& model) {
@@ -85,6 +94,14 @@ std::string DescribeModel(const Model& model) {
                           "%5d  %-10s  %16.10g  [%11.6g, %11.6g] x [%11.6g, %11.6g]  %-8s  %s\n",
                           face.index(), FaceTypeName(face.type()), face.area(), b.u0, b.u1, b.v0,
                           b.v1, face.reversed() ? "yes" : "no", face.trimmed() ? "yes" : "no");
+  }
+  const auto without_area = std::count_if(model.faces().begin(), model.faces().end(),
+                                          [](const Face& face) { return !(face.area() > 0); });
+  if (without_area > 0) {
+    absl::StrAppendFormat(&out,
+                          "%d faces have no area (area 0: thinner than the kernel's tolerance) "
+                          "and take no samples\n",
+                          without_area);
   }
   absl::StrAppend(&out, "curve order: ", absl::StrJoin(model.curve_order(), " "), "\n");
   return out;

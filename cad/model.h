@@ -72,7 +72,9 @@ class Face {
   int index() const { return index_; }
   FaceType type() const { return type_; }
   // Area of the trimmed face (the kernel's surface integral over the face,
-  // BRepGProp), in the model's length unit squared.
+  // BRepGProp), in the model's length unit squared; 0 for a face thinner on
+  // average than the kernel's tolerance (area <= Precision::Confusion() x its
+  // bounding box's diagonal), which takes no samples.
   double area() const { return area_; }
   // The native parameter box mapped onto the unit square.
   const ParameterBox& parameter_box() const { return box_; }
@@ -138,7 +140,8 @@ class Model {
   double total_area() const { return total_area_; }
   // The faces' indices in the order one curve visits them: the 3D Hilbert
   // order of their centroids (cad/face_order.h), so consecutive faces are
-  // close in space. A permutation of 0..faces().size()-1.
+  // close in space, then the faces without area in file order. A
+  // permutation of 0..faces().size()-1.
   const std::vector<int>& curve_order() const { return curve_order_; }
 
  private:

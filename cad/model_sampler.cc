@@ -66,6 +66,10 @@ absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
   // Stage one: every face's coarse tree (grade 0), for its mass.
   for (int f : model->curve_order()) {
     const Face& face = model->faces()[f];
+    if (!(face.area() > 0)) {  // at rounding level (cad/model.h): no samples
+      ++tree->skipped_faces_;
+      continue;
+    }
     Piece piece;
     piece.face = f;
     piece.surface = face.shared_surface();

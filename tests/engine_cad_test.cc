@@ -211,6 +211,79 @@ TEST(EngineCad, MalformedModelsAreRefusedByName) {
   EXPECT_EQ(e.engine.Start(triangle).status().code(), absl::StatusCode::kInvalidArgument);
 }
 
+// Every sample lies on the face it names, by a measure that shares nothing
+// with the sampler: the file read again and the distance to the exact trimmed
+// face (BRepExtrema), on trimmed planes, cylinders, cones and tori.
+TEST(EngineCad, EverySampleLiesOnItsFace) {
+  for (fx::Solid solid : {fx::Solid::kBoxWithHole, fx::Solid::kTiltedBoxWithHole,
+                          fx::Solid::kTiltedConeAndTorus, fx::Solid::kSplineHolePlate}) {
+    Engine e;
+    const std::string path = Fixture(solid);
+    const SampleBatch b = DrawAll(e.engine, ModelRequest("step:" + path, 600));
+    ASSERT_EQ(b.size(), 600u);
+    std::vector<fx::PointOnFace> points;
+    for (size_t i = 0; i < b.size(); ++i) {
+      points.push_back({static_cast<int>(b.face[i]), b.x[i], b.y[i], b.z[i]});
+    }
+    auto bytes = fx::SolidBytes(solid, cad::ModelFormat::kStep);
+    ASSERT_TRUE(bytes.ok());
+    auto worst = fx::MaxDistanceToFaces(*bytes, cad::ModelFormat::kStep, points);
+    ASSERT_TRUE(worst.ok()) << worst.status();
+    EXPECT_LT(*worst, 1e-6) << fx::SolidName(solid);
+
+  }
+}
+
+// Issue 37: faces with no area (loops of collinear points) take no samples;
+// a model of nothing else is refused, naming its faces; the face order and
+// the samples are the same whether the file is read here or through the
+// model check's BRep (the server's path).
+TEST(EngineCad, FacesWithoutAreaTakeNoSamplesAndAModelOfThemIsRefused) {
+  Engine e;
+  const std::string only = WriteTemp("engine_cad_collinear.step", fx::CollinearFacesStep(10, false));
+  auto status = e.engine.Start(ModelRequest("step:" + only, 1000)).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << status;
+  EXPECT_NE(status.message().find("no face with area"), std::string::npos) << status;
+  EXPECT_NE(status.message().find("engine_cad_collinear.step"), std::string::npos) << status;
+  EXPECT_NE(status.message().find("0, 1, 2"), std::string::npos) << status;
+
+  const std::string mixed_bytes = fx::CollinearFacesStep(10, true);
+  auto here = cad::Load(cad::ModelFormat::kStep, mixed_bytes, "mixed.step");
+  ASSERT_TRUE(here.ok()) << here.status();
+  ASSERT_EQ((*here)->faces().size(), 11u);
+  int square = -1;  // the one face with area
+  for (const cad::Face& face : (*here)->faces()) {
+    if (face.area() > 0) {
+      EXPECT_EQ(square, -1) << "a second face with area: " << face.index();
+      square = face.index();
+    }
+  }
+  ASSERT_GE(square, 0);
+  EXPECT_NEAR((*here)->total_area(), 1.0, 1e-12);
+  EXPECT_EQ((*here)->curve_order().front(), square);
+
+  const std::string mixed = WriteTemp("engine_cad_collinear_and_square.step", mixed_bytes);
+  const SampleBatch b = DrawAll(e.engine, ModelRequest("step:" + mixed, 2000));
+  ASSERT_EQ(b.size(), 2000u);
+  std::vector<fx::PointOnFace> points;
+  for (size_t i = 0; i < b.size(); ++i) {
+    ASSERT_EQ(b.face[i], static_cast<uint32_t>(square)) << "sample " << i << " on a face without area";
+    ASSERT_TRUE(b.z[i] == 0 && b.x[i] >= fx::kSquareX && b.x[i] <= fx::kSquareX + 1 && b.y[i] >= 0 &&
+                b.y[i] <= 1)
+        << "sample " << i << " off the square";
+    points.push_back({static_cast<int>(b.face[i]), b.x[i], b.y[i], b.z[i]});
+  }
+  auto worst = fx::MaxDistanceToFaces(mixed_bytes, cad::ModelFormat::kStep, points);
+  ASSERT_TRUE(worst.ok()) << worst.status();
+  EXPECT_LT(*worst, 1e-9);
+
+  auto brep = cad::ReadToBrep(cad::ModelFormat::kStep, mixed_bytes, "mixed.step");
+  ASSERT_TRUE(brep.ok()) << brep.status();
+  auto there = cad::LoadBrep(*brep, cad::ModelFormat::kStep, "mixed.step");
+  ASSERT_TRUE(there.ok()) << there.status();
+  EXPECT_EQ(cad::DescribeModel(**here), cad::DescribeModel(**there));
+}
+
 TEST(EngineCad, ANurbsPatchSamplesItsArea) {
   const std::string path = WriteTemp("engine_cad_patch.nurbs", fx::NurbsPatchText());
   Engine e;
