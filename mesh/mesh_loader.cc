@@ -6,7 +6,11 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <limits>
+#include <optional>
 #include <sstream>
+#include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -128,10 +132,13 @@ absl::StatusOr<ObjCensus> CheckObjLines(absl::string_view text, absl::string_vie
                                              line_number, tokens.size()));
     }
     for (int c = 0; c < 3; ++c) {
+      // Decimal only: SimpleAtod takes hex floats (0x1p3), which
+      // tinyobjloader reads as 0.
       double value;
-      if (!absl::SimpleAtod(tokens[c], &value) || !std::isfinite(value)) {
+      if (tokens[c].find_first_not_of("0123456789+-.eE") != absl::string_view::npos ||
+          !absl::SimpleAtod(tokens[c], &value) || !std::isfinite(value)) {
         return Malformed(name, absl::StrFormat("line %d: vertex coordinate '%s' is not a finite "
-                                               "number",
+                                               "decimal number",
                                                line_number, Echo(tokens[c])));
       }
     }
@@ -325,6 +332,97 @@ absl::Status CheckPlyHeader(absl::string_view bytes, absl::string_view name) {
   return Malformed(name, "the PLY header has no 'end_header' line in its first 1 MiB");
 }
 
+// The format line (line 2, as CGAL reads it) says ascii.
+bool IsAsciiPly(absl::string_view bytes) {
+  std::vector<absl::string_view> lines = absl::StrSplit(bytes, absl::MaxSplits('\n', 2));
+  if (lines.size() < 2) return false;
+  std::vector<absl::string_view> tokens =
+      absl::StrSplit(lines[1], absl::ByAnyChar(" \t\r\v\f"), absl::SkipEmpty());
+  return tokens.size() >= 2 && tokens[1] == "ascii";
+}
+
+// ASCII PLY integers that do not fit their declared type: CGAL reads an
+// 8-bit value as a short and casts it (a uchar list count of 259 becomes 3,
+// a uchar 300 becomes 44), and an unsigned one takes "-1" as its largest
+// value. So the tokens an integer property is about to read are checked
+// first, and the stream put back where it was.
+struct IntRange {
+  int64_t lo = 0, hi = 0;
+  const char* type = "";
+};
+template <typename T>
+std::optional<IntRange> RangeOf() {
+  if constexpr (std::is_integral_v<T>) {
+    return IntRange{std::numeric_limits<T>::min(), std::numeric_limits<T>::max(),
+                    sizeof(T) == 1 ? (std::is_signed_v<T> ? "char" : "uchar")
+                    : sizeof(T) == 2 ? (std::is_signed_v<T> ? "short" : "ushort")
+                                     : (std::is_signed_v<T> ? "int" : "uint")};
+  }
+  return std::nullopt;
+}
+
+// The ranges a property reads: a scalar's; a list's count and items.
+struct PropertyRanges {
+  std::optional<IntRange> scalar, count, item;
+  bool list = false;
+};
+
+template <typename Count, typename... Items>
+void ListRanges(const CgalPlyNumber* p, PropertyRanges* out) {
+  using CGAL::IO::internal::PLY_read_typed_list_with_typed_size;
+  (void)((dynamic_cast<const PLY_read_typed_list_with_typed_size<Count, Items>*>(p) &&
+          (*out = PropertyRanges{std::nullopt, RangeOf<Count>(), RangeOf<Items>(), true}, true)) ||
+         ...);
+}
+
+PropertyRanges RangesOf(const CgalPlyNumber* p) {
+  PropertyRanges r;
+  auto scalar = [&](auto type) {
+    using T = decltype(type);
+    if (!r.scalar && Is<T>(p)) r.scalar = RangeOf<T>();
+  };
+  scalar(int8_t{}), scalar(uint8_t{}), scalar(int16_t{}), scalar(uint16_t{}), scalar(int32_t{}),
+      scalar(uint32_t{});
+  if (r.scalar) return r;
+  auto list = [&](auto count) {
+    if (!r.list) {
+      ListRanges<decltype(count), int8_t, uint8_t, int16_t, uint16_t, int32_t, uint32_t, float,
+                 double>(p, &r);
+    }
+  };
+  list(uint8_t{}), list(int8_t{}), list(uint16_t{}), list(int16_t{});
+  return r;
+}
+
+// OK when the next tokens of `in` fit `ranges` (tokens that are no integer
+// at all are CGAL's to refuse); `in` is left where it was.
+absl::Status CheckAsciiIntegers(std::istream& in, const PropertyRanges& ranges,
+                                absl::string_view what, absl::string_view name) {
+  if (!ranges.scalar && !ranges.count) return absl::OkStatus();
+  const std::streampos start = in.tellg();
+  absl::Status status;
+  auto next = [&](const std::optional<IntRange>& range, int64_t* value) {
+    std::string token;
+    if (!(in >> token) || !absl::SimpleAtoi(token, value)) return false;
+    if (range && (*value < range->lo || *value > range->hi)) {
+      status = Malformed(name, absl::StrFormat("%s: %s does not fit its type %s (%d..%d)", what,
+                                               Echo(token), range->type, range->lo, range->hi));
+      return false;
+    }
+    return true;
+  };
+  int64_t count = 0, item = 0;
+  if (ranges.scalar) {
+    next(ranges.scalar, &item);
+  } else if (next(ranges.count, &count) && ranges.item) {
+    for (int64_t i = 0; i < count && next(ranges.item, &item); ++i) {
+    }
+  }
+  in.clear();
+  in.seekg(start);
+  return status;
+}
+
 absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view name,
                                      const MeshLoadOptions& options) {
   // The plainest binary files (what the Python package writes for arrays)
@@ -342,6 +440,7 @@ absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view 
   TriangleMesh mesh;
   mesh.name = std::string(name);
   bool have_vertices = false;
+  const bool ascii = IsAsciiPly(bytes);
   for (size_t e = 0; e < reader.number_of_elements(); ++e) {
     CgalPlyElement& element = reader.element(e);
     const size_t items = element.number_of_items();
@@ -403,9 +502,22 @@ absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view 
     };
     const ScalarGetter gx = getter(ix), gy = getter(iy), gz = getter(iz), gnx = getter(inx),
                        gny = getter(iny), gnz = getter(inz), gw = getter(iw);
+    std::vector<PropertyRanges> ranges;
+    if (ascii) {
+      for (size_t k = 0; k < props; ++k) ranges.push_back(RangesOf(element.property(k)));
+    }
     for (size_t j = 0; j < items; ++j) {
       if (options.check && (j & 0xffff) == 0) RETURN_IF_ERROR(options.check());
-      for (size_t k = 0; k < props; ++k) element.property(k)->get(in);
+      for (size_t k = 0; k < props; ++k) {
+        if (ascii) {
+          RETURN_IF_ERROR(CheckAsciiIntegers(
+              in, ranges[k],
+              absl::StrFormat("property '%s' of %s %d", Echo(element.property(k)->name()),
+                              Echo(element.name()), j),
+              name));
+        }
+        element.property(k)->get(in);
+      }
       if (!in) {
         return Malformed(name, absl::StrFormat("the file ends or breaks inside %s %d of %d (a "
                                                "truncated or malformed file?)",

@@ -87,6 +87,53 @@ TEST(MeshHostile, PlyIndicesPastTheVerticesAreRefusedWithTheIndex) {
   }
 }
 
+// Issue 37: CGAL reads an ASCII 8-bit value as a short and casts it, and an
+// unsigned one takes "-1" as its largest value; such values are refused,
+// naming the property, the item and the type, never wrapped.
+TEST(MeshHostile, AsciiPlyIntegersThatDoNotFitTheirTypeAreRefused) {
+  MeshLoadOptions options;
+  options.format = MeshFormat::kPly;
+  // A uchar list count of 259 would be read as 3 (then 256 corners dropped).
+  std::string corners = "259";
+  for (int i = 0; i < 259; ++i) absl::StrAppend(&corners, " ", i % 4);
+  ExpectRefused(LoadMesh(AsciiPly("int", corners + "\n", 1), "hostile.ply", options),
+                "property 'vertex_indices' of face 0: 259 does not fit its type uchar (0..255)");
+  // Corners of a narrow type, and a negative count.
+  ExpectRefused(LoadMesh(AsciiPly("uchar", "3 0 1 300\n", 1), "hostile.ply", options),
+                "300 does not fit its type uchar");
+  ExpectRefused(LoadMesh(AsciiPly("ushort", "3 0 1 -1\n", 1), "hostile.ply", options),
+                "-1 does not fit its type ushort (0..65535)");
+  ExpectRefused(LoadMesh(AsciiPly("int", "-3 0 1 2\n", 1), "hostile.ply", options),
+                "-3 does not fit its type uchar");
+  // A uchar coordinate of 300 would be read as 44.
+  const std::string uchar_vertex =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty uchar x\nproperty uchar y\n"
+      "property uchar z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  ExpectRefused(LoadMesh(uchar_vertex + "0 0 0\n300 0 0\n0 1 0\n3 0 1 2\n", "hostile.ply", options),
+                "property 'x' of vertex 1: 300 does not fit its type uchar (0..255)");
+  // The largest values of each type still load.
+  auto mesh = LoadMesh(uchar_vertex + "0 0 0\n255 0 0\n0 255 0\n3 0 1 2\n", "hostile.ply", options);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(mesh->positions[1].x, 255);
+  mesh = LoadMesh(AsciiPly("uchar", "3 0 1 2\n", 1), "hostile.ply", options);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(mesh->triangles.size(), 1u);
+}
+
+// Issue 37: tinyobjloader reads a hex float as 0; the line check refuses it.
+TEST(MeshHostile, ObjHexFloatsAreRefused) {
+  for (const std::string token : {"0x1p3", "0X10", "-0x1.8p1", "inf", "nan", "1e999"}) {
+    ExpectRefused(Obj(absl::StrCat("v ", token, " 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")),
+                  absl::StrCat("'", token, "' is not a finite decimal number"));
+  }
+  auto mesh = Obj("v 8 0 0\nv 1e0 0 +0.5\nv .5 1. -2E-1\nf 1 2 3\n");
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(mesh->positions[0].x, 8);
+  EXPECT_EQ(mesh->positions[1].z, 0.5);
+  EXPECT_EQ(mesh->positions[2].x, 0.5);
+  EXPECT_EQ(mesh->positions[2].z, -0.2);
+}
+
 // A property line before any element line made CGAL's header parser write
 // through a null pointer (fuzz/ply_fuzzer).
 TEST(MeshHostile, PlyPropertyBeforeAnyElementIsRefused) {
