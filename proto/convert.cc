@@ -245,7 +245,7 @@ absl::StatusOr<TreeSpec> FromProto(const v1::TreeSpec& p) {
   }
   spec.options.tolerance = p.tolerance();
   spec.options.depth_cap = p.depth_cap();
-  spec.options.rho = p.rho() == 0 ? 1.0 : p.rho();
+  spec.options.rho = p.has_rho() ? p.rho() : 1.0;  // a 0 sent is the engine's to refuse
   return spec;
 }
 

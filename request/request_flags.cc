@@ -1,10 +1,12 @@
 #include "request/request_flags.h"
 
+#include <cmath>
 #include <vector>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
+#include "base/echo.h"
 #include "base/status_macros.h"
 
 namespace sfc {
@@ -27,6 +29,22 @@ absl::StatusOr<std::vector<double>> Numbers(const std::string& what, absl::strin
   return values;
 }
 
+// CLI11 reads "-1" and numbers past 2^64 - 1 into a uint64_t as 2^64 - 1
+// without a word, so runs a user believes independent would share a seed:
+// whole-number flags are checked as typed, before that conversion.
+const CLI::Validator kWholeNumber(
+    [](std::string& text) -> std::string {
+      uint64_t value;
+      if (!text.empty() && text.find_first_not_of("0123456789") == std::string::npos &&
+          absl::SimpleAtoi(text, &value)) {
+        return "";
+      }
+      return absl::StrFormat("must be a whole number from 0 to 18446744073709551615 "
+                             "(2^64 - 1), got '%s'",
+                             Echo(text));
+    },
+    "UINT64");
+
 }  // namespace
 
 void AddTreeFlags(CLI::App* cmd, RequestFlags* f) {
@@ -46,16 +64,19 @@ void AddTreeFlags(CLI::App* cmd, RequestFlags* f) {
 }
 
 void AddSampleFlags(CLI::App* cmd, RequestFlags* f) {
-  cmd->add_option("--count,-n", f->count, "N, the number of samples in the set")->capture_default_str();
-  cmd->add_option("--seed", f->seed, "random seed")->capture_default_str();
+  cmd->add_option("--count,-n", f->count, "N, the number of samples in the set")
+      ->capture_default_str()
+      ->check(kWholeNumber);
+  cmd->add_option("--seed", f->seed, "random seed")->capture_default_str()->check(kWholeNumber);
   cmd->add_option("--sequence", f->sequence,
                   "jittered | equal | random | vandercorput | progressive")
       ->capture_default_str();
   cmd->add_option("--tree-count", f->tree_count,
                   "size the tree for this many samples (default: --count); keep it fixed to extend a "
-                  "progressive set byte-exactly");
-  cmd->add_option("--begin", f->begin, "first index of the range to return");
-  cmd->add_option("--end", f->end, "one past the last index (default: count)");
+                  "progressive set byte-exactly")
+      ->check(kWholeNumber);
+  cmd->add_option("--begin", f->begin, "first index of the range to return")->check(kWholeNumber);
+  cmd->add_option("--end", f->end, "one past the last index (default: count)")->check(kWholeNumber);
   cmd->add_option("--shard", f->shard, "shard i/K of the set (a contiguous stretch of the curve)");
   cmd->add_option("--region", f->region,
                   "only samples inside uv:U0,U1,V0,V1 (parameter rectangle) or "
@@ -83,6 +104,14 @@ absl::StatusOr<TreeSpec> ToTreeSpec(const RequestFlags& f) {
   spec.options.tolerance = f.tolerance;
   spec.options.depth_cap = f.depth_cap;
   spec.options.rho = f.rho;
+  // Checked here, before a request is sent: a server cannot tell a 0 from an
+  // old client's unset field (proto/sfcsampler/v1/sampler.proto).
+  if (!(f.rho > 0) || !std::isfinite(f.rho)) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("--rho must be a positive number (samples' worth of mass a leaf may hold; "
+                        "default 1), got %g",
+                        f.rho));
+  }
   return spec;
 }
 

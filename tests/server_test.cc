@@ -546,6 +546,45 @@ TEST(Server, ColumnsLeftOffDoNotTravelAndTheRestAreTheFullStreams) {
   EXPECT_NE(status.error_message().find("no value column"), std::string::npos) << status.error_message();
 }
 
+// Issue 37: rho has explicit presence on the wire. A 0 a client sends is
+// refused, not read as "unset"; an old client's unset field still means 1.
+TEST(Server, AnExplicitRhoOfZeroIsRefusedAndAnUnsetOneMeansOne) {
+  Running r = StartServer(LoopbackOptions());
+  auto channel = grpc::CreateChannel("127.0.0.1:" + std::to_string(r.server->port()),
+                                     grpc::InsecureChannelCredentials());
+  auto stub = v1::Sampler::NewStub(channel);
+  auto first_x = [&](std::optional<double> rho, grpc::Status* status) {
+    v1::SampleRequest request;
+    request.mutable_tree()->set_surface("torus");
+    if (rho) request.mutable_tree()->set_rho(*rho);
+    request.set_count(500);
+    grpc::ClientContext context;
+    auto reader = stub->Sample(&context, request);
+    v1::SampleResponse response;
+    std::string x;
+    while (reader->Read(&response)) {
+      if (x.empty() && response.has_batch()) x = response.batch().SerializeAsString();
+    }
+    *status = reader->Finish();
+    return x;
+  };
+  grpc::Status status;
+  first_x(0.0, &status);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(status.error_message().find("rho"), std::string::npos) << status.error_message();
+  const std::string unset = first_x(std::nullopt, &status);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  const std::string one = first_x(1.0, &status);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(unset, one);
+  EXPECT_FALSE(unset.empty());
+  // A 0 from the C++ client library (which sends what it is given) too.
+  SampleRequest zero = Request("torus", 500);
+  zero.tree.options.rho = 0;
+  auto fetched = Fetch(*r.client, zero);
+  EXPECT_EQ(fetched.status().code(), absl::StatusCode::kInvalidArgument);
+}
+
 // The C++ client asks for what SampleFields keeps and gets exactly that.
 TEST(Server, TheClientReceivesOnlyTheColumnsItAskedFor) {
   Running r = StartServer(LoopbackOptions());
