@@ -4,6 +4,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_replace.h"
 
 namespace sfc {
 
@@ -35,6 +36,10 @@ std::string Echo(absl::string_view text, size_t max) {
   }
   if (shown < text.size()) absl::StrAppend(&out, "... (", text.size(), " bytes)");
   return out;
+}
+
+std::string LogField(absl::string_view text, size_t max) {
+  return absl::StrReplaceAll(Echo(text, max), {{"\"", "\\\""}});
 }
 
 std::string ClipMessage(absl::string_view message, size_t max) {

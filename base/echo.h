@@ -24,6 +24,12 @@ inline constexpr size_t kMaxNameEcho = 128;
 // has at most max + 32 bytes, all printable ASCII.
 std::string Echo(absl::string_view text, size_t max = kMaxEcho);
 
+// `text` as the value of a quoted log field (key="..."): Echo's escapes, and
+// '"' as '\"', so no text, a client's or ours, can end the field early and
+// forge the fields after it (code=, sent=). At most max + 32 bytes before
+// the quotes' escapes.
+std::string LogField(absl::string_view text, size_t max = kMaxEcho);
+
 // `message` cut to at most `max` bytes (>= 32) at a character boundary, ending
 // with " ... (message clipped)" when cut. For the wire and logs: the text is
 // ours, so it is not escaped, but never longer than `max`.

@@ -19,7 +19,7 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
                                          v1::ModelInfo* response) {
   const auto start = Clock::now();
   grpc::Status status = Admit(*context);
-  std::string name;
+  std::string name, raw_name;  // escaped for messages; as sent, for the log's own escape
   std::optional<ModelFormat> format;
   // The bytes count against the model budget as they arrive.
   ModelStore::Upload upload = models_->StartUpload();
@@ -30,6 +30,7 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
       if (first) {
         // The name is the client's: escaped and clipped before any message
         // or log line shows it, and never stored (the model is shared).
+        raw_name = chunk.name();
         name = Echo(chunk.name(), kMaxNameEcho);
         format = ModelFormatFromName(chunk.format());
         if (!format) {
@@ -68,10 +69,10 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
   }
   metrics_->CountRequest("UploadModel", status.error_code());
   spdlog::info("rpc=UploadModel peer={} name=\"{}\" bytes={} sha256={} already={} seconds={:.3f} code={} msg=\"{}\"",
-               Echo(context->peer()), name, response->bytes(), response->sha256(),
-               response->already_stored(), SecondsSince(start),
+               Echo(context->peer()), LogField(raw_name, kMaxNameEcho), response->bytes(),
+               response->sha256(), response->already_stored(), SecondsSince(start),
                static_cast<int>(status.error_code()),
-               Echo(status.error_message(), kMaxStatusMessageBytes));
+               LogField(status.error_message(), kMaxStatusMessageBytes));
   return status;
 }
 

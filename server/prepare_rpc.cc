@@ -35,10 +35,10 @@ grpc::Status SamplerService::Prepare(grpc::ServerContext* context, const v1::Pre
   }
   metrics_->CountRequest("Prepare", status.error_code());
   spdlog::info("rpc=Prepare peer={} surface=\"{}\" count={} hit={} seconds={:.3f} code={} msg=\"{}\"",
-               Echo(context->peer()), Echo(request->tree().surface(), kMaxNameEcho),
+               Echo(context->peer()), LogField(request->tree().surface(), kMaxNameEcho),
                request->count(), response->tree().cache_hit(), SecondsSince(start),
                static_cast<int>(status.error_code()),
-               Echo(status.error_message(), kMaxStatusMessageBytes));
+               LogField(status.error_message(), kMaxStatusMessageBytes));
   return status;
 }
 

@@ -73,9 +73,9 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
   }
   metrics_->CountRequest("Sample", status.error_code());
   spdlog::info("rpc=Sample peer={} surface=\"{}\" count={} sent={} seconds={:.3f} code={} msg=\"{}\"",
-               Echo(context->peer()), Echo(request->tree().surface(), kMaxNameEcho),
+               Echo(context->peer()), LogField(request->tree().surface(), kMaxNameEcho),
                request->count(), sent, SecondsSince(start), static_cast<int>(status.error_code()),
-               Echo(status.error_message(), kMaxStatusMessageBytes));
+               LogField(status.error_message(), kMaxStatusMessageBytes));
   return status;
 }
 

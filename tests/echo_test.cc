@@ -44,5 +44,20 @@ TEST(Echo, ClipMessageKeepsShortMessagesAndCutsLongOnesAtACharacter) {
   EXPECT_EQ(body % 2, 0u) << "a UTF-8 sequence was split";
 }
 
+// Issue 37: a quoted log field cannot be ended early by the text inside it.
+TEST(Echo, LogFieldEscapesQuotesSoNoFieldCanBeForged) {
+  const std::string forged = "expr:1\" code=0 sent=1000 msg=\"";
+  const std::string field = LogField(forged);
+  EXPECT_EQ(field, "expr:1\\\" code=0 sent=1000 msg=\\\"");
+  // Read back as a log reader would: the field ends at the first quote not
+  // behind a backslash, which is the end of the field.
+  const std::string line = "surface=\"" + field + "\" code=3";
+  size_t end = line.find('"') + 1;
+  while (line[end] != '"') end += line[end] == '\\' ? 2 : 1;
+  EXPECT_EQ(line.substr(end), "\" code=3");
+  EXPECT_EQ(LogField("a\\\"b"), "a\\\\\\\"b");  // a backslash before a quote stays unambiguous
+  EXPECT_LE(LogField(std::string(10000, '"'), 100).size(), 2 * 100 + 32u);
+}
+
 }  // namespace
 }  // namespace sfc
