@@ -308,7 +308,11 @@ absl::StatusOr<v1::ModelInfo> SamplerClient::UploadModel(const std::string& form
   } while (offset < bytes.size());
   writer->WritesDone();
   const grpc::Status status = writer->Finish();
-  if (!status.ok()) return FromGrpcStatus(status);
+  if (!status.ok()) {
+    const absl::Status s = FromGrpcStatus(status);
+    const std::string message(s.message());
+    return absl::Status(s.code(), message + UploadCutHint(message, bytes.size()));
+  }
   return info;
 }
 

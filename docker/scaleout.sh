@@ -9,6 +9,7 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 replicas="${1:-3}"
 proxy_port="${2:-50080}"
 server="$root/build/server/sfcsampler-server"
+[ -x "$server" ] || { echo "scaleout: $server is missing: build first (bash tools/build.sh)" >&2; exit 1; }
 # SFC_SCALEOUT_DIR, if set, receives the logs and a state file for scripts:
 # "replicas" (one "pid port" line each), "proxy" (the port) and "ready".
 dir="${SFC_SCALEOUT_DIR:-$(mktemp -d)}"
@@ -23,6 +24,11 @@ for i in $(seq 1 "$replicas"); do
   pids+=($!)
   for _ in $(seq 100); do grep -q listening "$dir/replica$i.log" && break; sleep 0.05; done
   port=$(sed -n 's/.* port=\([0-9]*\) .*/\1/p' "$dir/replica$i.log")
+  if [ -z "$port" ]; then
+    echo "scaleout: replica $i did not start (log $dir/replica$i.log):" >&2
+    tail -5 "$dir/replica$i.log" >&2
+    exit 1
+  fi
   servers+="    server 127.0.0.1:$port max_fails=1 fail_timeout=10s;"$'\n'
   echo "${pids[-1]} $port" >> "$dir/replicas"
   echo "replica $i on 127.0.0.1:$port (log $dir/replica$i.log)"

@@ -112,4 +112,17 @@ absl::StatusOr<StoredModel> ReadModelFile(const ModelSpec& spec, uint64_t max_by
   return model;
 }
 
+std::string UploadCutHint(std::string_view message, uint64_t bytes) {
+  const bool cut = message.find("RST_STREAM") != std::string_view::npos ||
+                   message.find("http2 header with status") != std::string_view::npos ||
+                   message.find("content-type") != std::string_view::npos;
+  if (!cut) return "";
+  return absl::StrFormat(
+      " (the upload of %d bytes was cut off before the server answered: a proxy between this "
+      "client and the server may refuse large request bodies; nginx does above "
+      "client_max_body_size, 1 MiB by default: set it to 0 there, as docker/nginx.conf.template "
+      "does, so that the server's own model size limit applies)",
+      bytes);
+}
+
 }  // namespace sfc

@@ -33,6 +33,15 @@ std::string Sha256Hex(std::string_view bytes);
 // makes the same string.
 std::string ModelRoutingKey(ModelFormat format, std::string_view sha256);
 
+// What a client adds to an upload that failed without the server's word:
+// when `message` (gRPC's status text) shows the stream was reset or answered
+// by something that does not speak gRPC (a proxy's request-body limit: nginx
+// refuses bodies over client_max_body_size, 1 MiB by default, and the client
+// sees "Received RST_STREAM with error code 0"), a sentence that says so and
+// what to change; "" otherwise. `bytes`: the upload's size. Both clients
+// (client/sampler_client.cc, python/sfcsampler/client.py) append it.
+std::string UploadCutHint(std::string_view message, uint64_t bytes);
+
 // A parsed model spec: the format and the reference after the colon.
 struct ModelSpec {
   ModelFormat format;

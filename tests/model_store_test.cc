@@ -30,6 +30,20 @@ TEST(ModelSpec, NamesFormatAndReference) {
             absl::StatusCode::kInvalidArgument);
 }
 
+// Issue 37: an upload a proxy cut off (what gRPC reports for nginx's 413, in
+// C++ and in Python) gets a sentence that names the proxy's limit; the
+// server's own refusals get none.
+TEST(ModelSpec, AnUploadCutByAProxyIsExplained) {
+  for (const std::string message : {"Received RST_STREAM with error code 0",
+                                    "Received http2 header with status: 413"}) {
+    const std::string hint = UploadCutHint(message, 2800000);
+    EXPECT_THAT(hint, ::testing::HasSubstr("2800000 bytes")) << message;
+    EXPECT_THAT(hint, ::testing::HasSubstr("client_max_body_size")) << message;
+  }
+  EXPECT_EQ(UploadCutHint("upload \"a.obj\": 300000000 bytes, above the limit", 300000000), "");
+  EXPECT_EQ(UploadCutHint("failed to connect to all addresses", 10), "");
+}
+
 TEST(Sha256Hex, MatchesTheStandardsTestVectors) {
   // FIPS 180-2, appendix B.1, and the empty message.
   EXPECT_EQ(Sha256Hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");

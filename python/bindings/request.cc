@@ -8,6 +8,7 @@
 #include "python/bindings/errors.h"
 #include "python/bindings/register.h"
 #include "request/index_range.h"
+#include "request/model_spec.h"
 #include "request/routing_key.h"
 
 namespace py = pybind11;
@@ -158,6 +159,8 @@ Raises sfcsampler.InvalidArgumentError for malformed values.)doc")
             return py::make_tuple(range->first, range->second);
           },
           "the resolved index range (begin, end) before the region");
+  m.def("upload_cut_hint", &UploadCutHint, py::arg("message"), py::arg("bytes"),
+        "what to add to an upload's error when a proxy cut it (request/model_spec.h); '' if none");
 }
 
 }  // namespace sfc::python

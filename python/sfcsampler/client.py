@@ -205,7 +205,7 @@ class Client:
         try:
             return self._stub.UploadModel(chunks(), timeout=self._timeout, metadata=metadata).spec
         except grpc.RpcError as e:
-            raise _error(e) from None
+            raise _error(e, _core.upload_cut_hint(e.details() or "", len(local))) from None
 
     def _with_model(self, request):
         """`request` with a model file's surface, or a mesh=... in memory, replaced by the spec
