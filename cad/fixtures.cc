@@ -214,24 +214,37 @@ absl::StatusOr<std::string> SolidBytes(Solid solid, ModelFormat format, int copi
   return ReadBack(path);
 }
 
-std::string CollinearFacesStep(int collinear, bool with_square) {
+namespace {
+
+// A STEP of planar faces on z = 0, each bounded by a POLY_LOOP through
+// `loops[i]` (x, y), in one open shell of a surface model inside the product
+// structure the reader takes as its root. Written by hand: the kernel's
+// writer would not write degenerate loops.
+std::string PolyLoopFacesStep(const std::vector<std::vector<std::pair<double, double>>>& loops) {
   std::string data;
   int id = 0;
   auto add = [&](const std::string& record) {
     absl::StrAppend(&data, "#", ++id, " = ", record, ";\n");
     return id;
   };
+  auto real = [](double v) {  // a STEP REAL always has its decimal point: "1.", "1.E-05"
+    std::string text = absl::StrFormat("%.17G", v);
+    if (text.find('.') == std::string::npos) text.insert(std::min(text.find('E'), text.size()), ".");
+    return text;
+  };
   auto point = [&](double x, double y) {
-    return add(absl::StrFormat("CARTESIAN_POINT('',(%.17g,%.17g,0.))", x, y));
+    return add(absl::StrFormat("CARTESIAN_POINT('',(%s,%s,0.))", real(x), real(y)));
   };
   const int origin = point(0, 0);
   const int z = add("DIRECTION('',(0.,0.,1.))");
   const int x = add("DIRECTION('',(1.,0.,0.))");
   const int axes = add(absl::StrFormat("AXIS2_PLACEMENT_3D('',#%d,#%d,#%d)", origin, z, x));
   const int plane = add(absl::StrFormat("PLANE('',#%d)", axes));
-  auto references = [](const std::vector<int>& ids) {
+  auto references = [](const std::vector<int>& ids) {  // 8 a line, as writers wrap them
     std::string list;
-    for (int i : ids) absl::StrAppend(&list, list.empty() ? "#" : ",#", i);
+    for (size_t i = 0; i < ids.size(); ++i) {
+      absl::StrAppend(&list, i == 0 ? "#" : i % 8 ? ",#" : ",\n  #", ids[i]);
+    }
     return list;
   };
   std::vector<int> faces;
@@ -240,12 +253,10 @@ std::string CollinearFacesStep(int collinear, bool with_square) {
     const int bound = add(absl::StrFormat("FACE_OUTER_BOUND('',#%d,.T.)", loop));
     faces.push_back(add(absl::StrFormat("FACE_SURFACE('',(#%d),#%d,.T.)", bound, plane)));
   };
-  for (int k = 0; k < collinear; ++k) {
-    const double a = (k + 1) / std::sqrt(2.0), step = 0.5 / std::sqrt(3.0);
-    face({point(a, a), point(a + step, a + step), point(a + 2 * step, a + 2 * step)});
-  }
-  if (with_square) {
-    face({point(kSquareX, 0), point(kSquareX + 1, 0), point(kSquareX + 1, 1), point(kSquareX, 1)});
+  for (const auto& loop : loops) {
+    std::vector<int> points;
+    for (const auto& [px, py] : loop) points.push_back(point(px, py));
+    face(points);
   }
   // The faces in an open shell of a surface model, and the product around
   // it that the reader takes as its root.
@@ -278,6 +289,27 @@ std::string CollinearFacesStep(int collinear, bool with_square) {
       "FILE_NAME('','',(''),(''),'','','');\n"
       "FILE_SCHEMA(('AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }'));\nENDSEC;\nDATA;\n",
       data, "ENDSEC;\nEND-ISO-10303-21;\n");
+}
+
+}  // namespace
+
+std::string CollinearFacesStep(int collinear, bool with_square) {
+  std::vector<std::vector<std::pair<double, double>>> loops;
+  for (int k = 0; k < collinear; ++k) {
+    const double a = (k + 1) / std::sqrt(2.0), step = 0.5 / std::sqrt(3.0);
+    loops.push_back({{a, a}, {a + step, a + step}, {a + 2 * step, a + 2 * step}});
+  }
+  if (with_square) loops.push_back({{kSquareX, 0}, {kSquareX + 1, 0}, {kSquareX + 1, 1}, {kSquareX, 1}});
+  return PolyLoopFacesStep(loops);
+}
+
+std::string PolygonFaceStep(int corners) {
+  std::vector<std::pair<double, double>> loop;
+  for (int k = 0; k < corners; ++k) {
+    const double a = 2 * M_PI * k / corners;
+    loop.push_back({std::cos(a), std::sin(a)});
+  }
+  return PolyLoopFacesStep({loop});
 }
 
 absl::StatusOr<double> MaxDistanceToFaces(const std::string& bytes, ModelFormat format,

@@ -33,6 +33,25 @@ struct EngineLimits {
   int max_queued_parses = 8;
   double model_parse_seconds = 0;
   double parse_failure_ttl_seconds = 60;
+  // Isolation of parses from each other (engine/loaded_models.h): a parse
+  // holds its thread's slot for model_parse_fresh_seconds, then leaves it
+  // and yields the CPU (0: it keeps its slot); at most max_long_parses such
+  // parses at once; a request waits at most max_parse_queue_seconds for its
+  // parse to start (0: no limit).
+  double model_parse_fresh_seconds = 0;
+  int max_long_parses = 4;
+  double max_parse_queue_seconds = 0;
+  // A CAD file's CPU budget in the check process grows with its size:
+  // min(model_parse_seconds, kParseBaseSeconds + this x its MiB); 0: always
+  // model_parse_seconds.
+  double model_parse_seconds_per_mib = 0;
+  static constexpr double kParseBaseSeconds = 2;
+  // The CPU budget of parsing a file of `bytes` (0 = no limit).
+  double ParseSecondsFor(uint64_t bytes) const {
+    if (model_parse_seconds_per_mib <= 0) return model_parse_seconds;
+    const double scaled = kParseBaseSeconds + model_parse_seconds_per_mib * bytes / (1 << 20);
+    return model_parse_seconds > 0 && model_parse_seconds < scaled ? model_parse_seconds : scaled;
+  }
 };
 
 }  // namespace sfc

@@ -31,13 +31,27 @@ double CpuSeconds(clockid_t clock) {
 
 }  // namespace
 
+absl::Status ParseBudgetSpent(double seconds) {
+  return absl::ResourceExhaustedError(absl::StrFormat(
+      "reading the model took more than %g s of CPU and was stopped (model_parse_seconds: "
+      "--model-parse-seconds of sample, inspect, sample-many or the server, whose budget for a "
+      "CAD file is at most 2 s + --model-parse-seconds-per-mib a MiB of it): simplify the model "
+      "(fewer or simpler faces), or raise the limit",
+      seconds));
+}
+
 LoadedModels::LoadedModels(const LoadedModelsOptions& options)
     : options_([&options] {
         LoadedModelsOptions o = options;
         o.parse_threads = std::max(0, o.parse_threads);
         return o;
       }()) {
-  for (int i = 0; i < options_.parse_threads; ++i) threads_.emplace_back([this] { ParserLoop(); });
+  // A thread for each slot, and one for each long parse that left its slot.
+  const int threads = options_.parse_threads +
+                      (options_.parse_threads > 0 && options_.fresh_seconds > 0
+                           ? std::max(0, options_.max_long_parses)
+                           : 0);
+  for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { ParserLoop(); });
 }
 
 LoadedModels::~LoadedModels() {
@@ -81,10 +95,22 @@ absl::StatusOr<std::shared_ptr<const void>> LoadedModels::GetAny(
       parse_here = options_.parse_threads == 0;
       if (!parse_here &&
           queue_.size() >= static_cast<size_t>(std::max(0, options_.max_queued_parses))) {
-        ++stats_.parses_rejected;
-        return absl::ResourceExhaustedError(absl::StrFormat(
-            "%d model parses are already waiting for a parser (max_queued_parses); retry later",
-            queue_.size()));
+        // A full queue takes a smaller parse in place of its largest.
+        auto largest = std::max_element(
+            queue_.begin(), queue_.end(),
+            [](const auto& a, const auto& b) { return a->working_bytes < b->working_bytes; });
+        if (largest == queue_.end() || (*largest)->working_bytes <= working_bytes) {
+          ++stats_.parses_rejected;
+          ++stats_.parses_busy;
+          return absl::ResourceExhaustedError(absl::StrFormat(
+              "%d model parses are already waiting for a parser (max_queued_parses); retry later",
+              queue_.size()));
+        }
+        const std::shared_ptr<Job> pushed = *largest;
+        queue_.erase(largest);
+        DropQueued(pushed, absl::ResourceExhaustedError(
+                               "the server's model parse queue is full and smaller models took "
+                               "this one's place (max_queued_parses); retry later"));
       }
       job = std::make_shared<Job>();
       job->key = key;
@@ -93,6 +119,7 @@ absl::StatusOr<std::shared_ptr<const void>> LoadedModels::GetAny(
       pending_.emplace(key, job);
       if (parse_here) {  // started at once, as ParserLoop starts a queued one
         ++stats_.parsing;
+        job->started = true;
         working_bytes_ += working_bytes;
       } else {
         queue_.push_back(job);
@@ -102,6 +129,7 @@ absl::StatusOr<std::shared_ptr<const void>> LoadedModels::GetAny(
   }
   if (parse_here) RunJob(job, caller);
   // Wait in short steps, asking the caller between them.
+  const Clock::time_point queued_at = Clock::now();
   while (true) {
     absl::Status wanted = caller ? caller() : absl::OkStatus();
     absl::MutexLock lock(&mu_);
@@ -111,8 +139,17 @@ absl::StatusOr<std::shared_ptr<const void>> LoadedModels::GetAny(
       if (!job->result.ok()) return wanted.ok() ? job->result.status() : wanted;
       return job->result->model;
     }
+    if (wanted.ok() && !job->started && options_.max_queue_wait_seconds > 0 &&
+        std::chrono::duration<double>(Clock::now() - queued_at).count() >
+            options_.max_queue_wait_seconds) {
+      ++stats_.parses_busy;
+      wanted = absl::ResourceExhaustedError(absl::StrFormat(
+          "this model waited %g s for a parser while the server parsed others "
+          "(max_queue_wait_seconds); retry later",
+          options_.max_queue_wait_seconds));
+    }
     if (!wanted.ok()) {
-      --job->waiters;
+      --job->waiters;  // a queued job nobody waits for is dropped when its turn comes
       return wanted;
     }
     mu_.AwaitWithTimeout(absl::Condition(&job->done), absl::Milliseconds(50));
@@ -127,11 +164,15 @@ void LoadedModels::ParserLoop() {
     std::shared_ptr<Job> job;
     {
       absl::MutexLock lock(&mu_);
-      // The next parse (NextJob) starts when its working memory fits beside
-      // the running parses' (or nothing runs).
+      // The next parse (NextJob) starts when a slot is free (long parses hold
+      // none) and its working memory fits beside the running parses' (or
+      // nothing runs).
       auto ready = [this]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
         if (stopping_) return true;
         if (queue_.empty()) return false;
+        if (stats_.parsing - stats_.long_parses >= static_cast<uint64_t>(options_.parse_threads)) {
+          return false;
+        }
         return working_bytes_ == 0 || options_.working_budget_bytes == 0 ||
                working_bytes_ + queue_[NextJob()]->working_bytes <= options_.working_budget_bytes;
       };
@@ -158,6 +199,7 @@ void LoadedModels::ParserLoop() {
         continue;
       }
       ++stats_.parsing;
+      job->started = true;
       working_bytes_ += job->working_bytes;
     }
     RunJob(job, nullptr);
@@ -171,6 +213,9 @@ void LoadedModels::RunJob(const std::shared_ptr<Job>& job,
   clockid_t cpu_clock = CLOCK_THREAD_CPUTIME_ID;
   if (pthread_getcpuclockid(pthread_self(), &cpu_clock) != 0) cpu_clock = CLOCK_THREAD_CPUTIME_ID;
   const double cpu_start = CpuSeconds(cpu_clock);
+  const Clock::time_point wall_start = Clock::now();
+  // Slots exist for parses on this object's threads only.
+  const bool may_turn_long = options_.parse_threads > 0 && options_.fresh_seconds > 0;
   std::atomic<uint64_t> calls{0};
   absl::Mutex stop_mu;
   absl::Status stop;  // sticky once set; guarded by stop_mu
@@ -187,6 +232,19 @@ void LoadedModels::RunJob(const std::shared_ptr<Job>& job,
         now = absl::UnavailableError("the server is shutting down");
       } else if (job->waiters == 0) {
         now = absl::CancelledError("no request waits for this model any more");
+      } else if (may_turn_long && !job->long_parse &&
+                 std::chrono::duration<double>(Clock::now() - wall_start).count() >
+                     options_.fresh_seconds) {
+        if (stats_.long_parses < static_cast<uint64_t>(std::max(0, options_.max_long_parses))) {
+          job->long_parse = true;  // its slot is free: the next parse may start
+          ++stats_.long_parses;
+        } else {
+          job->busy = true;
+          now = absl::ResourceExhaustedError(absl::StrFormat(
+              "parsing this model takes more than %g s and the server is already parsing %d "
+              "such models (max_long_parses); it was stopped: retry later",
+              options_.fresh_seconds, options_.max_long_parses));
+        }
       }
     }
     // Inline, the parsing request's own check too (its deadline, its client).
@@ -197,11 +255,7 @@ void LoadedModels::RunJob(const std::shared_ptr<Job>& job,
     }
     const double spent = CpuSeconds(cpu_clock) - cpu_start;
     if (now.ok() && options_.parse_seconds > 0 && spent > options_.parse_seconds) {
-      now = absl::ResourceExhaustedError(absl::StrFormat(
-          "parsing the model took more than %g s of CPU (model_parse_seconds: the server's or "
-          "sample-many's --model-parse-seconds) and was stopped: simplify the model (fewer or "
-          "simpler faces), or raise the limit",
-          options_.parse_seconds));
+      now = ParseBudgetSpent(options_.parse_seconds);
     }
     absl::MutexLock l(&stop_mu);
     if (stop.ok()) stop = now;
@@ -223,11 +277,15 @@ void LoadedModels::RunJob(const std::shared_ptr<Job>& job,
   }
   absl::MutexLock lock(&mu_);
   --stats_.parsing;
+  if (job->long_parse) --stats_.long_parses;
   working_bytes_ -= job->working_bytes;
   ++stats_.parses;
   pending_.erase(job->key);
   if (result.ok()) {
     Keep(job->key, *result);
+  } else if (job->busy) {
+    ++stats_.parses_stopped;  // the server's load, not the model: the next request parses again
+    ++stats_.parses_busy;
   } else if (result.status().code() == absl::StatusCode::kCancelled ||
              result.status().code() == absl::StatusCode::kUnavailable) {
     ++stats_.parses_stopped;  // not the model's fault: the next request parses again
@@ -238,6 +296,13 @@ void LoadedModels::RunJob(const std::shared_ptr<Job>& job,
   }
   job->result = std::move(result);
   job->done = true;
+}
+
+void LoadedModels::DropQueued(const std::shared_ptr<Job>& job, absl::Status status) {
+  job->result = std::move(status);
+  job->done = true;
+  pending_.erase(job->key);
+  ++stats_.parses_busy;
 }
 
 size_t LoadedModels::NextJob() const {

@@ -9,10 +9,22 @@
 //    a CPU budget (thread CPU time, parse_seconds) that its ParseControl
 //    check reports when spent; a parse nobody waits for any more is told to
 //    stop too. The parsers poll the check (CAD: OpenCASCADE's user break).
+//  - Short parses first (issue 37: one hostile file held CAD for every
+//    client): a parse holds one of the parse_threads slots only for its first
+//    fresh_seconds; a parse still running then is "long" and leaves its slot
+//    to the parses waiting, runs on at the lowest priority (the CAD check
+//    process yields its CPU after that long, kinds/cad/model_check.h), and at
+//    most max_long_parses run so at once: one more is stopped with
+//    RESOURCE_EXHAUSTED (the server is busy, not the model at fault: not
+//    remembered). So a small model waits at most fresh_seconds for a slot
+//    and then gets the CPU before every long parse, whatever the other
+//    clients send or how long they stay.
 //  - Smallest first: of the parses waiting, the one with the least working
 //    memory (which grows with the file's size) starts next, so a small
 //    model does not wait behind large or hostile ones; a parse passed over
-//    kMaxPassedOver times starts next whatever its size.
+//    kMaxPassedOver times starts next whatever its size. A full queue takes
+//    a smaller parse in place of its largest (which is told so), and a
+//    request leaves a queue it waited in for max_queue_wait_seconds.
 //  - One parse per key: requests for a key being parsed wait for that parse.
 //  - A failed parse is remembered per key (a model's format + content hash
 //    + whatever changes the parse) for failure_ttl_seconds: the same hostile
@@ -56,6 +68,12 @@ struct LoadedModelsOptions {
   // before; working_budget_bytes then bounds each parse alone, not their sum.
   int parse_threads = 1;
   int max_queued_parses = 8;                    // parses waiting for a thread, >= 0
+  // How long (wall-clock) a parse holds its slot; past it the parse is long
+  // (see above). 0: a parse holds its slot to the end.
+  double fresh_seconds = 0;
+  int max_long_parses = 4;  // long parses running at once, >= 0
+  // Longest a request waits for its parse to start; 0 = no limit.
+  double max_queue_wait_seconds = 0;
   // CPU seconds one parse may take (its thread's CPU time); 0 = no budget.
   double parse_seconds = 0;
   double failure_ttl_seconds = 60;  // how long a failed parse is remembered, >= 0
@@ -74,9 +92,15 @@ struct LoadedModelsStats {
   uint64_t parses_rejected = 0;  // misses turned away: queue full
   uint64_t evictions = 0;
   uint64_t parsing = 0;          // running now
+  uint64_t long_parses = 0;      // running now past fresh_seconds (of parsing)
+  uint64_t parses_busy = 0;      // stopped or turned away because the server was busy
   uint64_t queued = 0;           // waiting for a thread now
   uint64_t working_bytes = 0;    // working memory reserved by running parses, now
 };
+
+// The status of a parse stopped at its CPU budget of `seconds`
+// (RESOURCE_EXHAUSTED): what it spent, which flags set the budget, what to do.
+absl::Status ParseBudgetSpent(double seconds);
 
 // What a parse may ask while it runs: OK to go on, or why to stop
 // (CANCELLED: nobody waits; RESOURCE_EXHAUSTED: CPU budget spent;
@@ -126,6 +150,9 @@ class LoadedModels {
     uint64_t working_bytes = 0;
     int passed_over = 0;  // guarded by mu_: smaller parses started before it
     int waiters = 0;  // guarded by mu_
+    bool started = false;  // guarded by mu_
+    bool long_parse = false;  // guarded by mu_: past fresh_seconds, counted in long_parses
+    bool busy = false;  // guarded by mu_: stopped for load, not for the model: not remembered
     bool done = false;
     absl::StatusOr<Parsed> result;
   };
@@ -160,6 +187,9 @@ class LoadedModels {
   std::deque<std::shared_ptr<Job>> queue_ ABSL_GUARDED_BY(mu_);
   std::unordered_map<std::string, Failure> failures_ ABSL_GUARDED_BY(mu_);
   uint64_t working_bytes_ ABSL_GUARDED_BY(mu_) = 0;  // reserved by running parses
+  // Ends a queued job that will not run: its waiters get `status`.
+  void DropQueued(const std::shared_ptr<Job>& job, absl::Status status)
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   bool stopping_ ABSL_GUARDED_BY(mu_) = false;
   LoadedModelsStats stats_ ABSL_GUARDED_BY(mu_);  // models and bytes: see kept_
   std::vector<std::thread> threads_;  // started in the constructor, joined in the destructor

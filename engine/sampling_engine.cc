@@ -35,6 +35,9 @@ SamplingEngine::SamplingEngine(const SurfaceKinds& kinds, EngineLimits limits, T
         o.max_queued_parses = limits.max_queued_parses;
         o.parse_seconds = limits.model_parse_seconds;
         o.failure_ttl_seconds = limits.parse_failure_ttl_seconds;
+        o.fresh_seconds = limits.model_parse_fresh_seconds;
+        o.max_long_parses = limits.max_long_parses;
+        o.max_queue_wait_seconds = limits.max_parse_queue_seconds;
         return o;
       }())) {}
 

@@ -71,6 +71,12 @@ grpc::Status SamplerService::GetCacheStats(grpc::ServerContext* context,
     response->set_max_queued_parses(po.max_queued_parses);
     response->set_parse_memory_bytes(po.working_budget_bytes);
     response->set_parse_memory_reserved(p.working_bytes);
+    response->set_model_parse_fresh_seconds(po.fresh_seconds);
+    response->set_max_long_parses(po.max_long_parses);
+    response->set_max_parse_queue_seconds(po.max_queue_wait_seconds);
+    response->set_model_parse_seconds_per_mib(options_.limits.model_parse_seconds_per_mib);
+    response->set_model_parses_long(p.long_parses);
+    response->set_model_parses_busy(p.parses_busy);
   }
   metrics_->CountRequest("GetCacheStats", status.error_code());
   return status;

@@ -25,6 +25,15 @@ struct ServerOptions {
     // and the parses running at once a memory budget (a 60 MB STEP file).
     l.model_parse_seconds = 120;
     l.parse_memory_bytes = uint64_t{2} << 30;
+    // One client's slow or hostile files must not hold CAD for the others
+    // (issue 37; bench/parse_isolation.py measures it): two slots, each held
+    // for half a second; the CPU budget grows with the file (10 s a MiB,
+    // about 10x what real STEP files take).
+    l.model_parse_threads = 2;
+    l.model_parse_fresh_seconds = 0.5;
+    l.max_long_parses = 4;
+    l.max_parse_queue_seconds = 30;
+    l.model_parse_seconds_per_mib = 10;
     return l;
   }();
   uint64_t cache_bytes = uint64_t{1} << 30;    // tree cache budget, 1 GiB

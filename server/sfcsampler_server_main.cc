@@ -103,6 +103,26 @@ int main(int argc, char** argv) {
                  "failed parse is remembered for --failure-ttl seconds")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--model-parse-seconds-per-mib", o.limits.model_parse_seconds_per_mib,
+                 "a CAD file's CPU budget is 2 s plus this much a MiB of file, at most "
+                 "--model-parse-seconds (0: always --model-parse-seconds)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--model-parse-fresh-seconds", o.limits.model_parse_fresh_seconds,
+                 "how long a parse holds one of the --model-parse-threads slots; past it the parse "
+                 "leaves its slot to the parses waiting and yields the CPU to them (0: it keeps "
+                 "its slot to the end)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--max-long-parses", o.limits.max_long_parses,
+                 "parses running past --model-parse-fresh-seconds at once; one more is stopped "
+                 "with RESOURCE_EXHAUSTED (retry later)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 64));
+  app.add_option("--max-parse-queue-seconds", o.limits.max_parse_queue_seconds,
+                 "longest a request waits for its model's parse to start (0: no limit)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--max-concurrent-streams", o.max_concurrent_streams, "Sample streams at once")
       ->capture_default_str();
   app.add_option("--max-batch-size", o.max_batch_size, "most samples per message")->capture_default_str();

@@ -282,5 +282,88 @@ TEST(LoadedModels, SmallParsesStartFirstAndNoneIsPassedOverForGood) {
   EXPECT_EQ(order.front().rfind("small", 0), 0u);
 }
 
+// Issue 37: a parse past fresh_seconds leaves its slot, so a small model
+// parses while a hostile one runs on; past max_long_parses a long parse is
+// stopped as the server's load (not remembered: the next request parses).
+TEST(LoadedModels, ALongParseLeavesItsSlotToTheParsesWaiting) {
+  LoadedModelsOptions o;
+  o.parse_threads = 1;
+  o.fresh_seconds = 0.05;
+  o.max_long_parses = 1;
+  LoadedModels loaded(o);
+  std::atomic<bool> started{false}, other{false}, leave{false};
+  auto until_leave = [&]() -> absl::Status {
+    return leave ? absl::CancelledError("done") : absl::OkStatus();
+  };
+  std::thread hog([&] { loaded.Get<int>("hog", Spinning(&started), until_leave, 1).IgnoreError(); });
+  while (loaded.stats().long_parses < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  std::atomic<int> parses{0};
+  EXPECT_TRUE(loaded.Get<int>("small", Returning(1, &parses), nullptr, 1).ok());
+  EXPECT_EQ(loaded.stats().parsing, 1u) << "the hog should still run";
+
+  // A second long parse is one past max_long_parses: stopped, with why.
+  auto second = loaded.Get<int>("second", Spinning(&other), nullptr, 1);
+  EXPECT_EQ(second.status().code(), absl::StatusCode::kResourceExhausted) << second.status();
+  EXPECT_NE(second.status().message().find("max_long_parses"), std::string::npos);
+  EXPECT_GE(loaded.stats().parses_busy, 1u);
+  EXPECT_TRUE(loaded.Get<int>("second", Returning(1, &parses), nullptr, 1).ok()) << "remembered";
+  EXPECT_EQ(parses.load(), 2);
+  leave = true;
+  hog.join();
+}
+
+// Issue 37: a full queue takes a smaller parse in place of its largest (a
+// flood of large hostile files does not turn small models away), and a
+// request leaves a queue it waited in for max_queue_wait_seconds.
+TEST(LoadedModels, AFullQueueTakesASmallerParseInPlaceOfItsLargest) {
+  LoadedModelsOptions o;
+  o.parse_threads = 1;
+  o.max_queued_parses = 1;
+  LoadedModels loaded(o);
+  std::atomic<bool> started{false}, leave{false};
+  auto until_leave = [&]() -> absl::Status {
+    return leave ? absl::CancelledError("done") : absl::OkStatus();
+  };
+  std::thread busy([&] { loaded.Get<int>("busy", Spinning(&started), until_leave, 1).IgnoreError(); });
+  while (!started) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  std::atomic<int> parses{0};
+  absl::Status large_status;
+  std::thread large([&] { large_status = loaded.Get<int>("large", Returning(1, &parses), nullptr, 1000).status(); });
+  while (loaded.stats().queued < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  std::thread small([&] { EXPECT_TRUE(loaded.Get<int>("small", Returning(1, &parses), nullptr, 10).ok()); });
+  large.join();
+  EXPECT_EQ(large_status.code(), absl::StatusCode::kResourceExhausted) << large_status;
+  EXPECT_NE(large_status.message().find("took this one's place"), std::string::npos) << large_status;
+  // A parse no smaller than the queued one is turned away as before.
+  auto refused = loaded.Get<int>("larger", Returning(1, &parses), nullptr, 10);
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_NE(refused.status().message().find("max_queued_parses"), std::string::npos);
+  leave = true;
+  busy.join();
+  small.join();
+  EXPECT_EQ(parses.load(), 1);
+}
+
+TEST(LoadedModels, ARequestLeavesAQueueItWaitedInTooLong) {
+  LoadedModelsOptions o;
+  o.parse_threads = 1;
+  o.max_queue_wait_seconds = 0.05;
+  LoadedModels loaded(o);
+  std::atomic<bool> started{false}, leave{false};
+  auto until_leave = [&]() -> absl::Status {
+    return leave ? absl::CancelledError("done") : absl::OkStatus();
+  };
+  std::thread busy([&] { loaded.Get<int>("busy", Spinning(&started), until_leave, 1).IgnoreError(); });
+  while (!started) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  std::atomic<int> parses{0};
+  auto waited = loaded.Get<int>("waits", Returning(1, &parses), nullptr, 1);
+  EXPECT_EQ(waited.status().code(), absl::StatusCode::kResourceExhausted) << waited.status();
+  EXPECT_NE(waited.status().message().find("max_queue_wait_seconds"), std::string::npos);
+  leave = true;
+  busy.join();
+  EXPECT_EQ(parses.load(), 0) << "a parse nobody waits for any more ran";
+  EXPECT_TRUE(loaded.Get<int>("waits", Returning(1, &parses), nullptr, 1).ok());
+}
+
 }  // namespace
 }  // namespace sfc

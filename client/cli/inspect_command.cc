@@ -9,13 +9,16 @@
 
 #include "client/cli/commands.h"
 #include "client/cli/exit_status.h"
+#include "client/cli/model_read_flags.h"
 #include "client/cli/sample_source.h"
 
 namespace sfc {
 namespace {
 
-int RunInspect(const std::vector<std::string>& specs) {
-  const std::unique_ptr<SampleSource> source = OpenSampleSource(ConnectionFlags{});  // in process
+int RunInspect(const std::vector<std::string>& specs, const ModelReadFlags& read) {
+  SampleSourceOptions options;
+  if (absl::Status applied = ApplyModelReadFlags(read, &options); !applied.ok()) return Fail(applied);
+  const std::unique_ptr<SampleSource> source = OpenSampleSource(ConnectionFlags{}, options);  // in process
   for (const std::string& spec : specs) {
     auto table = source->DescribeModel(spec);
     if (!table.ok()) return Fail(table.status());
@@ -28,12 +31,14 @@ int RunInspect(const std::vector<std::string>& specs) {
 
 Command AddInspectCommand(CLI::App& app) {
   auto specs = std::make_shared<std::vector<std::string>>();
+  auto read = std::make_shared<ModelReadFlags>();
   CLI::App* inspect = app.add_subcommand(
       "inspect",
       "list a CAD model's faces (index as in the face column, type, trimmed area, "
       "parameter box, orientation, trim) and the order the curve visits them");
   inspect->add_option("models", *specs, "step:FILE, iges:FILE or nurbs:FILE")->required();
-  return {inspect, [specs] { return RunInspect(*specs); }};
+  AddModelReadFlags(inspect, read.get());
+  return {inspect, [specs, read] { return RunInspect(*specs, *read); }};
 }
 
 }  // namespace sfc

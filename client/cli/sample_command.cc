@@ -11,6 +11,7 @@
 #include "client/cli/commands.h"
 #include "client/cli/connection_flags.h"
 #include "client/cli/exit_status.h"
+#include "client/cli/model_read_flags.h"
 #include "request/request_flags.h"
 #include "client/cli/sample_source.h"
 #include "client/sample_writer.h"
@@ -28,6 +29,7 @@ struct SampleFlags {
   std::vector<std::string> columns;  // --columns (empty: every column)
   Verbosity verbosity;
   ConnectionFlags connection;
+  ModelReadFlags model_read;
 };
 
 absl::StatusOr<OutputFormat> ParseFormat(const std::string& format, bool ascii) {
@@ -61,6 +63,9 @@ int RunSample(const SampleFlags& flags) {
   SampleSourceOptions options;
   options.batch_size = flags.batch_size;
   options.precision = *precision;
+  if (absl::Status read = ApplyModelReadFlags(flags.model_read, &options); !read.ok()) {
+    return Fail(read);
+  }
   const std::unique_ptr<SampleSource> source = OpenSampleSource(flags.connection, options);
   std::unique_ptr<SampleWriter> writer;
   Progress progress(!flags.verbosity.quiet);
@@ -128,6 +133,7 @@ Command AddSampleCommand(CLI::App& app) {
   sample->add_flag("--no-warnings", flags->verbosity.no_warnings,
                    "do not print the depth-cap warnings");
   AddConnectionFlags(sample, &flags->connection);
+  AddModelReadFlags(sample, &flags->model_read);
   return {sample, [flags] { return RunSample(*flags); }};
 }
 

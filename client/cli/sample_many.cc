@@ -20,7 +20,6 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/strip.h"
 #include "base/status_macros.h"
-#include "base/subprocess.h"
 #include "client/cli/commands.h"
 #include "client/cli/connection_flags.h"
 #include "client/cli/progress.h"
@@ -300,16 +299,7 @@ Command AddSampleManyCommand(CLI::App& app) {
   cmd->add_option("--manifest", f->manifest,
                   "also write a TSV: name, sha256, seed, samples, output, error (one row per model)");
   cmd->add_flag("--quiet,-q", f->quiet, "no progress bar and no summary (failures still print)");
-  cmd->add_option("--model-check-program", f->model_check_program,
-                  "in process: read each CAD file in this program, a process of its own, so one "
-                  "that crashes or loops the CAD kernel fails alone (auto = sfcsampler-model-check "
-                  "installed with this program, if any; none = in this process)")
-      ->capture_default_str();
-  cmd->add_option("--model-parse-seconds", f->model_parse_seconds,
-                  "in process: CPU seconds one model's parse may take (a CAD file's check "
-                  "program is stopped at this limit)")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+  AddModelReadFlags(cmd, &f->model_read);
   // With --server each model is uploaded once, only if the server lacks its bytes.
   AddConnectionFlags(cmd, &f->connection);
   // The tree and set flags of `sample`, the same for every model (not --surface).
@@ -388,13 +378,9 @@ int RunSampleMany(const SampleManyFlags& flags) {
   options.precision = job.precision;
   // Models run side by side; one model alone may use up to four threads.
   options.generation_threads = jobs > 1 ? 1 : 0;
-  const absl::StatusOr<std::string> check_program =
-      ResolveProgramFlag(flags.model_check_program, "sfcsampler-model-check");
-  if (!check_program.ok()) {
-    return Usage(absl::StrFormat("--model-check-program: %s", check_program.status().message()));
+  if (absl::Status read = ApplyModelReadFlags(flags.model_read, &options); !read.ok()) {
+    return Usage(std::string(read.message()));
   }
-  options.model_check_program = *check_program;
-  options.model_parse_seconds = flags.model_parse_seconds;
   const std::unique_ptr<SampleSource> source = OpenSampleSource(flags.connection, options);
   if (auto connected = source->Connect(); !connected.ok()) return Usage(std::string(connected.message()));
   job.source = source.get();

@@ -29,6 +29,7 @@
 
 #include "CLI/CLI.hpp"
 #include "client/cli/connection_flags.h"
+#include "client/cli/model_read_flags.h"
 #include "request/request_flags.h"
 
 namespace sfc {
@@ -43,13 +44,10 @@ struct SampleManyFlags {
   int jobs = 0;                 // 0: the hardware threads, at most 8
   std::string manifest;         // a TSV of every model's outcome, or ""
   bool quiet = false;
-  // In process, CAD files are read by this program, each in a process of its
-  // own with model_parse_seconds of CPU (so a file that crashes or loops the
-  // kernel, or leaves it broken for the next, fails alone): "auto" =
-  // sfcsampler-model-check installed with this program, else in process;
-  // "none" = in process; or a path.
-  std::string model_check_program = "auto";
-  double model_parse_seconds = 300;
+  // In process, CAD files are read each in a process of its own (so a file
+  // that crashes or loops the kernel, or leaves it broken for the next,
+  // fails alone).
+  ModelReadFlags model_read;
   ConnectionFlags connection;   // --server etc.; no --server = in process
   RequestFlags request;         // every model's request but the surface and seed
 };

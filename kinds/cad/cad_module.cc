@@ -49,7 +49,8 @@ absl::StatusOr<std::shared_ptr<const CadParse>> LoadCad(const StoredModel& model
   const uint64_t working_bytes = (uint64_t{1} << 20) + 30 * model.bytes->size();
   ModelCheckLimits check_limits;
   check_limits.program = context.limits->model_check_program;
-  check_limits.cpu_seconds = context.limits->model_parse_seconds;
+  check_limits.cpu_seconds = context.limits->ParseSecondsFor(model.bytes->size());
+  check_limits.yield_seconds = context.limits->model_parse_fresh_seconds;
   // The check process's address space. Measured (RLIMIT_AS given to
   // sfcsampler-model-check): the 22 KB box reads within 100 MiB; the 10 MB
   // STEP of 400 boxes (working_bytes 301 MB) is out of memory at 300 MiB

@@ -11,6 +11,7 @@
 #include "absl/strings/strip.h"
 #include "base/echo.h"
 #include "base/subprocess.h"
+#include "engine/loaded_models.h"
 
 namespace sfc {
 
@@ -21,7 +22,7 @@ absl::StatusOr<std::string> ReadModelInSubprocess(const ModelCheckLimits& limits
   const std::vector<std::string> argv = {
       limits.program, std::string(ModelFormatName(format)), name,
       absl::StrFormat("%d", static_cast<uint64_t>(limits.cpu_seconds + 0.999)),
-      absl::StrFormat("%d", limits.memory_bytes)};
+      absl::StrFormat("%d", limits.memory_bytes), absl::StrFormat("%g", limits.yield_seconds)};
   // The answer's size: the BRep of a model is about the size of its file,
   // at most a few times it.
   const size_t max_output = std::max<size_t>(size_t{16} << 20, 8 * bytes.size());
@@ -56,11 +57,7 @@ absl::StatusOr<std::string> ReadModelInSubprocess(const ModelCheckLimits& limits
         wall_seconds));
   }
   if (!run->exited && run->signal == SIGXCPU) {
-    return absl::ResourceExhaustedError(absl::StrFormat(
-        "reading the model took more than %g s of CPU (model_parse_seconds: the server's or "
-        "sample-many's --model-parse-seconds) and was stopped: simplify the model (fewer or "
-        "simpler faces), or raise the limit",
-        limits.cpu_seconds));
+    return ParseBudgetSpent(limits.cpu_seconds);
   }
   if (!run->exited) {
     return absl::InvalidArgumentError(absl::StrFormat(

@@ -31,6 +31,8 @@ struct ModelCheckLimits {
   std::string program;        // path of sfcsampler-model-check
   double cpu_seconds = 0;     // of the check process; 0 = none
   uint64_t memory_bytes = 0;  // its address space; 0 = none
+  // CPU seconds after which it runs in the idle scheduling class; 0 = never.
+  double yield_seconds = 0;
 };
 
 // The model's shape as binary BRep, read in the check process. Else the

@@ -1,9 +1,12 @@
-// sfcsampler-model-check FORMAT NAME CPU_SECONDS MEMORY_BYTES < FILE
+// sfcsampler-model-check FORMAT NAME CPU_SECONDS MEMORY_BYTES YIELD_SECONDS < FILE
 //
 // Reads a CAD model (step, iges or nurbs) from standard input with
 // cad::ReadToBrep (every check cad::Load makes), in a process of its own with
 // the given limits (0: none) on its CPU time (RLIMIT_CPU; SIGXCPU past it)
-// and address space (RLIMIT_AS). It dies with its parent. Prints one line
+// and address space (RLIMIT_AS). After YIELD_SECONDS of CPU (0: never) it
+// drops to the idle scheduling class (SCHED_IDLE): a long read yields the
+// CPU to every other process, the short reads of other clients' models
+// first (engine/loaded_models.h). It dies with its parent. Prints one line
 // and exits:
 //   0  "ok BYTES", then BYTES bytes: the model read, as cad::ReadToBrep's
 //      binary BRep, which the server loads with cad::LoadBrep;
@@ -11,9 +14,11 @@
 //   2  "usage ..."                  bad arguments.
 // A crash or a loop inside OpenCASCADE ends this process, not the server
 // (kinds/cad/model_check.h runs it; docs/MODELS.md says why).
+#include <sched.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/resource.h>
+#include <sys/time.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -47,10 +52,29 @@ int Print(int code, std::string line) {
 
 }  // namespace
 
+// SIGPROF, once YIELD_SECONDS of CPU are spent: this thread, the reader's,
+// to the idle class. (sched_setscheduler is a plain system call.)
+void YieldTheCpu(int) {
+  sched_param param{};
+  sched_setscheduler(0, SCHED_IDLE, &param);
+}
+
 int main(int argc, char** argv) {
   uint64_t cpu_seconds = 0, memory_bytes = 0;
-  if (argc != 5 || !absl::SimpleAtoi(argv[3], &cpu_seconds) || !absl::SimpleAtoi(argv[4], &memory_bytes)) {
-    return Print(2, "usage: sfcsampler-model-check FORMAT NAME CPU_SECONDS MEMORY_BYTES < FILE");
+  double yield_seconds = 0;
+  if (argc != 6 || !absl::SimpleAtoi(argv[3], &cpu_seconds) ||
+      !absl::SimpleAtoi(argv[4], &memory_bytes) || !absl::SimpleAtod(argv[5], &yield_seconds) ||
+      !(yield_seconds >= 0)) {
+    return Print(2, "usage: sfcsampler-model-check FORMAT NAME CPU_SECONDS MEMORY_BYTES "
+                    "YIELD_SECONDS < FILE");
+  }
+  if (yield_seconds > 0) {
+    signal(SIGPROF, YieldTheCpu);
+    const auto micros = static_cast<long>(yield_seconds * 1e6);
+    itimerval timer{};
+    timer.it_value.tv_sec = micros / 1000000;
+    timer.it_value.tv_usec = micros % 1000000;
+    setitimer(ITIMER_PROF, &timer, nullptr);
   }
   // Gone with the server: a parse nobody can read the answer of stops. (No
   // test of getppid() for a parent gone already: in a container the server
