@@ -56,7 +56,8 @@ absl::StatusOr<SamplingEngine::SpecKind> SamplingEngine::KindOf(const std::strin
   if (!out.kind) {
     return absl::UnimplementedError(absl::StrFormat(
         "this build of sfcsampler has no kind of surface for %s specs (it was configured "
-        "without it: SFC_BUILD_CAD=OFF or SFC_BUILD_MESH=OFF)",
+        "without it: SFC_BUILD_CAD=OFF or SFC_BUILD_MESH=OFF, as tools/sample.sh builds on a "
+        "fresh clone); bash tools/build.sh builds every kind",
         model ? absl::StrFormat("%s:", ModelFormatName(model->format)) : "formula"));
   }
   if (!model) return out;

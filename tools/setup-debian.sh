@@ -1,22 +1,31 @@
 #!/usr/bin/env bash
-# Installs everything sfcsampler needs from Debian bookworm's packages.
+# Installs what sfcsampler needs from Debian bookworm's packages.
+#   bash tools/setup-debian.sh           everything: the server, tests, Python, CAD, meshes
+#   bash tools/setup-debian.sh sample    only what the CLI needs to sample formula surfaces
+#                                        in process (tools/sample.sh, the README's first command)
 # Skips apt when every package is already installed. Safe to run again.
 set -euo pipefail
+mode="${1:-all}"
 
-packages=(
+# The CLI with the formula kind: compiler, core maths, specs, flags, the
+# client library it links (gRPC, Protobuf, OpenSSL) and its pictures.
+sample_packages=(
   build-essential cmake ninja-build pkg-config   # compiler and build
   libabsl-dev                                    # Status, StatusOr, strings, Mutex (core)
   libsleef-dev                                   # sin, cos, pow with the same bits on every x86-64 machine and
                                                  # vector width (core/vector_math.h): glibc picks FMA variants
   libmuparser-dev                                # user-defined surface and density expressions
   libcli11-dev                                   # command-line flags
+  libgrpc++-dev libgrpc-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler  # the CLI's --server
+  libssl-dev                                     # SHA-256 of model files, constant-time token comparison
+  libcairo2-dev libpng-dev                       # `render` and `eval` pictures
+)
+packages=(
+  "${sample_packages[@]}"
   libgtest-dev libgmock-dev                      # tests
   libbenchmark-dev                               # benchmarks
-  libgrpc++-dev libgrpc-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler  # service
   libspdlog-dev                                  # server logs
   prometheus-cpp-dev                             # server metrics
-  libcairo2-dev libpng-dev                       # pictures and plots
-  libssl-dev                                     # constant-time token comparison (CRYPTO_memcmp)
   libtinyobjloader-dev                           # OBJ meshes (mesh/): parses from a string, keeps vn
   libcgal-dev                                    # PLY meshes (mesh/): header-only reader from a stream, ASCII and
                                                  # binary, keeps every named vertex property (per-vertex weights);
@@ -40,6 +49,11 @@ packages=(
   libtbb-dev                                     # OpenCASCADE's CMake targets link libtbb.so
 )
 
+case "$mode" in
+  all) ;;
+  sample) packages=("${sample_packages[@]}") ;;
+  *) echo "usage: $0 [all|sample]" >&2; exit 2 ;;
+esac
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
