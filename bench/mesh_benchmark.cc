@@ -5,7 +5,7 @@
 //    binary PLY file: cold (read + parse + tree + samples) and warm (samples
 //    from the built tree), for the uniform density and |H| + 0.1. Each figure
 //    is the median of `repeats` runs.
-// 2. Quality: the spherical-triangle discrepancy (core/discrepancy.h, 128
+// 2. Quality: the spherical-triangle discrepancy (evaluation/discrepancy.h, 128
 //    random spherical triangles, points pushed radially to the unit sphere)
 //    for N = 2^l and 2^l + 2^(l-1), N = 64 .. 24576, ours against i.i.d.
 //    points on the same mesh, averaged over 4 seeds, with the least-squares

@@ -9,7 +9,7 @@
 # (SFCSAMPLER_VECTOR_PATH: scalar, sse2, avx) and must give the same hash.
 #
 # A changed hash means the same request now gives other samples: that needs
-# a new algorithm version (engine/sample_request.h), not a new pin.
+# a new algorithm version (request/sample_request.h), not a new pin.
 #   tests/pinned_bytes_test.sh CLI MAKE_CAD_FIXTURES PINS [--print]
 # --print writes the current hashes in the PINS format instead of checking.
 set -euo pipefail

@@ -67,7 +67,7 @@ PyRequest MakeRequest(std::string surface, std::string density, std::string curv
 }  // namespace
 
 void RegisterRequest(py::module_& m) {
-  // Defaults are the CLI's (client/cli/request_flags.h).
+  // Defaults are the CLI's (request/request_flags.h).
   const RequestFlags d;
   py::class_<PyRequest>(m, "Request", R"doc(
 A sampling request, parsed exactly as `sfcsampler sample` parses its flags

@@ -1,6 +1,6 @@
 // sfcsampler._core.Request: the keyword arguments of sfcsampler.sample() and
 // Client.sample(), parsed into an engine SampleRequest by the CLI's own
-// parser (client/cli/request_flags.h), so the same arguments mean the same
+// parser (request/request_flags.h), so the same arguments mean the same
 // request as the same `sfcsampler sample` flags. Immutable after
 // construction; thread-safe to read.
 #ifndef SFCSAMPLER_PYTHON_BINDINGS_REQUEST_H_

@@ -3,7 +3,7 @@ before the C++ parser (which reads them exactly as the CLI reads its flags)."""
 
 from sfcsampler import _core
 
-# The CLI's sample flags without dashes, '-' as '_' (client/cli/request_flags.h).
+# The CLI's sample flags without dashes, '-' as '_' (request/request_flags.h).
 KEYWORDS = ("surface", "density", "curve", "estimator", "tolerance", "depth_cap", "rho", "count", "seed",
             "sequence", "tree_count", "begin", "end", "shard", "region", "normals", "density_column",
             "curve_position", "face", "triangle")
