@@ -93,11 +93,13 @@ absl::StatusOr<SubprocessResult> RunSubprocess(const std::vector<std::string>& a
   for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
   pid_t pid = 0;
-  const int spawned = posix_spawn(&pid, argv[0].c_str(), &actions, &attributes, args.data(), environ);
+  const int spawned =
+      posix_spawn(&pid, argv[0].c_str(), &actions, &attributes, args.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attributes);
   if (spawned != 0) {
-    return absl::InternalError(absl::StrCat("cannot start ", argv[0], ": ", std::strerror(spawned)));
+    return absl::InternalError(
+        absl::StrCat("cannot start ", argv[0], ": ", std::strerror(spawned)));
   }
   ::close(out_write.fd);
   out_write.fd = -1;
@@ -137,7 +139,8 @@ std::string FindSiblingProgram(const std::string& name) {
   std::error_code error;
   const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
   if (error) return "";
-  for (const std::filesystem::path& dir : {self.parent_path(), self.parent_path().parent_path() / "server"}) {
+  for (const std::filesystem::path& dir :
+       {self.parent_path(), self.parent_path().parent_path() / "server"}) {
     const std::string path = (dir / name).string();
     if (access(path.c_str(), X_OK) == 0) return path;
   }

@@ -16,7 +16,9 @@ namespace {
 constexpr uint64_t kMillion = 1'000'000;
 
 std::shared_ptr<const Surface> Sphere() { return std::shared_ptr<const Surface>(MakeSphere(1)); }
-std::shared_ptr<const Density> Uniform() { return std::shared_ptr<const Density>(MakeUniformDensity()); }
+std::shared_ptr<const Density> Uniform() {
+  return std::shared_ptr<const Density>(MakeUniformDensity());
+}
 
 // Reads every sample of the cursor in batches of 64 Ki; returns the count.
 uint64_t Drain(SampleCursor& cursor, SampleBatch& batch) {
@@ -108,14 +110,19 @@ void BM_SampleFromBuiltTreeThreads(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * n);
   state.SetLabel("hilbert sphere, " + std::to_string(threads) + " threads");
 }
-BENCHMARK(BM_SampleFromBuiltTreeThreads)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SampleFromBuiltTreeThreads)
+    ->Arg(1)
+    ->Arg(2)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 
 // Bytes per leaf, measured from the tree's own arrays.
 void BM_BytesPerLeaf(benchmark::State& state) {
   auto surface = Sphere();
   auto density = Uniform();
   std::shared_ptr<const CurveTree> tree;
-  for (auto _ : state) tree = *CurveTree::Build(*surface, *density, {}, CurveTree::GradeFor(kMillion));
+  for (auto _ : state)
+    tree = *CurveTree::Build(*surface, *density, {}, CurveTree::GradeFor(kMillion));
   state.counters["bytes_per_leaf"] = static_cast<double>(tree->bytes()) / tree->leaf_count();
   state.counters["leaves"] = static_cast<double>(tree->leaf_count());
 }

@@ -38,14 +38,19 @@ int Run(uint64_t n) {
          // dA = 4 pi^2 r (R + r cos(2 pi v)) du dv
          const double r = 0.4;
          return 4 * kPi * kPi * r *
-                ((b - a) * ((d - c) + r * (std::sin(2 * kPi * d) - std::sin(2 * kPi * c)) / (2 * kPi)));
+                ((b - a) *
+                 ((d - c) + r * (std::sin(2 * kPi * d) - std::sin(2 * kPi * c)) / (2 * kPi)));
        }},
       {"plane", "expr:u+v", 1.0,
-       [](double a, double b, double c, double d) { return (b - a) * (d - c) * ((a + b) + (c + d)) / 2; }},
+       [](double a, double b, double c, double d) {
+         return (b - a) * (d - c) * ((a + b) + (c + d)) / 2;
+       }},
   };
   std::printf("N = %llu jittered Hilbert samples, grade-%d trees, rho = 1\n\n",
               static_cast<unsigned long long>(n), CurveTree::GradeFor(n));
-  std::printf("| surface | density | estimator | leaves | rel. error of S_M | worst cell |count - expected| |\n");
+  std::printf(
+      "| surface | density | estimator | leaves | rel. error of S_M | worst cell |count - "
+      "expected| |\n");
   std::printf("|---|---|---|---:|---:|---:|\n");
   for (const Case& c : cases) {
     auto surface = MakeSurface(c.surface);
@@ -54,7 +59,8 @@ int Run(uint64_t n) {
                             AreaEstimator::kFirstFundamentalForm, AreaEstimator::kQuadrature}) {
       CurveTreeOptions options;
       options.estimator = e;
-      auto tree = CurveTree::Build(*surface->surface, *density->density, options, CurveTree::GradeFor(n));
+      auto tree =
+          CurveTree::Build(*surface->surface, *density->density, options, CurveTree::GradeFor(n));
       if (!tree.ok()) {
         std::fprintf(stderr, "%s\n", tree.status().ToString().c_str());
         return 1;
@@ -90,4 +96,6 @@ int Run(uint64_t n) {
 }  // namespace
 }  // namespace sfc
 
-int main(int argc, char** argv) { return sfc::Run(argc > 1 ? std::strtoull(argv[1], nullptr, 10) : 100000); }
+int main(int argc, char** argv) {
+  return sfc::Run(argc > 1 ? std::strtoull(argv[1], nullptr, 10) : 100000);
+}

@@ -116,8 +116,8 @@ const char* const kSurfaces[] = {
     "expr:x=u;y=v;z=0.3*sin(6*u)*cos(4*v)",
     "expr:x=cos(u)*cos(v);y=cos(u)*sin(v);z=sin(u);u0=-_pi/2;u1=_pi/2;v0=-_pi;v1=_pi",
 };
-const char* const kDensities[] = {"uniform", "gaussian:floor=0.05", "mean:floor=0.1", "expr:0.1+u*v",
-                                  "expr:1+x*x"};
+const char* const kDensities[] = {"uniform", "gaussian:floor=0.05", "mean:floor=0.1",
+                                  "expr:0.1+u*v", "expr:1+x*x"};
 
 // Outcome counters, shared by the workers.
 class Tally {
@@ -146,7 +146,8 @@ class Tally {
       ++unexpected_;
       ++unexpected_by_[absl::StrFormat("%s, %s", scenario, CodeName(code))];
       if (examples_.size() < 10) {
-        examples_.push_back(absl::StrFormat("%s: code %d: %s", scenario, static_cast<int>(code), detail));
+        examples_.push_back(
+            absl::StrFormat("%s: code %d: %s", scenario, static_cast<int>(code), detail));
       }
     }
     return shed || shed_for_memory;
@@ -172,38 +173,46 @@ class Tally {
     for (const auto& [code, n] : by_code_) {
       std::printf("| status %s | %" PRIu64 " | |\n", CodeName(code), n);
     }
-    std::printf("| of which RESOURCE_EXHAUSTED for a full build or parse queue (load shed) | %" PRIu64
-                " | |\n",
-                shed_);
-    std::printf("| of which RESOURCE_EXHAUSTED for the tree memory of builds under way (load shed) | %" PRIu64
-                " | |\n",
-                shed_for_memory_);
-    std::printf("| model streams that met their model evicted, uploaded again | %" PRIu64 " | |\n", evicted_);
+    std::printf(
+        "| of which RESOURCE_EXHAUSTED for a full build or parse queue (load shed) | %" PRIu64
+        " | |\n",
+        shed_);
+    std::printf(
+        "| of which RESOURCE_EXHAUSTED for the tree memory of builds under way (load shed) | "
+        "%" PRIu64 " | |\n",
+        shed_for_memory_);
+    std::printf("| model streams that met their model evicted, uploaded again | %" PRIu64 " | |\n",
+                evicted_);
     for (const auto& [scenario, n] : by_scenario_) {
       std::printf("| scenario %s | %" PRIu64 " | |\n", scenario.c_str(), n);
     }
-    std::printf("| completed streams compared with an in-process run | %" PRIu64 " | |\n", checked_);
+    std::printf("| completed streams compared with an in-process run | %" PRIu64 " | |\n",
+                checked_);
     std::printf("| of those not byte-identical | %" PRIu64 " | 0 |\n", check_mismatches_);
     std::printf("| unexpected outcomes | %" PRIu64 " | 0 |\n", unexpected_);
     for (const auto& [what, n] : unexpected_by_) {
       std::printf("| unexpected: %s | %" PRIu64 " | 0 |\n", what.c_str(), n);
     }
     std::printf("| samples received | %" PRIu64 " | |\n", samples_.load());
-    std::printf("| samples/s (all streams, %.0f s) | %.3g | |\n", seconds, samples_.load() / seconds);
+    std::printf("| samples/s (all streams, %.0f s) | %.3g | |\n", seconds,
+                samples_.load() / seconds);
     const double mib = 1024.0 * 1024.0;
     // The server's memory budgets: trees, streams' working memory, uploaded
     // models (stored and being received), parsed models and parses' working
     // memory.
-    const double budget = limits.budget_bytes + limits.stream_memory_bytes + limits.model_budget_bytes +
-                          limits.parsed_model_budget_bytes + limits.parse_memory_bytes;
+    const double budget = limits.budget_bytes + limits.stream_memory_bytes +
+                          limits.model_budget_bytes + limits.parsed_model_budget_bytes +
+                          limits.parse_memory_bytes;
     std::printf(
         "| server memory budgets: cache + stream memory + models + parsed models + parse memory | "
         "%.1f + %.1f + %.1f + %.1f + %.1f = %.1f MiB | |\n",
-        limits.budget_bytes / mib, limits.stream_memory_bytes / mib, limits.model_budget_bytes / mib,
-        limits.parsed_model_budget_bytes / mib, limits.parse_memory_bytes / mib, budget / mib);
-    std::printf("| server peak VmRSS (sampled every 100 ms) | %.1f MiB | <= %.1f MiB |\n", peak_rss / mib,
+        limits.budget_bytes / mib, limits.stream_memory_bytes / mib,
+        limits.model_budget_bytes / mib, limits.parsed_model_budget_bytes / mib,
+        limits.parse_memory_bytes / mib, budget / mib);
+    std::printf("| server peak VmRSS (sampled every 100 ms) | %.1f MiB | <= %.1f MiB |\n",
+                peak_rss / mib, 1.2 * budget / mib);
+    std::printf("| server VmHWM at the end | %.1f MiB | <= %.1f MiB |\n", hwm / mib,
                 1.2 * budget / mib);
-    std::printf("| server VmHWM at the end | %.1f MiB | <= %.1f MiB |\n", hwm / mib, 1.2 * budget / mib);
     for (const std::string& e : examples_) std::printf("unexpected: %s\n", e.c_str());
   }
   uint64_t unexpected() const {
@@ -314,7 +323,9 @@ struct BadCase {
 BadCase BadRequest(std::mt19937_64& rng, const ServerLimits& limits) {
   SampleRequest r;
   r.count = 1000;
-  auto invalid = [&](const char* what) { return BadCase{r, grpc::StatusCode::INVALID_ARGUMENT, what}; };
+  auto invalid = [&](const char* what) {
+    return BadCase{r, grpc::StatusCode::INVALID_ARGUMENT, what};
+  };
   // The tree-budget case builds up to max_tree_leaves before it fails, so it
   // is rare (one bad request in 50); the others fail before any build.
   switch (rng() % 50 == 0 ? 10 : rng() % 10) {
@@ -344,8 +355,15 @@ class Worker {
   Worker(const Flags& flags, const ServerLimits& limits, Tally* tally, SamplerClient* client,
          v1::Sampler::Stub* stub, const SamplingEngine* engine, uint64_t seed,
          const SoakModels* models = nullptr, const SamplingEngine* model_engine = nullptr)
-      : flags_(flags), limits_(limits), tally_(tally), client_(client), stub_(stub), engine_(engine),
-        models_(models), model_engine_(model_engine), rng_(seed) {}
+      : flags_(flags),
+        limits_(limits),
+        tally_(tally),
+        client_(client),
+        stub_(stub),
+        engine_(engine),
+        models_(models),
+        model_engine_(model_engine),
+        rng_(seed) {}
 
   // Formula scenarios, or with `models` the model phase's.
   void Run(Clock::time_point stop) {
@@ -471,7 +489,8 @@ class Worker {
     const HostileUpload upload = models_->Hostile(rng_);
     const std::string scenario = absl::StrFormat("hostile (%s)", upload.what);
     auto refused = [](absl::StatusCode code) {
-      return code == absl::StatusCode::kInvalidArgument || code == absl::StatusCode::kResourceExhausted;
+      return code == absl::StatusCode::kInvalidArgument ||
+             code == absl::StatusCode::kResourceExhausted;
     };
     auto info = client_->UploadModel(upload.format, upload.name, upload.bytes);
     if (!info.ok()) {
@@ -489,7 +508,8 @@ class Worker {
       return absl::OkStatus();
     });
     if (summary.ok()) {
-      Report(scenario, grpc::StatusCode::OK, false, absl::StrFormat("%s accepted (%d samples)", upload.what, got));
+      Report(scenario, grpc::StatusCode::OK, false,
+             absl::StrFormat("%s accepted (%d samples)", upload.what, got));
       return;
     }
     // Evicted before its Sample: neither accepted nor refused; counted apart.
@@ -518,7 +538,8 @@ class Worker {
 
   // Runs `request` in `engine` in this process and compares every column bit
   // for bit.
-  static bool SameAsInProcess(const SamplingEngine& engine, const SampleRequest& request, const SampleBatch& wire) {
+  static bool SameAsInProcess(const SamplingEngine& engine, const SampleRequest& request,
+                              const SampleBatch& wire) {
     auto job = engine.Start(request);
     if (!job.ok()) return false;
     SampleBatch local;
@@ -528,7 +549,8 @@ class Worker {
       if (*n == 0) break;
     }
     auto same = [](const std::vector<double>& a, const std::vector<double>& b) {
-      return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * 8) == 0);
+      return a.size() == b.size() &&
+             (a.empty() || std::memcmp(a.data(), b.data(), a.size() * 8) == 0);
     };
     return local.index == wire.index && same(local.u, wire.u) && same(local.v, wire.v) &&
            same(local.x, wire.x) && same(local.y, wire.y) && same(local.z, wire.z) &&
@@ -581,7 +603,8 @@ class Worker {
         break;
       }
       Count(response);
-      std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(flags_.slow_read_seconds * 1000)));
+      std::this_thread::sleep_for(
+          std::chrono::milliseconds(static_cast<int>(flags_.slow_read_seconds * 1000)));
     }
     if (!ended) context.TryCancel();
     while (reader->Read(&response)) {
@@ -596,7 +619,8 @@ class Worker {
 
   void Deadline() {
     grpc::ClientContext context;
-    context.set_deadline(std::chrono::system_clock::now() + std::chrono::milliseconds(20 + rng_() % 200));
+    context.set_deadline(std::chrono::system_clock::now() +
+                         std::chrono::milliseconds(20 + rng_() % 200));
     auto reader = Open(&context, LongRequest(rng_), flags_.batch_size);
     v1::SampleResponse response;
     while (reader->Read(&response)) Count(response);
@@ -616,8 +640,8 @@ class Worker {
     while (reader->Read(&response)) got += Count(response);
     const grpc::Status status = reader->Finish();
     Report(absl::StrFormat("bad (%s)", bad.what), status.error_code(),
-                    status.error_code() == bad.expected && got == 0 && !status.error_message().empty(),
-                    status.error_message());
+           status.error_code() == bad.expected && got == 0 && !status.error_message().empty(),
+           status.error_message());
   }
 
   const Flags& flags_;
@@ -651,7 +675,8 @@ int Main(int argc, char** argv) {
   app.add_option("--streams", flags.streams, "concurrent streams")->capture_default_str();
   app.add_option("--seconds", flags.seconds, "how long to run")->capture_default_str();
   app.add_option("--seed", flags.seed, "seed of the scenario mix")->capture_default_str();
-  app.add_option("--slow-read-seconds", flags.slow_read_seconds, "a slow reader's pause between messages")
+  app.add_option("--slow-read-seconds", flags.slow_read_seconds,
+                 "a slow reader's pause between messages")
       ->capture_default_str();
   app.add_option("--slow-reads", flags.slow_reads, "messages a slow reader takes before it cancels")
       ->capture_default_str();
@@ -667,7 +692,8 @@ int Main(int argc, char** argv) {
                  "percent of the workers that upload and sample models (the model phase)")
       ->capture_default_str()
       ->check(CLI::Range(0, 100));
-  app.add_option("--model-dir", flags.model_dir, "an existing directory for the model phase's files")
+  app.add_option("--model-dir", flags.model_dir,
+                 "an existing directory for the model phase's files")
       ->capture_default_str();
   app.add_option("--large-subdivisions", flags.large_subdivisions,
                  "subdivisions of the large icosphere meshes (8: 1.3 M triangles)")
@@ -691,7 +717,8 @@ int Main(int argc, char** argv) {
   }
   auto stats = (*client)->GetCacheStats();
   if (!stats.ok()) {
-    std::fprintf(stderr, "load_generator: GetCacheStats: %s\n", std::string(stats.status().message()).c_str());
+    std::fprintf(stderr, "load_generator: GetCacheStats: %s\n",
+                 std::string(stats.status().message()).c_str());
     return 2;
   }
   ServerLimits limits;
@@ -728,7 +755,8 @@ int Main(int argc, char** argv) {
     models = *std::move(written);
     std::string large;
     for (const SoakModel& m : models->large()) {
-      large += absl::StrFormat(" %s %.1f MiB;", m.spec.substr(m.spec.rfind('/') + 1), m.bytes / (1024.0 * 1024.0));
+      large += absl::StrFormat(" %s %.1f MiB;", m.spec.substr(m.spec.rfind('/') + 1),
+                               m.bytes / (1024.0 * 1024.0));
     }
     std::printf("model phase: %d of %d workers; %zu good models; large meshes:%s\n", model_workers,
                 flags.streams, models->good().size(), large.c_str());

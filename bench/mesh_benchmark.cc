@@ -182,7 +182,8 @@ int main(int argc, char** argv) {
     for (uint64_t n : {uint64_t{1} << l, (uint64_t{1} << l) + (uint64_t{1} << (l - 1))}) {
       double d_ours = 0, d_iid = 0;
       for (uint64_t seed = 1; seed <= 4; ++seed) {
-        auto sampler = std::make_shared<MeshSampler>(*tree, Sequence(SequenceKind::kJittered, n, seed));
+        auto sampler =
+            std::make_shared<MeshSampler>(*tree, Sequence(SequenceKind::kJittered, n, seed));
         SampleBatch batch;
         DrawAll(sampler, &batch);
         d_ours += SphericalTriangleDiscrepancy(OnSphere(batch), 128, 100 + seed) / 4;
@@ -197,7 +198,8 @@ int main(int argc, char** argv) {
   for (size_t t = 0; t < sphere.triangles.size(); ++t) {
     // Spherical over flat area of each triangle (Van Oosterom-Strackee excess).
     const auto& f = sphere.triangles[t];
-    const Vec3 &a = sphere.positions[f[0]], &b = sphere.positions[f[1]], &c = sphere.positions[f[2]];
+    const Vec3 &a = sphere.positions[f[0]], &b = sphere.positions[f[1]],
+               &c = sphere.positions[f[2]];
     const double excess = 2 * std::atan2(std::abs(Dot(a, Cross(b, c))),
                                          1 + Dot(a, b) + Dot(b, c) + Dot(c, a));
     const double ratio = excess / (0.5 * Norm(sphere.FaceCross(t)));

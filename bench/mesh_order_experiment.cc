@@ -78,7 +78,9 @@ int main(int argc, char** argv) {
     const double cells = std::ldexp(1.0, 21);
     const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
     const double scale = (cells - 1) / extent;
-    auto q = [&](double v, double l) { return static_cast<uint32_t>(std::clamp((v - l) * scale, 0.0, cells - 1)); };
+    auto q = [&](double v, double l) {
+      return static_cast<uint32_t>(std::clamp((v - l) * scale, 0.0, cells - 1));
+    };
     orders.push_back({"hilbert3d", sorted_by([&](size_t t) {
                         return HilbertKey3(q(c[t].x, lo.x), q(c[t].y, lo.y), q(c[t].z, lo.z), 21);
                       })});
@@ -104,15 +106,18 @@ int main(int argc, char** argv) {
       if (n <= 6144) sizes.push_back(n);
     }
   }
-  std::printf("icosphere of %zu triangles; N = %llu..%llu; %d seeds; 128 spherical triangles per seed\n\n",
-              t_count, static_cast<unsigned long long>(sizes.front()),
-              static_cast<unsigned long long>(sizes.back()), seeds);
+  std::printf(
+      "icosphere of %zu triangles; N = %llu..%llu; %d seeds; 128 spherical triangles per seed\n\n",
+      t_count, static_cast<unsigned long long>(sizes.front()),
+      static_cast<unsigned long long>(sizes.back()), seeds);
   // Why an order scores as it does: how compact a run of the curve holding
   // 1/N of the area is (area-weighted RMS distance of its triangles'
   // centroids from their mean, over sqrt(4 pi / N)), and how often the curve
   // jumps (consecutive centroids further apart than 3 mean edge lengths).
   const double edge = std::sqrt(4 * 4 * kPi / (std::sqrt(3.0) * t_count));
-  std::printf("| order | RMS radius of a 1/N run, N = 1024 | N = 6144 | jumps > 3 edges per 1000 steps |\n|---|---:|---:|---:|\n");
+  std::printf(
+      "| order | RMS radius of a 1/N run, N = 1024 | N = 6144 | jumps > 3 edges per 1000 steps "
+      "|\n|---|---:|---:|---:|\n");
   for (const auto& [name, order] : orders) {
     double spread[2];
     int idx = 0;
@@ -122,19 +127,24 @@ int main(int argc, char** argv) {
       for (size_t r = 0; r + per <= t_count; r += per) {
         Vec3 mean{0, 0, 0};
         double w = 0;
-        for (size_t i = r; i < r + per; ++i) mean = mean + c[order[i]] * area[order[i]], w += area[order[i]];
+        for (size_t i = r; i < r + per; ++i)
+          mean = mean + c[order[i]] * area[order[i]], w += area[order[i]];
         mean = mean * (1 / w);
         double ss = 0;
-        for (size_t i = r; i < r + per; ++i) ss += area[order[i]] * Dot(c[order[i]] - mean, c[order[i]] - mean);
+        for (size_t i = r; i < r + per; ++i)
+          ss += area[order[i]] * Dot(c[order[i]] - mean, c[order[i]] - mean);
         sum += std::sqrt(ss / w);
       }
       spread[idx++] = sum / (t_count / per) / std::sqrt(4 * kPi / n);
     }
     size_t jumps = 0;
-    for (size_t i = 0; i + 1 < t_count; ++i) jumps += Norm(c[order[i + 1]] - c[order[i]]) > 3 * edge;
-    std::printf("| %s | %.3f | %.3f | %.2f |\n", name.c_str(), spread[0], spread[1], 1000.0 * jumps / (t_count - 1));
+    for (size_t i = 0; i + 1 < t_count; ++i)
+      jumps += Norm(c[order[i + 1]] - c[order[i]]) > 3 * edge;
+    std::printf("| %s | %.3f | %.3f | %.2f |\n", name.c_str(), spread[0], spread[1],
+                1000.0 * jumps / (t_count - 1));
   }
-  std::printf("\n| order | placement | slope (mean +- SE) | D at N = 6144 |\n|---|---|---:|---:|\n");
+  std::printf(
+      "\n| order | placement | slope (mean +- SE) | D at N = 6144 |\n|---|---|---:|---:|\n");
   for (const auto& [name, order] : orders) {
     std::vector<double> cum(t_count + 1, 0);
     for (size_t i = 0; i < t_count; ++i) cum[i + 1] = cum[i] + area[order[i]];
@@ -148,7 +158,9 @@ int main(int argc, char** argv) {
           std::vector<Vec3> pts(n);
           for (uint64_t k = 0; k < n; ++k) {
             const double m = (k + uni(rng)) / n * cum.back();
-            const size_t i = std::min(t_count - 1, static_cast<size_t>(std::upper_bound(cum.begin(), cum.end(), m) - cum.begin()) - 1);
+            const size_t i = std::min(
+                t_count - 1,
+                static_cast<size_t>(std::upper_bound(cum.begin(), cum.end(), m) - cum.begin()) - 1);
             const auto& f = mesh.triangles[order[i]];
             Vec3 p = c[order[i]];
             if (std::string(placement) == "curve") {
@@ -190,7 +202,8 @@ int main(int argc, char** argv) {
       double m, se, dm, dse;
       MeanAndStandardError(slopes, &m, &se);
       MeanAndStandardError(last, &dm, &dse);
-      std::printf("| %s | %s | %.3f +- %.3f | %.2e +- %.1e |\n", name.c_str(), placement, m, se, dm, dse);
+      std::printf("| %s | %s | %.3f +- %.3f | %.2e +- %.1e |\n", name.c_str(), placement, m, se, dm,
+                  dse);
       std::fflush(stdout);
     }
   }

@@ -78,7 +78,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   const std::vector<std::pair<std::string, std::string>> models = {
-      {"STEP box with a fillet and a hole (8 faces, 2 trimmed)", "step:" + dir + "/box_with_hole.step"},
+      {"STEP box with a fillet and a hole (8 faces, 2 trimmed)",
+       "step:" + dir + "/box_with_hole.step"},
       {"STEP sphere", "step:" + dir + "/sphere.step"},
   };
   std::printf("N = %llu, cold (parse + trees + samples, one thread), median of %d, each model "
@@ -103,8 +104,8 @@ int main(int argc, char** argv) {
       for (size_t i = 0; i < all.size(); ++i) d.push_back(all[i] - start[i]);
       return Median(d);
     };
-    std::printf("| %s | %.3f | %.3f, %.3f | %llu | %.3f | %.3f, %.3f | %llu | %.2f |\n", name.c_str(),
-                Median(model_s), Median(model_start), samples(model_s, model_start),
+    std::printf("| %s | %.3f | %.3f, %.3f | %llu | %.3f | %.3f, %.3f | %llu | %.2f |\n",
+                name.c_str(), Median(model_s), Median(model_start), samples(model_s, model_start),
                 static_cast<unsigned long long>(m.leaves), Median(sphere_s), Median(sphere_start),
                 samples(sphere_s, sphere_start), static_cast<unsigned long long>(s.leaves),
                 Median(model_s) / Median(sphere_s));

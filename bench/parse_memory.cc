@@ -152,15 +152,17 @@ int TimeReads(const std::string& spec) {
     return 1;
   }
   const double load_brep = seconds([&] { (void)sfc::cad::LoadBrep(*brep, *f, path, options); });
-  std::printf("%s: %zu bytes; Load %.3f s; ReadToBrep %.3f s (%zu bytes of BRep); LoadBrep %.3f s\n",
-              spec.c_str(), bytes.size(), load, read, brep->size(), load_brep);
+  std::printf(
+      "%s: %zu bytes; Load %.3f s; ReadToBrep %.3f s (%zu bytes of BRep); LoadBrep %.3f s\n",
+      spec.c_str(), bytes.size(), load, read, brep->size(), load_brep);
   return 0;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc == 4 && std::string(argv[1]) == "--one") return Measure(argv[2], std::string(argv[3]) == "1");
+  if (argc == 4 && std::string(argv[1]) == "--one")
+    return Measure(argv[2], std::string(argv[3]) == "1");
   if (argc == 3 && std::string(argv[1]) == "--time-reads") return TimeReads(argv[2]);
   if (argc == 4 && std::string(argv[1]) == "--repeat") return Repeat(argv[3], std::atoi(argv[2]));
   if (argc < 2) {

@@ -44,7 +44,8 @@ std::string ShellListingOneFace(const std::string& step, int copies) {
   const size_t open = text.find('(', text.find(',', shell));
   const size_t close = text.find(')', open);
   const std::string face = text.substr(open + 1, close - open - 1);
-  text.replace(open + 1, close - open - 1, absl::StrJoin(std::vector<std::string>(copies, face), ","));
+  text.replace(open + 1, close - open - 1,
+               absl::StrJoin(std::vector<std::string>(copies, face), ","));
   return text;
 }
 
@@ -117,7 +118,8 @@ HostileUpload SoakModels::Hostile(std::mt19937_64& rng) const {
     case 1:
       // Rare: each costs the server's parse CPU budget (a few seconds).
       if (rng() % 4 == 0) {
-        return {"step", "shell.step", ShellListingOneFace(sphere_step_, 60000 + static_cast<int>(variant % 1000)),
+        return {"step", "shell.step",
+                ShellListingOneFace(sphere_step_, 60000 + static_cast<int>(variant % 1000)),
                 "STEP shell listing one face 60 000 times"};
       }
       [[fallthrough]];
@@ -127,7 +129,8 @@ HostileUpload SoakModels::Hostile(std::mt19937_64& rng) const {
               "OBJ index past the vertices"};
     case 3:
       return {"ply", "billion.ply",
-              absl::StrCat("ply\nformat binary_little_endian 1.0\nelement vertex ", 1000000000 + variant,
+              absl::StrCat("ply\nformat binary_little_endian 1.0\nelement vertex ",
+                           1000000000 + variant,
                            "\nproperty float x\nproperty float y\nproperty float z\n"
                            "element face 1\nproperty list uchar int vertex_indices\nend_header\n",
                            std::string(64, '\0')),
@@ -135,7 +138,8 @@ HostileUpload SoakModels::Hostile(std::mt19937_64& rng) const {
     case 4:
       return {"step", "cut.step", box_step_.substr(0, 1000 + variant % 2000), "truncated STEP"};
     case 5:
-      return {"iges", "cut.iges", box_iges_.substr(0, 2000 + 81 * (variant % 20)), "truncated IGES"};
+      return {"iges", "cut.iges", box_iges_.substr(0, 2000 + 81 * (variant % 20)),
+              "truncated IGES"};
     case 6:
       return {"ply", "cut.ply", small_ply_.substr(0, small_ply_.size() / 2 + variant % 1000),
               "truncated binary PLY"};
@@ -145,7 +149,8 @@ HostileUpload SoakModels::Hostile(std::mt19937_64& rng) const {
 }
 #else   // a build without cad/ or mesh/
 absl::StatusOr<SoakModels> SoakModels::Write(const std::string&, int) {
-  return absl::UnimplementedError("the model phase needs a build with cad/ and mesh/ (SFC_BUILD_CAD, SFC_BUILD_MESH)");
+  return absl::UnimplementedError(
+      "the model phase needs a build with cad/ and mesh/ (SFC_BUILD_CAD, SFC_BUILD_MESH)");
 }
 HostileUpload SoakModels::Hostile(std::mt19937_64&) const { return {}; }
 #endif

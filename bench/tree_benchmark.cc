@@ -25,7 +25,9 @@ int main(int argc, char** argv) {
                         {"torus", "uniform"},
                         {"eight", "gaussian:floor=0.05"},
                         {"superellipsoid", "uniform"}};
-  std::printf("| surface, density | N | leaves | bytes | build | depth | singular leaves | model error (samples) |\n");
+  std::printf(
+      "| surface, density | N | leaves | bytes | build | depth | singular leaves | model error "
+      "(samples) |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const Case& c : cases) {
     auto surface = sfc::MakeSurface(c.surface);
@@ -33,11 +35,14 @@ int main(int argc, char** argv) {
     if (!surface.ok() || !density.ok()) return 1;
     for (uint64_t n : {uint64_t{10'000}, uint64_t{1'000'000}, uint64_t{100'000'000}}) {
       const auto start = std::chrono::steady_clock::now();
-      auto tree = CurveTree::Build(*surface->surface, *density->density, options, CurveTree::GradeFor(n));
-      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      auto tree =
+          CurveTree::Build(*surface->surface, *density->density, options, CurveTree::GradeFor(n));
+      const double seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (!tree.ok()) {
         std::printf("| %s, %s | %llu | %s | | | | | |\n", c.surface, c.density,
-                    static_cast<unsigned long long>(n), std::string(tree.status().message()).c_str());
+                    static_cast<unsigned long long>(n),
+                    std::string(tree.status().message()).c_str());
         continue;
       }
       const CurveTree& t = **tree;

@@ -229,7 +229,8 @@ std::string PolyLoopFacesStep(const std::vector<std::vector<std::pair<double, do
   };
   auto real = [](double v) {  // a STEP REAL always has its decimal point: "1.", "1.E-05"
     std::string text = absl::StrFormat("%.17G", v);
-    if (text.find('.') == std::string::npos) text.insert(std::min(text.find('E'), text.size()), ".");
+    if (text.find('.') == std::string::npos)
+      text.insert(std::min(text.find('E'), text.size()), ".");
     return text;
   };
   auto point = [&](double x, double y) {
@@ -266,7 +267,8 @@ std::string PolyLoopFacesStep(const std::vector<std::vector<std::pair<double, do
   const int radian = add("( NAMED_UNIT(*) PLANE_ANGLE_UNIT() SI_UNIT($,.RADIAN.) )");
   const int steradian = add("( NAMED_UNIT(*) SI_UNIT($,.STERADIAN.) SOLID_ANGLE_UNIT() )");
   const int uncertainty = add(absl::StrFormat(
-      "UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE(1.E-07),#%d,'distance_accuracy_value','')", mm));
+      "UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE(1.E-07),#%d,'distance_accuracy_value','')",
+      mm));
   const int context = add(absl::StrFormat(
       "( GEOMETRIC_REPRESENTATION_CONTEXT(3) GLOBAL_UNCERTAINTY_ASSIGNED_CONTEXT((#%d)) "
       "GLOBAL_UNIT_ASSIGNED_CONTEXT((#%d,#%d,#%d)) REPRESENTATION_CONTEXT('','') )",
@@ -275,11 +277,13 @@ std::string PolyLoopFacesStep(const std::vector<std::vector<std::pair<double, do
       "MANIFOLD_SURFACE_SHAPE_REPRESENTATION('',(#%d,#%d),#%d)", axes, surface_model, context));
   const int application =
       add("APPLICATION_CONTEXT('core data for automotive mechanical design processes')");
-  const int product_context = add(absl::StrFormat("PRODUCT_CONTEXT('',#%d,'mechanical')", application));
-  const int product = add(absl::StrFormat("PRODUCT('collinear','collinear','',(#%d))", product_context));
+  const int product_context =
+      add(absl::StrFormat("PRODUCT_CONTEXT('',#%d,'mechanical')", application));
+  const int product =
+      add(absl::StrFormat("PRODUCT('collinear','collinear','',(#%d))", product_context));
   const int formation = add(absl::StrFormat("PRODUCT_DEFINITION_FORMATION('','',#%d)", product));
-  const int definition_context =
-      add(absl::StrFormat("PRODUCT_DEFINITION_CONTEXT('part definition',#%d,'design')", application));
+  const int definition_context = add(
+      absl::StrFormat("PRODUCT_DEFINITION_CONTEXT('part definition',#%d,'design')", application));
   const int definition = add(
       absl::StrFormat("PRODUCT_DEFINITION('design','',#%d,#%d)", formation, definition_context));
   const int shape = add(absl::StrFormat("PRODUCT_DEFINITION_SHAPE('','',#%d)", definition));
@@ -299,7 +303,8 @@ std::string CollinearFacesStep(int collinear, bool with_square) {
     const double a = (k + 1) / std::sqrt(2.0), step = 0.5 / std::sqrt(3.0);
     loops.push_back({{a, a}, {a + step, a + step}, {a + 2 * step, a + 2 * step}});
   }
-  if (with_square) loops.push_back({{kSquareX, 0}, {kSquareX + 1, 0}, {kSquareX + 1, 1}, {kSquareX, 1}});
+  if (with_square)
+    loops.push_back({{kSquareX, 0}, {kSquareX + 1, 0}, {kSquareX + 1, 1}, {kSquareX, 1}});
   return PolyLoopFacesStep(loops);
 }
 

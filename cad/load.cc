@@ -242,8 +242,9 @@ absl::Status CheckTransfer(XSControl_Reader& reader, const ModelCensus& census, 
   }
   if (missing.size() > kNamed) absl::StrAppend(&named, ", ...");
   const std::string fail = !load_fail.empty() ? load_fail
-                           : process.IsNull() ? ""
-                                              : FirstFail(model, process->CheckList(Standard_False));
+                           : process.IsNull()
+                               ? ""
+                               : FirstFail(model, process->CheckList(Standard_False));
   return Invalid(
       format, name,
       absl::StrCat(missing.size(), " of its ", census.faces.size(),
@@ -472,13 +473,14 @@ absl::StatusOr<std::shared_ptr<const Model>> ModelFromShape(const TopoDS_Shape& 
   if (!any_area) {
     constexpr size_t kNamed = 8;
     std::string named;
-    for (size_t i = 0; i < std::min(faces.size(), kNamed); ++i) absl::StrAppend(&named, i ? ", " : "", i);
+    for (size_t i = 0; i < std::min(faces.size(), kNamed); ++i)
+      absl::StrAppend(&named, i ? ", " : "", i);
     if (faces.size() > kNamed) absl::StrAppend(&named, ", ...");
-    return Invalid(format, name,
-                   absl::StrCat("has no face with area: its ", faces.size(), " faces (", named,
-                                ") are thinner than the kernel's tolerance (",
-                                Precision::Confusion(),
-                                " model units); a degenerate or collapsed model? fix or re-export it"));
+    return Invalid(
+        format, name,
+        absl::StrCat("has no face with area: its ", faces.size(), " faces (", named,
+                     ") are thinner than the kernel's tolerance (", Precision::Confusion(),
+                     " model units); a degenerate or collapsed model? fix or re-export it"));
   }
   return std::make_shared<const Model>(std::string(name), std::move(faces));
 }
@@ -595,16 +597,17 @@ absl::StatusOr<std::shared_ptr<const Model>> Load(ModelFormat format, absl::stri
 absl::StatusOr<std::string> ReadToBrep(ModelFormat format, absl::string_view bytes,
                                        absl::string_view untrusted_name,
                                        const LoadOptions& options) {
-  return ReadThen(format, bytes, untrusted_name, options,
-                  [&](const TopoDS_Shape& shape, const std::string& name) -> absl::StatusOr<std::string> {
-                    // Every check Load makes of the faces, here, where a fault
-                    // costs this process.
-                    RETURN_IF_ERROR(ModelFromShape(shape, format, name, options).status());
-                    std::ostringstream out;
-                    BinTools::Write(shape, out, /*theWithTriangles=*/Standard_False,
-                                    /*theWithNormals=*/Standard_False, BinTools_FormatVersion_CURRENT);
-                    return out.str();
-                  });
+  return ReadThen(
+      format, bytes, untrusted_name, options,
+      [&](const TopoDS_Shape& shape, const std::string& name) -> absl::StatusOr<std::string> {
+        // Every check Load makes of the faces, here, where a fault
+        // costs this process.
+        RETURN_IF_ERROR(ModelFromShape(shape, format, name, options).status());
+        std::ostringstream out;
+        BinTools::Write(shape, out, /*theWithTriangles=*/Standard_False,
+                        /*theWithNormals=*/Standard_False, BinTools_FormatVersion_CURRENT);
+        return out.str();
+      });
 }
 
 absl::StatusOr<std::shared_ptr<const Model>> LoadBrep(absl::string_view brep, ModelFormat format,
@@ -617,7 +620,9 @@ absl::StatusOr<std::shared_ptr<const Model>> LoadBrep(absl::string_view brep, Mo
     std::istringstream in{std::string(brep)};
     TopoDS_Shape shape;
     BinTools::Read(shape, in);
-    if (shape.IsNull()) return absl::InternalError(absl::StrCat("the model check's shape of ", name, " could not be read back"));
+    if (shape.IsNull())
+      return absl::InternalError(
+          absl::StrCat("the model check's shape of ", name, " could not be read back"));
     return ModelFromShape(shape, format, name, options);
   });
 }

@@ -49,7 +49,9 @@ absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
   auto control_after = [&](uint64_t bytes_before) {
     BuildControl c = control;
     if (control.charge) {
-      c.charge = [charge = control.charge, bytes_before](uint64_t b) { return charge(bytes_before + b); };
+      c.charge = [charge = control.charge, bytes_before](uint64_t b) {
+        return charge(bytes_before + b);
+      };
     }
     return c;
   };
@@ -110,7 +112,8 @@ absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
     const uint64_t samples = static_cast<uint64_t>(std::ceil(static_cast<double>(count) * share));
     const int grade = CurveTree::GradeFor(std::max<uint64_t>(1, samples));
     if (grade > 0) {
-      auto refined = piece.tree->Refined(*piece.surface, *piece.density, grade, control_after(bytes));
+      auto refined =
+          piece.tree->Refined(*piece.surface, *piece.density, grade, control_after(bytes));
       if (!refined.ok()) return on_face(piece.face, refined.status());
       piece.tree = *std::move(refined);
     }
@@ -242,7 +245,8 @@ absl::StatusOr<size_t> ModelSampleCursor::Next(size_t max, SampleBatch* batch) {
       }
       if (j > i) {
         batch->AppendFrom(scratch_, i, j);
-        if (fields_.face) batch->face.insert(batch->face.end(), j - i, static_cast<uint32_t>(piece.face));
+        if (fields_.face)
+          batch->face.insert(batch->face.end(), j - i, static_cast<uint32_t>(piece.face));
         got += j - i;
       }
       i = j + 1;  // j is outside the region, or n

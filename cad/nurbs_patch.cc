@@ -33,8 +33,8 @@ class Parser {
       return Error(line, absl::StrCat(what, ": '", Echo(token), "' is not a number"));
     }
     if (!std::isfinite(value)) {
-      return Error(line,
-                   absl::StrCat(what, " is ", Echo(token), " (NaN or infinite); give finite numbers"));
+      return Error(
+          line, absl::StrCat(what, " is ", Echo(token), " (NaN or infinite); give finite numbers"));
     }
     return value;
   }
@@ -117,7 +117,8 @@ absl::StatusOr<NurbsPatch> ParseNurbsPatch(absl::string_view text, absl::string_
     }
     if (key == "degree" || key == "count") {
       if (tokens.size() != 3)
-        return parser.Error(line_number, absl::StrCat("'", Echo(key), "' takes two integers (u, v)"));
+        return parser.Error(line_number,
+                            absl::StrCat("'", Echo(key), "' takes two integers (u, v)"));
       ASSIGN_OR_RETURN(int a, parser.Integer(line_number, tokens[1], key));
       ASSIGN_OR_RETURN(int b, parser.Integer(line_number, tokens[2], key));
       if (key == "degree") {

@@ -97,7 +97,8 @@ bool IsIgesNumber(absl::string_view token) {
     while (i < token.size() && absl::ascii_isdigit(token[i])) ++i, ++digits;
   }
   if (digits == 0) return token.empty();
-  if (i < token.size() && (token[i] == 'E' || token[i] == 'e' || token[i] == 'D' || token[i] == 'd')) {
+  if (i < token.size() &&
+      (token[i] == 'E' || token[i] == 'e' || token[i] == 'D' || token[i] == 'd')) {
     ++i;
     if (i < token.size() && (token[i] == '+' || token[i] == '-')) ++i;
     size_t exponent = 0;
@@ -139,7 +140,8 @@ absl::Status CheckIgesParameters(absl::string_view data, const std::vector<uint6
         return absl::InvalidArgumentError(absl::StrFormat(
             "parameter data line %d: a string of %d characters is followed by '%s', not a "
             "delimiter; the file is damaged (fix or re-export it)",
-            lines[std::min(after / 64, lines.size() - 1)], length, Echo(data.substr(after, 8), 16)));
+            lines[std::min(after / 64, lines.size() - 1)], length,
+            Echo(data.substr(after, 8), 16)));
       }
     } else if (!IsIgesNumber(token)) {
       return absl::InvalidArgumentError(absl::StrFormat(
@@ -243,7 +245,8 @@ absl::StatusOr<ModelCensus> PreflightStep(absl::string_view bytes, const Preflig
         return absl::InvalidArgumentError(absl::StrFormat(
             "line %d: a ')' closes no '(' in the record starting '%s'; the file is damaged (fix "
             "or re-export it)",
-            LineOf(bytes, i), Echo(absl::StripLeadingAsciiWhitespace(bytes.substr(record_start, 40)))));
+            LineOf(bytes, i),
+            Echo(absl::StripLeadingAsciiWhitespace(bytes.substr(record_start, 40)))));
       }
       --depth;
     } else if (c == ';' && depth > 0) {
@@ -344,8 +347,8 @@ absl::StatusOr<ModelCensus> PreflightIges(absl::string_view bytes, const Preflig
     const absl::string_view status = line.substr(64, 8);
     const bool independent = status.size() == 8 && status.substr(2, 2) == "00";
     const bool face = type == 510 || type == 144 || type == 143;
-    const bool surface = type == 128 || type == 114 || type == 118 || type == 120 ||
-                         type == 122 || type == 140 || (type >= 190 && type <= 198 && type % 2 == 0);
+    const bool surface = type == 128 || type == 114 || type == 118 || type == 120 || type == 122 ||
+                         type == 140 || (type >= 190 && type <= 198 && type % 2 == 0);
     if (face || (surface && independent)) {
       census.faces.push_back(absl::StrCat("DE ", sequence, " type ", type));
       census.face_ids.push_back(sequence);

@@ -48,7 +48,8 @@ absl::StatusOr<Spec> ParseSpec(const std::string& kind, const std::vector<Catalo
   }
   Spec spec{entry, {}};
   if (colon != std::string::npos) {
-    for (absl::string_view part : absl::StrSplit(trimmed.substr(colon + 1), ';', absl::SkipWhitespace())) {
+    for (absl::string_view part :
+         absl::StrSplit(trimmed.substr(colon + 1), ';', absl::SkipWhitespace())) {
       const size_t eq = part.find('=');
       const std::string key(absl::StripAsciiWhitespace(part.substr(0, eq)));
       bool known = false;
@@ -90,7 +91,8 @@ std::string Canonical(const Spec& spec, const std::map<std::string, double>& num
     parts.push_back(it != numbers.end() ? absl::StrFormat("%s=%.17g", p.name, it->second)
                                         : absl::StrCat(p.name, "=", spec.values.at(p.name)));
   }
-  return parts.empty() ? spec.entry->name : absl::StrCat(spec.entry->name, ":", absl::StrJoin(parts, ";"));
+  return parts.empty() ? spec.entry->name
+                       : absl::StrCat(spec.entry->name, ":", absl::StrJoin(parts, ";"));
 }
 
 absl::Status Positive(const std::string& what, double value) {
@@ -105,7 +107,13 @@ class ExpressionSurface final : public Surface {
  public:
   ExpressionSurface(std::unique_ptr<Expression> x, std::unique_ptr<Expression> y,
                     std::unique_ptr<Expression> z, double u0, double u1, double v0, double v1)
-      : x_(std::move(x)), y_(std::move(y)), z_(std::move(z)), u0_(u0), du_(u1 - u0), v0_(v0), dv_(v1 - v0) {}
+      : x_(std::move(x)),
+        y_(std::move(y)),
+        z_(std::move(z)),
+        u0_(u0),
+        du_(u1 - u0),
+        v0_(v0),
+        dv_(v1 - v0) {}
 
   Vec3 Point(double u, double v) const override {
     const double uv[2] = {u0_ + u * du_, v0_ + v * dv_};
@@ -259,9 +267,10 @@ absl::StatusOr<SurfaceFromSpec> MakeSurface(const std::string& text) {
     out.surface = MakeSuperellipsoid(numbers["e"], numbers["reparam"] == 1);
   } else {  // expr
     if (!(numbers["u0"] < numbers["u1"]) || !(numbers["v0"] < numbers["v1"])) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "expr surface: the parameter box [%g,%g] x [%g,%g] is empty; it needs u0 < u1 and v0 < v1",
-          numbers["u0"], numbers["u1"], numbers["v0"], numbers["v1"]));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("expr surface: the parameter box [%g,%g] x [%g,%g] is empty; it needs u0 "
+                          "< u1 and v0 < v1",
+                          numbers["u0"], numbers["u1"], numbers["v0"], numbers["v1"]));
     }
     std::unique_ptr<Expression> xyz[3];
     const char* axes[3] = {"x", "y", "z"};
@@ -282,7 +291,8 @@ absl::StatusOr<DensityFromSpec> MakeDensity(const std::string& text) {
   DensityFromSpec out;
   if (absl::StartsWith(trimmed, "expr:")) {
     const std::string body(absl::StripAsciiWhitespace(trimmed.substr(5)));
-    ASSIGN_OR_RETURN(auto f, Expression::Compile("density expression", body, {"u", "v", "x", "y", "z"}));
+    ASSIGN_OR_RETURN(auto f,
+                     Expression::Compile("density expression", body, {"u", "v", "x", "y", "z"}));
     out.density = std::make_shared<ExpressionDensity>(std::move(f));
     out.canonical = absl::StrCat("expr:", body);
     out.name = "expr";
@@ -291,7 +301,8 @@ absl::StatusOr<DensityFromSpec> MakeDensity(const std::string& text) {
   ASSIGN_OR_RETURN(const Spec spec, ParseSpec("density", DensityCatalog(), trimmed));
   const std::string& name = spec.entry->name;
   if (name == "expr") {
-    return absl::InvalidArgumentError("density expr needs an expression: expr:EXPRESSION, e.g. expr:u+v");
+    return absl::InvalidArgumentError(
+        "density expr needs an expression: expr:EXPRESSION, e.g. expr:u+v");
   }
   std::map<std::string, double> numbers;
   for (const CatalogParameter& p : spec.entry->parameters) {

@@ -102,7 +102,8 @@ Dual<N> operator+(const Dual<N>& a, const Dual<N>& b) {
   Dual<N> r;
   r.v = a.v + b.v;
   r.d[0] = a.d[0] + b.d[0], r.d[1] = a.d[1] + b.d[1];
-  if constexpr (N == 2) r.h[0] = a.h[0] + b.h[0], r.h[1] = a.h[1] + b.h[1], r.h[2] = a.h[2] + b.h[2];
+  if constexpr (N == 2)
+    r.h[0] = a.h[0] + b.h[0], r.h[1] = a.h[1] + b.h[1], r.h[2] = a.h[2] + b.h[2];
   return r;
 }
 
@@ -120,7 +121,8 @@ Dual<N> operator-(const Dual<N>& a, const Dual<N>& b) {
   Dual<N> r;
   r.v = a.v - b.v;
   r.d[0] = a.d[0] - b.d[0], r.d[1] = a.d[1] - b.d[1];
-  if constexpr (N == 2) r.h[0] = a.h[0] - b.h[0], r.h[1] = a.h[1] - b.h[1], r.h[2] = a.h[2] - b.h[2];
+  if constexpr (N == 2)
+    r.h[0] = a.h[0] - b.h[0], r.h[1] = a.h[1] - b.h[1], r.h[2] = a.h[2] - b.h[2];
   return r;
 }
 

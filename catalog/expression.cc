@@ -503,7 +503,9 @@ absl::StatusOr<std::vector<Instruction>> Translate(const mu::ParserByteCode& byt
     return absl::InvalidArgumentError(absl::StrFormat(
         "%s: \"%s\" could not be compiled (%s); please report this expression", what, text, why));
   };
-  auto var_index = [&](const double* p) { return p >= vars && p < vars + var_count ? p - vars : -1; };
+  auto var_index = [&](const double* p) {
+    return p >= vars && p < vars + var_count ? p - vars : -1;
+  };
   auto emit = [&](Op op, int pops, int pushes, int32_t arg = 0, double a = 0, double b = 0,
                   Fn fn = Fn::kNone) {
     code.push_back({op, fn, arg, a, b});
@@ -628,8 +630,8 @@ Expression::Expression(std::string text, std::vector<Instruction> code)
 
 Expression::~Expression() = default;
 
-absl::StatusOr<std::unique_ptr<Expression>> Expression::Compile(std::string what, std::string text,
-                                                                std::vector<std::string> variables) {
+absl::StatusOr<std::unique_ptr<Expression>> Expression::Compile(
+    std::string what, std::string text, std::vector<std::string> variables) {
   if (absl::StripAsciiWhitespace(text).empty()) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "%s is empty; write an expression%s", what,

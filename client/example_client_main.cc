@@ -15,7 +15,8 @@ int main(int argc, char** argv) {
   sfc::SampleRequest request;
   request.count = 10000;
   CLI::App app{"sfcsampler-example-client: stream samples from a server with the client library"};
-  app.add_option("--server", options.target, "host:port of an sfcsampler-server")->capture_default_str();
+  app.add_option("--server", options.target, "host:port of an sfcsampler-server")
+      ->capture_default_str();
   app.add_option("--surface", request.tree.surface, "surface spec")->capture_default_str();
   app.add_option("--density", request.tree.density, "density spec")->capture_default_str();
   app.add_option("--count", request.count, "samples in the set")->capture_default_str();
@@ -48,6 +49,7 @@ int main(int argc, char** argv) {
               request.tree.surface.c_str(), summary->header.tree().key().c_str(),
               summary->header.algorithm_version().c_str());
   std::printf("first (%.17g, %.17g, %.17g)\n", first[0], first[1], first[2]);
-  if (seen > 0) std::printf("mean (%.6f, %.6f, %.6f)\n", sum[0] / seen, sum[1] / seen, sum[2] / seen);
+  if (seen > 0)
+    std::printf("mean (%.6f, %.6f, %.6f)\n", sum[0] / seen, sum[1] / seen, sum[2] / seen);
   return 0;
 }

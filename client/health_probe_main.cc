@@ -15,7 +15,9 @@
 int main(int argc, char** argv) {
   std::string address = "127.0.0.1:50052", service;
   double timeout = 2;
-  CLI::App app{"sfcsampler-health-probe: exit 0 when the server is SERVING, 1 when not, 2 when it cannot tell"};
+  CLI::App app{
+      "sfcsampler-health-probe: exit 0 when the server is SERVING, 1 when not, 2 when it cannot "
+      "tell"};
   app.add_option("--address", address, "host:port of the health listener")->capture_default_str();
   app.add_option("--timeout", timeout, "seconds to wait for the answer")
       ->capture_default_str()
@@ -27,7 +29,8 @@ int main(int argc, char** argv) {
     // Usage errors are "cannot tell" (2), like an unreachable server.
     return app.exit(e) == 0 ? 0 : 2;
   }
-  auto stub = grpc::health::v1::Health::NewStub(grpc::CreateChannel(address, grpc::InsecureChannelCredentials()));
+  auto stub = grpc::health::v1::Health::NewStub(
+      grpc::CreateChannel(address, grpc::InsecureChannelCredentials()));
   grpc::ClientContext context;
   context.set_deadline(std::chrono::system_clock::now() +
                        std::chrono::milliseconds(static_cast<int64_t>(timeout * 1000)));
@@ -36,7 +39,8 @@ int main(int argc, char** argv) {
   grpc::health::v1::HealthCheckResponse response;
   const grpc::Status status = stub->Check(&context, request, &response);
   if (!status.ok()) {
-    std::fprintf(stderr, "health check of %s failed: %s\n", address.c_str(), status.error_message().c_str());
+    std::fprintf(stderr, "health check of %s failed: %s\n", address.c_str(),
+                 status.error_message().c_str());
     return 2;
   }
   const bool serving = response.status() == grpc::health::v1::HealthCheckResponse::SERVING;

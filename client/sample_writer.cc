@@ -81,7 +81,8 @@ const std::vector<double>& Real(const SampleBatch& b, Col c) {
 
 absl::Status WriteAll(std::FILE* f, const std::string& data) {
   if (std::fwrite(data.data(), 1, data.size(), f) != data.size()) {
-    return absl::UnavailableError(absl::StrFormat("writing the output failed: %s", std::strerror(errno)));
+    return absl::UnavailableError(
+        absl::StrFormat("writing the output failed: %s", std::strerror(errno)));
   }
   return absl::OkStatus();
 }
@@ -97,7 +98,8 @@ absl::StatusOr<std::vector<Col>> Layout(OutputFormat format, const SampleFields&
              Col::kV, Col::kIndex, Col::kDensity, Col::kCurvePosition, Col::kFace,
              Col::kTriangle};
   } else {
-    for (int c = 0; c <= static_cast<int>(Col::kTriangle); ++c) order.push_back(static_cast<Col>(c));
+    for (int c = 0; c <= static_cast<int>(Col::kTriangle); ++c)
+      order.push_back(static_cast<Col>(c));
   }
   std::vector<bool> wanted(order.size(), columns.empty());
   for (const std::string& name : columns) {
@@ -133,8 +135,8 @@ absl::StatusOr<std::vector<Col>> Layout(OutputFormat format, const SampleFields&
 
 }  // namespace
 
-SampleWriter::SampleWriter(std::FILE* out, bool owns, OutputFormat format, const SampleFields& fields,
-                           OutputPrecision precision)
+SampleWriter::SampleWriter(std::FILE* out, bool owns, OutputFormat format,
+                           const SampleFields& fields, OutputPrecision precision)
     : out_(out), owns_(owns), format_(format), fields_(fields), precision_(precision) {}
 
 absl::Status SampleWriter::CheckColumns(OutputFormat format, const SampleFields& fields,
@@ -142,7 +144,8 @@ absl::Status SampleWriter::CheckColumns(OutputFormat format, const SampleFields&
   return Layout(format, fields, columns).status();
 }
 
-SampleFields SampleWriter::SourceFields(SampleFields fields, const std::vector<std::string>& columns) {
+SampleFields SampleWriter::SourceFields(SampleFields fields,
+                                        const std::vector<std::string>& columns) {
   if (columns.empty()) return fields;
   auto named = [&](std::initializer_list<const char*> names) {
     for (const char* name : names) {
@@ -210,7 +213,8 @@ absl::StatusOr<std::unique_ptr<SampleWriter>> SampleWriter::Open(
     return absl::InvalidArgumentError(
         absl::StrFormat("cannot open \"%s\" for writing: %s", path, std::strerror(errno)));
   }
-  auto writer = std::unique_ptr<SampleWriter>(new SampleWriter(f, path != "-", format, fields, precision));
+  auto writer =
+      std::unique_ptr<SampleWriter>(new SampleWriter(f, path != "-", format, fields, precision));
   for (Col c : layout) writer->layout_.push_back(static_cast<int>(c));
   writer->expected_ = expected_count;
   if (format == OutputFormat::kCsv) {
@@ -238,7 +242,8 @@ absl::Status SampleWriter::WriteHeader(uint64_t count) {
     return WriteAll(out_, NpyHeader(count));
   }
   h = "ply\n";
-  h += format_ == OutputFormat::kPlyAscii ? "format ascii 1.0\n" : "format binary_little_endian 1.0\n";
+  h += format_ == OutputFormat::kPlyAscii ? "format ascii 1.0\n"
+                                          : "format binary_little_endian 1.0\n";
   h += "comment sfcsampler samples in curve order\n";
   h += absl::StrFormat("element vertex %d\n", count);
   const char* type = precision_ == OutputPrecision::kFloat32 ? "float" : "double";
@@ -305,7 +310,8 @@ void SampleWriter::PackBinary(const SampleBatch& b) {
   const bool npy = format_ == OutputFormat::kNpy;
   const size_t index_width = npy ? sizeof(uint64_t) : sizeof(uint32_t);
   size_t record = 0;
-  for (const Column& c : columns) record += c.real ? real : c.index ? index_width : sizeof(uint32_t);
+  for (const Column& c : columns)
+    record += c.real ? real : c.index ? index_width : sizeof(uint32_t);
   buffer_.resize(n * record);
   char* out = buffer_.data();
   size_t offset = 0;
@@ -341,7 +347,8 @@ absl::Status SampleWriter::Write(const SampleBatch& batch) {
   const bool index = std::find(layout_.begin(), layout_.end(), static_cast<int>(Col::kIndex)) !=
                      layout_.end();
   if (ply && index && !batch.index.empty() && batch.index.back() > UINT32_MAX) {
-    return absl::InvalidArgumentError("PLY stores the sample index as uint32; use CSV for indices >= 2^32");
+    return absl::InvalidArgumentError(
+        "PLY stores the sample index as uint32; use CSV for indices >= 2^32");
   }
   RETURN_IF_ERROR(WriteRows(staging_ ? staging_ : out_, batch));
   written_ += batch.size();
@@ -359,7 +366,8 @@ absl::Status SampleWriter::Finish() {
     char buf[1 << 16];
     size_t n;
     while ((n = std::fread(buf, 1, sizeof(buf), staging_)) > 0) {
-      if (std::fwrite(buf, 1, n, out_) != n) return absl::UnavailableError("writing the output failed");
+      if (std::fwrite(buf, 1, n, out_) != n)
+        return absl::UnavailableError("writing the output failed");
     }
   }
   if (std::fflush(out_) != 0) return absl::UnavailableError("flushing the output failed");

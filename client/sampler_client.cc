@@ -35,7 +35,8 @@ absl::Status CheckResumedHeader(const v1::StreamHeader& first, const v1::StreamH
                                 uint64_t received) {
   auto differs = [&](const char* what, const std::string& a, const std::string& b) {
     return absl::FailedPreconditionError(absl::StrFormat(
-        "the stream was resumed on a server whose %s is %s, but it began with %s: the samples would "
+        "the stream was resumed on a server whose %s is %s, but it began with %s: the samples "
+        "would "
         "mix two different sets, so the %d received so far are the only valid ones; restart the "
         "whole request (or pin it to servers of one release)",
         what, b, a, received));
@@ -57,7 +58,8 @@ absl::Status CheckResumedHeader(const v1::StreamHeader& first, const v1::StreamH
 SamplerClient::SamplerClient(const ClientOptions& options, std::shared_ptr<grpc::Channel> channel)
     : options_(options), channel_(std::move(channel)), stub_(v1::Sampler::NewStub(channel_)) {}
 
-absl::StatusOr<std::unique_ptr<SamplerClient>> SamplerClient::Connect(const ClientOptions& options) {
+absl::StatusOr<std::unique_ptr<SamplerClient>> SamplerClient::Connect(
+    const ClientOptions& options) {
   std::shared_ptr<grpc::ChannelCredentials> credentials;
   if (options.tls) {
     grpc::SslCredentialsOptions ssl;
@@ -97,8 +99,9 @@ void SamplerClient::Decorate(grpc::ClientContext* context, const std::string& su
   if (!options_.token.empty()) context->AddMetadata("authorization", "Bearer " + options_.token);
   context->AddMetadata("x-surface-key", surface_key);
   if (options_.deadline_seconds > 0) {
-    context->set_deadline(std::chrono::system_clock::now() +
-                          std::chrono::milliseconds(static_cast<int64_t>(options_.deadline_seconds * 1000)));
+    context->set_deadline(
+        std::chrono::system_clock::now() +
+        std::chrono::milliseconds(static_cast<int64_t>(options_.deadline_seconds * 1000)));
   }
 }
 
@@ -157,7 +160,8 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
       } else if (response.has_header()) {
         // A resumed stream must continue the same set: same tree, same
         // algorithm, same seed (a rolling upgrade could mix two sets).
-        if (absl::Status s = CheckResumedHeader(summary.header, response.header(), summary.received);
+        if (absl::Status s =
+                CheckResumedHeader(summary.header, response.header(), summary.received);
             !s.ok()) {
           callback_error = s;
           break;
@@ -195,15 +199,17 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
       // Nothing silently lost: the server says how many it sent.
       const auto& trailers = context.GetServerTrailingMetadata();
       auto it = trailers.find("x-samples-sent");
-      if (it != trailers.end() && std::to_string(this_stream) != std::string(it->second.data(), it->second.size())) {
-        return absl::DataLossError(absl::StrFormat(
-            "the server sent %s samples but %d arrived", std::string(it->second.data(), it->second.size()),
-            this_stream));
+      if (it != trailers.end() &&
+          std::to_string(this_stream) != std::string(it->second.data(), it->second.size())) {
+        return absl::DataLossError(
+            absl::StrFormat("the server sent %s samples but %d arrived",
+                            std::string(it->second.data(), it->second.size()), this_stream));
       }
       if (have_header && summary.header.expected_samples() >= 0 &&
           summary.received != static_cast<uint64_t>(summary.header.expected_samples())) {
         return absl::DataLossError(absl::StrFormat("expected %d samples, received %d",
-                                                   summary.header.expected_samples(), summary.received));
+                                                   summary.header.expected_samples(),
+                                                   summary.received));
       }
       return summary;
     }
@@ -222,9 +228,10 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
         status.error_code() == grpc::StatusCode::UNAVAILABLE || transport_reset || model_moved;
     if (!resumable || attempt >= options_.max_resumes) {
       absl::Status s = FromGrpcStatus(status);
-      return absl::Status(s.code(), absl::StrFormat("%s (received %d samples%s)", s.message(),
-                                                    summary.received,
-                                                    summary.received ? absl::StrFormat(", last index %d", last_index) : ""));
+      return absl::Status(
+          s.code(),
+          absl::StrFormat("%s (received %d samples%s)", s.message(), summary.received,
+                          summary.received ? absl::StrFormat(", last index %d", last_index) : ""));
     }
     // Resume.
     ++summary.resumes;
@@ -337,7 +344,8 @@ absl::StatusOr<std::string> SamplerClient::EnsureModel(const std::string& spec) 
   v1::ModelInfo info;
   const grpc::Status found = stub_->FindModel(&context, find, &info);
   if (found.ok()) return info.spec();
-  if (found.error_code() != grpc::StatusCode::NOT_FOUND || !local.bytes) return FromGrpcStatus(found);
+  if (found.error_code() != grpc::StatusCode::NOT_FOUND || !local.bytes)
+    return FromGrpcStatus(found);
   auto uploaded = UploadModel(find.format(), local.name, *local.bytes);
   if (!uploaded.ok()) return uploaded.status();
   return uploaded->spec();
@@ -346,8 +354,10 @@ absl::StatusOr<std::string> SamplerClient::EnsureModel(const std::string& spec) 
 absl::StatusOr<bool> SamplerClient::CheckHealth(const std::string& service) {
   auto stub = grpc::health::v1::Health::NewStub(channel_);
   grpc::ClientContext context;
-  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(
-                                                              options_.deadline_seconds > 0 ? static_cast<int>(options_.deadline_seconds) : 5));
+  context.set_deadline(std::chrono::system_clock::now() +
+                       std::chrono::seconds(options_.deadline_seconds > 0
+                                                ? static_cast<int>(options_.deadline_seconds)
+                                                : 5));
   grpc::health::v1::HealthCheckRequest request;
   request.set_service(service);
   grpc::health::v1::HealthCheckResponse response;

@@ -67,7 +67,8 @@ SurfacePoint PointFromJet(const SurfaceJet& jet, double u, double v, bool curvat
 absl::Status CheckDensityValue(double delta, double u, double v) {
   if (std::isfinite(delta) && delta >= 0) return absl::OkStatus();
   return absl::InvalidArgumentError(absl::StrFormat(
-      "the density is %g at (u,v) = (%.17g, %.17g); densities must be finite and >= 0", delta, u, v));
+      "the density is %g at (u,v) = (%.17g, %.17g); densities must be finite and >= 0", delta, u,
+      v));
 }
 
 absl::Status SurfaceNotFiniteError(double u, double v) {
@@ -90,7 +91,8 @@ absl::Status CellMassesOnGrid(const Surface& surface, const Density& density,
   if (estimator != AreaEstimator::kFirstFundamentalForm) {
     for (int i = 0; i < n; ++i) {
       for (int j = 0; j < n; ++j) {
-        ASSIGN_OR_RETURN(masses[i * n + j], CellMass(surface, density, estimator, u0 + i * h, v0 + j * h, h));
+        ASSIGN_OR_RETURN(masses[i * n + j],
+                         CellMass(surface, density, estimator, u0 + i * h, v0 + j * h, h));
       }
     }
     return absl::OkStatus();
@@ -112,7 +114,8 @@ absl::StatusOr<double> CellMass(const Surface& surface, const Density& density,
                                 AreaEstimator estimator, double u0, double v0, double h) {
   switch (estimator) {
     case AreaEstimator::kFirstFundamentalForm: {
-      ASSIGN_OR_RETURN(const DensityAt d, EvaluateDensity(surface, density, u0 + h / 2, v0 + h / 2));
+      ASSIGN_OR_RETURN(const DensityAt d,
+                       EvaluateDensity(surface, density, u0 + h / 2, v0 + h / 2));
       return d.delta * d.area_element * h * h;
     }
     case AreaEstimator::kSquare: {
@@ -120,7 +123,8 @@ absl::StatusOr<double> CellMass(const Surface& surface, const Density& density,
       ASSIGN_OR_RETURN(const Vec3 p10, FinitePoint(surface, u0 + h, v0));
       ASSIGN_OR_RETURN(const Vec3 p11, FinitePoint(surface, u0 + h, v0 + h));
       ASSIGN_OR_RETURN(const Vec3 p01, FinitePoint(surface, u0, v0 + h));
-      ASSIGN_OR_RETURN(const DensityAt d, EvaluateDensity(surface, density, u0 + h / 2, v0 + h / 2));
+      ASSIGN_OR_RETURN(const DensityAt d,
+                       EvaluateDensity(surface, density, u0 + h / 2, v0 + h / 2));
       return d.delta * (TriangleArea(p00, p10, p11) + TriangleArea(p00, p11, p01));
     }
     case AreaEstimator::kQuadrature: {

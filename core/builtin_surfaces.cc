@@ -108,9 +108,10 @@ class Sphere final : public Surface {
   }
   void JetGrid(const double* us, int nu, const double* vs, int nv, int order,
                SurfaceJet* out) const override {
-    SinCosGrid(us, nu, Same, vs, nv, Twice, out, [&](double st, double ct, double sp, double cp, SurfaceJet* j) {
-      JetFrom(st, ct, sp, cp, order, j);
-    });
+    SinCosGrid(us, nu, Same, vs, nv, Twice, out,
+               [&](double st, double ct, double sp, double cp, SurfaceJet* j) {
+                 JetFrom(st, ct, sp, cp, order, j);
+               });
   }
 
  private:
@@ -161,9 +162,10 @@ class Torus final : public Surface {
   }
   void JetGrid(const double* us, int nu, const double* vs, int nv, int order,
                SurfaceJet* out) const override {
-    SinCosGrid(us, nu, Twice, vs, nv, Twice, out, [&](double sa, double ca, double sb, double cb, SurfaceJet* j) {
-      JetFrom(sa, ca, sb, cb, order, j);
-    });
+    SinCosGrid(us, nu, Twice, vs, nv, Twice, out,
+               [&](double sa, double ca, double sb, double cb, SurfaceJet* j) {
+                 JetFrom(sa, ca, sb, cb, order, j);
+               });
   }
 
  private:

@@ -129,8 +129,8 @@ Curve::Curve(const Definition& def)
         y = y * grid_ + ch.dy;
         state = ch.state;
       }
-      chunks_[(s << chunk_shift_) + value] =
-          ChunkEntry{static_cast<uint16_t>(x), static_cast<uint16_t>(y), static_cast<uint8_t>(state)};
+      chunks_[(s << chunk_shift_) + value] = ChunkEntry{
+          static_cast<uint16_t>(x), static_cast<uint16_t>(y), static_cast<uint8_t>(state)};
     }
   }
 

@@ -74,7 +74,8 @@ inline void HilbertKeys3(size_t n, const uint32_t* x, const uint32_t* y, const u
   for (size_t base = 0; base < n; base += kLanes) {
     const size_t lanes = n - base < kLanes ? n - base : kLanes;
     uint32_t a0[kLanes] = {}, a1[kLanes] = {}, a2[kLanes] = {};
-    for (size_t j = 0; j < lanes; ++j) a0[j] = x[base + j], a1[j] = y[base + j], a2[j] = z[base + j];
+    for (size_t j = 0; j < lanes; ++j)
+      a0[j] = x[base + j], a1[j] = y[base + j], a2[j] = z[base + j];
     for (uint32_t q = m; q > 1; q >>= 1) {
       for (size_t j = 0; j < kLanes; ++j) hilbert3d_internal::UndoLevel(q, a0[j], a1[j], a2[j]);
     }

@@ -29,7 +29,9 @@ Interval Make(double lo, double hi) {
   if (std::isnan(lo) || std::isnan(hi)) return Interval::NaN();
   return Interval::Of(lo, hi);
 }
-Interval LibMake(double a, double b) { return Make(LibDown(std::min(a, b)), LibUp(std::max(a, b))); }
+Interval LibMake(double a, double b) {
+  return Make(LibDown(std::min(a, b)), LibUp(std::max(a, b)));
+}
 
 bool HasInf(const Interval& x) { return std::isinf(x.lo) || std::isinf(x.hi); }
 bool HasZero(const Interval& x) { return x.lo <= 0 && x.hi >= 0; }

@@ -5,11 +5,11 @@
 // in ordinary round-to-nearest double arithmetic with the C library, yields
 // for any inputs inside the input intervals; for the continuous operations it
 // also encloses the exact real result (rint, sign and the comparisons enclose
-// what the double code computes, which is what sampling needs). Each operation computes its end points in round-to-nearest and then
-// widens them outward: one ulp (std::nextafter) after the correctly rounded
-// operations (+ - * / sqrt), and a relative margin of kLibmMargin after C
-// library functions, whose results glibc documents to within a few ulp and
-// which need not be monotone to the last bit.
+// what the double code computes, which is what sampling needs). Each operation computes its end
+// points in round-to-nearest and then widens them outward: one ulp (std::nextafter) after the
+// correctly rounded operations (+ - * / sqrt), and a relative margin of kLibmMargin after C library
+// functions, whose results glibc documents to within a few ulp and which need not be monotone to
+// the last bit.
 //
 // NaN is tracked explicitly: `maybe_nan` says the computation may yield NaN
 // (sqrt of a negative, 0 * inf, inf - inf, sin(inf), pow of a negative to a

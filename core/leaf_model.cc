@@ -107,7 +107,8 @@ void ComputeGridFactors(const LeafModel& model, LeafModel::Kind kind, int grid, 
         for (int b = 0; b < 3; ++b) f[axis][b][k] = basis[b];
       } else {
         const double piece = 1.0 / grid;
-        for (int b = 0; b < grid; ++b) f[axis][b][k] = Overlap(edge[k], edge[k + 1], b * piece, (b + 1) * piece);
+        for (int b = 0; b < grid; ++b)
+          f[axis][b][k] = Overlap(edge[k], edge[k + 1], b * piece, (b + 1) * piece);
       }
     }
   }
@@ -115,7 +116,8 @@ void ComputeGridFactors(const LeafModel& model, LeafModel::Kind kind, int grid, 
     for (int i = 0; i < n; ++i) out->x[a][i] = f[0][a][i];
     for (int j = 0; j < n; ++j) {
       double sum = 0;
-      for (int b = 0; b < factors; ++b) sum += static_cast<double>(model.c[a * factors + b]) * f[1][b][j];
+      for (int b = 0; b < factors; ++b)
+        sum += static_cast<double>(model.c[a * factors + b]) * f[1][b][j];
       out->row[a][j] = sum;
     }
   }

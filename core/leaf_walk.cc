@@ -72,7 +72,8 @@ int LeafWalk::TableLevels(double carried, int depth) const {
   if (!(carried >= (depth == 0 ? kNegligibleSamples : kTableSamples))) return 0;
   const int most = std::min(curve_.table_levels(), kMaxModelLevels - depth);
   int levels = 1;
-  while (levels < most && carried > kCellSamples * static_cast<double>(curve_.PowW(levels))) ++levels;
+  while (levels < most && carried > kCellSamples * static_cast<double>(curve_.PowW(levels)))
+    ++levels;
   return std::max(0, std::min(levels, most));
 }
 
@@ -202,11 +203,13 @@ void LeafWalk::Continue(size_t n) {
         static_cast<uint64_t>(static_cast<int64_t>(tr * static_cast<double>(scale))), scale - 1);
     states_[i] = static_cast<uint64_t>(at.state);
   }
-  curve_.DescendMany(digits_.data(), continuation_levels_, n, states_.data(), cx_.data(), cy_.data());
+  curve_.DescendMany(digits_.data(), continuation_levels_, n, states_.data(), cx_.data(),
+                     cy_.data());
   for (size_t i = 0; i < n; ++i) {
     const Square& at = reached_[reached_of_[i]];
     // For Hilbert the division is by 2^26: a multiplication, with the same bits.
-    const double cell = cells_power_of_two_ ? at.side * inverse_cells_ : at.side / continuation_cells_;
+    const double cell =
+        cells_power_of_two_ ? at.side * inverse_cells_ : at.side / continuation_cells_;
     const double x = static_cast<double>(static_cast<int64_t>(cx_[i]));
     const double y = static_cast<double>(static_cast<int64_t>(cy_[i]));
     double px = at.x0 + (x + 0.5) * cell, py = at.y0 + (y + 0.5) * cell;

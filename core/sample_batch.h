@@ -38,8 +38,11 @@ struct SampleBatch {
   using ValueColumn = std::vector<double> SampleBatch::*;
   static const std::array<ValueColumn, 10>& ValueColumns() {
     static constexpr std::array<ValueColumn, 10> kColumns = {
-        &SampleBatch::u,  &SampleBatch::v,  &SampleBatch::x,  &SampleBatch::y,       &SampleBatch::z,
-        &SampleBatch::nx, &SampleBatch::ny, &SampleBatch::nz, &SampleBatch::density, &SampleBatch::curve_position};
+        &SampleBatch::u,       &SampleBatch::v,
+        &SampleBatch::x,       &SampleBatch::y,
+        &SampleBatch::z,       &SampleBatch::nx,
+        &SampleBatch::ny,      &SampleBatch::nz,
+        &SampleBatch::density, &SampleBatch::curve_position};
     return kColumns;
   }
 

@@ -66,9 +66,9 @@ class Surface {
   // A box that provably holds Point(u, v) for every (u, v) in the rectangle
   // [u0,u1] x [v0,v1], as Point computes it in floating point (and as Jet's p,
   // which equals it), and the exact real value of the same formula too:
-  // interval arithmetic widened for rounding (core/interval.h). nullopt when the surface cannot bound
-  // itself, which is the default; callers then test points one by one.
-  // REQUIRES: 0 <= u0 <= u1 <= 1 and 0 <= v0 <= v1 <= 1.
+  // interval arithmetic widened for rounding (core/interval.h). nullopt when the surface cannot
+  // bound itself, which is the default; callers then test points one by one. REQUIRES: 0 <= u0 <=
+  // u1 <= 1 and 0 <= v0 <= v1 <= 1.
   virtual std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const;
 };
 

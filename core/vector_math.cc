@@ -22,7 +22,8 @@ VectorPath Detect() {
   const char* name = std::getenv("SFCSAMPLER_VECTOR_PATH");
   if (name == nullptr) return widest;
   for (VectorPath path : {VectorPath::kScalar, VectorPath::kSse2, VectorPath::kAvx}) {
-    if (VectorPathName(path) == name && static_cast<int>(path) <= static_cast<int>(widest)) return path;
+    if (VectorPathName(path) == name && static_cast<int>(path) <= static_cast<int>(widest))
+      return path;
   }
   return widest;
 }

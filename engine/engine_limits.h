@@ -11,7 +11,8 @@ namespace sfc {
 
 struct EngineLimits {
   uint64_t max_count = 100'000'000;              // largest N
-  uint64_t max_tree_leaves = uint64_t{1} << 22;  // per tree: 73 B a leaf (CurveTree::kBytesPerLeaf), 292 MiB
+  uint64_t max_tree_leaves = uint64_t{1}
+                             << 22;  // per tree: 73 B a leaf (CurveTree::kBytesPerLeaf), 292 MiB
   size_t max_spec_length = 4096;                 // surface/density spec, in characters
   int generation_threads = 1;                    // threads filling one stream's large batches
   // Sequences that are not monotone in k are sorted into curve order per

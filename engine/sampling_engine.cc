@@ -14,9 +14,9 @@ absl::Status CheckColumn(const SurfaceKinds& kinds, const SurfaceKind* kind, boo
                          const char* column) {
   if (kind && kind->info().*fills) return absl::OkStatus();
   const SurfaceKind* filling = kinds.Find([fills](const KindInfo& i) { return i.*fills; });
-  return absl::InvalidArgumentError(
-      absl::StrFormat("the %s column needs %s", column,
-                      filling ? filling->info().what : "a kind of surface this build does not have"));
+  return absl::InvalidArgumentError(absl::StrFormat(
+      "the %s column needs %s", column,
+      filling ? filling->info().what : "a kind of surface this build does not have"));
 }
 
 }  // namespace
@@ -104,8 +104,9 @@ absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint6
     }
   }
   ASSIGN_OR_RETURN(const SpecKind found, KindOf(spec.surface));
-  ASSIGN_OR_RETURN(ResolvedSurface resolved,
-                   found.kind->Resolve(spec, found.model ? &*found.model : nullptr, Context(caller)));
+  ASSIGN_OR_RETURN(
+      ResolvedSurface resolved,
+      found.kind->Resolve(spec, found.model ? &*found.model : nullptr, Context(caller)));
   PreparedTree prepared;
   prepared.key = std::move(resolved.key);
   prepared.grade = CurveTree::GradeFor(count);
@@ -154,7 +155,8 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
   if (request.fields.face || request.fields.triangle) {
     ASSIGN_OR_RETURN(const std::optional<ModelSpec> model, ParseModelSpec(request.tree.surface));
     const SurfaceKind* kind = kinds_.For(model);
-    if (request.fields.face) RETURN_IF_ERROR(CheckColumn(kinds_, kind, &KindInfo::face_column, "face"));
+    if (request.fields.face)
+      RETURN_IF_ERROR(CheckColumn(kinds_, kind, &KindInfo::face_column, "face"));
     if (request.fields.triangle) {
       RETURN_IF_ERROR(CheckColumn(kinds_, kind, &KindInfo::triangle_column, "triangle"));
     }
@@ -177,9 +179,10 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
   cursor.region = request.region;
   cursor.fields = request.fields;
   cursor.threads = limits_.generation_threads;
-  ASSIGN_OR_RETURN(job.cursor,
-                   job.tree.open_cursor(job.tree.lookup,
-                                        Sequence(request.sequence, request.count, request.seed), cursor));
+  ASSIGN_OR_RETURN(
+      job.cursor,
+      job.tree.open_cursor(job.tree.lookup, Sequence(request.sequence, request.count, request.seed),
+                           cursor));
   return job;
 }
 

@@ -61,7 +61,8 @@ NearestNeighbour PlaneNearestNeighbour(const std::vector<Point2>& points) {
 }
 
 NearestNeighbour SphereNearestNeighbour(const std::vector<Vec3>& points) {
-  return Stats(points, SphereSpacing(points.size()), [](const Vec3& a, const Vec3& b) { return Norm(a - b); });
+  return Stats(points, SphereSpacing(points.size()),
+               [](const Vec3& a, const Vec3& b) { return Norm(a - b); });
 }
 
 std::vector<Point2> ScrambledSobolSquare(uint64_t n, uint64_t seed) {
@@ -69,7 +70,8 @@ std::vector<Point2> ScrambledSobolSquare(uint64_t n, uint64_t seed) {
   std::mt19937_64 rng(seed);
   const uint32_t sx = static_cast<uint32_t>(rng()), sy = static_cast<uint32_t>(rng());
   for (Point2& q : p) {
-    const uint32_t x = static_cast<uint32_t>(q.x * 0x1.0p32), y = static_cast<uint32_t>(q.y * 0x1.0p32);
+    const uint32_t x = static_cast<uint32_t>(q.x * 0x1.0p32),
+                   y = static_cast<uint32_t>(q.y * 0x1.0p32);
     // Bits below 2^-32 are random too (the scramble's last level).
     q.x = (OwenScramble(x, sx) + 0.5) * 0x1.0p-32;
     q.y = (OwenScramble(y, sy) + 0.5) * 0x1.0p-32;
@@ -95,7 +97,8 @@ std::vector<Point2> DartThrowingSquare(uint64_t n, double radius, uint64_t seed)
   std::vector<Point2> out;
   for (uint64_t tries = 0; out.size() < n && tries < 1000 * n; ++tries) {
     const Point2 c{uni(rng), uni(rng)};
-    const int ci = std::min(g - 1, static_cast<int>(c.x * g)), cj = std::min(g - 1, static_cast<int>(c.y * g));
+    const int ci = std::min(g - 1, static_cast<int>(c.x * g)),
+              cj = std::min(g - 1, static_cast<int>(c.y * g));
     bool ok = true;
     for (int i = std::max(0, ci - 1); ok && i <= std::min(g - 1, ci + 1); ++i) {
       for (int j = std::max(0, cj - 1); ok && j <= std::min(g - 1, cj + 1); ++j) {
@@ -119,14 +122,16 @@ std::vector<Vec3> DartThrowingSphere(uint64_t n, double radius, uint64_t seed) {
   std::vector<std::vector<int>> grid(static_cast<size_t>(g) * g * g);
   std::vector<Vec3> out;
   for (uint64_t tries = 0; out.size() < n && tries < 1000 * n; ++tries) {
-    const double z = 1 - 2 * uni(rng), phi = 2 * kPi * uni(rng), s = std::sqrt(std::max(0.0, 1 - z * z));
+    const double z = 1 - 2 * uni(rng), phi = 2 * kPi * uni(rng),
+                 s = std::sqrt(std::max(0.0, 1 - z * z));
     const Vec3 c{s * std::cos(phi), s * std::sin(phi), z};
     const int ci = cell(c.x), cj = cell(c.y), ck = cell(c.z);
     bool ok = true;
     for (int i = std::max(0, ci - 1); ok && i <= std::min(g - 1, ci + 1); ++i) {
       for (int j = std::max(0, cj - 1); ok && j <= std::min(g - 1, cj + 1); ++j) {
         for (int k = std::max(0, ck - 1); ok && k <= std::min(g - 1, ck + 1); ++k) {
-          for (int p : grid[(static_cast<size_t>(i) * g + j) * g + k]) ok = ok && Norm(out[p] - c) >= r;
+          for (int p : grid[(static_cast<size_t>(i) * g + j) * g + k])
+            ok = ok && Norm(out[p] - c) >= r;
         }
       }
     }

@@ -32,7 +32,8 @@ double MassDensity(const Density& density, bool curvature, const SurfaceJet& jet
 
 // Distance from [a, b] to the nearest line, and which end is nearer; 0 when
 // the cell touches a line.
-double NearDistance(double a, double b, const std::vector<double>& lines, double* line, bool* at_left) {
+double NearDistance(double a, double b, const std::vector<double>& lines, double* line,
+                    bool* at_left) {
   double best = INFINITY;
   for (double l : lines) {
     const double d = l <= a ? a - l : l >= b ? l - b : 0;
@@ -42,7 +43,8 @@ double NearDistance(double a, double b, const std::vector<double>& lines, double
 }
 
 // The sorted, graded breakpoints of one axis.
-std::vector<double> Breakpoints(std::vector<double> x, const std::vector<double>& lines, int background) {
+std::vector<double> Breakpoints(std::vector<double> x, const std::vector<double>& lines,
+                                int background) {
   x.push_back(0);
   x.push_back(1);
   for (int k = 1; k < background; ++k) x.push_back(static_cast<double>(k) / background);
@@ -144,7 +146,8 @@ absl::StatusOr<SingularLines> DetectSingularLines(const Surface& surface, const 
           const double m7 = at(1e-7), m5 = at(1e-5), m3 = at(1e-3);
           // The local exponent on two scales; a line further than ~1e-5
           // away (a neighbouring candidate's) shows on one scale only.
-          const double fine = std::log(m7 / m5) / std::log(1e-2), coarse = std::log(m5 / m3) / std::log(1e-2);
+          const double fine = std::log(m7 / m5) / std::log(1e-2),
+                       coarse = std::log(m5 / m3) / std::log(1e-2);
           if (!std::isfinite(fine) || !std::isfinite(coarse)) continue;
           if (std::fabs(fine) > 0.1 && std::fabs(coarse) > 0.1 && fine * coarse > 0 &&
               std::fabs(fine - coarse) < 0.5 * std::max(std::fabs(fine), std::fabs(coarse))) {
@@ -159,10 +162,9 @@ absl::StatusOr<SingularLines> DetectSingularLines(const Surface& surface, const 
   return out;
 }
 
-absl::StatusOr<GradedBoxMeasure> GradedBoxMeasure::Build(const Surface& surface, const Density& density,
-                                                         const SingularLines& lines,
-                                                         std::vector<double> u_breaks,
-                                                         std::vector<double> v_breaks, int background) {
+absl::StatusOr<GradedBoxMeasure> GradedBoxMeasure::Build(
+    const Surface& surface, const Density& density, const SingularLines& lines,
+    std::vector<double> u_breaks, std::vector<double> v_breaks, int background) {
   GradedBoxMeasure g;
   g.u_ = Breakpoints(std::move(u_breaks), lines.u, background);
   g.v_ = Breakpoints(std::move(v_breaks), lines.v, background);
@@ -225,7 +227,8 @@ size_t GradedBoxMeasure::VIndex(double x) const {
   return std::lower_bound(v_.begin(), v_.end(), x) - v_.begin();
 }
 
-absl::StatusOr<BoxDiscrepancy> SampleAnchoredBoxDiscrepancy(const Surface& surface, const Density& density,
+absl::StatusOr<BoxDiscrepancy> SampleAnchoredBoxDiscrepancy(const Surface& surface,
+                                                            const Density& density,
                                                             const SingularLines& lines,
                                                             const std::vector<Point2>& uv,
                                                             const BoxDiscrepancyOptions& options) {
@@ -250,7 +253,8 @@ absl::StatusOr<BoxDiscrepancy> SampleAnchoredBoxDiscrepancy(const Surface& surfa
     return c;
   };
   std::vector<double> cu = corners(us), cv = corners(vs);
-  auto measure = GradedBoxMeasure::Build(surface, density, lines, std::move(cu), std::move(cv), options.background);
+  auto measure = GradedBoxMeasure::Build(surface, density, lines, std::move(cu), std::move(cv),
+                                         options.background);
   if (!measure.ok()) return measure.status();
   const std::vector<double>& bu = measure->u();
   const std::vector<double>& bv = measure->v();
@@ -259,12 +263,15 @@ absl::StatusOr<BoxDiscrepancy> SampleAnchoredBoxDiscrepancy(const Surface& surfa
   std::vector<int64_t> count((nu + 1) * (nv + 1), 0);
   auto c_at = [&](size_t i, size_t j) -> int64_t& { return count[i * (nv + 1) + j]; };
   for (const Point2& p : uv) {
-    const size_t i = std::min(nu - 1, static_cast<size_t>(std::upper_bound(bu.begin(), bu.end(), p.x) - bu.begin()) - 1);
-    const size_t j = std::min(nv - 1, static_cast<size_t>(std::upper_bound(bv.begin(), bv.end(), p.y) - bv.begin()) - 1);
+    const size_t i = std::min(
+        nu - 1, static_cast<size_t>(std::upper_bound(bu.begin(), bu.end(), p.x) - bu.begin()) - 1);
+    const size_t j = std::min(
+        nv - 1, static_cast<size_t>(std::upper_bound(bv.begin(), bv.end(), p.y) - bv.begin()) - 1);
     ++c_at(i + 1, j + 1);
   }
   for (size_t i = 1; i <= nu; ++i) {
-    for (size_t j = 1; j <= nv; ++j) c_at(i, j) += c_at(i - 1, j) + c_at(i, j - 1) - c_at(i - 1, j - 1);
+    for (size_t j = 1; j <= nv; ++j)
+      c_at(i, j) += c_at(i - 1, j) + c_at(i, j - 1) - c_at(i - 1, j - 1);
   }
   const double total = measure->total();
   BoxDiscrepancy best;

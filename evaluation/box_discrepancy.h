@@ -57,7 +57,8 @@ class GradedBoxMeasure {
   // values in [0,1]), and integrates every cell. Errors: INVALID_ARGUMENT if
   // delta dA is not finite or negative at a quadrature node.
   static absl::StatusOr<GradedBoxMeasure> Build(const Surface& surface, const Density& density,
-                                                const SingularLines& lines, std::vector<double> u_breaks,
+                                                const SingularLines& lines,
+                                                std::vector<double> u_breaks,
                                                 std::vector<double> v_breaks, int background = 128);
 
   // Sorted breakpoints, first 0, last 1.
@@ -95,11 +96,9 @@ struct BoxDiscrepancy {
 // grid point as the opposite one (4 x grid points), and `random_boxes` boxes
 // with random grid sides. Cost: the cells' quadrature, ~(6.5 K)^2 evaluations
 // for K cells an axis, plus O(N log K + K^2).
-absl::StatusOr<BoxDiscrepancy> SampleAnchoredBoxDiscrepancy(const Surface& surface,
-                                                            const Density& density,
-                                                            const SingularLines& lines,
-                                                            const std::vector<Point2>& uv,
-                                                            const BoxDiscrepancyOptions& options = {});
+absl::StatusOr<BoxDiscrepancy> SampleAnchoredBoxDiscrepancy(
+    const Surface& surface, const Density& density, const SingularLines& lines,
+    const std::vector<Point2>& uv, const BoxDiscrepancyOptions& options = {});
 
 }  // namespace sfc
 

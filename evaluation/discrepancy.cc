@@ -57,7 +57,8 @@ double StarDiscrepancy(const std::vector<Point2>& points, int max_corners) {
 
   std::vector<size_t> by_x(n);
   for (size_t i = 0; i < n; ++i) by_x[i] = i;
-  std::sort(by_x.begin(), by_x.end(), [&](size_t a, size_t b) { return points[a].x < points[b].x; });
+  std::sort(by_x.begin(), by_x.end(),
+            [&](size_t a, size_t b) { return points[a].x < points[b].x; });
   auto y_rank = [&](size_t i) {
     return static_cast<size_t>(std::lower_bound(ys_sorted.begin(), ys_sorted.end(), points[i].y) -
                                ys_sorted.begin());
@@ -65,15 +66,18 @@ double StarDiscrepancy(const std::vector<Point2>& points, int max_corners) {
   // For each b: the rank ranges of y < b and y <= b.
   std::vector<size_t> below(b_corners.size()), at_or_below(b_corners.size());
   for (size_t j = 0; j < b_corners.size(); ++j) {
-    below[j] = std::lower_bound(ys_sorted.begin(), ys_sorted.end(), b_corners[j]) - ys_sorted.begin();
-    at_or_below[j] = std::upper_bound(ys_sorted.begin(), ys_sorted.end(), b_corners[j]) - ys_sorted.begin();
+    below[j] =
+        std::lower_bound(ys_sorted.begin(), ys_sorted.end(), b_corners[j]) - ys_sorted.begin();
+    at_or_below[j] =
+        std::upper_bound(ys_sorted.begin(), ys_sorted.end(), b_corners[j]) - ys_sorted.begin();
   }
   Fenwick open(n), closed(n);  // points with x < a, and with x <= a
   size_t next_open = 0, next_closed = 0;
   double worst = 0;
   for (double a : a_corners) {
     while (next_open < n && points[by_x[next_open]].x < a) open.Add(y_rank(by_x[next_open++]));
-    while (next_closed < n && points[by_x[next_closed]].x <= a) closed.Add(y_rank(by_x[next_closed++]));
+    while (next_closed < n && points[by_x[next_closed]].x <= a)
+      closed.Add(y_rank(by_x[next_closed++]));
     for (size_t j = 0; j < b_corners.size(); ++j) {
       const double area = a * b_corners[j];
       const double inside_open = static_cast<double>(open.Prefix(below[j])) / n;
@@ -140,7 +144,8 @@ double TriangleDiscrepancy(const std::vector<Point2>& points, int grid) {
     int64_t inside = 0;
     for (int j = 0; j < grid; ++j) {
       inside += histogram[j];
-      worst = std::max(worst, std::fabs(static_cast<double>(inside) / n - AnchoredTriangleArea(a, values[j])));
+      worst = std::max(
+          worst, std::fabs(static_cast<double>(inside) / n - AnchoredTriangleArea(a, values[j])));
     }
   }
   return worst;

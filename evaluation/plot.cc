@@ -28,7 +28,9 @@ void Draw(cairo_t* cr, double width, double height, const std::map<std::string, 
   if (y1 <= y0) y1 = y0 + 1;
   const double left = 70, right = 200, top = 40, bottom = 50;
   auto px = [&](double x) { return left + (x - x0) / (x1 - x0) * (width - left - right); };
-  auto py = [&](double y) { return height - bottom - (y - y0) / (y1 - y0) * (height - top - bottom); };
+  auto py = [&](double y) {
+    return height - bottom - (y - y0) / (y1 - y0) * (height - top - bottom);
+  };
 
   cairo_set_source_rgb(cr, 1, 1, 1);
   cairo_paint(cr);
@@ -99,9 +101,11 @@ absl::Status PlotDiscrepancy(const std::vector<ProtocolRow>& rows, const std::st
                                      : measure == "triangular" ? r.triangular
                                      : measure == "density"    ? r.density
                                                                : r.spherical;
-    if (d && *d > 0) series[r.method].points.push_back({std::log10(static_cast<double>(r.n)), std::log10(*d)});
+    if (d && *d > 0)
+      series[r.method].points.push_back({std::log10(static_cast<double>(r.n)), std::log10(*d)});
   }
-  if (series.empty()) return absl::InvalidArgumentError("nothing to plot for " + domain + " " + measure);
+  if (series.empty())
+    return absl::InvalidArgumentError("nothing to plot for " + domain + " " + measure);
   for (auto& [name, s] : series) std::sort(s.points.begin(), s.points.end());
   const double width = 800, height = 560;
   const std::string title = absl::StrFormat("%s discrepancy (%s)", measure, domain);

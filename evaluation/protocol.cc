@@ -120,12 +120,14 @@ constexpr SurfaceCase kSurfaceCases[] = {
 
 // i.i.d. points with density proportional to delta dA, by rejection: the
 // baseline that should give a slope of -1/2.
-absl::StatusOr<std::vector<Point2>> RandomWithDensity(const Surface& surface, const Density& density,
-                                                      uint64_t n, uint64_t seed) {
+absl::StatusOr<std::vector<Point2>> RandomWithDensity(const Surface& surface,
+                                                      const Density& density, uint64_t n,
+                                                      uint64_t seed) {
   double peak = 0;
   for (int i = 0; i < 64; ++i) {
     for (int j = 0; j < 64; ++j) {
-      ASSIGN_OR_RETURN(const DensityAt d, EvaluateDensity(surface, density, (i + 0.5) / 64, (j + 0.5) / 64));
+      ASSIGN_OR_RETURN(const DensityAt d,
+                       EvaluateDensity(surface, density, (i + 0.5) / 64, (j + 0.5) / 64));
       peak = std::max(peak, d.delta * d.area_element);
     }
   }
@@ -155,8 +157,8 @@ const std::vector<std::string>& SphereMethods() {
   return *k;
 }
 
-absl::StatusOr<std::vector<ProtocolRow>> RunProtocol(const ProtocolOptions& options,
-                                                     const std::function<void(int, int)>& progress) {
+absl::StatusOr<std::vector<ProtocolRow>> RunProtocol(
+    const ProtocolOptions& options, const std::function<void(int, int)>& progress) {
   if (options.l_min < 1 || options.l_max < options.l_min || options.l_max > 22) {
     return absl::InvalidArgumentError("sizes need 1 <= l_min <= l_max <= 22");
   }
@@ -183,7 +185,8 @@ absl::StatusOr<std::vector<ProtocolRow>> RunProtocol(const ProtocolOptions& opti
   for (const std::string& method : plane) {
     std::unique_ptr<OurSampler> ours;
     auto on_square = [&](CurveType curve) {
-      return std::make_unique<OurSampler>(unit_square, CurveOptions(curve, AreaEstimator::kFirstFundamentalForm),
+      return std::make_unique<OurSampler>(unit_square,
+                                          CurveOptions(curve, AreaEstimator::kFirstFundamentalForm),
                                           uniform, "plane", "uniform", options.our_sets);
     };
     if (method == "hilbert-jittered") ours = on_square(CurveType::kHilbert);
@@ -222,8 +225,8 @@ absl::StatusOr<std::vector<ProtocolRow>> RunProtocol(const ProtocolOptions& opti
   for (const std::string& method : sphere) {
     std::unique_ptr<OurSampler> ours;
     auto on_sphere = [&](AreaEstimator estimator) {
-      return std::make_unique<OurSampler>(unit_sphere, CurveOptions(CurveType::kHilbert, estimator), uniform,
-                                          "sphere", "uniform", options.our_sets);
+      return std::make_unique<OurSampler>(unit_sphere, CurveOptions(CurveType::kHilbert, estimator),
+                                          uniform, "sphere", "uniform", options.our_sets);
     };
     if (method == "hilbert-jittered-fff") ours = on_sphere(AreaEstimator::kFirstFundamentalForm);
     if (method == "hilbert-jittered-triangle") ours = on_sphere(AreaEstimator::kTriangle);
@@ -270,7 +273,8 @@ absl::StatusOr<std::vector<ProtocolRow>> RunProtocol(const ProtocolOptions& opti
       auto cell_mass = [&](double u0, double v0, double) {
         return cells[std::lround(u0 * kGrid) * kGrid + std::lround(v0 * kGrid)];
       };
-      OurSampler ours(surface.surface, CurveOptions(CurveType::kHilbert, AreaEstimator::kFirstFundamentalForm),
+      OurSampler ours(surface.surface,
+                      CurveOptions(CurveType::kHilbert, AreaEstimator::kFirstFundamentalForm),
                       density.density, c.surface, c.density, options.our_sets);
       const std::vector<uint64_t> case_sizes = c.l_min ? Sizes(c.l_min, c.l_max) : sizes;
       for (const char* method : {"random", "hilbert-jittered"}) {
@@ -279,7 +283,8 @@ absl::StatusOr<std::vector<ProtocolRow>> RunProtocol(const ProtocolOptions& opti
           const auto start = std::chrono::steady_clock::now();
           std::vector<Point2> pts;
           if (std::string(method) == "random") {
-            ASSIGN_OR_RETURN(pts, RandomWithDensity(*surface.surface, *density.density, n, options.seed));
+            ASSIGN_OR_RETURN(
+                pts, RandomWithDensity(*surface.surface, *density.density, n, options.seed));
           } else {
             ASSIGN_OR_RETURN(const SampleBatch b, ours.Sample(n, options.seed));
             for (size_t i = 0; i < b.size(); ++i) pts.push_back({b.u[i], b.v[i]});
@@ -288,7 +293,8 @@ absl::StatusOr<std::vector<ProtocolRow>> RunProtocol(const ProtocolOptions& opti
           row.domain = domain;
           row.method = method;
           row.n = n;
-          row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+          row.seconds =
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
           row.density = ParameterRectDiscrepancy(pts, cell_mass, kGrid);
           rows.push_back(row);
         }
@@ -337,7 +343,9 @@ std::vector<SlopeRow> Slopes(const std::vector<ProtocolRow>& rows) {
 
 std::string RowsCsv(const std::vector<ProtocolRow>& rows) {
   std::string out = "domain,method,n,rectangular,circular,triangular,spherical,density,seconds\n";
-  auto cell = [](const std::optional<double>& d) { return d ? absl::StrFormat("%.6g", *d) : std::string(); };
+  auto cell = [](const std::optional<double>& d) {
+    return d ? absl::StrFormat("%.6g", *d) : std::string();
+  };
   for (const ProtocolRow& r : rows) {
     absl::StrAppend(&out, r.domain, ",", r.method, ",", r.n, ",", cell(r.rectangular), ",",
                     cell(r.circular), ",", cell(r.triangular), ",", cell(r.spherical), ",",
@@ -348,7 +356,8 @@ std::string RowsCsv(const std::vector<ProtocolRow>& rows) {
 }
 
 std::string SlopeTables(const std::vector<SlopeRow>& slopes) {
-  auto find = [&](const std::string& domain, const std::string& method, const std::string& measure) -> const SlopeRow* {
+  auto find = [&](const std::string& domain, const std::string& method,
+                  const std::string& measure) -> const SlopeRow* {
     for (const SlopeRow& s : slopes) {
       if (s.domain == domain && s.method == method && s.measure == measure) return &s;
     }
@@ -356,27 +365,35 @@ std::string SlopeTables(const std::vector<SlopeRow>& slopes) {
   };
   auto cell = [](const SlopeRow* s) {
     if (!s) return std::string("");
-    return s->paper ? absl::StrFormat("%.2f (paper %.2f)", s->slope, *s->paper) : absl::StrFormat("%.2f", s->slope);
+    return s->paper ? absl::StrFormat("%.2f (paper %.2f)", s->slope, *s->paper)
+                    : absl::StrFormat("%.2f", s->slope);
   };
   std::string out = "Plane, slope of log D against log N (ours, paper Table 1):\n\n"
                     "| method | rectangular | circular | triangular |\n|---|---:|---:|---:|\n";
   std::vector<std::string> seen;
   for (const SlopeRow& s : slopes) {
-    if (s.domain != "plane" || std::find(seen.begin(), seen.end(), s.method) != seen.end()) continue;
+    if (s.domain != "plane" || std::find(seen.begin(), seen.end(), s.method) != seen.end())
+      continue;
     seen.push_back(s.method);
-    absl::StrAppend(&out, "| ", s.method, " | ", cell(find("plane", s.method, "rectangular")), " | ",
-                    cell(find("plane", s.method, "circular")), " | ",
+    absl::StrAppend(&out, "| ", s.method, " | ", cell(find("plane", s.method, "rectangular")),
+                    " | ", cell(find("plane", s.method, "circular")), " | ",
                     cell(find("plane", s.method, "triangular")), " |\n");
   }
-  absl::StrAppend(&out, "\nSphere, spherical triangles (ours, paper Table 2):\n\n| method | spherical |\n|---|---:|\n");
+  absl::StrAppend(&out,
+                  "\nSphere, spherical triangles (ours, paper Table 2):\n\n| method | spherical "
+                  "|\n|---|---:|\n");
   for (const SlopeRow& s : slopes) {
     if (s.domain == "sphere") absl::StrAppend(&out, "| ", s.method, " | ", cell(&s), " |\n");
   }
-  absl::StrAppend(&out, "\nOther surfaces, density discrepancy over parameter rectangles (not in the paper):\n\n"
-                        "| surface and density | random (i.i.d. by the density) | hilbert-jittered |\n|---|---:|---:|\n");
+  absl::StrAppend(
+      &out,
+      "\nOther surfaces, density discrepancy over parameter rectangles (not in the paper):\n\n"
+      "| surface and density | random (i.i.d. by the density) | hilbert-jittered "
+      "|\n|---|---:|---:|\n");
   std::vector<std::string> domains;
   for (const SlopeRow& s : slopes) {
-    if (s.measure == "density" && std::find(domains.begin(), domains.end(), s.domain) == domains.end()) {
+    if (s.measure == "density" &&
+        std::find(domains.begin(), domains.end(), s.domain) == domains.end()) {
       domains.push_back(s.domain);
     }
   }

@@ -51,8 +51,9 @@ double SuperellipsoidExponent(const std::string& spec, bool* plain) {
   if (at == std::string::npos) return 1.0 / 3;
   const std::string value = spec.substr(at + 2, spec.find(';', at) - at - 2);
   const size_t slash = value.find('/');
-  return slash == std::string::npos ? std::stod(value)
-                                    : std::stod(value.substr(0, slash)) / std::stod(value.substr(slash + 1));
+  return slash == std::string::npos
+             ? std::stod(value)
+             : std::stod(value.substr(0, slash)) / std::stod(value.substr(slash + 1));
 }
 
 class Runner {
@@ -81,17 +82,19 @@ class Runner {
   void Log(const std::string& line) {
     if (o_.progress) o_.progress(line);
   }
-  void Check(std::string name, std::string measured, std::string target, bool pass, bool judged = true) {
+  void Check(std::string name, std::string measured, std::string target, bool pass,
+             bool judged = true) {
     report.checks.push_back({std::move(name), std::move(measured), std::move(target),
                              !judged ? "INFO" : pass ? "PASS" : "FAIL"});
   }
   void Out(const std::string& text) { absl::StrAppend(&report.tables, text); }
 
-  absl::StatusOr<SampleBatch> Sample(const std::string& surface, const std::string& density, uint64_t n,
-                                     uint64_t seed) {
+  absl::StatusOr<SampleBatch> Sample(const std::string& surface, const std::string& density,
+                                     uint64_t n, uint64_t seed) {
     ASSIGN_OR_RETURN(SampleBatch b, source_(surface, density, n, seed));
     if (b.size() != n) {
-      return absl::InternalError(absl::StrFormat("%s: asked for %d samples, got %d", surface, n, b.size()));
+      return absl::InternalError(
+          absl::StrFormat("%s: asked for %d samples, got %d", surface, n, b.size()));
     }
     return b;
   }
@@ -114,19 +117,28 @@ class Runner {
     };
     const std::vector<uint64_t> sizes = o_.full ? Sizes(64, 24576) : Sizes(64, 384);
     BoxDiscrepancyOptions box;
-    if (!o_.full) box.sample_corners = 32, box.random_corners = 16, box.background = 16, box.random_boxes = 5000;
-    Out(absl::StrFormat(
-        "## Density discrepancy on sample-anchored boxes (graded reference)\n\n"
-        "Boxes with corners at %d sample coordinates per axis (open and closed), %d random points and a grid "
-        "graded toward the singular lines (detected: the area element blows up or vanishes); every box's mass "
-        "integrated on the box by graded Gauss-Legendre. N = %d..%d (2^l and 3 2^(l-1)), seeds %s; slope = "
-        "least squares of log D on log N per seed, then mean +- standard error. `grid-256` is the old measure "
-        "(a fixed 256 x 256 grid) on the same sets.\n\n"
-        "| surface | density | lines u / v | slope | grid-256 slope | D at N = %d | D grid-256 | worst box (last seed) |\n"
-        "|---|---|---|---:|---:|---:|---:|---|\n",
-        box.sample_corners, box.random_corners, sizes.front(), sizes.back(), SeedList(o_.seeds), sizes.back()));
+    if (!o_.full)
+      box.sample_corners = 32, box.random_corners = 16, box.background = 16,
+      box.random_boxes = 5000;
+    Out(
+        absl::StrFormat("## Density discrepancy on sample-anchored boxes (graded reference)\n\n"
+                        "Boxes with corners at %d sample coordinates per axis (open and closed), "
+                        "%d random points and a grid "
+                        "graded toward the singular lines (detected: the area element blows up or "
+                        "vanishes); every box's mass "
+                        "integrated on the box by graded Gauss-Legendre. N = %d..%d (2^l and 3 "
+                        "2^(l-1)), seeds %s; slope = "
+                        "least squares of log D on log N per seed, then mean +- standard error. "
+                        "`grid-256` is the old measure "
+                        "(a fixed 256 x 256 grid) on the same sets.\n\n"
+                        "| surface | density | lines u / v | slope | grid-256 slope | D at N = %d "
+                        "| D grid-256 | worst box (last seed) |\n"
+                        "|---|---|---|---:|---:|---:|---:|---|\n",
+                        box.sample_corners, box.random_corners, sizes.front(), sizes.back(),
+                        SeedList(o_.seeds), sizes.back()));
     // D by N, mean of the seeds, with the grid-256 measure's in brackets.
-    std::string by_n = "\nD by N, mean of the seeds (grid-256 in brackets):\n\n| surface | density |";
+    std::string by_n =
+        "\nD by N, mean of the seeds (grid-256 in brackets):\n\n| surface | density |";
     for (uint64_t n : sizes) absl::StrAppend(&by_n, " ", n, " |");
     absl::StrAppend(&by_n, "\n|---|---|");
     for (size_t i = 0; i < sizes.size(); ++i) absl::StrAppend(&by_n, "---:|");
@@ -135,8 +147,10 @@ class Runner {
     for (const Case& c : o_.full ? absl::MakeConstSpan(cases) : absl::MakeConstSpan(cases, 2)) {
       ASSIGN_OR_RETURN(const SurfaceFromSpec surface, MakeSurface(c.surface));
       ASSIGN_OR_RETURN(const DensityFromSpec density, MakeDensity(c.density));
-      ASSIGN_OR_RETURN(const SingularLines lines, DetectSingularLines(*surface.surface, *density.density));
-      ASSIGN_OR_RETURN(const std::vector<double> cells, GradedCellMasses(*surface.surface, *density.density, 256, 8));
+      ASSIGN_OR_RETURN(const SingularLines lines,
+                       DetectSingularLines(*surface.surface, *density.density));
+      ASSIGN_OR_RETURN(const std::vector<double> cells,
+                       GradedCellMasses(*surface.surface, *density.density, 256, 8));
       auto cell_mass = [&](double u0, double v0, double) {
         return cells[std::lround(u0 * 256) * 256 + std::lround(v0 * 256)];
       };
@@ -150,8 +164,9 @@ class Runner {
           std::vector<Point2> uv(b.size());
           for (size_t i = 0; i < b.size(); ++i) uv[i] = {b.u[i], b.v[i]};
           box.seed = seed * 1000003 + n;
-          ASSIGN_OR_RETURN(const BoxDiscrepancy d,
-                           SampleAnchoredBoxDiscrepancy(*surface.surface, *density.density, lines, uv, box));
+          ASSIGN_OR_RETURN(
+              const BoxDiscrepancy d,
+              SampleAnchoredBoxDiscrepancy(*surface.surface, *density.density, lines, uv, box));
           ns.push_back(static_cast<double>(n));
           ds.push_back(d.d);
           gs.push_back(ParameterRectDiscrepancy(uv, cell_mass, 256));
@@ -163,24 +178,31 @@ class Runner {
         grid_slopes.push_back(LogLogSlope(ns, gs));
         last.push_back(ds.back());
         last_grid.push_back(gs.back());
-        Log(absl::StrFormat("boxes %s with %s, seed %d: slope %.3f (grid-256 %.3f); worst box at N = %d: "
-                            "[%.6g, %.6g] x [%.6g, %.6g], %.5f of the points, %.5f of the mass",
-                            c.surface, c.density, seed, slopes.back(), grid_slopes.back(), sizes.back(), worst.u0,
-                            worst.u1, worst.v0, worst.v1, worst.point_fraction, worst.mass_fraction));
+        Log(absl::StrFormat(
+            "boxes %s with %s, seed %d: slope %.3f (grid-256 %.3f); worst box at N = %d: "
+            "[%.6g, %.6g] x [%.6g, %.6g], %.5f of the points, %.5f of the mass",
+            c.surface, c.density, seed, slopes.back(), grid_slopes.back(), sizes.back(), worst.u0,
+            worst.u1, worst.v0, worst.v1, worst.point_fraction, worst.mass_fraction));
       }
       auto list = [](const std::vector<double>& x) {
-        return absl::StrJoin(x, " ", [](std::string* out, double v) { absl::StrAppend(out, absl::StrFormat("%g", v)); });
+        return absl::StrJoin(x, " ", [](std::string* out, double v) {
+          absl::StrAppend(out, absl::StrFormat("%g", v));
+        });
       };
-      Out(absl::StrFormat("| %s | %s | %s / %s | %s | %s | %s | %s | [%.6g, %.6g] x [%.6g, %.6g]: %.5f of the points, %.5f of the mass |\n",
-                          c.surface, c.density, list(lines.u), list(lines.v), PlusMinus(slopes),
-                          PlusMinus(grid_slopes), PlusMinus(last, "%.2e"), PlusMinus(last_grid, "%.2e"),
-                          worst.u0, worst.u1, worst.v0, worst.v1, worst.point_fraction, worst.mass_fraction));
+      Out(absl::StrFormat(
+          "| %s | %s | %s / %s | %s | %s | %s | %s | [%.6g, %.6g] x [%.6g, %.6g]: %.5f of the "
+          "points, %.5f of the mass |\n",
+          c.surface, c.density, list(lines.u), list(lines.v), PlusMinus(slopes),
+          PlusMinus(grid_slopes), PlusMinus(last, "%.2e"), PlusMinus(last_grid, "%.2e"), worst.u0,
+          worst.u1, worst.v0, worst.v1, worst.point_fraction, worst.mass_fraction));
       by_n += absl::StrFormat("| %s | %s |", c.surface, c.density);
-      for (size_t i = 0; i < sizes.size(); ++i) absl::StrAppend(&by_n, absl::StrFormat(" %.2e (%.2e) |", d_sum[i], g_sum[i]));
+      for (size_t i = 0; i < sizes.size(); ++i)
+        absl::StrAppend(&by_n, absl::StrFormat(" %.2e (%.2e) |", d_sum[i], g_sum[i]));
       by_n += "\n";
       double mean, se;
       MeanAndStandardError(slopes, &mean, &se);
-      Check(absl::StrFormat("box slope, %s with %s, N = %d..%d", c.surface, c.density, sizes.front(), sizes.back()),
+      Check(absl::StrFormat("box slope, %s with %s, N = %d..%d", c.surface, c.density,
+                            sizes.front(), sizes.back()),
             PlusMinus(slopes), c.judged ? "<= -0.70" : "", mean <= -0.70, c.judged && o_.full);
     }
     Out(by_n);
@@ -191,7 +213,8 @@ class Runner {
   // Section 2: strips beside singular lines.
   absl::Status Strips() {
     const uint64_t n = o_.full ? 200000 : 20000;
-    const std::vector<uint64_t> seeds = o_.full ? o_.strip_seeds : std::vector<uint64_t>{o_.strip_seeds.front()};
+    const std::vector<uint64_t> seeds =
+        o_.full ? o_.strip_seeds : std::vector<uint64_t>{o_.strip_seeds.front()};
     const double bands[] = {0, 1e-4, 1e-3, 2e-3, 1e-2};
     struct Case {
       const char* surface;
@@ -205,11 +228,16 @@ class Runner {
     };
     Out(absl::StrFormat(
         "## Samples in strips beside the singular lines, N = %d, seeds %s\n\n"
-        "Distance in unit parameter of the natural angles: longitude / 2 pi to the nearest of -pi, -pi/2, 0, "
-        "pi/2 (all four lines together), |latitude| / pi for the equator, (pi/2 - |latitude|) / pi for the two "
-        "poles together. Uniform density: angles from the points' coordinates (so any parameterisation), exact "
-        "counts from the closed-form quadrature in the angles (t = w^12). Other densities: distances in (u, v), "
-        "exact from the graded box reference. Pass: every count within max(2 %% of exact, 2 sqrt(max(exact, 1))).\n\n"
+        "Distance in unit parameter of the natural angles: longitude / 2 pi to the nearest of -pi, "
+        "-pi/2, 0, "
+        "pi/2 (all four lines together), |latitude| / pi for the equator, (pi/2 - |latitude|) / pi "
+        "for the two "
+        "poles together. Uniform density: angles from the points' coordinates (so any "
+        "parameterisation), exact "
+        "counts from the closed-form quadrature in the angles (t = w^12). Other densities: "
+        "distances in (u, v), "
+        "exact from the graded box reference. Pass: every count within max(2 %% of exact, 2 "
+        "sqrt(max(exact, 1))).\n\n"
         "| surface | density | line | band | exact | counts | worst deviation / tolerance |\n"
         "|---|---|---|---|---:|---|---:|\n",
         n, SeedList(seeds)));
@@ -231,14 +259,18 @@ class Runner {
       } else {
         ASSIGN_OR_RETURN(const SurfaceFromSpec surface, MakeSurface(c.surface));
         ASSIGN_OR_RETURN(const DensityFromSpec density, MakeDensity(c.density));
-        ASSIGN_OR_RETURN(const SingularLines lines, DetectSingularLines(*surface.surface, *density.density));
+        ASSIGN_OR_RETURN(const SingularLines lines,
+                         DetectSingularLines(*surface.surface, *density.density));
         std::vector<double> ub, vb;
         for (double d : bands) {
-          for (double l : {0.0, 0.25, 0.5, 0.75, 1.0}) vb.push_back(std::clamp(l - d, 0.0, 1.0)), vb.push_back(std::clamp(l + d, 0.0, 1.0));
-          for (double l : {0.0, 0.5, 1.0}) ub.push_back(std::clamp(l - d, 0.0, 1.0)), ub.push_back(std::clamp(l + d, 0.0, 1.0));
+          for (double l : {0.0, 0.25, 0.5, 0.75, 1.0})
+            vb.push_back(std::clamp(l - d, 0.0, 1.0)), vb.push_back(std::clamp(l + d, 0.0, 1.0));
+          for (double l : {0.0, 0.5, 1.0})
+            ub.push_back(std::clamp(l - d, 0.0, 1.0)), ub.push_back(std::clamp(l + d, 0.0, 1.0));
         }
-        ASSIGN_OR_RETURN(const GradedBoxMeasure m,
-                         GradedBoxMeasure::Build(*surface.surface, *density.density, lines, ub, vb));
+        ASSIGN_OR_RETURN(
+            const GradedBoxMeasure m,
+            GradedBoxMeasure::Build(*surface.surface, *density.density, lines, ub, vb));
         const size_t nu = m.u().size() - 1, nv = m.v().size() - 1;
         auto within = [&](int family, double d) {
           double s = 0;
@@ -253,7 +285,8 @@ class Runner {
           return s / m.total();
         };
         for (int f = 0; f < 3; ++f) {
-          for (int b = 0; b < 4; ++b) exact[f][b] = within(f, bands[b + 1]) - (b ? within(f, bands[b]) : 0);
+          for (int b = 0; b < 4; ++b)
+            exact[f][b] = within(f, bands[b + 1]) - (b ? within(f, bands[b]) : 0);
         }
       }
       int64_t counts[3][4][8] = {};
@@ -299,9 +332,10 @@ class Runner {
           Out(absl::StrFormat("| %s | %s | %s | %s | %.0f | %s | %.2f |\n", c.surface, c.density,
                               family_names[f], band_names[b], ex, list, band_worst));
         }
-        Check(absl::StrFormat("strips, %s with %s, %s lines, N = %d", c.surface, c.density, family_names[f], n),
-              absl::StrFormat("worst |count - exact| / tolerance = %.2f", worst_ratio), "<= 1 (every band, seed)",
-              worst_ratio <= 1, o_.full);
+        Check(absl::StrFormat("strips, %s with %s, %s lines, N = %d", c.surface, c.density,
+                              family_names[f], n),
+              absl::StrFormat("worst |count - exact| / tolerance = %.2f", worst_ratio),
+              "<= 1 (every band, seed)", worst_ratio <= 1, o_.full);
       }
       Log(absl::StrFormat("strips %s with %s done", c.surface, c.density));
     }
@@ -327,9 +361,12 @@ class Runner {
     };
     Out(absl::StrFormat(
         "## Stratification beside the lines: samples in thin bands, N = %d, seeds 1..%d\n\n"
-        "Mean and standard deviation across seeds (angles from the points' coordinates). The mean checks "
-        "the mass; the spread checks that the set is still stratified there (i.i.d. points spread by "
-        "sqrt(mean)).\n\n| surface | band | mean | SD across seeds | i.i.d. SD |\n|---|---|---:|---:|---:|\n",
+        "Mean and standard deviation across seeds (angles from the points' coordinates). The mean "
+        "checks "
+        "the mass; the spread checks that the set is still stratified there (i.i.d. points spread "
+        "by "
+        "sqrt(mean)).\n\n| surface | band | mean | SD across seeds | i.i.d. SD "
+        "|\n|---|---|---:|---:|---:|\n",
         n, seeds));
     for (const char* e_text : {"1/3", "1/4"}) {
       double sd_of[2][3] = {};
@@ -355,15 +392,17 @@ class Runner {
           double mean, se;
           MeanAndStandardError(counts[j], &mean, &se);
           sd_of[k][j] = se * std::sqrt(static_cast<double>(seeds));
-          Out(absl::StrFormat("| %s | %s | %.1f | %.1f | %.1f |\n", spec, bands[j].name, mean, sd_of[k][j],
-                              std::sqrt(mean)));
+          Out(absl::StrFormat("| %s | %s | %.1f | %.1f | %.1f |\n", spec, bands[j].name, mean,
+                              sd_of[k][j], std::sqrt(mean)));
         }
         ++k;
       }
-      Check(absl::StrFormat("stratification beside the lines, e = %s, N = %d: SD across %d seeds over reparam=1's "
-                            "(equator band, longitude band, control)", e_text, n, seeds),
-            absl::StrFormat("%.1f, %.1f, %.1f", sd_of[0][0] / sd_of[1][0], sd_of[0][1] / sd_of[1][1],
-                            sd_of[0][2] / sd_of[1][2]),
+      Check(absl::StrFormat("stratification beside the lines, e = %s, N = %d: SD across %d seeds "
+                            "over reparam=1's "
+                            "(equator band, longitude band, control)",
+                            e_text, n, seeds),
+            absl::StrFormat("%.1f, %.1f, %.1f", sd_of[0][0] / sd_of[1][0],
+                            sd_of[0][1] / sd_of[1][1], sd_of[0][2] / sd_of[1][2]),
             "", true, false);
       Log(absl::StrFormat("bands e = %s done", e_text));
     }
@@ -377,10 +416,11 @@ class Runner {
                                                 : std::vector<uint64_t>{10000};
     const char* surfaces[] = {"superellipsoid", "superellipsoid:reparam=1", "superellipsoid:e=1/4"};
     const size_t count = o_.full ? 3 : 2;
-    Out(absl::StrFormat(
-        "## Monte Carlo: the mean of x^2 over the surface (uniform density), error per seed (seeds %s)\n\n"
-        "| surface | exact | N | errors |\n|---|---:|---:|---|\n",
-        SeedList(o_.seeds)));
+    Out(
+        absl::StrFormat("## Monte Carlo: the mean of x^2 over the surface (uniform density), error "
+                        "per seed (seeds %s)\n\n"
+                        "| surface | exact | N | errors |\n|---|---:|---:|---|\n",
+                        SeedList(o_.seeds)));
     for (const char* spec : absl::MakeConstSpan(surfaces, count)) {
       bool plain;
       const double e = SuperellipsoidExponent(spec, &plain);
@@ -399,8 +439,8 @@ class Runner {
         Out(absl::StrFormat("| %s | %.7f | %d | %s |\n", spec, exact, n, list));
       }
       Check(absl::StrFormat("Monte Carlo x^2, %s, N = %d", spec, sizes.back()),
-            absl::StrFormat("worst |error| %.2e", worst_last), "< 1e-5 in every seed", worst_last < 1e-5,
-            o_.full && std::string(spec) != "superellipsoid:reparam=1");
+            absl::StrFormat("worst |error| %.2e", worst_last), "< 1e-5 in every seed",
+            worst_last < 1e-5, o_.full && std::string(spec) != "superellipsoid:reparam=1");
       Log(absl::StrFormat("Monte Carlo %s done", spec));
     }
     Out("\n");
@@ -427,7 +467,8 @@ class Runner {
       jit_last.push_back(d2.back());
     }
     Out(absl::StrFormat(
-        "## Plane, star discrepancy (anchored boxes, corners at 2048 point coordinates), N = %d..%d, seeds %s\n\n"
+        "## Plane, star discrepancy (anchored boxes, corners at 2048 point coordinates), N = "
+        "%d..%d, seeds %s\n\n"
         "| set | slope | D at N = %d |\n|---|---:|---:|\n| ours (hilbert-jittered) | %s | %s |\n"
         "| 2D jittered | %s | %s |\n\n",
         sizes.front(), sizes.back(), SeedList(o_.seeds), sizes.back(), PlusMinus(ours),
@@ -435,15 +476,16 @@ class Runner {
     double m1, s1, m2, s2;
     MeanAndStandardError(ours, &m1, &s1);
     MeanAndStandardError(jit, &m2, &s2);
-    Check(absl::StrFormat("plane star-discrepancy slope, ours vs 2D jittered (%s), N = %d..%d", PlusMinus(jit),
-                          sizes.front(), sizes.back()),
+    Check(absl::StrFormat("plane star-discrepancy slope, ours vs 2D jittered (%s), N = %d..%d",
+                          PlusMinus(jit), sizes.front(), sizes.back()),
           PlusMinus(ours), "<= jittered + 2 SE", m1 <= m2 + 2 * std::hypot(s1, s2), o_.full);
     Log("plane done");
     return absl::OkStatus();
   }
 
   // Spherical-triangle slopes of one sphere-shaped set source, per seed.
-  absl::StatusOr<std::vector<double>> SphereSlopes(const std::string& spec, const std::vector<uint64_t>& sizes,
+  absl::StatusOr<std::vector<double>> SphereSlopes(const std::string& spec,
+                                                   const std::vector<uint64_t>& sizes,
                                                    std::vector<double>* last) {
     std::vector<double> slopes;
     for (uint64_t seed : o_.seeds) {
@@ -482,39 +524,43 @@ class Runner {
         SeedList(o_.seeds)));
     std::vector<double> last;
     ASSIGN_OR_RETURN(const std::vector<double> sphere, SphereSlopes("sphere", sizes, &last));
-    Out(absl::StrFormat("| built-in sphere | %d..%d | %s | %s |\n", sizes.front(), sizes.back(), PlusMinus(sphere),
-                        PlusMinus(last, "%.2e")));
+    Out(absl::StrFormat("| built-in sphere | %d..%d | %s | %s |\n", sizes.front(), sizes.back(),
+                        PlusMinus(sphere), PlusMinus(last, "%.2e")));
     double ms, ss;
     MeanAndStandardError(sphere, &ms, &ss);
     if (Wants("sphere")) {
-      Check(absl::StrFormat("sphere spherical-triangle slope, N = %d..%d", sizes.front(), sizes.back()),
+      Check(absl::StrFormat("sphere spherical-triangle slope, N = %d..%d", sizes.front(),
+                            sizes.back()),
             PlusMinus(sphere), "<= -0.73", ms <= -0.73, o_.full);
     }
     if (Wants("models") && !o_.step_sphere.empty()) {
       last.clear();
       ASSIGN_OR_RETURN(const std::vector<double> step, SphereSlopes(o_.step_sphere, sizes, &last));
-      Out(absl::StrFormat("| %s | %d..%d | %s | %s |\n", o_.step_sphere, sizes.front(), sizes.back(),
-                          PlusMinus(step), PlusMinus(last, "%.2e")));
+      Out(absl::StrFormat("| %s | %d..%d | %s | %s |\n", o_.step_sphere, sizes.front(),
+                          sizes.back(), PlusMinus(step), PlusMinus(last, "%.2e")));
       double m, s;
       MeanAndStandardError(step, &m, &s);
-      Check(absl::StrFormat("CAD sphere (%s) slope against the built-in (%s), N = %d..%d", o_.step_sphere,
-                            PlusMinus(sphere), sizes.front(), sizes.back()),
+      Check(absl::StrFormat("CAD sphere (%s) slope against the built-in (%s), N = %d..%d",
+                            o_.step_sphere, PlusMinus(sphere), sizes.front(), sizes.back()),
             PlusMinus(step), "within 0.01 of the built-in", std::fabs(m - ms) <= 0.01, o_.full);
     }
     if (Wants("models") && !o_.mesh_sphere.empty()) {
       last.clear();
-      ASSIGN_OR_RETURN(const std::vector<double> builtin, SphereSlopes("sphere", mesh_sizes, &last));
-      Out(absl::StrFormat("| built-in sphere | %d..%d | %s | %s |\n", mesh_sizes.front(), mesh_sizes.back(),
-                          PlusMinus(builtin), PlusMinus(last, "%.2e")));
+      ASSIGN_OR_RETURN(const std::vector<double> builtin,
+                       SphereSlopes("sphere", mesh_sizes, &last));
+      Out(absl::StrFormat("| built-in sphere | %d..%d | %s | %s |\n", mesh_sizes.front(),
+                          mesh_sizes.back(), PlusMinus(builtin), PlusMinus(last, "%.2e")));
       last.clear();
-      ASSIGN_OR_RETURN(const std::vector<double> mesh, SphereSlopes(o_.mesh_sphere, mesh_sizes, &last));
-      Out(absl::StrFormat("| %s | %d..%d | %s | %s |\n", o_.mesh_sphere, mesh_sizes.front(), mesh_sizes.back(),
-                          PlusMinus(mesh), PlusMinus(last, "%.2e")));
+      ASSIGN_OR_RETURN(const std::vector<double> mesh,
+                       SphereSlopes(o_.mesh_sphere, mesh_sizes, &last));
+      Out(absl::StrFormat("| %s | %d..%d | %s | %s |\n", o_.mesh_sphere, mesh_sizes.front(),
+                          mesh_sizes.back(), PlusMinus(mesh), PlusMinus(last, "%.2e")));
       double mb, sb, mm, sm;
       MeanAndStandardError(builtin, &mb, &sb);
       MeanAndStandardError(mesh, &mm, &sm);
-      Check(absl::StrFormat("mesh sphere (%s) slope against the built-in (%s), N = %d..%d", o_.mesh_sphere,
-                            PlusMinus(builtin), mesh_sizes.front(), mesh_sizes.back()),
+      Check(absl::StrFormat("mesh sphere (%s) slope against the built-in (%s), N = %d..%d",
+                            o_.mesh_sphere, PlusMinus(builtin), mesh_sizes.front(),
+                            mesh_sizes.back()),
             PlusMinus(mesh), "within 0.01 of the built-in", std::fabs(mm - mb) <= 0.01, o_.full);
     }
     Out("\n");
@@ -525,29 +571,36 @@ class Runner {
   // Section 6: blue-noise figures at N = 4096 (a measurement, no target).
   absl::Status BlueNoise() {
     const uint64_t n = 4096;
-    const std::vector<uint64_t> seeds = o_.full ? o_.seeds : std::vector<uint64_t>{o_.seeds.front()};
+    const std::vector<uint64_t> seeds =
+        o_.full ? o_.seeds : std::vector<uint64_t>{o_.seeds.front()};
     Out(absl::StrFormat(
-        "## Blue noise, N = %d: nearest-neighbour distance relative to hexagonal packing (min / mean), seeds %s\n\n"
-        "Plane: Euclidean in the unit square. Sphere: chord on the unit sphere; the square's sets mapped by "
-        "z = 1 - 2x, phi = 2 pi y. Dart throwing with radius 0.75 of the hexagonal spacing (0.80 jams near 3 860 points) is the Poisson-disk "
+        "## Blue noise, N = %d: nearest-neighbour distance relative to hexagonal packing (min / "
+        "mean), seeds %s\n\n"
+        "Plane: Euclidean in the unit square. Sphere: chord on the unit sphere; the square's sets "
+        "mapped by "
+        "z = 1 - 2x, phi = 2 pi y. Dart throwing with radius 0.75 of the hexagonal spacing (0.80 "
+        "jams near 3 860 points) is the Poisson-disk "
         "reference here; bench/blue_noise.py gives scipy's qmc.PoissonDisk.\n\n"
         "| set | plane min | plane mean | sphere min | sphere mean |\n|---|---:|---:|---:|---:|\n",
         n, SeedList(seeds)));
     std::map<std::string, std::vector<double>> f[4];
-    const char* names[] = {"ours (hilbert-jittered)", "2D jittered", "scrambled Sobol (Owen)", "dart throwing r = 0.75"};
+    const char* names[] = {"ours (hilbert-jittered)", "2D jittered", "scrambled Sobol (Owen)",
+                           "dart throwing r = 0.75"};
     for (uint64_t seed : seeds) {
       ASSIGN_OR_RETURN(const SampleBatch plane, Sample("plane", "uniform", n, seed));
       ASSIGN_OR_RETURN(const SampleBatch sphere, Sample("sphere", "uniform", n, seed));
       std::vector<Point2> ours(n);
       std::vector<Vec3> ours_s(n);
-      for (size_t i = 0; i < n; ++i) ours[i] = {plane.u[i], plane.v[i]}, ours_s[i] = {sphere.x[i], sphere.y[i], sphere.z[i]};
+      for (size_t i = 0; i < n; ++i)
+        ours[i] = {plane.u[i], plane.v[i]}, ours_s[i] = {sphere.x[i], sphere.y[i], sphere.z[i]};
       const std::vector<Point2> jit = JitteredSquare(n, seed), sob = ScrambledSobolSquare(n, seed);
       const std::vector<Point2> dart = DartThrowingSquare(n, 0.75, seed);
       const std::vector<Vec3> dart_s = DartThrowingSphere(n, 0.75, seed);
       const NearestNeighbour p[] = {PlaneNearestNeighbour(ours), PlaneNearestNeighbour(jit),
                                     PlaneNearestNeighbour(sob), PlaneNearestNeighbour(dart)};
-      const NearestNeighbour s[] = {SphereNearestNeighbour(ours_s), SphereNearestNeighbour(SquareToSphere(jit)),
-                                    SphereNearestNeighbour(SquareToSphere(sob)), SphereNearestNeighbour(dart_s)};
+      const NearestNeighbour s[] = {
+          SphereNearestNeighbour(ours_s), SphereNearestNeighbour(SquareToSphere(jit)),
+          SphereNearestNeighbour(SquareToSphere(sob)), SphereNearestNeighbour(dart_s)};
       for (int k = 0; k < 4; ++k) {
         f[0][names[k]].push_back(p[k].min);
         f[1][names[k]].push_back(p[k].mean);
@@ -556,11 +609,11 @@ class Runner {
       }
     }
     for (const char* name : names) {
-      Out(absl::StrFormat("| %s | %s | %s | %s | %s |\n", name, PlusMinus(f[0][name]), PlusMinus(f[1][name]),
-                          PlusMinus(f[2][name]), PlusMinus(f[3][name])));
+      Out(absl::StrFormat("| %s | %s | %s | %s | %s |\n", name, PlusMinus(f[0][name]),
+                          PlusMinus(f[1][name]), PlusMinus(f[2][name]), PlusMinus(f[3][name])));
       Check(absl::StrFormat("blue noise N = 4096, %s: plane min / mean, sphere min / mean", name),
-            absl::StrFormat("%.2f / %.2f, %.2f / %.2f", Mean(f[0][name]), Mean(f[1][name]), Mean(f[2][name]),
-                            Mean(f[3][name])),
+            absl::StrFormat("%.2f / %.2f, %.2f / %.2f", Mean(f[0][name]), Mean(f[1][name]),
+                            Mean(f[2][name]), Mean(f[3][name])),
             "", true, false);
     }
     Out("\n");
@@ -590,10 +643,13 @@ void MeanAndStandardError(const std::vector<double>& x, double* mean, double* se
   *se = n > 1 ? std::sqrt(ss / (n - 1) / n) : 0;
 }
 
-absl::StatusOr<QualityReport> RunQuality(const QualityOptions& options, const QualitySource& source) {
-  if (options.seeds.empty() || options.strip_seeds.empty()) return absl::InvalidArgumentError("no seeds");
+absl::StatusOr<QualityReport> RunQuality(const QualityOptions& options,
+                                         const QualitySource& source) {
+  if (options.seeds.empty() || options.strip_seeds.empty())
+    return absl::InvalidArgumentError("no seeds");
   for (const std::string& s : options.sections) {
-    static const char* const kKnown[] = {"boxes", "strips", "bands", "mc", "plane", "sphere", "models", "blue"};
+    static const char* const kKnown[] = {"boxes", "strips", "bands",  "mc",
+                                         "plane", "sphere", "models", "blue"};
     if (std::find(std::begin(kKnown), std::end(kKnown), s) == std::end(kKnown)) {
       return absl::InvalidArgumentError(absl::StrCat(
           "unknown quality section \"", s, "\" (boxes strips bands mc plane sphere models blue)"));

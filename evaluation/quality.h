@@ -42,7 +42,8 @@ struct QualityOptions {
   bool full = false;
   std::vector<uint64_t> seeds = {1, 2, 3};             // slopes and Monte Carlo
   std::vector<uint64_t> strip_seeds = {5, 6, 7};       // strips (the seed 5 first)
-  std::vector<std::string> sections;  // empty: all of boxes strips bands mc plane sphere models blue
+  std::vector<std::string>
+      sections;             // empty: all of boxes strips bands mc plane sphere models blue
   std::string step_sphere;  // model spec of a sphere (step:/tmp/fx/sphere.step); empty: skipped
   std::string mesh_sphere;  // model spec of a sphere mesh (ply:/tmp/ico.ply); empty: skipped
   std::function<void(const std::string&)> progress;  // one line per finished item
@@ -60,7 +61,8 @@ struct QualityReport {
   std::string tables;  // markdown: every figure with its seeds
 };
 
-absl::StatusOr<QualityReport> RunQuality(const QualityOptions& options, const QualitySource& source);
+absl::StatusOr<QualityReport> RunQuality(const QualityOptions& options,
+                                         const QualitySource& source);
 
 // The summary table of `checks` (markdown).
 std::string QualitySummary(const std::vector<QualityCheck>& checks);

@@ -25,21 +25,24 @@ double RadicalInverse2(uint64_t k) {
 
 std::vector<Point2> RandomSquare(uint64_t n, uint64_t seed) {
   std::vector<Point2> p(n);
-  for (uint64_t i = 0; i < n; ++i) p[i] = {CounterUniform(seed, 21, i), CounterUniform(seed, 22, i)};
+  for (uint64_t i = 0; i < n; ++i)
+    p[i] = {CounterUniform(seed, 21, i), CounterUniform(seed, 22, i)};
   return p;
 }
 
 std::vector<Point2> JitteredSquare(uint64_t n, uint64_t seed) {
   std::vector<Point2> p;
   p.reserve(n);
-  const uint64_t rows = std::max<uint64_t>(1, static_cast<uint64_t>(std::sqrt(static_cast<double>(n))));
+  const uint64_t rows =
+      std::max<uint64_t>(1, static_cast<uint64_t>(std::sqrt(static_cast<double>(n))));
   uint64_t k = 0;
   double y0 = 0;
   for (uint64_t r = 0; r < rows; ++r) {
     const uint64_t cells = n / rows + (r < n % rows ? 1 : 0);
     const double height = static_cast<double>(cells) / n;  // equal-area strata
     for (uint64_t c = 0; c < cells; ++c, ++k) {
-      p.push_back({(c + CounterUniform(seed, 23, k)) / cells, y0 + height * CounterUniform(seed, 24, k)});
+      p.push_back(
+          {(c + CounterUniform(seed, 23, k)) / cells, y0 + height * CounterUniform(seed, 24, k)});
     }
     y0 += height;
   }
@@ -88,7 +91,8 @@ std::vector<Vec3> RandomSphere(uint64_t n, uint64_t seed) {
 
 std::vector<Vec3> HammersleySphere(uint64_t n) {
   std::vector<Vec3> p(n);
-  for (uint64_t k = 0; k < n; ++k) p[k] = FromZPhi(2 * RadicalInverse2(k) - 1, 2 * kPi * (k + 0.5) / n);
+  for (uint64_t k = 0; k < n; ++k)
+    p[k] = FromZPhi(2 * RadicalInverse2(k) - 1, 2 * kPi * (k + 0.5) / n);
   return p;
 }
 

@@ -64,7 +64,8 @@ double AreaElementCS(double e, double ca, double sa, double cb, double sb) {
   const double dSa = e * std::pow(sa, e - 1) * ca, dCa = e * std::pow(ca, e - 1) * sa;
   const double dSb = e * std::pow(sb, e - 1) * cb, dCb = e * std::pow(cb, e - 1) * sb;
   const double wronskian = e * std::pow(cb * sb, e - 1);
-  return std::pow(ca, e) * std::sqrt(dSa * dSa * (dSb * dSb + dCb * dCb) + dCa * dCa * wronskian * wronskian);
+  return std::pow(ca, e) *
+         std::sqrt(dSa * dSa * (dSb * dSb + dCb * dCb) + dCa * dCa * wronskian * wronskian);
 }
 
 }  // namespace
@@ -90,7 +91,9 @@ double SuperellipsoidOctantIntegral(double e, double a0, double a1, double b0, d
   return sum;
 }
 
-double SuperellipsoidArea(double e) { return 8 * SuperellipsoidOctantIntegral(e, 0, kHalfPi, 0, kHalfPi); }
+double SuperellipsoidArea(double e) {
+  return 8 * SuperellipsoidOctantIntegral(e, 0, kHalfPi, 0, kHalfPi);
+}
 
 double SuperellipsoidLongitudeStripFraction(double e, double d) {
   // 4 lines x 2 sides x 2 latitude halves = 16 octant strips of 8 octants.
@@ -109,9 +112,9 @@ double SuperellipsoidPoleStripFraction(double e, double d) {
 }
 
 double SuperellipsoidMeanX2(double e) {
-  const double x2 = SuperellipsoidOctantIntegral(e, 0, kHalfPi, 0, kHalfPi, [e](double ca, double cb) {
-    return std::pow(ca, 2 * e) * std::pow(cb, 2 * e);
-  });
+  const double x2 = SuperellipsoidOctantIntegral(
+      e, 0, kHalfPi, 0, kHalfPi,
+      [e](double ca, double cb) { return std::pow(ca, 2 * e) * std::pow(cb, 2 * e); });
   return x2 / SuperellipsoidOctantIntegral(e, 0, kHalfPi, 0, kHalfPi);
 }
 
@@ -120,7 +123,8 @@ double SuperellipsoidLongitude(double e, double x, double y) {
 }
 
 double SuperellipsoidLatitude(double e, double x, double y, double z) {
-  return std::atan2(SignedRoot(z, e), std::hypot(std::pow(std::fabs(x), 1 / e), std::pow(std::fabs(y), 1 / e)));
+  return std::atan2(SignedRoot(z, e),
+                    std::hypot(std::pow(std::fabs(x), 1 / e), std::pow(std::fabs(y), 1 / e)));
 }
 
 }  // namespace sfc

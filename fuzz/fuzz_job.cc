@@ -15,7 +15,8 @@ namespace {
                "fuzz: %s\n  surface=\"%s\" density=\"%s\" count=%llu tree_count=%llu begin=%llu "
                "end=%llu shard=%llu/%llu sequence=%d region=%d\n",
                what, r.tree.surface.c_str(), r.tree.density.c_str(),
-               static_cast<unsigned long long>(r.count), static_cast<unsigned long long>(r.tree_count),
+               static_cast<unsigned long long>(r.count),
+               static_cast<unsigned long long>(r.tree_count),
                static_cast<unsigned long long>(r.begin), static_cast<unsigned long long>(r.end),
                static_cast<unsigned long long>(r.shard_index),
                static_cast<unsigned long long>(r.shard_count), static_cast<int>(r.sequence),
@@ -63,7 +64,8 @@ void CheckRequest(const SampleRequest& request) {
   if (job->begin != range->first || job->end != range->second) {
     Fail("Start resolved another range than ResolveRange", request);
   }
-  if (job->begin > job->end || job->end > request.count) Fail("a range outside [0, count)", request);
+  if (job->begin > job->end || job->end > request.count)
+    Fail("a range outside [0, count)", request);
 
   std::vector<bool> seen(job->end - job->begin, false);
   uint64_t emitted = 0;

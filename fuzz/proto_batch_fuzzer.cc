@@ -55,9 +55,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const size_t uv = fields.uv ? n : 0, xyz = fields.xyz ? n : 0;
     if (batch.u.size() != uv || batch.v.size() != uv || batch.x.size() != xyz ||
         batch.y.size() != xyz || batch.z.size() != xyz) {
-      Fail("an accepted batch has a column of another length than its indices, or one not asked for");
+      Fail(
+          "an accepted batch has a column of another length than its indices, or one not asked "
+          "for");
     }
-    if (fields.normal && (batch.nx.size() != added || batch.ny.size() != added || batch.nz.size() != added)) {
+    if (fields.normal &&
+        (batch.nx.size() != added || batch.ny.size() != added || batch.nz.size() != added)) {
       Fail("an accepted batch lacks a requested normal column");
     }
     if (fields.density && batch.density.size() != added) Fail("an accepted batch lacks densities");

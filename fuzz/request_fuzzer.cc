@@ -77,7 +77,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     default: {
       sfc::Vec3 lo, hi;
-      for (double* c : {&lo.x, &lo.y, &lo.z, &hi.x, &hi.y, &hi.z}) *c = in.ConsumeFloatingPoint<double>();
+      for (double* c : {&lo.x, &lo.y, &lo.z, &hi.x, &hi.y, &hi.z})
+        *c = in.ConsumeFloatingPoint<double>();
       r.region = sfc::Region::Box(lo, hi);
       break;
     }

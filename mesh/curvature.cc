@@ -42,7 +42,8 @@ VertexCurvature ComputeVertexCurvature(const TriangleMesh& mesh) {
       const Vec3 eik = mesh.positions[i] - mesh.positions[k];
       laplace[i] += eij * cot[(c + 2) % 3] + eik * cot[(c + 1) % 3];
       if (!obtuse) {
-        out.mixed_area[i] += (Dot(eij, eij) * cot[(c + 2) % 3] + Dot(eik, eik) * cot[(c + 1) % 3]) / 8;
+        out.mixed_area[i] +=
+            (Dot(eij, eij) * cot[(c + 2) % 3] + Dot(eik, eik) * cot[(c + 1) % 3]) / 8;
       } else {
         out.mixed_area[i] += angle[c] > M_PI / 2 ? area / 2 : area / 4;
       }

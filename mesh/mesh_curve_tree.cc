@@ -371,8 +371,8 @@ uint64_t UniformBits(double t) { return static_cast<uint64_t>(t * 45035996273704
 // Maps a point of a uniform cell's frame to barycentrics; the area position.
 void FinishUniform(const MeshCurveTree::Cell& cell, uint64_t bits, double ca, double cb,
                    std::array<double, 3>* bary, double* area_position) {
-  *area_position = cell.area_begin +
-                   cell.area_size * ((static_cast<double>(bits) + 0.5) * (1.0 / 4503599627370496.0));
+  *area_position = cell.area_begin + cell.area_size * ((static_cast<double>(bits) + 0.5) *
+                                                       (1.0 / 4503599627370496.0));
   const Bary &e = cell.corner[0], &x = cell.corner[1], &a = cell.corner[2];
   for (int i = 0; i < 3; ++i) (*bary)[i] = e[i] + ca * (x[i] - e[i]) + cb * (a[i] - e[i]);
 }

@@ -178,10 +178,11 @@ absl::StatusOr<TriangleMesh> LoadObj(absl::string_view bytes, absl::string_view 
     faces_read += shape.mesh.num_face_vertices.size();
   }
   if (faces_read != census.face_lines) {
-    return Malformed(name, absl::StrFormat("the file has %d face lines but the OBJ reader kept %d; "
-                                           "a damaged face line? (reader: %s)",
-                                           census.face_lines, faces_read,
-                                           Echo(absl::StripAsciiWhitespace(reader.Warning()), 200)));
+    return Malformed(name,
+                     absl::StrFormat("the file has %d face lines but the OBJ reader kept %d; "
+                                     "a damaged face line? (reader: %s)",
+                                     census.face_lines, faces_read,
+                                     Echo(absl::StripAsciiWhitespace(reader.Warning()), 200)));
   }
   TriangleMesh mesh;
   mesh.name = std::string(name);
@@ -427,7 +428,8 @@ absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view 
                                      const MeshLoadOptions& options) {
   // The plainest binary files (what the Python package writes for arrays)
   // without the istream (mesh/plain_ply.h); the same mesh.
-  if (std::optional<TriangleMesh> plain = ReadPlainBinaryPly(bytes, name, options.weight_property)) {
+  if (std::optional<TriangleMesh> plain =
+          ReadPlainBinaryPly(bytes, name, options.weight_property)) {
     return *std::move(plain);
   }
   RETURN_IF_ERROR(CheckPlyHeader(bytes, name));
@@ -543,11 +545,12 @@ absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view 
           // Vertices come before faces in every writer's files; a face that
           // names a vertex past them is refused here, with the index.
           if (c < 0 || static_cast<uint64_t>(c) >= mesh.positions.size()) {
-            return Malformed(name, absl::StrFormat("face %d uses vertex index %d, but the file "
-                                                   "has %d vertices before its faces (indices "
-                                                   "0..%d)",
-                                                   j, c, mesh.positions.size(),
-                                                   static_cast<int64_t>(mesh.positions.size()) - 1));
+            return Malformed(name,
+                             absl::StrFormat("face %d uses vertex index %d, but the file "
+                                             "has %d vertices before its faces (indices "
+                                             "0..%d)",
+                                             j, c, mesh.positions.size(),
+                                             static_cast<int64_t>(mesh.positions.size()) - 1));
           }
           corners.push_back(static_cast<uint32_t>(c));
         }

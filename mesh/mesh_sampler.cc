@@ -116,7 +116,8 @@ MeshSampler::MeshSampler(std::shared_ptr<const MeshCurveTree> tree, Sequence seq
 
 size_t MeshSampler::LeafForMass(double m) const {
   const auto& ends = tree_->mass_ends();
-  const size_t l = static_cast<size_t>(std::upper_bound(ends.begin(), ends.end(), m) - ends.begin());
+  const size_t l =
+      static_cast<size_t>(std::upper_bound(ends.begin(), ends.end(), m) - ends.begin());
   // q_k S_M can round up to S_M itself: it then belongs to the last leaf with mass.
   return l >= ends.size() ? last_positive_leaf_ : l;
 }

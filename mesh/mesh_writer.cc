@@ -20,10 +20,12 @@ void AppendRaw(std::string* out, T value) {
 
 std::string MeshToObj(const TriangleMesh& mesh) {
   std::string out = "# sfcsampler mesh\n";
-  for (const Vec3& p : mesh.positions) absl::StrAppendFormat(&out, "v %.17g %.17g %.17g\n", p.x, p.y, p.z);
+  for (const Vec3& p : mesh.positions)
+    absl::StrAppendFormat(&out, "v %.17g %.17g %.17g\n", p.x, p.y, p.z);
   const bool normals = !mesh.normals.empty();
   if (normals) {
-    for (const Vec3& n : mesh.normals) absl::StrAppendFormat(&out, "vn %.17g %.17g %.17g\n", n.x, n.y, n.z);
+    for (const Vec3& n : mesh.normals)
+      absl::StrAppendFormat(&out, "vn %.17g %.17g %.17g\n", n.x, n.y, n.z);
   }
   for (const auto& t : mesh.triangles) {
     if (normals) {

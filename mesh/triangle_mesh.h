@@ -21,7 +21,7 @@ struct MeshStats {
   uint64_t vertices = 0;
   uint64_t faces = 0;                  // faces as the file lists them (a polygon counts once)
   uint64_t triangulated_polygons = 0;  // faces with more than 3 corners, split into a fan
-  uint64_t degenerate_triangles = 0;   // zero-area triangles: kept in the index space, never sampled
+  uint64_t degenerate_triangles = 0;  // zero-area triangles: kept in the index space, never sampled
   uint64_t non_manifold_edges = 0;     // edges of more than two triangles (CountEdges)
   uint64_t boundary_edges = 0;         // edges of exactly one triangle (CountEdges)
   double area = 0;                     // total area of the non-degenerate triangles

@@ -62,7 +62,8 @@ template <typename T>
 double LoadLittleEndian(const char* p) {
   using Bits = std::conditional_t<sizeof(T) == 8, uint64_t, uint32_t>;
   Bits bits = 0;
-  for (size_t b = 0; b < sizeof bits; ++b) bits |= static_cast<Bits>(static_cast<unsigned char>(p[b])) << (8 * b);
+  for (size_t b = 0; b < sizeof bits; ++b)
+    bits |= static_cast<Bits>(static_cast<unsigned char>(p[b])) << (8 * b);
   T t;
   std::memcpy(&t, &bits, sizeof t);
   return t;
@@ -111,8 +112,9 @@ void PutRawColumns(const SampleBatch& b, const SampleFields& fields, v1::RawColu
 template <typename T>
 absl::Status TakeRaw(const char* name, const std::string& from, size_t n, std::vector<double>* to) {
   if (from.size() != n * sizeof(T)) {
-    return absl::DataLossError(absl::StrFormat("a batch's raw column %s has %d bytes for %d samples of %d bytes",
-                                               name, from.size(), n, sizeof(T)));
+    return absl::DataLossError(
+        absl::StrFormat("a batch's raw column %s has %d bytes for %d samples of %d bytes", name,
+                        from.size(), n, sizeof(T)));
   }
   const size_t old = to->size();
   to->resize(old + n);
@@ -133,7 +135,8 @@ absl::Status TakeRaw(const char* name, const std::string& from, size_t n, std::v
 }
 
 template <typename T>
-absl::Status TakeRawColumns(const v1::RawColumns& c, const SampleFields& fields, size_t n, SampleBatch* b) {
+absl::Status TakeRawColumns(const v1::RawColumns& c, const SampleFields& fields, size_t n,
+                            SampleBatch* b) {
   if (fields.uv) {
     RETURN_IF_ERROR(TakeRaw<T>("u", c.u(), n, &b->u));
     RETURN_IF_ERROR(TakeRaw<T>("v", c.v(), n, &b->v));
@@ -213,14 +216,16 @@ struct ColumnLengths {
 
 ColumnLengths LengthsOf(const SampleBatch& b) {
   ColumnLengths l{b.index.size(), b.face.size(), b.triangle.size(), {}};
-  for (size_t c = 0; c < l.values.size(); ++c) l.values[c] = (b.*SampleBatch::ValueColumns()[c]).size();
+  for (size_t c = 0; c < l.values.size(); ++c)
+    l.values[c] = (b.*SampleBatch::ValueColumns()[c]).size();
   return l;
 }
 
 // Shortens every column of `b` back to `l` (each is at least that long).
 void ShortenTo(const ColumnLengths& l, SampleBatch* b) {
   b->index.resize(l.index), b->face.resize(l.face), b->triangle.resize(l.triangle);
-  for (size_t c = 0; c < l.values.size(); ++c) (b->*SampleBatch::ValueColumns()[c]).resize(l.values[c]);
+  for (size_t c = 0; c < l.values.size(); ++c)
+    (b->*SampleBatch::ValueColumns()[c]).resize(l.values[c]);
 }
 
 }  // namespace
@@ -236,12 +241,15 @@ absl::StatusOr<TreeSpec> FromProto(const v1::TreeSpec& p) {
     default: return absl::InvalidArgumentError(absl::StrFormat("unknown curve %d", p.curve()));
   }
   switch (p.estimator()) {
-    case v1::AREA_ESTIMATOR_FFF: spec.options.estimator = AreaEstimator::kFirstFundamentalForm; break;
+    case v1::AREA_ESTIMATOR_FFF:
+      spec.options.estimator = AreaEstimator::kFirstFundamentalForm;
+      break;
     case v1::AREA_ESTIMATOR_TRIANGLE: spec.options.estimator = AreaEstimator::kTriangle; break;
     case v1::AREA_ESTIMATOR_SQUARE: spec.options.estimator = AreaEstimator::kSquare; break;
     case v1::AREA_ESTIMATOR_QUADRATURE: spec.options.estimator = AreaEstimator::kQuadrature; break;
     default:
-      return absl::InvalidArgumentError(absl::StrFormat("unknown area estimator %d", p.estimator()));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("unknown area estimator %d", p.estimator()));
   }
   spec.options.tolerance = p.tolerance();
   spec.options.depth_cap = p.depth_cap();
@@ -279,13 +287,16 @@ absl::StatusOr<SampleRequest> FromProto(const v1::SampleRequest& p) {
     case v1::SEQUENCE_RANDOM: r.sequence = SequenceKind::kRandom; break;
     case v1::SEQUENCE_VAN_DER_CORPUT: r.sequence = SequenceKind::kVanDerCorput; break;
     case v1::SEQUENCE_PROGRESSIVE: r.sequence = SequenceKind::kProgressive; break;
-    default: return absl::InvalidArgumentError(absl::StrFormat("unknown sequence %d", p.sequence()));
+    default:
+      return absl::InvalidArgumentError(absl::StrFormat("unknown sequence %d", p.sequence()));
   }
   if (p.precision() != v1::PRECISION_FLOAT64 && p.precision() != v1::PRECISION_FLOAT32) {
     return absl::InvalidArgumentError(absl::StrFormat("unknown precision %d", p.precision()));
   }
-  if (p.column_encoding() != v1::COLUMN_ENCODING_PACKED && p.column_encoding() != v1::COLUMN_ENCODING_RAW) {
-    return absl::InvalidArgumentError(absl::StrFormat("unknown column encoding %d", p.column_encoding()));
+  if (p.column_encoding() != v1::COLUMN_ENCODING_PACKED &&
+      p.column_encoding() != v1::COLUMN_ENCODING_RAW) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("unknown column encoding %d", p.column_encoding()));
   }
   r.count = p.count();
   r.seed = p.seed();
@@ -310,7 +321,8 @@ absl::StatusOr<SampleRequest> FromProto(const v1::SampleRequest& p) {
   r.fields.xyz = !p.omit_xyz();
   if (WireValueColumns(r.fields) == 0) {
     return absl::InvalidArgumentError(
-        "omit_uv and omit_xyz leave no value column: keep u v or x y z, or ask for normals, density "
+        "omit_uv and omit_xyz leave no value column: keep u v or x y z, or ask for normals, "
+        "density "
         "or curve_position");
   }
   return r;
@@ -380,12 +392,13 @@ void ToProto(const SampleBatch& b, const SampleFields& fields, v1::Precision pre
 }
 
 size_t WireValueColumns(const SampleFields& fields) {
-  return (fields.uv ? 2 : 0) + (fields.xyz ? 3 : 0) + (fields.normal ? 3 : 0) + (fields.density ? 1 : 0) +
-         (fields.curve_position ? 1 : 0);
+  return (fields.uv ? 2 : 0) + (fields.xyz ? 3 : 0) + (fields.normal ? 3 : 0) +
+         (fields.density ? 1 : 0) + (fields.curve_position ? 1 : 0);
 }
 
 uint32_t MaxSamplesPerMessage(const SampleFields& fields, v1::Precision precision,
-                              bool indices_listed, size_t reserved_bytes, size_t max_message_bytes) {
+                              bool indices_listed, size_t reserved_bytes,
+                              size_t max_message_bytes) {
   const size_t columns = WireValueColumns(fields);
   const size_t width = precision == v1::PRECISION_FLOAT32 ? sizeof(float) : sizeof(double);
   const size_t index_columns = (fields.face ? 1 : 0) + (fields.triangle ? 1 : 0);
@@ -396,19 +409,23 @@ uint32_t MaxSamplesPerMessage(const SampleFields& fields, v1::Precision precisio
   // wrappers at most 72 more.
   const size_t fixed = reserved_bytes + 6 * (columns + index_columns + 1) + 72;
   if (max_message_bytes <= fixed) return 0;
-  return static_cast<uint32_t>(std::min<size_t>((max_message_bytes - fixed) / per_sample, UINT32_MAX));
+  return static_cast<uint32_t>(
+      std::min<size_t>((max_message_bytes - fixed) / per_sample, UINT32_MAX));
 }
 
-absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fields, SampleBatch* out) {
+absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fields,
+                             SampleBatch* out) {
   const size_t n = in.size();
   if (in.index_size() != 0 && static_cast<size_t>(in.index_size()) != n) {
-    return absl::DataLossError(absl::StrFormat("a batch has %d indices for %d samples", in.index_size(), n));
+    return absl::DataLossError(
+        absl::StrFormat("a batch has %d indices for %d samples", in.index_size(), n));
   }
   if (n == 0) return absl::OkStatus();
   if (WireValueColumns(fields) == 0) {
     return absl::InvalidArgumentError("the request leaves no value column on the wire");
   }
-  if (!in.has_f64() && !in.has_f32() && !in.has_raw()) return absl::DataLossError("a batch has no columns");
+  if (!in.has_f64() && !in.has_f32() && !in.has_raw())
+    return absl::DataLossError("a batch has no columns");
   const bool raw32 = in.has_raw() && in.raw().precision() == v1::PRECISION_FLOAT32;
   if (in.has_raw() && !raw32 && in.raw().precision() != v1::PRECISION_FLOAT64) {
     return absl::DataLossError(absl::StrFormat("a batch's raw columns have unknown precision %d",
@@ -424,10 +441,12 @@ absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fiel
     status = raw32 ? TakeRawColumns<float>(in.raw(), fields, n, out)
                    : TakeRawColumns<double>(in.raw(), fields, n, out);
   } else {
-    status = in.has_f64() ? TakeColumns(in.f64(), fields, n, out) : TakeColumns(in.f32(), fields, n, out);
+    status = in.has_f64() ? TakeColumns(in.f64(), fields, n, out)
+                          : TakeColumns(in.f32(), fields, n, out);
   }
   if (status.ok() && fields.face) status = TakeIndexColumn("face", in.face(), n, &out->face);
-  if (status.ok() && fields.triangle) status = TakeIndexColumn("triangle", in.triangle(), n, &out->triangle);
+  if (status.ok() && fields.triangle)
+    status = TakeIndexColumn("triangle", in.triangle(), n, &out->triangle);
   if (!status.ok()) {
     ShortenTo(before, out);
     return status;

@@ -47,7 +47,8 @@ uint32_t MaxSamplesPerMessage(const SampleFields& fields, v1::Precision precisio
 // does not ask for are ignored. DATA_LOSS when a column has the wrong length
 // or a requested column is missing, and then nothing is appended;
 // INVALID_ARGUMENT when `fields` leaves no value column.
-absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fields, SampleBatch* out);
+absl::Status AppendFromProto(const v1::SampleBatch& in, const SampleFields& fields,
+                             SampleBatch* out);
 
 // The longest status message the server sends, in bytes; longer ones are
 // clipped by ToGrpcStatus (base/echo.h ClipMessage).

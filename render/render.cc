@@ -64,12 +64,14 @@ struct Canvas {
 
 double AutoRadius(const View& v, size_t n) {
   if (v.point_radius > 0) return v.point_radius;
-  return std::clamp(0.22 * v.width / std::sqrt(static_cast<double>(std::max<size_t>(n, 1))), 0.5, 4.0);
+  return std::clamp(0.22 * v.width / std::sqrt(static_cast<double>(std::max<size_t>(n, 1))), 0.5,
+                    4.0);
 }
 
 // Blue (t = 0) to red (t = 1) through green.
 void Hue(cairo_t* cr, double t) {
-  const double r = std::clamp(2 * t - 0.5, 0.0, 1.0), g = 1 - std::fabs(2 * t - 1), b = std::clamp(1.5 - 2 * t, 0.0, 1.0);
+  const double r = std::clamp(2 * t - 0.5, 0.0, 1.0), g = 1 - std::fabs(2 * t - 1),
+               b = std::clamp(1.5 - 2 * t, 0.0, 1.0);
   cairo_set_source_rgb(cr, 0.85 * r, 0.75 * g, 0.9 * b);
 }
 
@@ -93,8 +95,10 @@ absl::Status RenderSamples(const SampleBatch& s, const View& view, const std::st
   cam.Fit(pts);
   std::vector<size_t> order(pts.size());
   std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return cam.Depth(pts[a]) < cam.Depth(pts[b]); });
-  const Vec3 light = (cam.toward * 0.8 + cam.up * 0.5 + cam.right * 0.3) * (1 / Norm(cam.toward * 0.8 + cam.up * 0.5 + cam.right * 0.3));
+  std::sort(order.begin(), order.end(),
+            [&](size_t a, size_t b) { return cam.Depth(pts[a]) < cam.Depth(pts[b]); });
+  const Vec3 light = (cam.toward * 0.8 + cam.up * 0.5 + cam.right * 0.3) *
+                     (1 / Norm(cam.toward * 0.8 + cam.up * 0.5 + cam.right * 0.3));
   Canvas canvas(view);
   const double r = AutoRadius(view, pts.size());
   for (size_t i : order) {
@@ -112,7 +116,8 @@ absl::Status RenderCurve(const CurveTree& tree, const Surface& surface, const Vi
   const std::vector<Vec3> pts = LeafCentres(tree, &surface);
   cam.Fit(pts);
   Canvas canvas(view);
-  cairo_set_line_width(canvas.cr, std::clamp(600.0 / std::sqrt(static_cast<double>(pts.size())), 0.4, 2.0));
+  cairo_set_line_width(canvas.cr,
+                       std::clamp(600.0 / std::sqrt(static_cast<double>(pts.size())), 0.4, 2.0));
   for (size_t l = 1; l < pts.size(); ++l) {
     Hue(canvas.cr, static_cast<double>(l) / pts.size());
     cairo_move_to(canvas.cr, cam.X(pts[l - 1]), cam.Y(pts[l - 1]));
@@ -122,7 +127,8 @@ absl::Status RenderCurve(const CurveTree& tree, const Surface& surface, const Vi
   return canvas.Save(view, path);
 }
 
-absl::Status RenderParameterSamples(const SampleBatch& s, const View& view, const std::string& path) {
+absl::Status RenderParameterSamples(const SampleBatch& s, const View& view,
+                                    const std::string& path) {
   Canvas canvas(view);
   const double m = 0.05 * view.width, side = view.width - 2 * m;
   cairo_set_source_rgb(canvas.cr, 0, 0, 0);
@@ -136,11 +142,13 @@ absl::Status RenderParameterSamples(const SampleBatch& s, const View& view, cons
   return canvas.Save(view, path);
 }
 
-absl::Status RenderParameterCurve(const CurveTree& tree, const View& view, const std::string& path) {
+absl::Status RenderParameterCurve(const CurveTree& tree, const View& view,
+                                  const std::string& path) {
   Canvas canvas(view);
   const double m = 0.05 * view.width, side = view.width - 2 * m;
   const std::vector<Vec3> pts = LeafCentres(tree, nullptr);
-  cairo_set_line_width(canvas.cr, std::clamp(600.0 / std::sqrt(static_cast<double>(pts.size())), 0.4, 2.0));
+  cairo_set_line_width(canvas.cr,
+                       std::clamp(600.0 / std::sqrt(static_cast<double>(pts.size())), 0.4, 2.0));
   for (size_t l = 1; l < pts.size(); ++l) {
     Hue(canvas.cr, static_cast<double>(l) / pts.size());
     cairo_move_to(canvas.cr, m + pts[l - 1].x * side, m + (1 - pts[l - 1].y) * side);

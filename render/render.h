@@ -24,7 +24,8 @@ struct View {
 
 // Samples as shaded discs on the surface, drawn back to front.
 // REQUIRES: `samples` has normals.
-absl::Status RenderSamples(const SampleBatch& samples, const View& view, const std::string& png_path);
+absl::Status RenderSamples(const SampleBatch& samples, const View& view,
+                           const std::string& png_path);
 
 // The tree's curve (its leaves' centres in curve order) mapped through f,
 // coloured from blue to red along the curve.
@@ -34,7 +35,8 @@ absl::Status RenderCurve(const CurveTree& tree, const Surface& surface, const Vi
 // The same in the parameter square: samples as dots, or the curve.
 absl::Status RenderParameterSamples(const SampleBatch& samples, const View& view,
                                     const std::string& png_path);
-absl::Status RenderParameterCurve(const CurveTree& tree, const View& view, const std::string& png_path);
+absl::Status RenderParameterCurve(const CurveTree& tree, const View& view,
+                                  const std::string& png_path);
 
 }  // namespace sfc
 

@@ -12,8 +12,9 @@ absl::StatusOr<std::pair<uint64_t, uint64_t>> ResolveIndexRange(
       return absl::InvalidArgumentError("ask for either an index range or a shard, not both");
     }
     if (request.shard_index >= request.shard_count) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "shard index %d must be below the shard count %d", request.shard_index, request.shard_count));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("shard index %d must be below the shard count %d", request.shard_index,
+                          request.shard_count));
     }
     // Shard i of K holds [floor(iN/K), floor((i+1)N/K)).
     auto bound = [&](uint64_t i) {

@@ -54,7 +54,8 @@ std::string ModelRoutingKey(ModelFormat format, std::string_view sha256) {
 
 absl::StatusOr<std::optional<ModelSpec>> ParseModelSpec(std::string_view text) {
   // Bookworm's Abseil has its own string_view.
-  const absl::string_view spec = absl::StripAsciiWhitespace(absl::string_view(text.data(), text.size()));
+  const absl::string_view spec =
+      absl::StripAsciiWhitespace(absl::string_view(text.data(), text.size()));
   const size_t colon = spec.find(':');
   if (colon == absl::string_view::npos) return std::nullopt;
   const auto format = ModelFormatFromName(std::string_view(spec.data(), colon));
@@ -92,17 +93,19 @@ absl::StatusOr<StoredModel> ReadModelFile(const ModelSpec& spec, uint64_t max_by
   std::error_code error;
   const auto size = std::filesystem::file_size(spec.reference, error);
   if (error) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("cannot read the model \"%s\": %s", Echo(spec.reference, kMaxNameEcho), error.message()));
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "cannot read the model \"%s\": %s", Echo(spec.reference, kMaxNameEcho), error.message()));
   }
   if (size > max_bytes) {
-    return absl::ResourceExhaustedError(absl::StrFormat(
-        "the model \"%s\" is %d bytes, more than the limit of %d", Echo(spec.reference, kMaxNameEcho), size, max_bytes));
+    return absl::ResourceExhaustedError(
+        absl::StrFormat("the model \"%s\" is %d bytes, more than the limit of %d",
+                        Echo(spec.reference, kMaxNameEcho), size, max_bytes));
   }
   std::ifstream in(spec.reference, std::ios::binary);
   auto bytes = std::make_shared<std::string>(size, '\0');
   if (!in || !in.read(bytes->data(), static_cast<std::streamsize>(size))) {
-    return absl::InvalidArgumentError(absl::StrFormat("cannot read the model \"%s\"", Echo(spec.reference, kMaxNameEcho)));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("cannot read the model \"%s\"", Echo(spec.reference, kMaxNameEcho)));
   }
   StoredModel model;
   model.format = spec.format;

@@ -18,13 +18,14 @@ absl::StatusOr<std::vector<double>> Numbers(const std::string& what, absl::strin
   for (absl::string_view part : absl::StrSplit(text, ',')) {
     double v;
     if (!absl::SimpleAtod(part, &v)) {
-      return absl::InvalidArgumentError(absl::StrFormat("%s: \"%s\" is not a number", what, std::string(part)));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("%s: \"%s\" is not a number", what, std::string(part)));
     }
     values.push_back(v);
   }
   if (values.size() != expected) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("%s takes %d comma-separated numbers, got %d", what, expected, values.size()));
+    return absl::InvalidArgumentError(absl::StrFormat("%s takes %d comma-separated numbers, got %d",
+                                                      what, expected, values.size()));
   }
   return values;
 }
@@ -48,12 +49,14 @@ const CLI::Validator kWholeNumber(
 }  // namespace
 
 void AddTreeFlags(CLI::App* cmd, RequestFlags* f) {
-  cmd->add_option("--surface", f->surface, "surface spec, e.g. sphere, torus:R=2;r=0.5 (see `surfaces`)")
+  cmd->add_option("--surface", f->surface,
+                  "surface spec, e.g. sphere, torus:R=2;r=0.5 (see `surfaces`)")
       ->capture_default_str();
   cmd->add_option("--density", f->density, "density spec: uniform, gaussian, mean, expr:EXPRESSION")
       ->capture_default_str();
   cmd->add_option("--curve", f->curve, "hilbert | hilbert2 | peano")->capture_default_str();
-  cmd->add_option("--estimator", f->estimator, "area x density estimator: triangle | square | fff | quadrature")
+  cmd->add_option("--estimator", f->estimator,
+                  "area x density estimator: triangle | square | fff | quadrature")
       ->capture_default_str();
   cmd->add_option("--tolerance", f->tolerance,
                   "the paper's a, surface units (0 = 1% of the bounding-box diagonal)")
@@ -71,9 +74,10 @@ void AddSampleFlags(CLI::App* cmd, RequestFlags* f) {
   cmd->add_option("--sequence", f->sequence,
                   "jittered | equal | random | vandercorput | progressive")
       ->capture_default_str();
-  cmd->add_option("--tree-count", f->tree_count,
-                  "size the tree for this many samples (default: --count); keep it fixed to extend a "
-                  "progressive set byte-exactly")
+  cmd->add_option(
+         "--tree-count", f->tree_count,
+         "size the tree for this many samples (default: --count); keep it fixed to extend a "
+         "progressive set byte-exactly")
       ->check(kWholeNumber);
   cmd->add_option("--begin", f->begin, "first index of the range to return")->check(kWholeNumber);
   cmd->add_option("--end", f->end, "one past the last index (default: count)")->check(kWholeNumber);

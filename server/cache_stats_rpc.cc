@@ -5,7 +5,8 @@ namespace sfc {
 namespace v1 = ::sfcsampler::v1;
 
 grpc::Status SamplerService::GetCacheStats(grpc::ServerContext* context,
-                                           const v1::GetCacheStatsRequest*, v1::CacheStats* response) {
+                                           const v1::GetCacheStatsRequest*,
+                                           v1::CacheStats* response) {
   grpc::Status status = Admit(*context);
   if (status.ok()) {
     const TreeCacheStats s = cache_->stats();

@@ -7,7 +7,8 @@ namespace sfc {
 
 namespace v1 = ::sfcsampler::v1;
 
-grpc::Status SamplerService::ListCatalog(grpc::ServerContext* context, const v1::ListCatalogRequest*,
+grpc::Status SamplerService::ListCatalog(grpc::ServerContext* context,
+                                         const v1::ListCatalogRequest*,
                                          v1::ListCatalogResponse* response) {
   grpc::Status status = Admit(*context);
   if (status.ok()) {

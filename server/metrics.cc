@@ -39,7 +39,8 @@ class CacheStatsCollector final : public prometheus::Collectable {
     };
     using T = prometheus::MetricType;
     add("sfcsampler_cache_hits_total", "Requests whose tree was cached", T::Counter, s.hits);
-    add("sfcsampler_cache_misses_total", "Requests whose tree was not cached", T::Counter, s.misses);
+    add("sfcsampler_cache_misses_total", "Requests whose tree was not cached", T::Counter,
+        s.misses);
     add("sfcsampler_cache_waits_total", "Requests that waited for another request's build",
         T::Counter, s.waits);
     add("sfcsampler_tree_builds_total", "Trees built from scratch", T::Counter, s.builds);
@@ -52,8 +53,9 @@ class CacheStatsCollector final : public prometheus::Collectable {
     add("sfcsampler_cache_budget_bytes", "The cache's memory budget", T::Gauge,
         cache_->budget_bytes());
     add("sfcsampler_builds_running", "Tree builds running now", T::Gauge, s.builds_running);
-    add("sfcsampler_building_bytes", "Bytes of trees being built (counted against the cache budget)",
-        T::Gauge, s.building_bytes);
+    add("sfcsampler_building_bytes",
+        "Bytes of trees being built (counted against the cache budget)", T::Gauge,
+        s.building_bytes);
     add("sfcsampler_retired_tree_bytes",
         "Bytes of evicted trees that streams still hold (counted against the cache budget)",
         T::Gauge, s.retired_bytes);
@@ -108,7 +110,8 @@ ServerMetrics::ServerMetrics() : registry_(std::make_shared<prometheus::Registry
                                      0.001, 0.003, 0.01, 0.03, 0.1, 0.3, 1, 3, 10, 30});
 }
 
-std::shared_ptr<prometheus::Collectable> ServerMetrics::CacheCollector(const TreeCache* cache) const {
+std::shared_ptr<prometheus::Collectable> ServerMetrics::CacheCollector(
+    const TreeCache* cache) const {
   return std::make_shared<CacheStatsCollector>(cache);
 }
 

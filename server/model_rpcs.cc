@@ -34,10 +34,11 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
         name = Echo(chunk.name(), kMaxNameEcho);
         format = ModelFormatFromName(chunk.format());
         if (!format) {
-          status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                                absl::StrFormat("unknown model format \"%s\"; use step, iges, nurbs, "
-                                                "obj or ply",
-                                                Echo(chunk.format())));
+          status =
+              grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                           absl::StrFormat("unknown model format \"%s\"; use step, iges, nurbs, "
+                                           "obj or ply",
+                                           Echo(chunk.format())));
         }
         first = false;
         if (status.ok() && chunk.total_bytes() > 0) {
@@ -68,15 +69,18 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
     }
   }
   metrics_->CountRequest("UploadModel", status.error_code());
-  spdlog::info("rpc=UploadModel peer={} name=\"{}\" bytes={} sha256={} already={} seconds={:.3f} code={} msg=\"{}\"",
-               Echo(context->peer()), LogField(raw_name, kMaxNameEcho), response->bytes(),
-               response->sha256(), response->already_stored(), SecondsSince(start),
-               static_cast<int>(status.error_code()),
-               LogField(status.error_message(), kMaxStatusMessageBytes));
+  spdlog::info(
+      "rpc=UploadModel peer={} name=\"{}\" bytes={} sha256={} already={} seconds={:.3f} code={} "
+      "msg=\"{}\"",
+      Echo(context->peer()), LogField(raw_name, kMaxNameEcho), response->bytes(),
+      response->sha256(), response->already_stored(), SecondsSince(start),
+      static_cast<int>(status.error_code()),
+      LogField(status.error_message(), kMaxStatusMessageBytes));
   return status;
 }
 
-grpc::Status SamplerService::FindModel(grpc::ServerContext* context, const v1::FindModelRequest* request,
+grpc::Status SamplerService::FindModel(grpc::ServerContext* context,
+                                       const v1::FindModelRequest* request,
                                        v1::ModelInfo* response) {
   grpc::Status status = Admit(*context);
   if (status.ok()) {

@@ -101,8 +101,9 @@ absl::StatusOr<StoredModel> ModelStore::Put(ModelFormat format, std::string byte
                                             const std::string& name, bool* already) {
   Upload upload = StartUpload();
   if (absl::Status appended = upload.Append(std::move(bytes)); !appended.ok()) {
-    return absl::Status(appended.code(), absl::StrFormat("upload \"%s\": %s", Echo(name, kMaxNameEcho),
-                                                         appended.message()));
+    return absl::Status(
+        appended.code(),
+        absl::StrFormat("upload \"%s\": %s", Echo(name, kMaxNameEcho), appended.message()));
   }
   return Put(format, std::move(upload), name, already);
 }

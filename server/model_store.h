@@ -94,7 +94,8 @@ class ModelStore final : public ModelSource {
 
   // sha256 references only; a path is INVALID_ARGUMENT (the server opens no
   // client paths), an unknown hash NOT_FOUND.
-  absl::StatusOr<StoredModel> Resolve(const ModelSpec& spec) const override ABSL_LOCKS_EXCLUDED(mu_);
+  absl::StatusOr<StoredModel> Resolve(const ModelSpec& spec) const override
+      ABSL_LOCKS_EXCLUDED(mu_);
 
   // Called with the hash of every model evicted for the budget, outside the
   // store's lock. Set once, before the store is shared.

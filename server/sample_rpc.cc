@@ -40,9 +40,10 @@ uint64_t StreamWorkingBytes(const SampleRequest& request, const v1::SampleReques
   const uint64_t width = wire.precision() == v1::PRECISION_FLOAT32 ? 4 : 8;
   // The messages the stream holds, plus the serialized copy gRPC keeps of the
   // one being written until the transport has sent it.
-  const uint64_t messages = (pipeline_depth <= 0 ? 1 : static_cast<uint64_t>(pipeline_depth) + 2) + 1;
-  const uint64_t per_sample =
-      (8 + 8 * columns + 4 * index_columns) + messages * (8 + width * wire_columns + 4 * index_columns);
+  const uint64_t messages =
+      (pipeline_depth <= 0 ? 1 : static_cast<uint64_t>(pipeline_depth) + 2) + 1;
+  const uint64_t per_sample = (8 + 8 * columns + 4 * index_columns) +
+                              messages * (8 + width * wire_columns + 4 * index_columns);
   const uint64_t batch = wire.batch_size() != 0 ? wire.batch_size() : kDefaultBatchSize;
   return sort + per_sample * std::min(n, batch);
 }
@@ -72,10 +73,11 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
     }
   }
   metrics_->CountRequest("Sample", status.error_code());
-  spdlog::info("rpc=Sample peer={} surface=\"{}\" count={} sent={} seconds={:.3f} code={} msg=\"{}\"",
-               Echo(context->peer()), LogField(request->tree().surface(), kMaxNameEcho),
-               request->count(), sent, SecondsSince(start), static_cast<int>(status.error_code()),
-               LogField(status.error_message(), kMaxStatusMessageBytes));
+  spdlog::info(
+      "rpc=Sample peer={} surface=\"{}\" count={} sent={} seconds={:.3f} code={} msg=\"{}\"",
+      Echo(context->peer()), LogField(request->tree().surface(), kMaxNameEcho), request->count(),
+      sent, SecondsSince(start), static_cast<int>(status.error_code()),
+      LogField(status.error_message(), kMaxStatusMessageBytes));
   return status;
 }
 
@@ -85,20 +87,24 @@ grpc::Status SamplerService::PrepareModelOutsideSlot(grpc::ServerContext* contex
   if (!model.ok() || !model->has_value()) return grpc::Status::OK;  // RunSample says why
   auto parsed = FromProto(request);
   if (!parsed.ok()) return ToGrpcStatus(parsed.status());
-  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(options_.request_deadline_seconds));
-  auto prepared = engine_.Prepare(parsed->tree, parsed->tree_count ? parsed->tree_count : parsed->count,
-                                  RequestControl(context, deadline, options_.request_deadline_seconds));
+  const auto deadline =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                         std::chrono::duration<double>(options_.request_deadline_seconds));
+  auto prepared =
+      engine_.Prepare(parsed->tree, parsed->tree_count ? parsed->tree_count : parsed->count,
+                      RequestControl(context, deadline, options_.request_deadline_seconds));
   if (!prepared.ok()) return ToGrpcStatus(prepared.status());
   return grpc::Status::OK;
 }
 
-grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::SampleRequest& request,
+grpc::Status SamplerService::RunSample(grpc::ServerContext* context,
+                                       const v1::SampleRequest& request,
                                        grpc::ServerWriter<v1::SampleResponse>* writer,
                                        uint64_t* sent) {
   const auto start = Clock::now();
-  const auto deadline = start + std::chrono::duration_cast<Clock::duration>(
-                                    std::chrono::duration<double>(options_.request_deadline_seconds));
+  const auto deadline =
+      start + std::chrono::duration_cast<Clock::duration>(
+                  std::chrono::duration<double>(options_.request_deadline_seconds));
   auto parsed = FromProto(request);
   if (!parsed.ok()) return ToGrpcStatus(parsed.status());
   if (request.batch_size() > options_.max_batch_size) {
@@ -133,10 +139,11 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
   const uint32_t fits = MaxSamplesPerMessage(parsed->fields, request.precision(), indices_listed,
                                              header.ByteSizeLong(), options_.max_message_bytes);
   if (fits == 0) {
-    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                        absl::StrFormat("the stream header alone is %d bytes, more than the server's "
-                                        "max_message_bytes of %d; use shorter specs",
-                                        header.ByteSizeLong(), options_.max_message_bytes));
+    return grpc::Status(
+        grpc::StatusCode::INVALID_ARGUMENT,
+        absl::StrFormat("the stream header alone is %d bytes, more than the server's "
+                        "max_message_bytes of %d; use shorter specs",
+                        header.ByteSizeLong(), options_.max_message_bytes));
   }
   if (request.batch_size() > fits) {
     return grpc::Status(

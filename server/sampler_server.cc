@@ -30,7 +30,8 @@ absl::StatusOr<std::string> ReadFile(const std::string& path) {
 absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> Credentials(const ServerOptions& o) {
   if (o.tls_cert_file.empty() && o.tls_key_file.empty()) {
     if (!o.tls_client_ca_file.empty()) {
-      return absl::InvalidArgumentError("--tls-client-ca needs TLS: give --tls-cert and --tls-key too");
+      return absl::InvalidArgumentError(
+          "--tls-client-ca needs TLS: give --tls-cert and --tls-key too");
     }
     return grpc::InsecureServerCredentials();
   }
@@ -50,7 +51,8 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> Credentials(const Serve
     ssl.client_certificate_request = GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY;
   }
   auto credentials = grpc::SslServerCredentials(ssl);
-  if (!o.token.empty()) credentials->SetAuthMetadataProcessor(std::make_shared<TokenAuthProcessor>(o.token));
+  if (!o.token.empty())
+    credentials->SetAuthMetadataProcessor(std::make_shared<TokenAuthProcessor>(o.token));
   return credentials;
 }
 
@@ -114,8 +116,9 @@ absl::StatusOr<std::unique_ptr<SamplerServer>> SamplerServer::Start(const Server
   server->cache_ = std::make_unique<TreeCache>(cache_options,
                                                [metrics](double s) { metrics->ObserveBuild(s); });
   server->models_ = std::make_unique<ModelStore>(options.model_bytes, options.max_model_bytes);
-  server->service_ = std::make_unique<SamplerService>(options, server->cache_.get(), server->models_.get(),
-                                                      metrics, /*token_checked_by_transport=*/tls);
+  server->service_ =
+      std::make_unique<SamplerService>(options, server->cache_.get(), server->models_.get(),
+                                       metrics, /*token_checked_by_transport=*/tls);
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
@@ -156,9 +159,10 @@ absl::StatusOr<std::unique_ptr<SamplerServer>> SamplerServer::Start(const Server
     server->exposer_->RegisterCollectable(metrics->registry());
     server->exposer_->RegisterCollectable(server->cache_collector_);
   }
-  spdlog::info("listening address={} port={} health_port={} metrics_port={} tls={} mutual_tls={} token={}",
-               options.address, server->port_, server->health_port_, server->metrics_port(), tls,
-               !options.tls_client_ca_file.empty(), !options.token.empty());
+  spdlog::info(
+      "listening address={} port={} health_port={} metrics_port={} tls={} mutual_tls={} token={}",
+      options.address, server->port_, server->health_port_, server->metrics_port(), tls,
+      !options.tls_client_ca_file.empty(), !options.token.empty());
   return server;
 }
 
@@ -176,7 +180,8 @@ void SamplerServer::Shutdown(double grace_seconds, double drain_seconds) {
   if (!server_) return;
   using Clock = std::chrono::system_clock;
   const auto start = Clock::now();
-  const auto deadline = start + std::chrono::milliseconds(static_cast<int64_t>(grace_seconds * 1000));
+  const auto deadline =
+      start + std::chrono::milliseconds(static_cast<int64_t>(grace_seconds * 1000));
   const auto seconds_since = [](Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
   };
@@ -201,8 +206,9 @@ void SamplerServer::Shutdown(double grace_seconds, double drain_seconds) {
   // wait while bytes are still leaving: until no connection to our port has
   // had unsent data for 200 ms (or none is left), up to the grace deadline
   // and at least `drain_seconds` after the streams ended.
-  const auto drain_until = std::max(deadline, Clock::now() + std::chrono::milliseconds(
-                                                                 static_cast<int64_t>(drain_seconds * 1000)));
+  const auto drain_until =
+      std::max(deadline, Clock::now() +
+                             std::chrono::milliseconds(static_cast<int64_t>(drain_seconds * 1000)));
   auto quiet_since = Clock::now();
   while (drain_seconds > 0 && Clock::now() < drain_until) {
     if (ConnectionsWithUnsentData(port_) > 0) quiet_since = Clock::now();
@@ -214,8 +220,9 @@ void SamplerServer::Shutdown(double grace_seconds, double drain_seconds) {
   if (health_server_) health_server_->Shutdown(Clock::now());
   server_->Wait();
   if (health_server_) health_server_->Wait();
-  spdlog::info("shutdown: streams done after {:.3f} s, transports flushed and closed after {:.3f} s",
-               streams_done, seconds_since(start));
+  spdlog::info(
+      "shutdown: streams done after {:.3f} s, transports flushed and closed after {:.3f} s",
+      streams_done, seconds_since(start));
   server_.reset();
   health_server_.reset();
 }

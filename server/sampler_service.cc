@@ -37,7 +37,8 @@ grpc::Status SamplerService::Admit(const grpc::ServerContext& context) const {
   if (!authenticator_) return grpc::Status::OK;
   const auto& md = context.client_metadata();
   auto it = md.find("authorization");
-  if (it == md.end() || !authenticator_->Matches(std::string_view(it->second.data(), it->second.size()))) {
+  if (it == md.end() ||
+      !authenticator_->Matches(std::string_view(it->second.data(), it->second.size()))) {
     return grpc::Status(grpc::StatusCode::UNAUTHENTICATED, TokenAuthenticator::kRefusal);
   }
   return grpc::Status::OK;

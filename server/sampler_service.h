@@ -45,7 +45,8 @@ class SamplerService final : public ::sfcsampler::v1::Sampler::Service {
 
   grpc::Status Sample(grpc::ServerContext* context, const ::sfcsampler::v1::SampleRequest* request,
                       grpc::ServerWriter<::sfcsampler::v1::SampleResponse>* writer) override;
-  grpc::Status Prepare(grpc::ServerContext* context, const ::sfcsampler::v1::PrepareRequest* request,
+  grpc::Status Prepare(grpc::ServerContext* context,
+                       const ::sfcsampler::v1::PrepareRequest* request,
                        ::sfcsampler::v1::PrepareResponse* response) override;
   grpc::Status ListCatalog(grpc::ServerContext* context,
                            const ::sfcsampler::v1::ListCatalogRequest* request,
@@ -56,7 +57,8 @@ class SamplerService final : public ::sfcsampler::v1::Sampler::Service {
   grpc::Status UploadModel(grpc::ServerContext* context,
                            grpc::ServerReader<::sfcsampler::v1::ModelChunk>* reader,
                            ::sfcsampler::v1::ModelInfo* response) override;
-  grpc::Status FindModel(grpc::ServerContext* context, const ::sfcsampler::v1::FindModelRequest* request,
+  grpc::Status FindModel(grpc::ServerContext* context,
+                         const ::sfcsampler::v1::FindModelRequest* request,
                          ::sfcsampler::v1::ModelInfo* response) override;
 
   uint32_t active_streams() const { return active_streams_.load(); }
@@ -71,7 +73,8 @@ class SamplerService final : public ::sfcsampler::v1::Sampler::Service {
   // other requests (and for errors RunSample reports itself).
   grpc::Status PrepareModelOutsideSlot(grpc::ServerContext* context,
                                        const ::sfcsampler::v1::SampleRequest& request);
-  grpc::Status RunSample(grpc::ServerContext* context, const ::sfcsampler::v1::SampleRequest& request,
+  grpc::Status RunSample(grpc::ServerContext* context,
+                         const ::sfcsampler::v1::SampleRequest& request,
                          grpc::ServerWriter<::sfcsampler::v1::SampleResponse>* writer,
                          uint64_t* sent);
 

@@ -40,11 +40,11 @@ struct ServerOptions {
   }();
   uint64_t cache_bytes = uint64_t{1} << 30;    // tree cache budget, 1 GiB
   int max_concurrent_builds = 2;               // tree builds at once (threads of the cache)
-  int max_queued_builds = 16;                  // builds waiting for those; more are RESOURCE_EXHAUSTED
+  int max_queued_builds = 16;  // builds waiting for those; more are RESOURCE_EXHAUSTED
   double failure_ttl_seconds = 60;             // a failed build is remembered this long
   uint64_t model_bytes = uint64_t{1} << 30;     // uploaded models kept, LRU past it
   uint64_t max_model_bytes = uint64_t{256} << 20;  // one upload, bytes
-  uint32_t max_concurrent_streams = 64;        // Sample streams at once; more are RESOURCE_EXHAUSTED
+  uint32_t max_concurrent_streams = 64;  // Sample streams at once; more are RESOURCE_EXHAUSTED
   uint32_t max_batch_size = 1 << 20;           // samples per message a client may ask for
   // Largest message the server sends, in bytes; batches are sized to fit it.
   // 4 MiB is what stock gRPC clients accept by default.

@@ -27,7 +27,8 @@ namespace {
 // --model-check-program: "none" is "", "auto" the program next to this one
 // (or "" when this build reads no CAD files), a path itself when it can run.
 absl::Status ResolveModelCheckProgram(const std::string& flag, std::string* program) {
-  const bool reads_cad = sfc::RegisteredSurfaceKinds().For(sfc::ModelSpec{sfc::ModelFormat::kStep}) != nullptr;
+  const bool reads_cad =
+      sfc::RegisteredSurfaceKinds().For(sfc::ModelSpec{sfc::ModelFormat::kStep}) != nullptr;
   if (flag == "none" || !reads_cad) {
     *program = "";
     return absl::OkStatus();
@@ -65,12 +66,16 @@ int main(int argc, char** argv) {
   app.add_option("--health-address", o.health_address,
                  "host:port of a health-only listener without TLS or token (\"\" = none)")
       ->capture_default_str();
-  app.add_option("--metrics-address", o.metrics_address, "host:port of Prometheus /metrics (\"\" = none)")
+  app.add_option("--metrics-address", o.metrics_address,
+                 "host:port of Prometheus /metrics (\"\" = none)")
       ->capture_default_str();
   app.add_option("--max-count", o.limits.max_count, "largest N per request")->capture_default_str();
-  app.add_option("--max-tree-leaves", o.limits.max_tree_leaves, absl::StrFormat("largest tree, in leaves (%d bytes each)", sfc::CurveTree::kBytesPerLeaf))
+  app.add_option(
+         "--max-tree-leaves", o.limits.max_tree_leaves,
+         absl::StrFormat("largest tree, in leaves (%d bytes each)", sfc::CurveTree::kBytesPerLeaf))
       ->capture_default_str();
-  app.add_option("--max-spec-length", o.limits.max_spec_length, "longest surface or density spec, characters")
+  app.add_option("--max-spec-length", o.limits.max_spec_length,
+                 "longest surface or density spec, characters")
       ->capture_default_str();
   app.add_option("--max-sorted-range", o.limits.max_sorted_range,
                  "most samples per request for sequences sorted into curve order (random, "
@@ -80,7 +85,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--model-bytes", o.model_bytes, "uploaded models kept, bytes (LRU eviction)")
       ->capture_default_str();
-  app.add_option("--max-model-bytes", o.max_model_bytes, "largest model one upload may carry, bytes")
+  app.add_option("--max-model-bytes", o.max_model_bytes,
+                 "largest model one upload may carry, bytes")
       ->capture_default_str();
   app.add_option("--parsed-model-bytes", o.limits.parsed_model_bytes,
                  "parsed models kept (meshes, CAD models), bytes (LRU eviction)")
@@ -125,14 +131,16 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--max-concurrent-streams", o.max_concurrent_streams, "Sample streams at once")
       ->capture_default_str();
-  app.add_option("--max-batch-size", o.max_batch_size, "most samples per message")->capture_default_str();
+  app.add_option("--max-batch-size", o.max_batch_size, "most samples per message")
+      ->capture_default_str();
   app.add_option("--max-message-bytes", o.max_message_bytes,
                  "largest message sent, bytes; batches are sized to fit (4 MiB: what stock gRPC "
                  "clients accept)")
       ->capture_default_str();
-  app.add_option("--stream-memory-bytes", o.stream_memory_bytes,
-                 "working memory of all streams together (sorting random/van der Corput/progressive "
-                 "ranges: 16 bytes a sample; batches and messages); streams wait for it")
+  app.add_option(
+         "--stream-memory-bytes", o.stream_memory_bytes,
+         "working memory of all streams together (sorting random/van der Corput/progressive "
+         "ranges: 16 bytes a sample; batches and messages); streams wait for it")
       ->capture_default_str();
   app.add_option("--stream-pipeline-depth", o.stream_pipeline_depth,
                  "messages a stream generates ahead of its writes (it holds at most this + 2); 0: "
@@ -158,27 +166,33 @@ int main(int argc, char** argv) {
                  "threads that fill one stream's batches (same samples, same order)")
       ->capture_default_str()
       ->check(CLI::Range(1, 64));
-  app.add_option("--request-deadline", o.request_deadline_seconds, "longest a stream may run, seconds")
+  app.add_option("--request-deadline", o.request_deadline_seconds,
+                 "longest a stream may run, seconds")
       ->capture_default_str();
   app.add_option("--shutdown-grace", o.shutdown_grace_seconds,
                  "seconds in-flight streams get on SIGTERM before they are cancelled")
       ->capture_default_str();
-  app.add_option("--tls-cert", o.tls_cert_file, "PEM certificate chain; with --tls-key enables TLS");
+  app.add_option("--tls-cert", o.tls_cert_file,
+                 "PEM certificate chain; with --tls-key enables TLS");
   app.add_option("--tls-key", o.tls_key_file, "PEM private key");
-  app.add_option("--tls-client-ca", o.tls_client_ca_file,
-                 "PEM CA certificates; clients must present a certificate they signed (mutual TLS)");
-  app.add_option("--token-file", token_file, "file holding the bearer token every sampler RPC must carry");
+  app.add_option(
+      "--tls-client-ca", o.tls_client_ca_file,
+      "PEM CA certificates; clients must present a certificate they signed (mutual TLS)");
+  app.add_option("--token-file", token_file,
+                 "file holding the bearer token every sampler RPC must carry");
   app.add_option("--trim-interval-ms", trim_interval_ms,
                  "how often freed heap memory is given back to the system (malloc_trim); 0 = never")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   std::string model_check = "auto";
-  app.add_option("--model-check-program", model_check,
-                 "reads each CAD file in a process of its own, where a crash or a loop in the CAD "
-                 "kernel costs one request, and makes the model of the shape it sends back (auto: "
-                 "sfcsampler-model-check next to this program; none: read CAD files in this process)")
+  app.add_option(
+         "--model-check-program", model_check,
+         "reads each CAD file in a process of its own, where a crash or a loop in the CAD "
+         "kernel costs one request, and makes the model of the shape it sends back (auto: "
+         "sfcsampler-model-check next to this program; none: read CAD files in this process)")
       ->capture_default_str();
-  app.add_option("--log-level", log_level, "trace | debug | info | warn | error")->capture_default_str();
+  app.add_option("--log-level", log_level, "trace | debug | info | warn | error")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   if (absl::Status found = ResolveModelCheckProgram(model_check, &o.limits.model_check_program);
       !found.ok()) {

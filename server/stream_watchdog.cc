@@ -53,7 +53,8 @@ void StreamWatchdog::Loop() {
     mu_.AwaitWithTimeout(absl::Condition(&stopping_), absl::FromChrono(period_));
     const auto now = Clock::now();
     for (Watch* w : watches_) {
-      if (w->reason_ != Reason::kNone || !w->writing_ || now - w->write_started_ <= timeout) continue;
+      if (w->reason_ != Reason::kNone || !w->writing_ || now - w->write_started_ <= timeout)
+        continue;
       w->reason_ = Reason::kWriteTimeout;
       // Thread-safe; the stream's blocked Write returns false.
       w->context_->TryCancel();

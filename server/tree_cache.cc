@@ -53,16 +53,18 @@ absl::StatusOr<TreeLookup> TreeCache::Get(const TreeKey& key, int grade, const T
       }
     }
     if (stopping_) {
-      return absl::UnavailableError("the server is shutting down; retry on another replica or later");
+      return absl::UnavailableError(
+          "the server is shutting down; retry on another replica or later");
     }
     if (auto it = failures_.find(id); it != failures_.end()) {
       const double age = std::chrono::duration<double>(Clock::now() - it->second.when).count();
       if (age < options_.failure_ttl_seconds) {
         ++stats_.failure_hits;
         const absl::Status& s = it->second.status;
-        return absl::Status(s.code(), absl::StrFormat("%s (this tree's build failed %.0f s ago; the "
-                                                      "server remembers failed builds for %g s)",
-                                                      s.message(), age, options_.failure_ttl_seconds));
+        return absl::Status(s.code(),
+                            absl::StrFormat("%s (this tree's build failed %.0f s ago; the "
+                                            "server remembers failed builds for %g s)",
+                                            s.message(), age, options_.failure_ttl_seconds));
       }
       failures_.erase(it);
     }
@@ -137,7 +139,9 @@ void TreeCache::BuilderLoop() {
     std::shared_ptr<Job> job;
     {
       absl::MutexLock lock(&mu_);
-      auto has_work = [this]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { return stopping_ || !queue_.empty(); };
+      auto has_work = [this]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
+        return stopping_ || !queue_.empty();
+      };
       mu_.Await(absl::Condition(&has_work));
       if (stopping_) return;
       job = std::move(queue_.front());
@@ -155,7 +159,8 @@ absl::Status TreeCache::BuildCheck(const Job& job) const {
     return absl::UnavailableError("the server is shutting down; the tree build was stopped");
   }
   if (job.waiters == 0) {
-    return absl::CancelledError("every request waiting for this tree has gone; its build was stopped");
+    return absl::CancelledError(
+        "every request waiting for this tree has gone; its build was stopped");
   }
   return absl::OkStatus();
 }
@@ -244,13 +249,14 @@ void TreeCache::Finish(Job& job, Result result, double seconds) {
     if (failures_.size() >= kMaxFailures) {
       const auto now = Clock::now();
       for (auto it = failures_.begin(); it != failures_.end();) {
-        const bool expired =
-            std::chrono::duration<double>(now - it->second.when).count() >= options_.failure_ttl_seconds;
+        const bool expired = std::chrono::duration<double>(now - it->second.when).count() >=
+                             options_.failure_ttl_seconds;
         it = expired ? failures_.erase(it) : std::next(it);
       }
       if (failures_.size() >= kMaxFailures) failures_.erase(failures_.begin());
     }
-    if (options_.failure_ttl_seconds > 0) failures_[job.id] = Failure{result.status(), Clock::now()};
+    if (options_.failure_ttl_seconds > 0)
+      failures_[job.id] = Failure{result.status(), Clock::now()};
   }
   job.result = std::move(result);
   job.done = true;
@@ -262,7 +268,8 @@ void TreeCache::Stop() {
     stopping_ = true;
     for (const std::shared_ptr<Job>& job : queue_) {
       pending_.erase(job->id);
-      job->result = absl::UnavailableError("the server is shutting down; retry on another replica or later");
+      job->result =
+          absl::UnavailableError("the server is shutting down; retry on another replica or later");
       job->done = true;
       ++stats_.builds_stopped;
     }

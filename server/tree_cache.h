@@ -6,11 +6,10 @@
 // (one build). A miss for grade g refines the finest cached coarser grade of
 // the same tree instead of building anew (the result is the same tree, see
 // core/curve_tree.h). The cache holds at most budget_bytes of trees and evicts
-// the least recently used; trees (of any kind: engine/tree_source.h AnyTree) are shared as shared_ptrs, so
-// a stream keeps its tree alive through eviction. Such an evicted tree still
-// takes memory: it stays counted against budget_bytes ("retired") until the
-// last holder lets go, and a request for it takes it back into the cache
-// instead of building a second copy.
+// the least recently used; trees (of any kind: engine/tree_source.h AnyTree) are shared as
+// shared_ptrs, so a stream keeps its tree alive through eviction. Such an evicted tree still takes
+// memory: it stays counted against budget_bytes ("retired") until the last holder lets go, and a
+// request for it takes it back into the cache instead of building a second copy.
 //
 // Builds are bounded:
 //  - they run on max_concurrent_builds threads of the cache's own; at most
@@ -86,7 +85,8 @@ class TreeCache final : public TreeSource {
  public:
   // `on_build`, if set, is called with the seconds of every finished build or
   // refinement (outside the lock).
-  explicit TreeCache(const TreeCacheOptions& options, std::function<void(double)> on_build = nullptr);
+  explicit TreeCache(const TreeCacheOptions& options,
+                     std::function<void(double)> on_build = nullptr);
   ~TreeCache() override;  // Stop()s
   TreeCache(const TreeCache&) = delete;
   TreeCache& operator=(const TreeCache&) = delete;

@@ -15,7 +15,8 @@ TEST(BlueNoise, HexagonalLatticeScoresOne) {
   const double d = 0.02;
   std::vector<Point2> pts;
   for (int row = 0; row * d * std::sqrt(3.0) / 2 < 1; ++row) {
-    for (double x = (row % 2) * d / 2; x < 1; x += d) pts.push_back({x, row * d * std::sqrt(3.0) / 2});
+    for (double x = (row % 2) * d / 2; x < 1; x += d)
+      pts.push_back({x, row * d * std::sqrt(3.0) / 2});
   }
   const NearestNeighbour nn = PlaneNearestNeighbour(pts);
   // The spacing for this many points differs from d only by the lattice's

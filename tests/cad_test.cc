@@ -613,7 +613,8 @@ TEST(CadModel, ClosedFormsGiveTheKernelsBits) {
           const int order = 1 + k % 2;
           const SurfaceJet x = a.surface().Jet(s, t, order), y = b.surface().Jet(s, t, order);
           const Vec3 p = a.surface().Point(s, t), q = b.surface().Point(s, t);
-          ASSERT_EQ(std::memcmp(&p, &q, sizeof(Vec3)), 0) << "face " << f << " at " << s << ", " << t;
+          ASSERT_EQ(std::memcmp(&p, &q, sizeof(Vec3)), 0)
+              << "face " << f << " at " << s << ", " << t;
           for (auto [u, w] : {std::pair{x.p, y.p}, {x.fu, y.fu}, {x.fv, y.fv}, {x.fuu, y.fuu},
                               {x.fuv, y.fuv}, {x.fvv, y.fvv}}) {
             ASSERT_EQ(std::memcmp(&u, &w, sizeof(Vec3)), 0)

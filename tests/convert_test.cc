@@ -32,7 +32,8 @@ TEST(AppendFromProto, GivesBackTheBatchThatToProtoSent) {
   SampleBatch got;
   ASSERT_TRUE(AppendFromProto(wire, SampleFields{}, &got).ok());
   EXPECT_EQ(got.index, sent.index);
-  for (auto column : {&SampleBatch::u, &SampleBatch::v, &SampleBatch::x, &SampleBatch::y, &SampleBatch::z}) {
+  for (auto column :
+       {&SampleBatch::u, &SampleBatch::v, &SampleBatch::x, &SampleBatch::y, &SampleBatch::z}) {
     ASSERT_EQ((got.*column).size(), (sent.*column).size());
     for (size_t i = 0; i < sent.size(); ++i) {
       EXPECT_EQ(std::signbit((got.*column)[i]), std::signbit((sent.*column)[i]));
@@ -187,10 +188,12 @@ TEST(RawColumns, AreLittleEndianIeeeValuesBackToBack) {
     uint32_t bits32;
     std::memcpy(&bits32, &f, sizeof bits32);
     for (size_t k = 0; k < 8; ++k) {
-      EXPECT_EQ(static_cast<unsigned char>(wire64.raw().x()[8 * i + k]), (bits64 >> (8 * k)) & 0xff);
+      EXPECT_EQ(static_cast<unsigned char>(wire64.raw().x()[8 * i + k]),
+                (bits64 >> (8 * k)) & 0xff);
     }
     for (size_t k = 0; k < 4; ++k) {
-      EXPECT_EQ(static_cast<unsigned char>(wire32.raw().x()[4 * i + k]), (bits32 >> (8 * k)) & 0xff);
+      EXPECT_EQ(static_cast<unsigned char>(wire32.raw().x()[4 * i + k]),
+                (bits32 >> (8 * k)) & 0xff);
     }
   }
 }
@@ -298,7 +301,8 @@ TEST(WireColumns, OnlyTheAskedForColumnsTravelAndArrive) {
         // The message's size follows the columns it carries.
         const size_t width = precision == v1::PRECISION_FLOAT32 ? 4 : 8;
         EXPECT_GE(narrow.ByteSizeLong(), WireValueColumns(fields) * width * sent.size());
-        EXPECT_LT(narrow.ByteSizeLong(), (WireValueColumns(fields) * width + 1) * sent.size() + 100);
+        EXPECT_LT(narrow.ByteSizeLong(),
+                  (WireValueColumns(fields) * width + 1) * sent.size() + 100);
       }
     }
   }
@@ -310,7 +314,8 @@ TEST(WireColumns, AMessageOfTheMostThatFitWithoutUvFitsTheCapAndHoldsMore) {
   for (auto precision : {v1::PRECISION_FLOAT64, v1::PRECISION_FLOAT32}) {
     const size_t cap = 1 << 16;
     const uint32_t n = MaxSamplesPerMessage(positions, precision, true, 0, cap);
-    EXPECT_GT(n, MaxSamplesPerMessage(all, precision, true, 0, cap) * 4 / 3);  // 48 or 28 bytes a sample against 32 or 20
+    EXPECT_GT(n, MaxSamplesPerMessage(all, precision, true, 0, cap) * 4 /
+                     3);  // 48 or 28 bytes a sample against 32 or 20
     const SampleBatch b = EveryColumn(n, 13, false);
     v1::SampleResponse response;
     ToProto(b, positions, precision, response.mutable_batch(), v1::COLUMN_ENCODING_RAW);

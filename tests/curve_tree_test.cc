@@ -67,10 +67,13 @@ TEST(CurveTree, EveryLeafThatCarriesEnoughSamplesPassesTheFlatnessTestOrSitsAtTh
       double spread = 0;
       for (int i = 0; i <= 2; ++i) {
         for (int j = 0; j <= 2; ++j) {
-          spread = std::max(spread, Norm(s.surface->Point(c.u0 + i * c.size / 2, c.v0 + j * c.size / 2) - centre));
+          spread = std::max(
+              spread,
+              Norm(s.surface->Point(c.u0 + i * c.size / 2, c.v0 + j * c.size / 2) - centre));
         }
       }
-      const double samples = (s.tree->mass_end(l) - s.tree->mass_begin(l)) / s.tree->base_mass() * n;
+      const double samples =
+          (s.tree->mass_end(l) - s.tree->mass_begin(l)) / s.tree->base_mass() * n;
       // 1% margin: the test reads the leaf's running-sum mass, the build its own estimate.
       if (samples > floor * 1.01) {
         ASSERT_LE(spread, options.tolerance) << surface << " leaf " << l;
@@ -128,7 +131,8 @@ TEST(CurveTree, RefiningACachedTreeEqualsBuildingAFreshOne) {
       ASSERT_EQ((*refined)->leaf_start(l), fresh.tree->leaf_start(l));
       ASSERT_EQ((*refined)->mass_end(l), fresh.tree->mass_end(l));  // bit-identical
       ASSERT_EQ((*refined)->leaf_fail_grade(l), fresh.tree->leaf_fail_grade(l));
-      for (int k = 0; k < 9; ++k) ASSERT_EQ((*refined)->leaf_model(l).c[k], fresh.tree->leaf_model(l).c[k]);
+      for (int k = 0; k < 9; ++k)
+        ASSERT_EQ((*refined)->leaf_model(l).c[k], fresh.tree->leaf_model(l).c[k]);
     }
   }
 }
@@ -228,7 +232,8 @@ TEST(CurveTree, SingularLinesAreLocatedAndTheTreeStaysSmall) {
       }
       return false;
     };
-    EXPECT_TRUE(near_line(h.u0, h.size, {0, 0.5, 1}) || near_line(h.v0, h.size, {0, 0.25, 0.5, 0.75, 1}))
+    EXPECT_TRUE(near_line(h.u0, h.size, {0, 0.5, 1}) ||
+                near_line(h.v0, h.size, {0, 0.25, 0.5, 0.75, 1}))
         << h.u0 << " " << h.v0 << " " << h.size;
   }
   EXPECT_LE(s.tree->leaf_count(), uint64_t{1} << 20);

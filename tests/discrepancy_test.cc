@@ -69,7 +69,8 @@ TEST(TriangleDiscrepancy, EqualsBruteForceOverItsFamily) {
         const double a = (i + 0.5) / grid * 2.5, b = (j + 0.5) / grid * 2.5;
         int inside = 0;
         for (const auto& p : pts) inside += p.x / a + p.y / b < 1;
-        brute = std::max(brute, std::fabs(static_cast<double>(inside) / n - AnchoredTriangleArea(a, b)));
+        brute = std::max(brute,
+                         std::fabs(static_cast<double>(inside) / n - AnchoredTriangleArea(a, b)));
       }
     }
     EXPECT_NEAR(TriangleDiscrepancy(pts, grid), brute, 1e-12) << n;
@@ -127,7 +128,8 @@ TEST(ReferenceSets, SobolIsA02SequenceInBase2) {
     for (int k = 0; k <= m; ++k) {
       std::set<std::pair<uint64_t, uint64_t>> cells;
       for (const auto& p : pts) {
-        cells.insert({static_cast<uint64_t>(p.x * (1 << k)), static_cast<uint64_t>(p.y * (1 << (m - k)))});
+        cells.insert(
+            {static_cast<uint64_t>(p.x * (1 << k)), static_cast<uint64_t>(p.y * (1 << (m - k)))});
       }
       EXPECT_EQ(cells.size(), n) << "m " << m << " k " << k;
     }
@@ -147,7 +149,8 @@ TEST(ReferenceSets, JitteredPutsOnePointInEachEqualAreaStratum) {
       const uint64_t cells = n / rows + (r < n % rows ? 1 : 0);
       const double height = static_cast<double>(cells) / n;
       for (const auto& p : pts) {
-        if (p.y >= y0 && p.y < y0 + height) occupied.insert({r, static_cast<uint64_t>(p.x * cells)});
+        if (p.y >= y0 && p.y < y0 + height)
+          occupied.insert({r, static_cast<uint64_t>(p.x * cells)});
       }
       y0 += height;
     }

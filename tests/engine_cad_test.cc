@@ -39,7 +39,8 @@ struct Engine {
   DirectTreeSource source;
   FileModelSource files;
   SamplingEngine engine;
-  explicit Engine(int threads = 1) : engine(RegisteredSurfaceKinds(), Limits(threads), &source, &files) {}
+  explicit Engine(int threads = 1)
+      : engine(RegisteredSurfaceKinds(), Limits(threads), &source, &files) {}
   static EngineLimits Limits(int threads) {
     EngineLimits limits;
     limits.generation_threads = threads;
@@ -59,7 +60,8 @@ SampleRequest ModelRequest(const std::string& surface, uint64_t count, uint64_t 
 
 TEST(EngineCad, NoSampleOfTheBoxWithAHoleLeavesItsFace) {
   Engine e;
-  const SampleBatch b = DrawAll(e.engine, ModelRequest("step:" + Fixture(fx::Solid::kBoxWithHole), 30000));
+  const SampleBatch b =
+      DrawAll(e.engine, ModelRequest("step:" + Fixture(fx::Solid::kBoxWithHole), 30000));
   ASSERT_EQ(b.size(), 30000u);
   ASSERT_EQ(b.face.size(), b.size());
   // The solid's exact geometry: inside the box, outside the hole, inside the
@@ -71,7 +73,8 @@ TEST(EngineCad, NoSampleOfTheBoxWithAHoleLeavesItsFace) {
     ASSERT_TRUE(x >= -eps && x <= fx::kBoxX + eps && y >= -eps && y <= fx::kBoxY + eps &&
                 z >= -eps && z <= fx::kBoxZ + eps)
         << "sample " << i << " outside the box";
-    ASSERT_GE(std::hypot(x - cx, y - cy), fx::kHoleRadius - eps) << "sample " << i << " in the hole";
+    ASSERT_GE(std::hypot(x - cx, y - cy), fx::kHoleRadius - eps)
+        << "sample " << i << " in the hole";
     if (x > fx0 && y > fy0) {
       ASSERT_LE(std::hypot(x - fx0, y - fy0), fx::kFilletRadius + eps)
           << "sample " << i << " beyond the rounded edge";
@@ -86,7 +89,8 @@ TEST(EngineCad, FacesGetSamplesInProportionToTheirExactAreas) {
   ASSERT_TRUE(model.ok()) << model.status();
   Engine e;
   for (uint64_t n : {1000u, 20000u}) {
-    const SampleBatch b = DrawAll(e.engine, ModelRequest("step:" + Fixture(fx::Solid::kBoxWithHole), n));
+    const SampleBatch b =
+        DrawAll(e.engine, ModelRequest("step:" + Fixture(fx::Solid::kBoxWithHole), n));
     std::map<uint32_t, double> counts;
     for (uint32_t f : b.face) ++counts[f];
     for (const cad::Face& face : (*model)->faces()) {
@@ -126,8 +130,9 @@ TEST(EngineCad, AStepSphereSamplesAsWellAsTheBuiltInSphere) {
   const double model_slope = LogLogSlope(ns, model_d), builtin_slope = LogLogSlope(ns, builtin_d);
   RecordProperty("step_sphere_slope", std::to_string(model_slope));
   RecordProperty("builtin_sphere_slope", std::to_string(builtin_slope));
-  std::printf("spherical-triangle discrepancy slope, N = 64..24576: STEP sphere %.3f, built-in %.3f\n",
-              model_slope, builtin_slope);
+  std::printf(
+      "spherical-triangle discrepancy slope, N = 64..24576: STEP sphere %.3f, built-in %.3f\n",
+      model_slope, builtin_slope);
   EXPECT_LE(model_slope, -0.72);
   EXPECT_LE(model_slope, builtin_slope + 0.03);
 }
@@ -185,7 +190,8 @@ TEST(EngineCad, MalformedModelsAreRefusedByName) {
   Engine e;
   auto bytes = fx::SolidBytes(fx::Solid::kBoxWithHole, cad::ModelFormat::kStep);
   ASSERT_TRUE(bytes.ok());
-  const std::string truncated = WriteTemp("engine_cad_truncated.step", bytes->substr(0, bytes->size() / 3));
+  const std::string truncated =
+      WriteTemp("engine_cad_truncated.step", bytes->substr(0, bytes->size() / 3));
   auto status = e.engine.Start(ModelRequest("step:" + truncated, 100)).status();
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << status;
   EXPECT_NE(status.message().find("engine_cad_truncated.step"), std::string::npos) << status;
@@ -240,7 +246,8 @@ TEST(EngineCad, EverySampleLiesOnItsFace) {
 // model check's BRep (the server's path).
 TEST(EngineCad, FacesWithoutAreaTakeNoSamplesAndAModelOfThemIsRefused) {
   Engine e;
-  const std::string only = WriteTemp("engine_cad_collinear.step", fx::CollinearFacesStep(10, false));
+  const std::string only =
+      WriteTemp("engine_cad_collinear.step", fx::CollinearFacesStep(10, false));
   auto status = e.engine.Start(ModelRequest("step:" + only, 1000)).status();
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << status;
   EXPECT_NE(status.message().find("no face with area"), std::string::npos) << status;
@@ -267,9 +274,10 @@ TEST(EngineCad, FacesWithoutAreaTakeNoSamplesAndAModelOfThemIsRefused) {
   ASSERT_EQ(b.size(), 2000u);
   std::vector<fx::PointOnFace> points;
   for (size_t i = 0; i < b.size(); ++i) {
-    ASSERT_EQ(b.face[i], static_cast<uint32_t>(square)) << "sample " << i << " on a face without area";
-    ASSERT_TRUE(b.z[i] == 0 && b.x[i] >= fx::kSquareX && b.x[i] <= fx::kSquareX + 1 && b.y[i] >= 0 &&
-                b.y[i] <= 1)
+    ASSERT_EQ(b.face[i], static_cast<uint32_t>(square))
+        << "sample " << i << " on a face without area";
+    ASSERT_TRUE(b.z[i] == 0 && b.x[i] >= fx::kSquareX && b.x[i] <= fx::kSquareX + 1 &&
+                b.y[i] >= 0 && b.y[i] <= 1)
         << "sample " << i << " off the square";
     points.push_back({static_cast<int>(b.face[i]), b.x[i], b.y[i], b.z[i]});
   }

@@ -189,7 +189,8 @@ TEST(EngineMesh, PerVertexWeightsFromAPlyPropertyShiftTheSamples) {
   TriangleMesh sphere = MakeIcosphere(3);
   sphere.weights.clear();
   for (const Vec3& p : sphere.positions) sphere.weights.push_back(p.x > 0 ? 4.0 : 1.0);
-  const std::string path = WriteTemp("engine_mesh_weights.ply", MeshToPly(sphere, false, "quality"));
+  const std::string path =
+      WriteTemp("engine_mesh_weights.ply", MeshToPly(sphere, false, "quality"));
   DirectTreeSource source;
   FileModelSource files;
   SamplingEngine engine(RegisteredSurfaceKinds(), {}, &source, &files);

@@ -60,7 +60,8 @@ TEST(Engine, ASingularityExhaustsTheLeafBudgetAndIsLocated) {
   const std::string marker = "(u,v) = (";
   const size_t at = status.message().find(marker);
   ASSERT_NE(at, std::string::npos) << status;
-  EXPECT_NEAR(std::atof(std::string(status.message().substr(at + marker.size())).c_str()), 0.3, 0.01);
+  EXPECT_NEAR(std::atof(std::string(status.message().substr(at + marker.size())).c_str()), 0.3,
+              0.01);
 }
 
 TEST(Engine, NegativeDensityIsInvalidArgument) {
@@ -99,8 +100,8 @@ TEST(Engine, UnknownSurfaceDensityOrParameterIsInvalidArgument) {
               absl::StatusCode::kInvalidArgument, "accepted: r");
   ExpectError(StartWith("torus:r=-1", "uniform", 10).status(), absl::StatusCode::kInvalidArgument,
               "> 0");
-  ExpectError(StartWith("sphere:r=1;r=2", "uniform", 10).status(), absl::StatusCode::kInvalidArgument,
-              "given twice");
+  ExpectError(StartWith("sphere:r=1;r=2", "uniform", 10).status(),
+              absl::StatusCode::kInvalidArgument, "given twice");
 }
 
 TEST(Engine, OverlongSpecIsInvalidArgument) {
@@ -192,8 +193,9 @@ TEST(Engine, ShardsPartitionTheIndexRange) {
 
 TEST(Catalog, EveryListedSurfaceSamplesWithEveryBuiltInDensity) {
   for (const CatalogEntry& e : SurfaceCatalog()) {
-    const std::string spec =
-        e.name == "expr" ? "expr:x=u;y=v;z=u*v" : e.name == "superellipsoid" ? "superellipsoid:reparam=1" : e.name;
+    const std::string spec = e.name == "expr"             ? "expr:x=u;y=v;z=u*v"
+                             : e.name == "superellipsoid" ? "superellipsoid:reparam=1"
+                                                          : e.name;
     for (const char* density : {"uniform", "gaussian:floor=0.1", "mean:floor=0.1", "expr:1+x*x"}) {
       EXPECT_TRUE(RunToEnd(spec, density, 500).ok()) << spec << " " << density;
     }
@@ -227,7 +229,8 @@ TEST(Surfaces, AnalyticJetsAgreeWithFiniteDifferences) {
     for (double u : {0.13, 0.5, 0.77}) {
       for (double v : {0.21, 0.64}) {
         const SurfaceJet a = s->surface->Jet(u, v, 2), n = numeric.Jet(u, v, 2);
-        for (auto [x, y] : {std::pair{a.fu, n.fu}, {a.fv, n.fv}}) EXPECT_LT(Norm(x - y), 1e-8) << spec;
+        for (auto [x, y] : {std::pair{a.fu, n.fu}, {a.fv, n.fv}})
+          EXPECT_LT(Norm(x - y), 1e-8) << spec;
         for (auto [x, y] : {std::pair{a.fuu, n.fuu}, {a.fuv, n.fuv}, {a.fvv, n.fvv}}) {
           EXPECT_LT(Norm(x - y), 1e-4 * (1 + Norm(x))) << spec;
         }

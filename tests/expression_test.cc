@@ -302,7 +302,8 @@ TEST(Expression, IntervalsEncloseEveryPointValue) {
       const Interval in[2] = {Interval::Of(u0, u0 + w), Interval::Of(v0, v0 + w)};
       const Interval bound = e->Evaluate(in);
       for (int k = 0; k < 30; ++k) {
-        const double x[2] = {k == 0 ? u0 : u0 + w * unit(rng), k == 1 ? v0 + w : v0 + w * unit(rng)};
+        const double x[2] = {k == 0 ? u0 : u0 + w * unit(rng),
+                             k == 1 ? v0 + w : v0 + w * unit(rng)};
         const double value = e->Evaluate(x);
         if (std::isnan(value)) {
           EXPECT_TRUE(bound.maybe_nan) << text;
@@ -348,7 +349,8 @@ TEST(Expression, ManyThreadsEvaluateOneExpression) {
         const double u = (i % 97) / 97.0, v = (i % 89) / 89.0;
         const double x[2] = {u, v};
         // Our sin and cos are SLEEF's (core/vector_math.h), bit for bit.
-        wrong[t] += e->Evaluate(x) != math::SinCosOf(u).sin * math::SinCosOf(v).cos + (u < v ? u : v);
+        wrong[t] +=
+            e->Evaluate(x) != math::SinCosOf(u).sin * math::SinCosOf(v).cos + (u < v ? u : v);
       }
     });
   }

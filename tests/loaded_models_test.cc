@@ -190,7 +190,8 @@ TEST(LoadedModels, AFullQueueIsResourceExhausted) {
   auto until_leave = [&]() -> absl::Status {
     return leave ? absl::CancelledError("done") : absl::OkStatus();
   };
-  std::thread running([&] { loaded.Get<int>("a", Spinning(&started), until_leave, 0).IgnoreError(); });
+  std::thread running(
+      [&] { loaded.Get<int>("a", Spinning(&started), until_leave, 0).IgnoreError(); });
   while (!started) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   std::thread queued([&] { loaded.Get<int>("b", Spinning(&other), until_leave, 0).IgnoreError(); });
   while (loaded.stats().queued < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
@@ -220,10 +221,12 @@ TEST(LoadedModels, ParsesRunOnlyWhileTheirWorkingMemoryFits) {
   auto until_leave = [&]() -> absl::Status {
     return leave ? absl::CancelledError("done") : absl::OkStatus();
   };
-  std::thread first([&] { loaded.Get<int>("a", Spinning(&first_started), until_leave, 600).IgnoreError(); });
+  std::thread first(
+      [&] { loaded.Get<int>("a", Spinning(&first_started), until_leave, 600).IgnoreError(); });
   while (!first_started) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   EXPECT_EQ(loaded.stats().working_bytes, 600u);
-  std::thread second([&] { loaded.Get<int>("b", Spinning(&second_started), until_leave, 600).IgnoreError(); });
+  std::thread second(
+      [&] { loaded.Get<int>("b", Spinning(&second_started), until_leave, 600).IgnoreError(); });
   while (loaded.stats().queued < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
   EXPECT_FALSE(second_started) << "600 + 600 bytes of parses ran at once on a budget of 1000";
@@ -249,7 +252,8 @@ TEST(LoadedModels, SmallParsesStartFirstAndNoneIsPassedOverForGood) {
   auto until_leave = [&]() -> absl::Status {
     return leave ? absl::CancelledError("done") : absl::OkStatus();
   };
-  std::thread running([&] { loaded.Get<int>("busy", Spinning(&started), until_leave, 1).IgnoreError(); });
+  std::thread running(
+      [&] { loaded.Get<int>("busy", Spinning(&started), until_leave, 1).IgnoreError(); });
   while (!started) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   absl::Mutex order_mu;
   std::vector<std::string> order;
@@ -262,11 +266,13 @@ TEST(LoadedModels, SmallParsesStartFirstAndNoneIsPassedOverForGood) {
   };
   // Queued while "busy" runs: a large parse, then ten small ones.
   std::vector<std::thread> waiting;
-  waiting.emplace_back([&] { ASSERT_TRUE(loaded.Get<int>("large", recording("large"), nullptr, 1000).ok()); });
+  waiting.emplace_back(
+      [&] { ASSERT_TRUE(loaded.Get<int>("large", recording("large"), nullptr, 1000).ok()); });
   while (loaded.stats().queued < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   for (int i = 0; i < 10; ++i) {
     const std::string name = absl::StrCat("small", i);
-    waiting.emplace_back([&, name] { ASSERT_TRUE(loaded.Get<int>(name, recording(name), nullptr, 10).ok()); });
+    waiting.emplace_back(
+        [&, name] { ASSERT_TRUE(loaded.Get<int>(name, recording(name), nullptr, 10).ok()); });
     while (loaded.stats().queued < static_cast<uint64_t>(i + 2)) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
@@ -295,7 +301,8 @@ TEST(LoadedModels, ALongParseLeavesItsSlotToTheParsesWaiting) {
   auto until_leave = [&]() -> absl::Status {
     return leave ? absl::CancelledError("done") : absl::OkStatus();
   };
-  std::thread hog([&] { loaded.Get<int>("hog", Spinning(&started), until_leave, 1).IgnoreError(); });
+  std::thread hog(
+      [&] { loaded.Get<int>("hog", Spinning(&started), until_leave, 1).IgnoreError(); });
   while (loaded.stats().long_parses < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   std::atomic<int> parses{0};
   EXPECT_TRUE(loaded.Get<int>("small", Returning(1, &parses), nullptr, 1).ok());
@@ -324,16 +331,21 @@ TEST(LoadedModels, AFullQueueTakesASmallerParseInPlaceOfItsLargest) {
   auto until_leave = [&]() -> absl::Status {
     return leave ? absl::CancelledError("done") : absl::OkStatus();
   };
-  std::thread busy([&] { loaded.Get<int>("busy", Spinning(&started), until_leave, 1).IgnoreError(); });
+  std::thread busy(
+      [&] { loaded.Get<int>("busy", Spinning(&started), until_leave, 1).IgnoreError(); });
   while (!started) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   std::atomic<int> parses{0};
   absl::Status large_status;
-  std::thread large([&] { large_status = loaded.Get<int>("large", Returning(1, &parses), nullptr, 1000).status(); });
+  std::thread large([&] {
+    large_status = loaded.Get<int>("large", Returning(1, &parses), nullptr, 1000).status();
+  });
   while (loaded.stats().queued < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  std::thread small([&] { EXPECT_TRUE(loaded.Get<int>("small", Returning(1, &parses), nullptr, 10).ok()); });
+  std::thread small(
+      [&] { EXPECT_TRUE(loaded.Get<int>("small", Returning(1, &parses), nullptr, 10).ok()); });
   large.join();
   EXPECT_EQ(large_status.code(), absl::StatusCode::kResourceExhausted) << large_status;
-  EXPECT_NE(large_status.message().find("took this one's place"), std::string::npos) << large_status;
+  EXPECT_NE(large_status.message().find("took this one's place"), std::string::npos)
+      << large_status;
   // A parse no smaller than the queued one is turned away as before.
   auto refused = loaded.Get<int>("larger", Returning(1, &parses), nullptr, 10);
   EXPECT_EQ(refused.status().code(), absl::StatusCode::kResourceExhausted);
@@ -353,7 +365,8 @@ TEST(LoadedModels, ARequestLeavesAQueueItWaitedInTooLong) {
   auto until_leave = [&]() -> absl::Status {
     return leave ? absl::CancelledError("done") : absl::OkStatus();
   };
-  std::thread busy([&] { loaded.Get<int>("busy", Spinning(&started), until_leave, 1).IgnoreError(); });
+  std::thread busy(
+      [&] { loaded.Get<int>("busy", Spinning(&started), until_leave, 1).IgnoreError(); });
   while (!started) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   std::atomic<int> parses{0};
   auto waited = loaded.Get<int>("waits", Returning(1, &parses), nullptr, 1);

@@ -79,8 +79,9 @@ TEST(MeshHostile, PlyIndicesPastTheVerticesAreRefusedWithTheIndex) {
   auto good = LoadMesh(AsciiPly("int", "3 0 1 2\n3 1 3 2\n", 2), "hostile.ply", options);
   ASSERT_TRUE(good.ok()) << good.status();
   EXPECT_EQ(good->triangles.size(), 2u);
-  for (const auto& [type, index] : {std::pair{"int", "4"}, std::pair{"int", "-1"},
-                                    std::pair{"uint", "4294967295"}, std::pair{"int", "2147483647"}}) {
+  for (const auto& [type, index] :
+       {std::pair{"int", "4"}, std::pair{"int", "-1"}, std::pair{"uint", "4294967295"},
+        std::pair{"int", "2147483647"}}) {
     auto mesh = LoadMesh(AsciiPly(type, absl::StrCat("3 0 1 ", index, "\n"), 1), "hostile.ply",
                          options);
     ExpectRefused(mesh, absl::StrCat("vertex index ", index, ","));
@@ -139,8 +140,9 @@ TEST(MeshHostile, ObjHexFloatsAreRefused) {
 TEST(MeshHostile, PlyPropertyBeforeAnyElementIsRefused) {
   MeshLoadOptions options;
   options.format = MeshFormat::kPly;
-  auto mesh = LoadMesh("ply\nformat ascii 1.0\nproperty double x\nelement vertex 1\nend_header\n0\n",
-                       "hostile.ply", options);
+  auto mesh =
+      LoadMesh("ply\nformat ascii 1.0\nproperty double x\nelement vertex 1\nend_header\n0\n",
+               "hostile.ply", options);
   ExpectRefused(mesh, "a property before any element");
   // Line 2 is the format line for CGAL, whatever it says.
   ExpectRefused(LoadMesh("ply\nelement ascii 1.0\nproperty double x\nend_header\n0\n",

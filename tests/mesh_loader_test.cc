@@ -72,7 +72,8 @@ TEST(MeshLoader, KeepsVertexNormalsAndNamedWeights) {
     auto loaded = LoadMesh(bytes, "w.ply", options);
     ASSERT_TRUE(loaded.ok()) << loaded.status();
     ASSERT_EQ(loaded->weights.size(), sphere.weights.size());
-    for (size_t i = 0; i < sphere.weights.size(); ++i) EXPECT_EQ(loaded->weights[i], sphere.weights[i]);
+    for (size_t i = 0; i < sphere.weights.size(); ++i)
+      EXPECT_EQ(loaded->weights[i], sphere.weights[i]);
     ASSERT_EQ(loaded->normals.size(), sphere.positions.size());
     EXPECT_NEAR(loaded->normals[5].x, sphere.positions[5].x, 1e-12);
     options.weight_property = "missing";
@@ -166,7 +167,8 @@ TEST(MeshLoader, BrokenFilesGetClearErrorsNamingTheFile) {
   ExpectError(load("inf.obj"), StatusCode::kInvalidArgument, "inf.obj", "finite");
   ExpectError(load("nan_ascii.ply"), StatusCode::kInvalidArgument, "nan_ascii.ply", "vertex");
   ExpectError(load("huge_count.ply"), StatusCode::kInvalidArgument, "huge_count.ply", "truncated");
-  ExpectError(load("wide_list.ply"), StatusCode::kInvalidArgument, "wide_list.ply", "list uchar int");
+  ExpectError(load("wide_list.ply"), StatusCode::kInvalidArgument, "wide_list.ply",
+              "list uchar int");
   ExpectError(LoadMesh(binary, "big.ply", {.max_bytes = binary.size() - 1}),
               StatusCode::kResourceExhausted, "big.ply", "limit");
   ExpectError(LoadMeshFile((dir / "cut_bin.ply").string(), {.max_bytes = 100}),

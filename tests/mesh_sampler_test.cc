@@ -112,12 +112,14 @@ TEST(MeshSampler, IcosphereCapDiscrepancyIsFarBelowIid) {
     const double ours_d = CapDiscrepancy(ours, 300, 11);
     // The typical i.i.d. figure: the median of three sets.
     std::vector<double> iid;
-    for (uint64_t s = 1; s <= 3; ++s) iid.push_back(CapDiscrepancy(IidMeshPoints(surface->mesh(), n, s), 300, 11));
+    for (uint64_t s = 1; s <= 3; ++s)
+      iid.push_back(CapDiscrepancy(IidMeshPoints(surface->mesh(), n, s), 300, 11));
     std::sort(iid.begin(), iid.end());
     const double iid_d = iid[1];
     SCOPED_TRACE(::testing::Message() << "N=" << n << " ours=" << ours_d << " iid=" << iid_d);
     EXPECT_LT(ours_d, (n < 4096 ? 0.5 : 0.3) * iid_d);
-    std::printf("N=%d cap discrepancy (count): ours %.2f, i.i.d. %.2f\n", static_cast<int>(n), ours_d, iid_d);
+    std::printf("N=%d cap discrepancy (count): ours %.2f, i.i.d. %.2f\n", static_cast<int>(n),
+                ours_d, iid_d);
     EXPECT_LT(ours_d, 3 * std::pow(n, 0.25));  // the jittered set's own scale, N^(1/4)
   }
 }
@@ -230,7 +232,8 @@ TEST(MeshSampler, RangesJoinToTheFullSetAndHaveNoDuplicates) {
   const Drawn full = Draw(sampler, 0, n);
   SampleBatch joined;
   const uint64_t cuts[] = {0, 1, 4999, 17000, 29999, n};
-  for (size_t i = 0; i + 1 < std::size(cuts); ++i) joined.Append(Draw(sampler, cuts[i], cuts[i + 1]).batch);
+  for (size_t i = 0; i + 1 < std::size(cuts); ++i)
+    joined.Append(Draw(sampler, cuts[i], cuts[i + 1]).batch);
   EXPECT_EQ(joined.index, full.batch.index);
   EXPECT_EQ(joined.x, full.batch.x);
   EXPECT_EQ(joined.z, full.batch.z);
@@ -240,7 +243,8 @@ TEST(MeshSampler, RangesJoinToTheFullSetAndHaveNoDuplicates) {
     EXPECT_EQ(s.bary[1], full.batch.u[k]);
   }
   std::set<std::tuple<double, double, double>> distinct;
-  for (size_t i = 0; i < n; ++i) distinct.insert({full.batch.x[i], full.batch.y[i], full.batch.z[i]});
+  for (size_t i = 0; i < n; ++i)
+    distinct.insert({full.batch.x[i], full.batch.y[i], full.batch.z[i]});
   EXPECT_EQ(distinct.size(), n);
 }
 
@@ -266,14 +270,16 @@ TEST(MeshSampler, RegionEqualsFilteredFullSet) {
 
 TEST(MeshSampler, NonMonotoneSequencesComeInCurveOrder) {
   const uint64_t n = 4096;
-  for (SequenceKind kind : {SequenceKind::kRandom, SequenceKind::kVanDerCorput, SequenceKind::kProgressive}) {
+  for (SequenceKind kind :
+       {SequenceKind::kRandom, SequenceKind::kVanDerCorput, SequenceKind::kProgressive}) {
     const auto sampler = MakeSampler(Icosphere(4), UniformMeshDensity(), n, 9, kind);
     const Drawn d = Draw(sampler, 0, n, {}, {.curve_position = true});
     ASSERT_EQ(d.batch.size(), n);
     std::vector<uint64_t> sorted = d.batch.index;
     std::sort(sorted.begin(), sorted.end());
     for (uint64_t k = 0; k < n; ++k) ASSERT_EQ(sorted[k], k);
-    for (size_t i = 1; i < n; ++i) ASSERT_GE(d.batch.curve_position[i], d.batch.curve_position[i - 1]);
+    for (size_t i = 1; i < n; ++i)
+      ASSERT_GE(d.batch.curve_position[i], d.batch.curve_position[i - 1]);
   }
 }
 
@@ -284,9 +290,10 @@ TEST(MeshSampler, ConsecutiveSamplesAreCloseOnTheSurface) {
   for (size_t i = 1; i < n; ++i) steps.push_back(Norm(At(d.batch, i) - At(d.batch, i - 1)));
   std::sort(steps.begin(), steps.end());
   const double spacing = std::sqrt(4 * M_PI / n);  // side of a sample's share of the area
-  std::printf("consecutive steps / spacing: median %.2f, p90 %.2f, p99 %.2f, p99.9 %.2f, max %.2f\n",
-              steps[n / 2] / spacing, steps[n * 9 / 10] / spacing, steps[n * 99 / 100] / spacing,
-              steps[n * 999 / 1000] / spacing, steps.back() / spacing);
+  std::printf(
+      "consecutive steps / spacing: median %.2f, p90 %.2f, p99 %.2f, p99.9 %.2f, max %.2f\n",
+      steps[n / 2] / spacing, steps[n * 9 / 10] / spacing, steps[n * 99 / 100] / spacing,
+      steps[n * 999 / 1000] / spacing, steps.back() / spacing);
   // Most steps are one sample spacing; the 3D Hilbert order of triangles
   // jumps where the curve leaves the shell and re-enters it elsewhere, rarely.
   EXPECT_LT(steps[n / 2], 1.5 * spacing);

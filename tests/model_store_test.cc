@@ -86,7 +86,8 @@ TEST(ModelStore, TurnsAwayLargeModelsAndEvictsTheLeastRecentlyUsed) {
   ASSERT_TRUE(store.Resolve(**ParseModelSpec(first.Spec())).ok());  // first is now recent
   auto third = *store.Put(ModelFormat::kPly, std::string(100, 'c'), "c.ply");
   EXPECT_TRUE(store.Resolve(**ParseModelSpec(first.Spec())).ok());
-  EXPECT_EQ(store.Resolve(**ParseModelSpec(second.Spec())).status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(store.Resolve(**ParseModelSpec(second.Spec())).status().code(),
+            absl::StatusCode::kNotFound);
   EXPECT_TRUE(store.Resolve(**ParseModelSpec(third.Spec())).ok());
   EXPECT_EQ(store.stats().evictions, 1u);
   EXPECT_LE(store.stats().bytes, 300u);
@@ -119,7 +120,8 @@ TEST(ModelStore, UploadsBeingReceivedCountAgainstTheBudget) {
   // 200 stored + 150 in flight would pass 300: the stored model made room.
   EXPECT_EQ(store.stats().evictions, 1u);
   EXPECT_EQ(store.stats().bytes, 0u);
-  EXPECT_EQ(store.Resolve(**ParseModelSpec(stored->Spec())).status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(store.Resolve(**ParseModelSpec(stored->Spec())).status().code(),
+            absl::StatusCode::kNotFound);
 
   ModelStore::Upload second = store.StartUpload();
   const absl::Status refused = second.Append(std::string(200, 'b'));

@@ -199,9 +199,9 @@ TEST(RegionRequest, SurfacesWithoutBoundsAreFilteredSampleBySample) {
 }
 
 TEST(Region, ParameterRectanglesMustLieInTheUnitSquare) {
-  for (const Region& bad : {Region::ParameterRect(-0.1, 0.5, 0, 1),
-                            Region::ParameterRect(0.5, 1.2, 0, 1),
-                            Region::ParameterRect(0, 1, -1, 0.5), Region::ParameterRect(0, 1, 0.5, 2)}) {
+  for (const Region& bad :
+       {Region::ParameterRect(-0.1, 0.5, 0, 1), Region::ParameterRect(0.5, 1.2, 0, 1),
+        Region::ParameterRect(0, 1, -1, 0.5), Region::ParameterRect(0, 1, 0.5, 2)}) {
     const absl::Status st = bad.Validate();
     EXPECT_EQ(st.code(), absl::StatusCode::kInvalidArgument);
     EXPECT_NE(std::string(st.message()).find("unit square"), std::string::npos) << st;

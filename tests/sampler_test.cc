@@ -151,10 +151,10 @@ TEST(Sampler, NoTwoSamplesCoincide) {
 // curve, so jittered sampling puts N * mass(cell) / total samples in it, give
 // or take the two strata cut by the stretch's ends: |count - expected| < 2,
 // plus the error of the area x density estimate.
-void ExpectCellCountsWithinJitterBound(const char* surface, const char* density, uint64_t n,
-                                       const std::function<double(double, double, double, double)>& true_mass,
-                                       double total, int depth, double slack,
-                                       const CurveTreeOptions& options = {}) {
+void ExpectCellCountsWithinJitterBound(
+    const char* surface, const char* density, uint64_t n,
+    const std::function<double(double, double, double, double)>& true_mass, double total, int depth,
+    double slack, const CurveTreeOptions& options = {}) {
   const auto s = MakeSetup(surface, density, n, options);
   const SampleBatch b = Collect(MakeSampler(s, SequenceKind::kJittered, n, 9), 0, n);
   const int side = 1 << depth;
@@ -241,7 +241,8 @@ TEST(Sampler, ProgressivePrefixesAreStratifiedAndExtendTheSet) {
   // Every power-of-two prefix puts one q in each stratum.
   for (uint64_t m = 1; m <= n2; m *= 2) {
     std::set<uint64_t> strata;
-    for (uint64_t k = 0; k < m; ++k) strata.insert(static_cast<uint64_t>(large->sequence().At(k) * m));
+    for (uint64_t k = 0; k < m; ++k)
+      strata.insert(static_cast<uint64_t>(large->sequence().At(k) * m));
     EXPECT_EQ(strata.size(), m);
   }
   // Samples [0, n1) of the larger set are the smaller set.

@@ -74,7 +74,8 @@ void ExpectEqual(const SampleBatch& a, const SampleBatch& b) {
 
 void ExpectStatus(const absl::Status& s, absl::StatusCode code, const std::string& mentions) {
   EXPECT_EQ(s.code(), code) << s;
-  EXPECT_NE(s.message().find(mentions), std::string::npos) << s.message() << " should mention " << mentions;
+  EXPECT_NE(s.message().find(mentions), std::string::npos)
+      << s.message() << " should mention " << mentions;
 }
 
 TEST(Server, ShardsJoinToTheFullSetInOrder) {
@@ -104,7 +105,8 @@ TEST(Server, AStreamCutByTheClientResumesByteIdentical) {
     return first.size() < 7000 ? absl::OkStatus() : absl::CancelledError("cut");
   });
   ASSERT_EQ(cut.status().code(), absl::StatusCode::kCancelled);
-  auto rest = Fetch(*r.client, SamplerClient::Range(request, first.index.back() + 1, request.count));
+  auto rest =
+      Fetch(*r.client, SamplerClient::Range(request, first.index.back() + 1, request.count));
   ASSERT_TRUE(rest.ok());
   first.Append(*rest);
   ExpectEqual(first, *uncut);
@@ -155,15 +157,16 @@ TEST(Server, AResumeOnAServerOfAnotherReleaseFailsInsteadOfMixingSets) {
   std::unique_ptr<SamplerServer> upgraded;
   uint64_t received = 0;
   bool restarted = false;
-  auto result = client->Sample(LongStream(2'000'000, 8), [&](const v1::StreamHeader&, const SampleBatch& b) {
-    received += b.size();
-    if (!restarted && received >= 50000) {
-      // The replica is replaced by one of the current release mid-stream.
-      restarted = true;
-      upgraded = ReplaceOnSamePort(*server, LoopbackOptions());
-    }
-    return absl::OkStatus();
-  });
+  auto result =
+      client->Sample(LongStream(2'000'000, 8), [&](const v1::StreamHeader&, const SampleBatch& b) {
+        received += b.size();
+        if (!restarted && received >= 50000) {
+          // The replica is replaced by one of the current release mid-stream.
+          restarted = true;
+          upgraded = ReplaceOnSamePort(*server, LoopbackOptions());
+        }
+        return absl::OkStatus();
+      });
   ExpectStatus(result.status(), absl::StatusCode::kFailedPrecondition, "algorithm version");
   ExpectStatus(result.status(), absl::StatusCode::kFailedPrecondition, "sfcsampler-older-release");
 }
@@ -220,9 +223,10 @@ TEST(Server, EveryEncodingAndPrecisionCarriesTheEmbeddedEnginesSamples) {
                             &SampleBatch::density, &SampleBatch::curve_position}) {
           ASSERT_EQ(((*wire).*column).size(), local.size());
           for (size_t i = 0; i < local.size(); ++i) {
-            const double expected = precision == v1::PRECISION_FLOAT64
-                                        ? (local.*column)[i]
-                                        : static_cast<double>(static_cast<float>((local.*column)[i]));
+            const double expected =
+                precision == v1::PRECISION_FLOAT64
+                    ? (local.*column)[i]
+                    : static_cast<double>(static_cast<float>((local.*column)[i]));
             ASSERT_EQ(((*wire).*column)[i], expected) << "sample " << i << " depth " << depth;
           }
         }
@@ -301,14 +305,15 @@ TEST(Server, ASlowReaderDoesNotMakeTheServerGenerateAhead) {
   const uint64_t n = 4'000'000;
   int batches = 0;
   double streamed_after_stall = 0;
-  auto result = r.client->Sample(Request("plane", n), [&](const v1::StreamHeader&, const SampleBatch&) {
-    if (++batches == 2) {
-      std::this_thread::sleep_for(milliseconds(1000));
-      streamed_after_stall = r.server->metrics().samples_streamed();
-      return absl::CancelledError("done");
-    }
-    return absl::OkStatus();
-  });
+  auto result =
+      r.client->Sample(Request("plane", n), [&](const v1::StreamHeader&, const SampleBatch&) {
+        if (++batches == 2) {
+          std::this_thread::sleep_for(milliseconds(1000));
+          streamed_after_stall = r.server->metrics().samples_streamed();
+          return absl::CancelledError("done");
+        }
+        return absl::OkStatus();
+      });
   EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled);
   // Only what HTTP/2 flow control admits was produced: a few MB, not 4 M samples.
   EXPECT_LT(streamed_after_stall, 40 * 16384.0);
@@ -319,10 +324,11 @@ TEST(Server, ACancelledStreamIsFreedAtOnce) {
   ClientOptions co;
   co.batch_size = 1000;
   Running r = StartServer(LoopbackOptions(), co);
-  auto result = r.client->Sample(Request("sphere", 1'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
-    EXPECT_EQ(r.server->service().active_streams(), 1u);
-    return absl::CancelledError("enough");
-  });
+  auto result = r.client->Sample(Request("sphere", 1'000'000),
+                                 [&](const v1::StreamHeader&, const SampleBatch&) {
+                                   EXPECT_EQ(r.server->service().active_streams(), 1u);
+                                   return absl::CancelledError("enough");
+                                 });
   EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled);
   // "At once": well within 200 ms of the cancel, not after the 10^6 samples.
   const auto until = std::chrono::steady_clock::now() + milliseconds(200);
@@ -347,7 +353,8 @@ ServerOptions HeavyOptions() {
 
 // Waits up to `seconds` for `done`; true if it came.
 bool Within(double seconds, const std::function<bool()>& done) {
-  const auto until = std::chrono::steady_clock::now() + milliseconds(static_cast<int>(seconds * 1000));
+  const auto until =
+      std::chrono::steady_clock::now() + milliseconds(static_cast<int>(seconds * 1000));
   while (!done()) {
     if (std::chrono::steady_clock::now() > until) return false;
     std::this_thread::sleep_for(milliseconds(10));
@@ -485,7 +492,8 @@ TEST(Server, AStockClientReceivesEveryColumnWithinItsDefaultMessageLimit) {
   auto client = *SamplerClient::Connect(co);
   SampleRequest all = Request("torus", 300000);
   all.fields.normal = all.fields.density = all.fields.curve_position = true;
-  ExpectStatus(Fetch(*client, all).status(), absl::StatusCode::kInvalidArgument, "max_message_bytes");
+  ExpectStatus(Fetch(*client, all).status(), absl::StatusCode::kInvalidArgument,
+               "max_message_bytes");
 }
 
 // Columns a client leaves off (omit_uv, omit_xyz) do not travel, the
@@ -496,7 +504,8 @@ TEST(Server, ColumnsLeftOffDoNotTravelAndTheRestAreTheFullStreams) {
   auto channel = grpc::CreateChannel("127.0.0.1:" + std::to_string(r.server->port()),
                                      grpc::InsecureChannelCredentials());
   auto stub = v1::Sampler::NewStub(channel);
-  auto stream = [&](bool omit_uv, bool omit_xyz, bool normals, size_t* bytes, grpc::Status* status) {
+  auto stream = [&](bool omit_uv, bool omit_xyz, bool normals, size_t* bytes,
+                    grpc::Status* status) {
     v1::SampleRequest request;
     request.mutable_tree()->set_surface("torus");
     request.set_count(20000);
@@ -543,7 +552,8 @@ TEST(Server, ColumnsLeftOffDoNotTravelAndTheRestAreTheFullStreams) {
 
   stream(true, true, false, &none_bytes, &status);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-  EXPECT_NE(status.error_message().find("no value column"), std::string::npos) << status.error_message();
+  EXPECT_NE(status.error_message().find("no value column"), std::string::npos)
+      << status.error_message();
 }
 
 // Issue 37: rho has explicit presence on the wire. A 0 a client sends is
@@ -625,8 +635,10 @@ TEST(Server, EveryBadInputGetsItsStatusCode) {
   ExpectStatus(fetch(region), kInvalid, "empty");
   ExpectStatus(fetch(Request("sphere", 0)), kInvalid, "count");
   ExpectStatus(fetch(Request("sphere", 2'000'000)), kInvalid, "max_count");
-  ExpectStatus(fetch(Request("expr:x=u;y=v;z=" + std::string(300, '1'), 10)), kInvalid, "max_spec_length");
-  ExpectStatus(fetch(Request("expr:x=u;y=v;z=1/(u-0.3)", 1'000'000)), absl::StatusCode::kResourceExhausted, "max_leaves");
+  ExpectStatus(fetch(Request("expr:x=u;y=v;z=" + std::string(300, '1'), 10)), kInvalid,
+               "max_spec_length");
+  ExpectStatus(fetch(Request("expr:x=u;y=v;z=1/(u-0.3)", 1'000'000)),
+               absl::StatusCode::kResourceExhausted, "max_leaves");
   ExpectStatus(fetch(Request("expr:x=u;y=v;z=u**v", 10)), kInvalid, "position");
 
   ClientOptions big_batches;
@@ -644,10 +656,11 @@ TEST(Server, StreamsBeyondTheConcurrencyLimitAreResourceExhausted) {
   Running r = StartServer(options, co);
   absl::Status second;
   // The server is still writing the first stream when the second request comes.
-  auto first = r.client->Sample(LongStream(4'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
-    second = Fetch(*r.client, Request("torus", 10)).status();
-    return absl::CancelledError("checked");
-  });
+  auto first =
+      r.client->Sample(LongStream(4'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
+        second = Fetch(*r.client, Request("torus", 10)).status();
+        return absl::CancelledError("checked");
+      });
   EXPECT_EQ(first.status().code(), absl::StatusCode::kCancelled) << first.status();
   ExpectStatus(second, absl::StatusCode::kResourceExhausted, "max_concurrent_streams");
 }
@@ -659,10 +672,11 @@ TEST(Server, TheServerDeadlineEndsLongStreams) {
   co.batch_size = 100;
   Running r = StartServer(options, co);
   // A tree that builds at once, and a stream that runs past the deadline.
-  auto result = r.client->Sample(LongStream(4'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
-    std::this_thread::sleep_for(milliseconds(2));
-    return absl::OkStatus();
-  });
+  auto result =
+      r.client->Sample(LongStream(4'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
+        std::this_thread::sleep_for(milliseconds(2));
+        return absl::OkStatus();
+      });
   ExpectStatus(result.status(), absl::StatusCode::kDeadlineExceeded, "resume after the last index");
 }
 
@@ -679,17 +693,18 @@ TEST(Server, AReaderThatStopsReadingIsCutAndFreesItsSlot) {
     Running r = StartServer(options, co);
     std::atomic<bool> freed{false};
     std::atomic<double> stalled{0};
-    auto result = r.client->Sample(Request("plane", 4'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
-      // Stop reading: the server's writes block on flow control. Its slot
-      // must come free while this client still holds the stream open.
-      const auto until = std::chrono::steady_clock::now() + milliseconds(5000);
-      while (std::chrono::steady_clock::now() < until && !freed) {
-        freed = r.server->service().active_streams() == 0;
-        std::this_thread::sleep_for(milliseconds(10));
-      }
-      stalled = r.server->metrics().stalled_streams();
-      return absl::OkStatus();
-    });
+    auto result = r.client->Sample(
+        Request("plane", 4'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
+          // Stop reading: the server's writes block on flow control. Its slot
+          // must come free while this client still holds the stream open.
+          const auto until = std::chrono::steady_clock::now() + milliseconds(5000);
+          while (std::chrono::steady_clock::now() < until && !freed) {
+            freed = r.server->service().active_streams() == 0;
+            std::this_thread::sleep_for(milliseconds(10));
+          }
+          stalled = r.server->metrics().stalled_streams();
+          return absl::OkStatus();
+        });
     EXPECT_TRUE(freed) << "the stalled stream still held its slot after 5 s, depth " << depth;
     EXPECT_EQ(stalled.load(), 1.0) << "depth " << depth;
     EXPECT_FALSE(result.ok());
@@ -706,7 +721,8 @@ TEST(Server, AModelIsUploadedOnceAndNamedByItsHash) {
   Running r = StartServer(options);
   const std::string path = ::testing::TempDir() + "/server_test_model.obj";
   std::string content;
-  for (int i = 0; i < 200000; ++i) content += "v " + std::to_string(i) + " 0 0\n";  // > 1 MiB: several chunks
+  for (int i = 0; i < 200000; ++i)
+    content += "v " + std::to_string(i) + " 0 0\n";  // > 1 MiB: several chunks
   std::ofstream(path) << content;
   auto spec = r.client->EnsureModel("obj:" + path);
   ASSERT_TRUE(spec.ok()) << spec.status();
@@ -725,8 +741,8 @@ TEST(Server, AModelIsUploadedOnceAndNamedByItsHash) {
                absl::StatusCode::kNotFound, "upload it again");
   ExpectStatus(r.client->UploadModel("ply", "huge.ply", std::string(4 << 20, 'x')).status(),
                absl::StatusCode::kResourceExhausted, "max_model_bytes");
-  ExpectStatus(r.client->UploadModel("dwg", "a.dwg", "x").status(), absl::StatusCode::kInvalidArgument,
-               "unknown model format");
+  ExpectStatus(r.client->UploadModel("dwg", "a.dwg", "x").status(),
+               absl::StatusCode::kInvalidArgument, "unknown model format");
   EXPECT_EQ(r.server->models().stats().rejected, 1u);
 }
 
@@ -748,7 +764,8 @@ TEST(Server, TheStreamHeaderSaysWhereTheParameterisationIsSingularAndThePrecisio
       }
       return false;
     };
-    EXPECT_TRUE(on_quarter_line(w.u0(), w.u0() + w.size()) || on_quarter_line(w.v0(), w.v0() + w.size()))
+    EXPECT_TRUE(on_quarter_line(w.u0(), w.u0() + w.size()) ||
+                on_quarter_line(w.v0(), w.v0() + w.size()))
         << w.u0() << " " << w.v0() << " " << w.size();
   }
   // The precision reached stays below the jittered set's own discrepancy

@@ -53,7 +53,9 @@ TEST(Subprocess, PassesInputAndOutputAndTheExitCode) {
 // A program that blocks uses no CPU, so only the wall clock ends it.
 TEST(Subprocess, AProgramThatBlocksIsKilledAtTheWallClockLimit) {
   absl::StatusOr<SubprocessResult> run;
-  const double seconds = SecondsOf([&] { run = RunSubprocess({"/bin/sleep", "100"}, "", 100, 0.3, nullptr); });
+  const double seconds = SecondsOf([&] {
+    run = RunSubprocess({"/bin/sleep", "100"}, "", 100, 0.3, nullptr);
+  });
   ASSERT_TRUE(run.ok()) << run.status();
   EXPECT_TRUE(run->timed_out);
   EXPECT_FALSE(run->exited);

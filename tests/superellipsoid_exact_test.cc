@@ -75,7 +75,8 @@ TEST(SuperellipsoidExact, AgreesWithTheGradedBoxMeasure) {
     const size_t nu = m->u().size() - 1, nv = m->v().size() - 1;
     for (double d : {1e-4, 1e-3, 1e-2}) {
       double strip = m->Mass(0, nu, 0, m->VIndex(d)) + m->Mass(0, nu, m->VIndex(1 - d), nv);
-      for (double l : {0.25, 0.5, 0.75}) strip += m->Mass(0, nu, m->VIndex(l - d), m->VIndex(l + d));
+      for (double l : {0.25, 0.5, 0.75})
+        strip += m->Mass(0, nu, m->VIndex(l - d), m->VIndex(l + d));
       EXPECT_NEAR(strip / total, SuperellipsoidLongitudeStripFraction(e, d), 2e-8) << e << " " << d;
       const double eq = m->Mass(m->UIndex(0.5 - d), m->UIndex(0.5 + d), 0, nv);
       EXPECT_NEAR(eq / total, SuperellipsoidEquatorStripFraction(e, d), 2e-8) << e << " " << d;

@@ -14,11 +14,13 @@ namespace {
 
 // 4th-order central differences of Point.
 Vec3 Du(const Surface& s, double u, double v, double h) {
-  return (s.Point(u - 2 * h, v) - s.Point(u + 2 * h, v) + (s.Point(u + h, v) - s.Point(u - h, v)) * 8) *
+  return (s.Point(u - 2 * h, v) - s.Point(u + 2 * h, v) +
+          (s.Point(u + h, v) - s.Point(u - h, v)) * 8) *
          (1 / (12 * h));
 }
 Vec3 Dv(const Surface& s, double u, double v, double h) {
-  return (s.Point(u, v - 2 * h) - s.Point(u, v + 2 * h) + (s.Point(u, v + h) - s.Point(u, v - h)) * 8) *
+  return (s.Point(u, v - 2 * h) - s.Point(u, v + 2 * h) +
+          (s.Point(u, v + h) - s.Point(u, v - h)) * 8) *
          (1 / (12 * h));
 }
 
@@ -38,9 +40,12 @@ void ExpectJetMatchesDifferences(const Surface& s) {
       ExpectNear(j.fu, Du(s, u, v, h), 1e-7, "fu", u, v);
       ExpectNear(j.fv, Dv(s, u, v, h), 1e-7, "fv", u, v);
       const double k = 1e-3;
-      ExpectNear(j.fuu, (Du(s, u + k, v, h) - Du(s, u - k, v, h)) * (1 / (2 * k)), 1e-3, "fuu", u, v);
-      ExpectNear(j.fvv, (Dv(s, u, v + k, h) - Dv(s, u, v - k, h)) * (1 / (2 * k)), 1e-3, "fvv", u, v);
-      ExpectNear(j.fuv, (Du(s, u, v + k, h) - Du(s, u, v - k, h)) * (1 / (2 * k)), 1e-3, "fuv", u, v);
+      ExpectNear(j.fuu, (Du(s, u + k, v, h) - Du(s, u - k, v, h)) * (1 / (2 * k)), 1e-3, "fuu", u,
+                 v);
+      ExpectNear(j.fvv, (Dv(s, u, v + k, h) - Dv(s, u, v - k, h)) * (1 / (2 * k)), 1e-3, "fvv", u,
+                 v);
+      ExpectNear(j.fuv, (Du(s, u, v + k, h) - Du(s, u, v - k, h)) * (1 / (2 * k)), 1e-3, "fuv", u,
+                 v);
       // The grid version is the same jet.
       double us[1] = {u}, vs[1] = {v};
       SurfaceJet g;

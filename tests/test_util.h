@@ -40,7 +40,8 @@ inline std::shared_ptr<const Sampler> MakeSampler(const Setup& s, SequenceKind k
 
 // All samples of [begin, end) inside `region`, read in batches of `batch`.
 inline SampleBatch Collect(std::shared_ptr<const Sampler> sampler, uint64_t begin, uint64_t end,
-                           const Region& region = {}, SampleFields fields = {}, size_t batch = 1000) {
+                           const Region& region = {}, SampleFields fields = {},
+                           size_t batch = 1000) {
   SampleBatch all;
   auto cursor = SampleCursor::Create(std::move(sampler), begin, end, region, fields);
   EXPECT_TRUE(cursor.ok()) << cursor.status();

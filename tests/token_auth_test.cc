@@ -19,14 +19,16 @@ TEST(TokenAuthenticator, GuardsTheSamplerServiceOnly) {
   EXPECT_TRUE(TokenAuthenticator::Guards("/sfcsampler.v1.Sampler/Sample"));
   EXPECT_TRUE(TokenAuthenticator::Guards("/sfcsampler.v1.Sampler/GetCacheStats"));
   EXPECT_FALSE(TokenAuthenticator::Guards("/grpc.health.v1.Health/Check"));
-  EXPECT_FALSE(TokenAuthenticator::Guards("/grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo"));
+  EXPECT_FALSE(
+      TokenAuthenticator::Guards("/grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo"));
   EXPECT_FALSE(TokenAuthenticator::Guards("/sfcsampler.v1.SamplerX/Sample"));
 }
 
 TEST(TokenAuthProcessor, RefusesSamplerCallsWithoutTheTokenAndLetsHealthThrough) {
   TokenAuthProcessor processor("s3cret");
   grpc::AuthMetadataProcessor::OutputMetadata consumed, response;
-  const std::string sample = "/sfcsampler.v1.Sampler/Sample", health = "/grpc.health.v1.Health/Check";
+  const std::string sample = "/sfcsampler.v1.Sampler/Sample",
+                    health = "/grpc.health.v1.Health/Check";
   const std::string good = "Bearer s3cret", bad = "Bearer guess";
   grpc::AuthMetadataProcessor::InputMetadata md;
   md.emplace(":path", sample);

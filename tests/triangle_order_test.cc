@@ -51,7 +51,8 @@ double Spread(const Geometry& g, const std::vector<uint32_t>& order, size_t run)
   for (size_t b = 0; b + run <= order.size(); b += run) {
     Vec3 mean{0, 0, 0};
     double area = 0;
-    for (size_t i = b; i < b + run; ++i) mean = mean + g.centroid[order[i]], area += g.area[order[i]];
+    for (size_t i = b; i < b + run; ++i)
+      mean = mean + g.centroid[order[i]], area += g.area[order[i]];
     mean = mean * (1.0 / run);
     double rms = 0;
     for (size_t i = b; i < b + run; ++i) {

@@ -17,7 +17,8 @@ namespace sfc::math {
 namespace {
 
 std::vector<double> Arguments() {
-  std::vector<double> x = {0, 0.5, 1, 1.5, 2, -0.5, 0x1p-1074, 0x1p-30, 1 - 0x1p-53, 0.25, 1e6 + 0.25};
+  std::vector<double> x = {0,         0.5,     1,           1.5,  2,         -0.5,
+                           0x1p-1074, 0x1p-30, 1 - 0x1p-53, 0.25, 1e6 + 0.25};
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> unit(0, 2), wide(-1e3, 1e3);
   for (int i = 0; i < 100000; ++i) x.push_back(unit(rng));

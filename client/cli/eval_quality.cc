@@ -12,22 +12,26 @@ namespace sfc {
 
 void AddEvalQualityFlags(CLI::App* eval, EvalQualityFlags* f) {
   eval->add_option("--sections", f->sections,
-                   "protocol (the paper's Tables 1-2) and/or quality (issue 19: sample-anchored boxes, strips, "
+                   "protocol (the paper's Tables 1-2) and/or quality (issue 19: sample-anchored "
+                   "boxes, strips, "
                    "Monte Carlo, plane, sphere, models, blue noise)")
       ->delimiter(',')
       ->capture_default_str();
   eval->add_option("--quality-sections", f->quality_sections,
                    "subset of: boxes strips bands mc plane sphere models blue (default all)")
       ->delimiter(',');
-  eval->add_option("--quality-seeds", f->seeds, "seeds of the quality report's slopes and Monte Carlo (>= 3)")
+  eval->add_option("--quality-seeds", f->seeds,
+                   "seeds of the quality report's slopes and Monte Carlo (>= 3)")
       ->delimiter(',')
       ->capture_default_str();
-  eval->add_option("--step-sphere", f->step_sphere,
-                   "quality: a CAD sphere to compare with the built-in (e.g. step:/tmp/fx/sphere.step from "
-                   "build/cad/make_cad_fixtures /tmp/fx)");
-  eval->add_option("--mesh-sphere", f->mesh_sphere,
-                   "quality: a sphere mesh to compare with the built-in (e.g. ply:/tmp/ico.ply from "
-                   "bench/eval_quality.sh)");
+  eval->add_option(
+      "--step-sphere", f->step_sphere,
+      "quality: a CAD sphere to compare with the built-in (e.g. step:/tmp/fx/sphere.step from "
+      "build/cad/make_cad_fixtures /tmp/fx)");
+  eval->add_option(
+      "--mesh-sphere", f->mesh_sphere,
+      "quality: a sphere mesh to compare with the built-in (e.g. ply:/tmp/ico.ply from "
+      "bench/eval_quality.sh)");
 }
 
 bool WantsSection(const EvalQualityFlags& flags, const std::string& section) {

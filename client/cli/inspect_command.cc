@@ -17,8 +17,10 @@ namespace {
 
 int RunInspect(const std::vector<std::string>& specs, const ModelReadFlags& read) {
   SampleSourceOptions options;
-  if (absl::Status applied = ApplyModelReadFlags(read, &options); !applied.ok()) return Fail(applied);
-  const std::unique_ptr<SampleSource> source = OpenSampleSource(ConnectionFlags{}, options);  // in process
+  if (absl::Status applied = ApplyModelReadFlags(read, &options); !applied.ok())
+    return Fail(applied);
+  const std::unique_ptr<SampleSource> source =
+      OpenSampleSource(ConnectionFlags{}, options);  // in process
   for (const std::string& spec : specs) {
     auto table = source->DescribeModel(spec);
     if (!table.ok()) return Fail(table.status());

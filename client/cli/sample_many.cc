@@ -78,15 +78,19 @@ absl::StatusOr<std::vector<Named>> Expand(const std::string& input) {
   std::vector<Named> out;
   std::error_code error;
   auto sorted = [&out] {
-    std::sort(out.begin(), out.end(), [](const Named& a, const Named& b) { return a.name < b.name; });
+    std::sort(out.begin(), out.end(),
+              [](const Named& a, const Named& b) { return a.name < b.name; });
   };
   if (fs::is_directory(input, error)) {
     for (auto it = fs::recursive_directory_iterator(input, error); !error && it != fs::end(it);
          it.increment(error)) {
       const std::string path = it->path().string();
-      if (it->is_regular_file(error) && FormatOf(path)) out.push_back({path, RelativeName(path, input)});
+      if (it->is_regular_file(error) && FormatOf(path))
+        out.push_back({path, RelativeName(path, input)});
     }
-    if (error) return absl::InvalidArgumentError(absl::StrFormat("cannot list %s: %s", input, error.message()));
+    if (error)
+      return absl::InvalidArgumentError(
+          absl::StrFormat("cannot list %s: %s", input, error.message()));
     sorted();
     if (out.empty()) {
       return absl::InvalidArgumentError(absl::StrFormat(
@@ -107,7 +111,8 @@ absl::StatusOr<std::vector<Named>> Expand(const std::string& input) {
     }
     globfree(&matches);
     sorted();
-    if (out.empty()) return absl::InvalidArgumentError(absl::StrFormat("the pattern %s matches no files", input));
+    if (out.empty())
+      return absl::InvalidArgumentError(absl::StrFormat("the pattern %s matches no files", input));
     return out;
   }
   if (FormatOf(input)) return std::vector<Named>{{input, RelativeName(input, "")}};
@@ -215,7 +220,8 @@ absl::Status SampleOne(const Job& job, Outcome* o) {
   writer.reset();
   if (status.ok()) {
     fs::rename(part, o->output, error);
-    if (error) status = absl::InternalError(absl::StrFormat("cannot rename %s: %s", part, error.message()));
+    if (error)
+      status = absl::InternalError(absl::StrFormat("cannot rename %s: %s", part, error.message()));
   }
   if (!status.ok()) fs::remove(part, error);
   return status;
@@ -277,10 +283,11 @@ Command AddSampleManyCommand(CLI::App& app) {
       "sample-many",
       "sample many model files (a folder, a glob, a list file) in parallel, one output per model; "
       "each model's seed comes from --seed and its content hash");
-  cmd->add_option("inputs", f->inputs,
-                  "folders (their .step .stp .iges .igs .nurbs .obj .ply files, in subfolders too), "
-                  "glob patterns, list "
-                  "files (a path a line) or model files")
+  cmd->add_option(
+         "inputs", f->inputs,
+         "folders (their .step .stp .iges .igs .nurbs .obj .ply files, in subfolders too), "
+         "glob patterns, list "
+         "files (a path a line) or model files")
       ->required();
   cmd->add_option("--output-dir,-O", f->out_dir,
                   "where the outputs go: one NAME.FORMAT per model, NAME its path relative to the "
@@ -293,28 +300,35 @@ Command AddSampleManyCommand(CLI::App& app) {
                   "write only these columns, comma-separated (e.g. x,y,z; default all): index, u, "
                   "v, x, y, z, nx, ny, nz, density, curve_position, face, triangle")
       ->delimiter(',');
-  cmd->add_option("--jobs,-j", f->jobs, "models sampled at once (0 = the hardware threads, at most 8)")
+  cmd->add_option("--jobs,-j", f->jobs,
+                  "models sampled at once (0 = the hardware threads, at most 8)")
       ->capture_default_str()
       ->check(CLI::Range(0, 256));
-  cmd->add_option("--manifest", f->manifest,
-                  "also write a TSV: name, sha256, seed, samples, output, error (one row per model)");
+  cmd->add_option(
+      "--manifest", f->manifest,
+      "also write a TSV: name, sha256, seed, samples, output, error (one row per model)");
   cmd->add_flag("--quiet,-q", f->quiet, "no progress bar and no summary (failures still print)");
   AddModelReadFlags(cmd, &f->model_read);
   // With --server each model is uploaded once, only if the server lacks its bytes.
   AddConnectionFlags(cmd, &f->connection);
   // The tree and set flags of `sample`, the same for every model (not --surface).
   RequestFlags* r = &f->request;
-  cmd->add_option("--density", r->density, "density spec (uniform, gaussian:floor=F, mean:floor=F, expr:...)")
+  cmd->add_option("--density", r->density,
+                  "density spec (uniform, gaussian:floor=F, mean:floor=F, expr:...)")
       ->capture_default_str();
-  cmd->add_option("--curve", r->curve, "hilbert | hilbert2 | peano (CAD models)")->capture_default_str();
+  cmd->add_option("--curve", r->curve, "hilbert | hilbert2 | peano (CAD models)")
+      ->capture_default_str();
   cmd->add_option("--estimator", r->estimator, "triangle | square | fff | quadrature (CAD models)")
       ->capture_default_str();
-  cmd->add_option("--tolerance", r->tolerance, "the paper's a (0 = the default)")->capture_default_str();
-  cmd->add_option("--depth-cap", r->depth_cap, "the paper's r (0 = deepest)")->capture_default_str();
+  cmd->add_option("--tolerance", r->tolerance, "the paper's a (0 = the default)")
+      ->capture_default_str();
+  cmd->add_option("--depth-cap", r->depth_cap, "the paper's r (0 = deepest)")
+      ->capture_default_str();
   cmd->add_option("--rho", r->rho, "max samples' worth of mass per leaf")->capture_default_str();
   AddSampleFlags(cmd, r);
   cmd->get_option("--seed")->description(
-      "base seed: each model's seed is derived from it and the model's SHA-256 (--manifest lists them)");
+      "base seed: each model's seed is derived from it and the model's SHA-256 (--manifest lists "
+      "them)");
   return {cmd, [flags] { return RunSampleMany(*flags); }};
 }
 
@@ -333,7 +347,8 @@ int RunSampleMany(const SampleManyFlags& flags) {
   if (flags.precision != "float64" && flags.precision != "float32") {
     return Usage("--precision must be float64 or float32");
   }
-  job.precision = flags.precision == "float32" ? OutputPrecision::kFloat32 : OutputPrecision::kFloat64;
+  job.precision =
+      flags.precision == "float32" ? OutputPrecision::kFloat32 : OutputPrecision::kFloat64;
   {  // the shared flags, checked once on a stand-in surface
     RequestFlags probe = flags.request;
     probe.surface = "sphere";
@@ -373,7 +388,8 @@ int RunSampleMany(const SampleManyFlags& flags) {
   }
 
   const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
-  const size_t jobs = std::min<size_t>(outcomes.size(), flags.jobs > 0 ? flags.jobs : std::min(8u, hardware));
+  const size_t jobs =
+      std::min<size_t>(outcomes.size(), flags.jobs > 0 ? flags.jobs : std::min(8u, hardware));
   SampleSourceOptions options;
   options.precision = job.precision;
   // Models run side by side; one model alone may use up to four threads.
@@ -382,7 +398,8 @@ int RunSampleMany(const SampleManyFlags& flags) {
     return Usage(std::string(read.message()));
   }
   const std::unique_ptr<SampleSource> source = OpenSampleSource(flags.connection, options);
-  if (auto connected = source->Connect(); !connected.ok()) return Usage(std::string(connected.message()));
+  if (auto connected = source->Connect(); !connected.ok())
+    return Usage(std::string(connected.message()));
   job.source = source.get();
 
   const auto start = std::chrono::steady_clock::now();
@@ -398,7 +415,8 @@ int RunSampleMany(const SampleManyFlags& flags) {
         o.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         o.done = status.ok();
         if (!status.ok()) {
-          o.error = absl::StrFormat("%s: %s", absl::StatusCodeToString(status.code()), status.message());
+          o.error =
+              absl::StrFormat("%s: %s", absl::StatusCodeToString(status.code()), status.message());
           o.samples = 0;
         }
         bar.Step(!status.ok(), o.samples);
@@ -407,7 +425,8 @@ int RunSampleMany(const SampleManyFlags& flags) {
   }
   for (auto& t : workers) t.join();
   bar.Clear();
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   size_t failed = 0;
   uint64_t samples = 0;
@@ -425,10 +444,13 @@ int RunSampleMany(const SampleManyFlags& flags) {
       tsv << o.name << '\t' << o.sha256 << '\t' << o.seed << '\t' << o.samples << '\t'
           << (o.done ? o.output : "") << '\t' << message << '\n';
     }
-    if (!tsv) std::fprintf(stderr, "sfcsampler sample-many: cannot write %s\n", flags.manifest.c_str());
+    if (!tsv)
+      std::fprintf(stderr, "sfcsampler sample-many: cannot write %s\n", flags.manifest.c_str());
   }
   if (!flags.quiet) {
-    std::fprintf(stderr, "sample-many: %zu models, %zu written to %s, %zu failed; %llu samples in %.3f s (%zu at once)\n",
+    std::fprintf(stderr,
+                 "sample-many: %zu models, %zu written to %s, %zu failed; %llu samples in %.3f s "
+                 "(%zu at once)\n",
                  outcomes.size(), outcomes.size() - failed, flags.out_dir.c_str(), failed,
                  static_cast<unsigned long long>(samples), seconds, jobs);
   }

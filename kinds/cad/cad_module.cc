@@ -130,9 +130,9 @@ class CadKind final : public SurfaceKind {
                          const CursorSpec& spec) -> absl::StatusOr<std::unique_ptr<BatchCursor>> {
       auto model_tree = TreeAs<cad::ModelTree>(lookup.any.get());
       if (!model_tree) return absl::InternalError("a CAD request found a tree of another kind");
-      ASSIGN_OR_RETURN(auto cursor,
-                       cad::ModelSampleCursor::Create(std::move(model_tree), sequence, spec.begin,
-                                                      spec.end, spec.region, spec.fields, spec.threads));
+      ASSIGN_OR_RETURN(auto cursor, cad::ModelSampleCursor::Create(
+                                        std::move(model_tree), sequence, spec.begin, spec.end,
+                                        spec.region, spec.fields, spec.threads));
       return std::make_unique<CadBatchCursor>(std::move(cursor));
     };
     out.forget = [loaded = context.loaded, sha256 = model->sha256] { loaded->ForgetModel(sha256); };

@@ -15,8 +15,9 @@
 
 namespace sfc {
 
-absl::StatusOr<std::string> ReadModelInSubprocess(const ModelCheckLimits& limits, ModelFormat format,
-                                                  const std::string& bytes, const std::string& name,
+absl::StatusOr<std::string> ReadModelInSubprocess(const ModelCheckLimits& limits,
+                                                  ModelFormat format, const std::string& bytes,
+                                                  const std::string& name,
                                                   const std::function<absl::Status()>& check) {
   const double wall_seconds = limits.cpu_seconds > 0 ? std::max(10.0, 4 * limits.cpu_seconds) : 0;
   const std::vector<std::string> argv = {
@@ -26,7 +27,8 @@ absl::StatusOr<std::string> ReadModelInSubprocess(const ModelCheckLimits& limits
   // The answer's size: the BRep of a model is about the size of its file,
   // at most a few times it.
   const size_t max_output = std::max<size_t>(size_t{16} << 20, 8 * bytes.size());
-  absl::StatusOr<SubprocessResult> run = RunSubprocess(argv, bytes, max_output, wall_seconds, check);
+  absl::StatusOr<SubprocessResult> run =
+      RunSubprocess(argv, bytes, max_output, wall_seconds, check);
   if (!run.ok()) return run.status();
   const size_t end_of_line = run->output.find('\n');
   absl::string_view line = absl::StripTrailingAsciiWhitespace(

@@ -41,8 +41,9 @@ struct ModelCheckLimits {
 // wall-clock time (4x its CPU limit, at least 10 s); INTERNAL when the
 // program cannot be run or its answer is malformed; `check`'s status when it
 // said to stop (the process is killed).
-absl::StatusOr<std::string> ReadModelInSubprocess(const ModelCheckLimits& limits, ModelFormat format,
-                                                  const std::string& bytes, const std::string& name,
+absl::StatusOr<std::string> ReadModelInSubprocess(const ModelCheckLimits& limits,
+                                                  ModelFormat format, const std::string& bytes,
+                                                  const std::string& name,
                                                   const std::function<absl::Status()>& check);
 
 }  // namespace sfc

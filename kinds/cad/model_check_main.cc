@@ -88,7 +88,8 @@ int main(int argc, char** argv) {
   auto format = sfc::cad::ParseModelFormat(argv[1]);
   if (!format.ok()) return Print(2, "usage: unknown format");
   try {
-    const std::string bytes{std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>()};
+    const std::string bytes{std::istreambuf_iterator<char>(std::cin),
+                            std::istreambuf_iterator<char>()};
     sfc::cad::LoadOptions options;
     options.max_bytes = std::max(options.max_bytes, bytes.size());
     auto brep = sfc::cad::ReadToBrep(*format, bytes, argv[2], options);

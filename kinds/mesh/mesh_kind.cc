@@ -39,8 +39,9 @@ absl::StatusOr<MeshDensityChoice> ParseMeshDensity(const std::string& text) {
   }
   if (absl::StartsWith(spec, "expr:")) {
     const std::string body(absl::StripAsciiWhitespace(spec.substr(5)));
-    ASSIGN_OR_RETURN(std::shared_ptr<const Expression> f,
-                     Expression::Compile("mesh density expression (in x, y, z)", body, {"x", "y", "z"}));
+    ASSIGN_OR_RETURN(
+        std::shared_ptr<const Expression> f,
+        Expression::Compile("mesh density expression (in x, y, z)", body, {"x", "y", "z"}));
     out.density = std::make_shared<FunctionMeshDensity>(
         [f](const MeshPoint& p) {
           const double xyz[3] = {p.position.x, p.position.y, p.position.z};
@@ -134,7 +135,8 @@ absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::
             const std::string name = model.name.empty() ? model.Spec() : model.name;
             ASSIGN_OR_RETURN(TriangleMesh mesh, LoadMesh(*model.bytes, name, options));
             RETURN_IF_ERROR(check());
-            std::shared_ptr<const MeshSurface> parsed = MeshSurface::Create(std::move(mesh), curvature);
+            std::shared_ptr<const MeshSurface> parsed =
+                MeshSurface::Create(std::move(mesh), curvature);
             const uint64_t bytes = MeshSurfaceBytes(*parsed);
             return LoadedModels::Parsed{std::move(parsed), bytes};
           },
@@ -174,9 +176,11 @@ absl::StatusOr<std::unique_ptr<BatchCursor>> OpenMeshCursor(const TreeLookup& lo
 class MeshKind final : public SurfaceKind {
  public:
   const KindInfo& info() const override {
-    static const KindInfo* const info =
-        new KindInfo{"mesh", "a mesh surface (obj: or ply:)", {ModelFormat::kObj, ModelFormat::kPly},
-                     /*face_column=*/false, /*triangle_column=*/true};
+    static const KindInfo* const info = new KindInfo{"mesh",
+                                                     "a mesh surface (obj: or ply:)",
+                                                     {ModelFormat::kObj, ModelFormat::kPly},
+                                                     /*face_column=*/false,
+                                                     /*triangle_column=*/true};
     return *info;
   }
 

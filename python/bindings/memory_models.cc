@@ -30,7 +30,8 @@ absl::StatusOr<StoredModel> MemoryModelSource::Resolve(const ModelSpec& spec) co
   if (spec.sha256.empty()) return files_.Resolve(spec);
   {
     absl::MutexLock lock(&mu_);
-    auto it = held_.find(absl::StrFormat("%s:sha256=%s", ModelFormatName(spec.format), spec.sha256));
+    auto it =
+        held_.find(absl::StrFormat("%s:sha256=%s", ModelFormatName(spec.format), spec.sha256));
     if (it != held_.end()) return it->second.model;
   }
   return absl::NotFoundError(absl::StrFormat(

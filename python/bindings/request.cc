@@ -143,13 +143,14 @@ Raises sfcsampler.InvalidArgumentError for malformed values.)doc")
       .def_property_readonly("curve_position",
                              [](const PyRequest& r) { return r.request.fields.curve_position; })
       .def_property_readonly("face", [](const PyRequest& r) { return r.request.fields.face; })
-      .def_property_readonly("triangle", [](const PyRequest& r) { return r.request.fields.triangle; })
+      .def_property_readonly("triangle",
+                             [](const PyRequest& r) { return r.request.fields.triangle; })
       .def_property_readonly(
           "surface_key", [](const PyRequest& r) { return RoutingKey(r.request.tree); },
-          "the routing key sent as x-surface-key for consistent-hash proxies (request/routing_key.h)")
+          "the routing key sent as x-surface-key for consistent-hash proxies "
+          "(request/routing_key.h)")
       .def_property_readonly(
-          "monotone",
-          [](const PyRequest& r) { return SequenceIsMonotone(r.request.sequence); },
+          "monotone", [](const PyRequest& r) { return SequenceIsMonotone(r.request.sequence); },
           "whether indices grow along the stream (a broken stream resumes after the last index)")
       .def_property_readonly(
           "index_range",
