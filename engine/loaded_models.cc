@@ -232,11 +232,36 @@ void LoadedModels::RunJob(const std::shared_ptr<Job>& job,
         now = absl::UnavailableError("the server is shutting down");
       } else if (job->waiters == 0) {
         now = absl::CancelledError("no request waits for this model any more");
+      } else if (job->evicted) {
+        now = absl::ResourceExhaustedError(absl::StrFormat(
+            "parsing this model took more than %g s, and smaller models needed its place among "
+            "the %d long parses the server runs at once (max_long_parses); it was stopped: "
+            "retry later",
+            options_.fresh_seconds, options_.max_long_parses));
       } else if (may_turn_long && !job->long_parse &&
                  std::chrono::duration<double>(Clock::now() - wall_start).count() >
                      options_.fresh_seconds) {
-        if (stats_.long_parses < static_cast<uint64_t>(std::max(0, options_.max_long_parses))) {
+        // Past max_long_parses, the largest long parse is stopped: this one,
+        // unless a running one is larger (it stops at its next check).
+        const size_t limit = static_cast<size_t>(std::max(0, options_.max_long_parses));
+        const size_t running_long = static_cast<size_t>(std::count_if(
+            long_jobs_.begin(), long_jobs_.end(), [](const auto& j) { return !j->evicted; }));
+        std::shared_ptr<Job> largest;
+        if (running_long >= limit) {
+          for (const auto& other : long_jobs_) {
+            if (!other->evicted && other->working_bytes > job->working_bytes &&
+                (!largest || other->working_bytes > largest->working_bytes)) {
+              largest = other;
+            }
+          }
+          if (largest) {
+            largest->evicted = true;
+            largest->busy = true;
+          }
+        }
+        if (running_long < limit || largest) {
           job->long_parse = true;  // its slot is free: the next parse may start
+          long_jobs_.push_back(job);
           ++stats_.long_parses;
         } else {
           job->busy = true;
@@ -277,7 +302,10 @@ void LoadedModels::RunJob(const std::shared_ptr<Job>& job,
   }
   absl::MutexLock lock(&mu_);
   --stats_.parsing;
-  if (job->long_parse) --stats_.long_parses;
+  if (job->long_parse) {
+    --stats_.long_parses;
+    long_jobs_.erase(std::find(long_jobs_.begin(), long_jobs_.end(), job));
+  }
   working_bytes_ -= job->working_bytes;
   ++stats_.parses;
   pending_.erase(job->key);

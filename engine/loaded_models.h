@@ -14,11 +14,13 @@
 //    fresh_seconds; a parse still running then is "long" and leaves its slot
 //    to the parses waiting, runs on at the lowest priority (the CAD check
 //    process yields its CPU after that long, kinds/cad/model_check.h), and at
-//    most max_long_parses run so at once: one more is stopped with
+//    most max_long_parses run so at once: past that the largest of them (by
+//    working memory, the new one when it is no smaller) is stopped with
 //    RESOURCE_EXHAUSTED (the server is busy, not the model at fault: not
-//    remembered). So a small model waits at most fresh_seconds for a slot
-//    and then gets the CPU before every long parse, whatever the other
-//    clients send or how long they stay.
+//    remembered), so a small model slowed by a busy machine is never the
+//    one stopped for hostile large ones. So a small model waits at most
+//    fresh_seconds for a slot and then gets the CPU before every long
+//    parse, whatever the other clients send or how long they stay.
 //  - Smallest first: of the parses waiting, the one with the least working
 //    memory (which grows with the file's size) starts next, so a small
 //    model does not wait behind large or hostile ones; a parse passed over
@@ -153,6 +155,7 @@ class LoadedModels {
     bool started = false;  // guarded by mu_
     bool long_parse = false;  // guarded by mu_: past fresh_seconds, counted in long_parses
     bool busy = false;  // guarded by mu_: stopped for load, not for the model: not remembered
+    bool evicted = false;  // guarded by mu_: a smaller parse took its place among the long ones
     bool done = false;
     absl::StatusOr<Parsed> result;
   };
@@ -187,6 +190,7 @@ class LoadedModels {
   std::deque<std::shared_ptr<Job>> queue_ ABSL_GUARDED_BY(mu_);
   std::unordered_map<std::string, Failure> failures_ ABSL_GUARDED_BY(mu_);
   uint64_t working_bytes_ ABSL_GUARDED_BY(mu_) = 0;  // reserved by running parses
+  std::vector<std::shared_ptr<Job>> long_jobs_ ABSL_GUARDED_BY(mu_);  // running past fresh_seconds
   // Ends a queued job that will not run: its waiters get `status`.
   void DropQueued(const std::shared_ptr<Job>& job, absl::Status status)
       ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);

@@ -301,8 +301,9 @@ TEST(LoadedModels, ALongParseLeavesItsSlotToTheParsesWaiting) {
   auto until_leave = [&]() -> absl::Status {
     return leave ? absl::CancelledError("done") : absl::OkStatus();
   };
+  absl::Status hog_status;
   std::thread hog(
-      [&] { loaded.Get<int>("hog", Spinning(&started), until_leave, 1).IgnoreError(); });
+      [&] { hog_status = loaded.Get<int>("hog", Spinning(&started), until_leave, 1).status(); });
   while (loaded.stats().long_parses < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   std::atomic<int> parses{0};
   EXPECT_TRUE(loaded.Get<int>("small", Returning(1, &parses), nullptr, 1).ok());
@@ -315,8 +316,23 @@ TEST(LoadedModels, ALongParseLeavesItsSlotToTheParsesWaiting) {
   EXPECT_GE(loaded.stats().parses_busy, 1u);
   EXPECT_TRUE(loaded.Get<int>("second", Returning(1, &parses), nullptr, 1).ok()) << "remembered";
   EXPECT_EQ(parses.load(), 2);
-  leave = true;
+
+  // A smaller parse turning long takes a larger one's place: the larger one
+  // (a hostile file, say) is stopped, not the small one a busy machine slowed.
+  std::atomic<bool> small_started{false};
+  absl::Status small_status;
+  std::thread small([&] {
+    small_status =
+        loaded.Get<int>("small-but-slow", Spinning(&small_started), until_leave, 0).status();
+  });
   hog.join();
+  EXPECT_EQ(hog_status.code(), absl::StatusCode::kResourceExhausted) << hog_status;
+  EXPECT_NE(hog_status.message().find("smaller models needed its place"), std::string::npos)
+      << hog_status;
+  EXPECT_EQ(loaded.stats().long_parses, 1u) << "the small parse runs on as the long one";
+  leave = true;
+  small.join();
+  EXPECT_EQ(small_status.code(), absl::StatusCode::kCancelled) << small_status;
 }
 
 // Issue 37: a full queue takes a smaller parse in place of its largest (a

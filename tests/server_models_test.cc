@@ -291,7 +291,9 @@ TEST(ServerModels, ASmallStepIsServedWhileHostileStepsParse) {
     const double busy = median_of_3();
     auto during = r.client->GetCacheStats();
     ASSERT_TRUE(during.ok());
-    EXPECT_EQ(during->model_parses_long(), static_cast<uint64_t>(hostile_count))
+    // Still running (a slowed small parse may have taken one's place among
+    // the long parses: engine/loaded_models.h).
+    EXPECT_GE(during->model_parses_long(), static_cast<uint64_t>(hostile_count) - 1)
         << "the hostile parses ended before the measurement";
     std::printf("cold 2 KB STEP: usual %.3f s, with %d hostile parses %.3f s (%.2fx)\n", usual,
                 hostile_count, busy, busy / usual);
