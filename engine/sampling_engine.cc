@@ -4,6 +4,7 @@
 #include "base/status_macros.h"
 #include "engine/model_source.h"
 #include "request/index_range.h"
+#include "request/tree_count.h"
 
 namespace sfc {
 namespace {
@@ -86,8 +87,7 @@ absl::StatusOr<std::string> SamplingEngine::DescribeModel(const std::string& spe
   return kind->Describe(*found.model, Context({}));
 }
 
-absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint64_t count,
-                                                     const BuildControl& caller) const {
+absl::Status SamplingEngine::CheckCount(uint64_t count) const {
   if (count == 0) return absl::InvalidArgumentError("count must be >= 1");
   if (count > limits_.max_count) {
     return absl::InvalidArgumentError(absl::StrFormat(
@@ -95,6 +95,12 @@ absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint6
         "request into index ranges or shards",
         count, limits_.max_count));
   }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint64_t count,
+                                                     const BuildControl& caller) const {
+  RETURN_IF_ERROR(CheckCount(count));
   for (const auto* text : {&spec.surface, &spec.density}) {
     if (text->size() > limits_.max_spec_length) {
       return absl::InvalidArgumentError(absl::StrFormat(
@@ -129,14 +135,7 @@ absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint6
 
 absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
                                                   const BuildControl& caller) const {
-  if (request.count == 0) return absl::InvalidArgumentError("count must be >= 1");
-  if (request.count > limits_.max_count) {
-    // Checked before any tree is built for it.
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "count %d is above this server's limit of %d samples per request (max_count); split the "
-        "request into index ranges or shards",
-        request.count, limits_.max_count));
-  }
+  RETURN_IF_ERROR(CheckCount(request.count));  // before anything is built for it
   const bool radical_inverse = request.sequence == SequenceKind::kVanDerCorput ||
                                request.sequence == SequenceKind::kProgressive;
   if (radical_inverse && request.count > (uint64_t{1} << 32)) {
@@ -161,14 +160,7 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
       RETURN_IF_ERROR(CheckColumn(kinds_, kind, &KindInfo::triangle_column, "triangle"));
     }
   }
-  if (request.tree_count != 0 && request.tree_count < request.count) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "tree_count %d is below count %d: the tree must be sized for at least the whole set "
-        "(leave tree_count 0 to size it for count, or set it to the final size of a progressive "
-        "set)",
-        request.tree_count, request.count));
-  }
-  const uint64_t tree_count = request.tree_count == 0 ? request.count : request.tree_count;
+  ASSIGN_OR_RETURN(const uint64_t tree_count, ResolveTreeCount(request));
   SamplingJob job;
   ASSIGN_OR_RETURN(job.tree, Prepare(request.tree, tree_count, caller));
   job.begin = range.first;

@@ -79,6 +79,8 @@ class SamplingEngine {
     std::optional<StoredModel> model;
   };
   absl::StatusOr<SpecKind> KindOf(const std::string& spec) const;
+  // INVALID_ARGUMENT for a count of 0 or past limits_.max_count.
+  absl::Status CheckCount(uint64_t count) const;
   KindContext Context(const BuildControl& caller) const;
 
   const SurfaceKinds& kinds_;

@@ -30,6 +30,8 @@ absl::StatusOr<std::vector<double>> Numbers(const std::string& what, absl::strin
   return values;
 }
 
+}  // namespace
+
 // CLI11 reads "-1" and numbers past 2^64 - 1 into a uint64_t as 2^64 - 1
 // without a word, so runs a user believes independent would share a seed:
 // whole-number flags are checked as typed, before that conversion.
@@ -45,8 +47,6 @@ const CLI::Validator kWholeNumber(
                              Echo(text));
     },
     "UINT64");
-
-}  // namespace
 
 void AddTreeFlags(CLI::App* cmd, RequestFlags* f) {
   cmd->add_option("--surface", f->surface,

@@ -30,6 +30,10 @@ struct RequestFlags {
   bool face = false, triangle = false;
 };
 
+// Checks a uint64_t flag as typed: a whole number from 0 to 2^64 - 1, else
+// an error quoting it (CLI11 alone saturates -1 and 2^64 to 2^64 - 1).
+extern const CLI::Validator kWholeNumber;
+
 // Adds the tree-shaping flags (surface, density, curve, ...) to `cmd`.
 void AddTreeFlags(CLI::App* cmd, RequestFlags* flags);
 // Adds the set-selection flags (count, seed, sequence, range, shard, region, columns).

@@ -11,6 +11,7 @@
 #include "server/message_pipeline.h"
 #include "server/request_control.h"
 #include "spdlog/spdlog.h"
+#include "request/tree_count.h"
 
 namespace sfc {
 
@@ -90,8 +91,10 @@ grpc::Status SamplerService::PrepareModelOutsideSlot(grpc::ServerContext* contex
   const auto deadline =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(
                          std::chrono::duration<double>(options_.request_deadline_seconds));
+  auto tree_count = ResolveTreeCount(*parsed);
+  if (!tree_count.ok()) return ToGrpcStatus(tree_count.status());
   auto prepared =
-      engine_.Prepare(parsed->tree, parsed->tree_count ? parsed->tree_count : parsed->count,
+      engine_.Prepare(parsed->tree, *tree_count,
                       RequestControl(context, deadline, options_.request_deadline_seconds));
   if (!prepared.ok()) return ToGrpcStatus(prepared.status());
   return grpc::Status::OK;

@@ -1,8 +1,10 @@
 // The flags every sampling subcommand shares (request/request_flags.h), read
 // as the CLI and the Python keywords read them (issue 37): whole numbers
 // outside 0..2^64-1 are refused quoting what was typed, never saturated, and
-// rho must be positive before a request leaves the client.
+// rho must be positive before a request leaves the client. And the one rule
+// for the size a request's tree is built for (request/tree_count.h).
 #include "request/request_flags.h"
+#include "request/tree_count.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -63,6 +65,18 @@ TEST(RequestFlags, RhoMustBePositiveBeforeARequestIsMade) {
   auto request = ToSampleRequest(flags);
   ASSERT_TRUE(request.ok()) << request.status();
   EXPECT_EQ(request->tree.options.rho, 0.25);
+}
+
+TEST(TreeCount, TheTreeHoldsTheWholeSet) {
+  RequestFlags flags;
+  ASSERT_EQ(Parse({"--count", "1000"}, &flags), "");
+  EXPECT_EQ(*ResolveTreeCount(*ToSampleRequest(flags)), 1000u);  // 0: sized for count
+  ASSERT_EQ(Parse({"--count", "1000", "--tree-count", "4096"}, &flags), "");
+  EXPECT_EQ(*ResolveTreeCount(*ToSampleRequest(flags)), 4096u);
+  ASSERT_EQ(Parse({"--count", "1000", "--tree-count", "999"}, &flags), "");
+  auto below = ResolveTreeCount(*ToSampleRequest(flags));
+  EXPECT_EQ(below.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(below.status().message().find("tree_count 999 is below count 1000"), std::string::npos);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include "client/cli/exit_status.h"
 #include "request/request_flags.h"
 #include "client/cli/sample_source.h"
+#include "request/tree_count.h"
 
 namespace sfc {
 namespace {
@@ -19,12 +20,13 @@ struct PrepareFlags {
 };
 
 int RunPrepare(const PrepareFlags& flags) {
-  auto spec = ToTreeSpec(flags.request);
-  if (!spec.ok()) return Fail(spec.status());
+  auto request = ToSampleRequest(flags.request);
+  if (!request.ok()) return Fail(request.status());
+  auto tree_count = ResolveTreeCount(*request);
+  if (!tree_count.ok()) return Fail(tree_count.status());
   const std::unique_ptr<SampleSource> source = OpenSampleSource(flags.connection);
   Progress progress(true);
-  auto tree = source->Prepare(
-      *spec, flags.request.tree_count ? flags.request.tree_count : flags.request.count, &progress);
+  auto tree = source->Prepare(request->tree, *tree_count, &progress);
   progress.Done();
   if (!tree.ok()) return Fail(tree.status());
   PrintTreeSummary(*tree);
@@ -40,7 +42,8 @@ Command AddPrepareCommand(CLI::App& app) {
       app.add_subcommand("prepare", "build (warm) a curve tree and print its key and statistics");
   AddTreeFlags(prepare, &flags->request);
   prepare->add_option("--count,-n", flags->request.count, "size the tree for this many samples")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(kWholeNumber);
   AddConnectionFlags(prepare, &flags->connection);
   return {prepare, [flags] { return RunPrepare(*flags); }};
 }

@@ -22,6 +22,7 @@
 #include "python/bindings/recent_tree_source.h"
 #include "python/bindings/register.h"
 #include "python/bindings/request.h"
+#include "request/tree_count.h"
 
 namespace py = pybind11;
 
@@ -195,8 +196,9 @@ class PyEngine {
     absl::StatusOr<PreparedTree> tree;
     {
       py::gil_scoped_release release;
-      const SampleRequest& q = r.request;
-      tree = engine_.Prepare(q.tree, q.tree_count ? q.tree_count : q.count);
+      const absl::StatusOr<uint64_t> tree_count = ResolveTreeCount(r.request);
+      tree = tree_count.ok() ? engine_.Prepare(r.request.tree, *tree_count)
+                             : absl::StatusOr<PreparedTree>(tree_count.status());
     }
     ThrowIfError(tree.status());
     return TreeInfoDict(*tree);
