@@ -212,13 +212,15 @@ class CurveTree::Builder {
       const int g = curve_.grid();
       for (int c = 0; c < curve_.arity(); ++c) {
         const Curve::Child& ch = curve_.ChildOf(state, c);
-        RETURN_IF_ERROR(Geometric(depth + 1, start + c * span, x * g + ch.dx, y * g + ch.dy, ch.state));
+        RETURN_IF_ERROR(
+            Geometric(depth + 1, start + c * span, x * g + ch.dx, y * g + ch.dy, ch.state));
       }
       return absl::OkStatus();
     }
     if (wants_split && depth >= options_.depth_cap) {
       ++report_.geometry_capped_leaves;
-      RecordHit({DepthCapHit::Test::kGeometry, u0, v0, h, spread, options_.tolerance}, &report_.worst);
+      RecordHit({DepthCapHit::Test::kGeometry, u0, v0, h, spread, options_.tolerance},
+                &report_.worst);
     }
     if (stage1_starts_.size() >= options_.max_leaves) return BudgetError();
     ASSIGN_OR_RETURN(const CellEval eval, Evaluate(depth, x, y));
@@ -235,7 +237,8 @@ class CurveTree::Builder {
   absl::StatusOr<double> CellSpread(double u0, double v0, double h) const {
     double us[9], vs[9], x[9], y[9], z[9];
     for (int i = 0; i <= 2; ++i) {
-      for (int j = 0; j <= 2; ++j) us[3 * i + j] = u0 + i * (h / 2), vs[3 * i + j] = v0 + j * (h / 2);
+      for (int j = 0; j <= 2; ++j)
+        us[3 * i + j] = u0 + i * (h / 2), vs[3 * i + j] = v0 + j * (h / 2);
     }
     surface_.Points(us, vs, 9, x, y, z);
     const Vec3 c{x[4], y[4], z[4]};
@@ -419,7 +422,8 @@ class CurveTree::Builder {
     if (!(centre > margin && centre < 1 - margin)) return kNoWarp;
     ASSIGN_OR_RETURN(const double below, PowerBeside(u0, v0, h, axis, centre, -1));
     ASSIGN_OR_RETURN(const double above, PowerBeside(u0, v0, h, axis, centre, 1));
-    if (!(std::fabs(below - above) <= kInteriorPowerMismatch) || !(below + above < 0)) return kNoWarp;
+    if (!(std::fabs(below - above) <= kInteriorPowerMismatch) || !(below + above < 0))
+      return kNoWarp;
     AxisWarp warp = PowerLaw((below + above) / 2, 0);
     if (warp.power != 1) warp.centre = centre;
     return warp;
@@ -585,7 +589,8 @@ class CurveTree::Builder {
   absl::Status Grow() {
     if (starts_.size() >= options_.max_leaves) return BudgetError();
     if (starts_.size() == starts_.capacity()) {
-      Reserve(std::min<uint64_t>(options_.max_leaves, starts_.capacity() + starts_.capacity() / 2 + 1024));
+      Reserve(std::min<uint64_t>(options_.max_leaves,
+                                 starts_.capacity() + starts_.capacity() / 2 + 1024));
     }
     return absl::OkStatus();
   }
@@ -601,11 +606,13 @@ class CurveTree::Builder {
 
   // Asks the caller whether to go on, every BuildControl::kCheckInterval cells.
   absl::Status Checkpoint() {
-    if ((!control_.check && !control_.charge) || ++cells_since_check_ < BuildControl::kCheckInterval) {
+    if ((!control_.check && !control_.charge) ||
+        ++cells_since_check_ < BuildControl::kCheckInterval) {
       return absl::OkStatus();
     }
     cells_since_check_ = 0;
-    if (control_.charge) RETURN_IF_ERROR(control_.charge(starts_.size() * CurveTree::kBytesPerLeaf));
+    if (control_.charge)
+      RETURN_IF_ERROR(control_.charge(starts_.size() * CurveTree::kBytesPerLeaf));
     return control_.check ? control_.check() : absl::OkStatus();
   }
 
@@ -694,7 +701,8 @@ absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Build(const Surface&
                                                                   int grade,
                                                                   const BuildControl& control) {
   if (grade < 0 || grade > 62) {
-    return absl::InvalidArgumentError(absl::StrFormat("tree grade must be in [0, 62], got %d", grade));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("tree grade must be in [0, 62], got %d", grade));
   }
   ASSIGN_OR_RETURN(const CurveTreeOptions resolved, ResolveOptions(surface, options));
   auto tree = std::shared_ptr<CurveTree>(new CurveTree());
@@ -730,11 +738,8 @@ absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Build(const Surface&
   return std::shared_ptr<const CurveTree>(std::move(tree));
 }
 
-
-absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Refined(const Surface& surface,
-                                                                    const Density& density,
-                                                                    int grade,
-                                                                    const BuildControl& control) const {
+absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Refined(
+    const Surface& surface, const Density& density, int grade, const BuildControl& control) const {
   if (grade < grade_ || grade > 62) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "cannot refine a grade-%d tree to grade %d; grades only grow, up to 62", grade_, grade));
@@ -782,10 +787,11 @@ size_t CurveTree::LeafAt(uint64_t index) const {
 
 size_t CurveTree::FirstLeafEndingAbove(double m, size_t lo) const {
   const double unit = mass_unit_;
-  return static_cast<size_t>(
-      std::upper_bound(mass_end_.begin() + lo, mass_end_.end(), m,
-                       [unit](double x, uint64_t end) { return x < static_cast<double>(end) * unit; }) -
-      mass_end_.begin());
+  return static_cast<size_t>(std::upper_bound(mass_end_.begin() + lo, mass_end_.end(), m,
+                                              [unit](double x, uint64_t end) {
+                                                return x < static_cast<double>(end) * unit;
+                                              }) -
+                             mass_end_.begin());
 }
 
 void CurveTree::ComputeDepthRange() {
@@ -803,9 +809,10 @@ void CurveTree::ComputeReport() {
   r.mass_capped_leaves = r.small_failing_leaves = r.singular_leaves = r.warped_leaves = 0;
   r.error_samples = r.unresolved_error_samples = 0;
   r.singular.clear();
-  r.worst.erase(std::remove_if(r.worst.begin(), r.worst.end(),
-                               [](const DepthCapHit& h) { return h.test == DepthCapHit::Test::kMass; }),
-                r.worst.end());
+  r.worst.erase(
+      std::remove_if(r.worst.begin(), r.worst.end(),
+                     [](const DepthCapHit& h) { return h.test == DepthCapHit::Test::kMass; }),
+      r.worst.end());
   const double n = std::ldexp(1.0, grade_);
   for (size_t l = 0; l < starts_.size(); ++l) {
     const double error = errors_[l] / base_mass_ * n;
@@ -831,8 +838,9 @@ void CurveTree::ComputeReport() {
     if (piecewise || warped) {
       const Cell c = LeafCell(l);
       DepthCapHit hit{DepthCapHit::Test::kSingular, c.u0, c.v0, c.size, 0, 0};
-      auto pos = std::upper_bound(r.singular.begin(), r.singular.end(), hit,
-                                  [](const DepthCapHit& a, const DepthCapHit& b) { return a.size < b.size; });
+      auto pos = std::upper_bound(
+          r.singular.begin(), r.singular.end(), hit,
+          [](const DepthCapHit& a, const DepthCapHit& b) { return a.size < b.size; });
       r.singular.insert(pos, hit);
       if (r.singular.size() > PrecisionReport::kMaxReported) r.singular.pop_back();
     }
