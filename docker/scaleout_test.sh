@@ -145,14 +145,16 @@ kill "$scaleout" 2>/dev/null || true; wait "$scaleout" 2>/dev/null || true
 mdir="$dir/models"; mkdir -p "$mdir/cluster"
 [ -x "$build/cad/make_cad_fixtures" ] || { echo "scaleout_test: all checks passed (no CAD build: models skipped)"; exit 0; }
 "$build/cad/make_cad_fixtures" "$mdir" > /dev/null
-# A torus of 128 x 64 quads as OBJ.
-awk 'BEGIN { n = 128; m = 64; pi = atan2(0, -1)
-  for (i = 0; i < n; i++) for (j = 0; j < m; j++) {
-    a = 2 * pi * i / n; b = 2 * pi * j / m
-    printf "v %.9f %.9f %.9f\n", (1 + 0.3 * cos(b)) * cos(a), (1 + 0.3 * cos(b)) * sin(a), 0.3 * sin(b) }
-  for (i = 0; i < n; i++) for (j = 0; j < m; j++) {
-    p = i * m + j + 1; q = ((i + 1) % n) * m + j + 1; r = ((i + 1) % n) * m + (j + 1) % m + 1; t = i * m + (j + 1) % m + 1
-    printf "f %d %d %d %d\n", p, q, r, t } }' > "$mdir/torus.obj"
+torus_obj() {  # N M: a torus of N x M quads as OBJ on stdout
+  awk -v n="$1" -v m="$2" 'BEGIN { pi = atan2(0, -1)
+    for (i = 0; i < n; i++) for (j = 0; j < m; j++) {
+      a = 2 * pi * i / n; b = 2 * pi * j / m
+      printf "v %.9f %.9f %.9f\n", (1 + 0.3 * cos(b)) * cos(a), (1 + 0.3 * cos(b)) * sin(a), 0.3 * sin(b) }
+    for (i = 0; i < n; i++) for (j = 0; j < m; j++) {
+      p = i * m + j + 1; q = ((i + 1) % n) * m + j + 1; r = ((i + 1) % n) * m + (j + 1) % m + 1; t = i * m + (j + 1) % m + 1
+      printf "f %d %d %d %d\n", p, q, r, t } }'
+}
+torus_obj 128 64 > "$mdir/torus.obj"
 proxy_port=$((20000 + RANDOM % 20000))
 SFC_SCALEOUT_DIR="$mdir/cluster" PATH="$PATH" bash "$root/docker/scaleout.sh" 3 "$proxy_port" > "$mdir/scaleout.log" 2>&1 &
 scaleout=$!
@@ -206,13 +208,7 @@ echo "model kill: the mesh's replica killed mid-stream; $(grep -o '[0-9]* resume
 # 6. A model over nginx's default body limit (1 MiB): a 300 x 150 torus,
 # about 2.8 MB of OBJ, uploads through the proxy (client_max_body_size 0)
 # and samples byte-identical to in-process.
-awk 'BEGIN { n = 300; m = 150; pi = atan2(0, -1)
-  for (i = 0; i < n; i++) for (j = 0; j < m; j++) {
-    a = 2 * pi * i / n; b = 2 * pi * j / m
-    printf "v %.9f %.9f %.9f\n", (1 + 0.3 * cos(b)) * cos(a), (1 + 0.3 * cos(b)) * sin(a), 0.3 * sin(b) }
-  for (i = 0; i < n; i++) for (j = 0; j < m; j++) {
-    p = i * m + j + 1; q = ((i + 1) % n) * m + j + 1; r = ((i + 1) % n) * m + (j + 1) % m + 1; t = i * m + (j + 1) % m + 1
-    printf "f %d %d %d %d\n", p, q, r, t } }' > "$mdir/large_torus.obj"
+torus_obj 300 150 > "$mdir/large_torus.obj"
 large_bytes=$(stat -c %s "$mdir/large_torus.obj")
 [ "$large_bytes" -gt $((2 * 1024 * 1024)) ] || fail "the large mesh has only $large_bytes bytes"
 "$cli" sample -q --surface "obj:$mdir/large_torus.obj" --count 50000 --seed 6 -o "$mdir/large-embedded.csv"
