@@ -15,8 +15,8 @@ clients H:
      waits 1 s so their parses run, then times the sphere again; each
      hostile client stays connected for --hold seconds, then leaves. The
      hostile file (cad/fixtures.h): --kind polygon, one face of --size
-     corners (default 6 000: the kernel's read grows like corners^3 and
-     takes about 40 s, in 40 MB); --kind collinear, --size faces without
+     corners (default 6 000: the kernel's read grows like corners^2.7 and
+     takes 53 s of CPU, in 44 MB); --kind collinear, --size faces without
      area (issue 37's 10^5-face file: 36 MB, 2 ms and 900 KB a face).
 Prints each round's pair, the median ratio with-hostile / alone for each H,
 and the server's parse statistics. The target (issue 37): at most 2x.

@@ -79,8 +79,9 @@ std::string CollinearFacesStep(int collinear, bool with_square);
 
 // A STEP of one planar face bounded by a POLY_LOOP of `corners` points on
 // the unit circle: a valid model the kernel reads in time that grows like
-// corners^3 and little memory (measured with OCC 7.6: 2 000 corners, 158 KB,
-// 2 s of CPU and 38 MB; 8 000 corners, 633 KB, more than 100 s and 45 MB).
+// corners^2.7 and little memory (measured with OCC 7.6, sfcsampler-model-check
+// alone: 2 000 corners 2.0 s of CPU and 36 MB; 6 000 corners, 487 KB, 53 s
+// and 44 MB; 8 000 corners, 650 KB, 116 s and 47 MB).
 // The hostile parse of the isolation test and bench/parse_isolation.py.
 std::string PolygonFaceStep(int corners);
 
