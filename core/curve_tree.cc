@@ -63,6 +63,17 @@ int SamplesGrade(double mass, double base, double scale) {
   return kNeverFails;
 }
 
+// The smallest grade at which the leaf carries kRoughFloor samples: where a
+// leaf's model misses a fixed share of its own mass (a step, a kink at a zero
+// or a singular line cuts it), it is examined down to this floor, which does
+// not grow with N, so the error along the feature falls like N^(-1/2).
+int RoughGrade(double mass, double base) {
+  for (int g = 0; g <= 62; ++g) {
+    if (mass / base * std::ldexp(1.0, g) >= CurveTree::kRoughFloor) return g;
+  }
+  return kNeverFails;
+}
+
 // The smallest grade in [0, 62] at which the leaf fails, kNeverFails if none.
 // Both conditions are monotone in g, so a binary search finds it.
 int FailGrade(double error, double mass, double base, double rho) {
@@ -125,9 +136,13 @@ class CurveTree::Builder {
 
   // Stage 2 from the cell (depth, x, y) whose curve range starts at `start`:
   // appends its leaves at `grade`.
-  absl::Status RefineCell(int depth, uint64_t start, uint64_t x, uint64_t y, int state) {
+  // `rough_parent`: the cell's parent failed the rough test (stage-1 leaves:
+  // true, as stage 1 tests no mass; a refined leaf: as recorded,
+  // leaf_rough_parent).
+  absl::Status RefineCell(int depth, uint64_t start, uint64_t x, uint64_t y, int state,
+                          bool rough_parent) {
     ASSIGN_OR_RETURN(const CellEval eval, Evaluate(depth, x, y));
-    return Refine(depth, start, x, y, state, eval);
+    return Refine(depth, start, x, y, state, eval, rough_parent);
   }
 
   void StartStage2(double base, int grade, size_t expected_leaves) {
@@ -276,7 +291,10 @@ class CurveTree::Builder {
     if (!eval.singular && !eval.varies) return eval;
     double sub[9];
     ASSIGN_OR_RETURN(const double triangles, SubSquareMasses(u0, v0, h, eval.delta, sub));
-    if (!eval.singular && !(triangles > kSingularExcess * eval.mass)) return eval;
+    // Either way: a node beside a blow-up line also overshoots.
+    const bool misses =
+        triangles > kSingularExcess * eval.mass || eval.mass > kSingularExcess * triangles;
+    if (!eval.singular && !misses) return eval;
     // The quadrature misses mass: a singular line inside the cell?
     bool interior = false;
     for (int axis = 0; axis < 2; ++axis) {
@@ -346,11 +364,12 @@ class CurveTree::Builder {
 
   // The mass density m = delta |f_u x f_v| at leaf coordinate x along the
   // cell's axis `axis`, across it at the cell's middle; +infinity where the
-  // area element is not finite.
+  // surface or its area element is not finite.
   absl::StatusOr<double> AxisDensity(double u0, double v0, double h, int axis, double x) const {
     const double u = axis == 0 ? u0 + x * h : u0 + h / 2, v = axis == 0 ? v0 + h / 2 : v0 + x * h;
     const SurfaceJet jet = surface_.Jet(u, v, order_);
-    if (!IsFinite(jet.p)) return SurfaceNotFiniteError(u, v);
+    // The searches close in on the line itself, where a pole is not finite.
+    if (!IsFinite(jet.p)) return INFINITY;
     double area;
     const SurfacePoint point = PointFromJet(jet, u, v, order_ == 2, &area);
     if (!std::isfinite(area)) return INFINITY;
@@ -477,6 +496,55 @@ class CurveTree::Builder {
     return total;
   }
 
+  // Whether the leaf's model misses a fixed share of its mass, so that it and
+  // its children are examined down to kRoughFloor: a quadratic that misses
+  // more than rho kRoughShare (a step or a crease cuts the cell), or the
+  // piecewise fallback, which spreads samples evenly inside its sub-squares
+  // however the mass lies there (a blow-up line just beyond the cell's
+  // edge). A warped model follows its line by construction; its error
+  // shrinks with the leaf, and the error test governs it.
+  bool IsRough(const CellEval& eval, double error) const {
+    if (eval.piecewise) return true;
+    if (eval.warp[0].power != 1 || eval.warp[1].power != 1) return false;
+    return error > kRoughShare * options_.rho * eval.mass;
+  }
+
+  // What the children's nodes cannot see: a step or crease of m within
+  // 0.056 of the cell's side from an edge lies beyond every child's Gauss
+  // node. m at the cell's 4 corners and 4 edge midpoints is compared with
+  // the quadratic's value there; where one differs from it by more than
+  // kEdgeJump of the largest node value, the band beside that edge
+  // (kEdgeBand of the cell) is counted as mis-modelled by that difference.
+  // 0 for warped and piecewise models (their edges are singular lines).
+  double EdgeError(const CellEval& eval, double u0, double v0, double h) const {
+    if (eval.piecewise || eval.warp[0].power != 1 || eval.warp[1].power != 1) return 0.0;
+    const double at[3] = {0, 0.5, 1};
+    double us[3], vs[3];
+    for (int i = 0; i < 3; ++i) us[i] = u0 + at[i] * h, vs[i] = v0 + at[i] * h;
+    us[2] = u0 + h, vs[2] = v0 + h;
+    SurfaceJet jets[9];
+    surface_.JetGrid(us, 3, vs, 3, order_, jets);
+    double top = 0;
+    for (int k = 0; k < 9; ++k) top = std::max(top, std::fabs(eval.values[k]));
+    double worst = 0;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        if (i == 1 && j == 1) continue;
+        const SurfaceJet& jet = jets[3 * i + j];
+        // A pole or singular line on the edge: the warps' business.
+        if (!IsFinite(jet.p)) continue;
+        double area;
+        const SurfacePoint point = PointFromJet(jet, us[i], vs[j], order_ == 2, &area);
+        if (!std::isfinite(area)) continue;
+        const double delta = density_.Value(point);
+        if (!std::isfinite(delta)) continue;
+        const double gap = std::fabs(delta * area - QuadraticAt(eval.values, at[i], at[j]));
+        if (gap > kEdgeJump * top) worst = std::max(worst, gap);
+      }
+    }
+    return worst * kEdgeBand * h * h;
+  }
+
   // The parent model's integral over child (cx, cy) of its g x g grid.
   double ModelOverChild(const CellEval& eval, int cx, int cy, double h) const {
     const int g = curve_.grid();
@@ -487,14 +555,18 @@ class CurveTree::Builder {
   }
 
   absl::Status Refine(int depth, uint64_t start, uint64_t x, uint64_t y, int state,
-                      const CellEval& eval) {
+                      const CellEval& eval, bool rough_parent) {
     const int g = curve_.grid();
     const double h = 1.0 / curve_.PowG(depth);
     // A leaf too light to fail at this grade is not examined: it keeps the
     // grade at which it must be (a pure function of the cell), and a later
     // refinement examines it then, as a fresh build would.
+    // Below the error floor only the children of a rough leaf are examined:
+    // a feature the parent's test did not see is too small to matter there.
     int fail = SamplesGrade(eval.mass, base_, kErrorFloor);
+    if (rough_parent) fail = std::min(fail, RoughGrade(eval.mass, base_));
     double error = 0;
+    bool rough = false;
     CellEval children[9];
     if (fail <= grade_ && depth < curve_.max_depth()) {
       for (int c = 0; c < curve_.arity(); ++c) {
@@ -502,7 +574,10 @@ class CurveTree::Builder {
         ASSIGN_OR_RETURN(children[c], Evaluate(depth + 1, x * g + ch.dx, y * g + ch.dy));
         error += std::fabs(ModelOverChild(eval, ch.dx, ch.dy, h) - children[c].mass);
       }
+      error += EdgeError(eval, x * h, y * h, h);
       fail = FailGrade(error, eval.mass, base_, options_.rho);
+      rough = IsRough(eval, error);
+      if (rough) fail = std::min(fail, RoughGrade(eval.mass, base_));
       // The paper's flatness test, for leaves that carry a whole sample.
       int flat = SamplesGrade(eval.mass, base_, kFlatnessFloor);
       // Beside a line where the area element blows up (a warp with power
@@ -530,7 +605,7 @@ class CurveTree::Builder {
       for (int c = 0; c < curve_.arity(); ++c) {
         const Curve::Child& ch = curve_.ChildOf(state, c);
         RETURN_IF_ERROR(Refine(depth + 1, start + c * span, x * g + ch.dx, y * g + ch.dy, ch.state,
-                               children[c]));
+                               children[c], rough));
       }
       return absl::OkStatus();
     }
@@ -544,7 +619,8 @@ class CurveTree::Builder {
     models_.push_back(eval.piecewise ? LeafModel::FromPiecewise(eval.values, g)
                                      : LeafModel::FromQuadratic(eval.values, eval.warp));
     errors_.push_back(static_cast<float>(error));
-    info_.push_back(static_cast<uint8_t>(fail | (eval.piecewise ? kPiecewiseBit : 0)));
+    info_.push_back(static_cast<uint8_t>(fail | (eval.piecewise ? kPiecewiseBit : 0) |
+                                         (rough_parent ? kRoughParentBit : 0)));
     return absl::OkStatus();
   }
 
@@ -731,7 +807,7 @@ absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Build(const Surface&
   for (size_t l = 0; l < starts.size(); ++l) {
     const uint64_t end = l + 1 < starts.size() ? starts[l + 1] : curve.Span(0);
     const Cell cell = CellOfRange(curve, starts[l], end);
-    RETURN_IF_ERROR(builder.RefineCell(cell.depth, starts[l], cell.x, cell.y, cell.state));
+    RETURN_IF_ERROR(builder.RefineCell(cell.depth, starts[l], cell.x, cell.y, cell.state, true));
   }
   tree->precision_ = builder.report();
   RETURN_IF_ERROR(builder.Finish(tree.get()));
@@ -756,7 +832,8 @@ absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Refined(
   for (size_t l = 0; l < leaf_count(); ++l) {
     const Cell cell = LeafCell(l);
     if (leaf_fail_grade(l) <= grade && cell.depth < options_.depth_cap) {
-      RETURN_IF_ERROR(builder.RefineCell(cell.depth, starts_[l], cell.x, cell.y, cell.state));
+      RETURN_IF_ERROR(builder.RefineCell(cell.depth, starts_[l], cell.x, cell.y, cell.state,
+                                         leaf_rough_parent(l)));
     } else {
       RETURN_IF_ERROR(builder.CopyLeaf(*this, l));
     }

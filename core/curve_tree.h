@@ -149,6 +149,19 @@ class CurveTree {
   static constexpr double kErrorFloorPower = 0.5;
   static constexpr double kFlatnessFloor = 1.0 / 16;
   static constexpr double kSingularExcess = 1.02;
+  // A rough leaf (its quadratic misses more than rho kRoughShare of its mass, or
+  // it fell back to the piecewise model) and its children are examined while
+  // they carry at least kRoughFloor samples, a floor that does not grow with
+  // N: steps, creases at zeros and singular lines at any position get leaves
+  // small enough that the error along them falls like N^(-1/2)
+  // (docs/ALGORITHM.md, "Features inside a leaf").
+  static constexpr double kRoughShare = 0.01;
+  static constexpr double kRoughFloor = 1.0 / 2048;
+  // The edge probe (EdgeError): a gap of kEdgeJump of the largest node value
+  // between m and the model at a corner or edge midpoint counts, over a band
+  // of kEdgeBand of the cell.
+  static constexpr double kEdgeJump = 0.05;
+  static constexpr double kEdgeBand = 1.0 / 16;
 
   const Curve& curve() const { return *curve_; }
   // The options with tolerance and depth cap resolved to the values used.
@@ -192,6 +205,9 @@ class CurveTree {
   }
   // The smallest grade at which the leaf fails the error test (63: never).
   int leaf_fail_grade(size_t l) const { return info_[l] & kFailGradeMask; }
+  // Whether the leaf's parent failed the rough test (kRoughShare), so the
+  // leaf is examined down to kRoughFloor.
+  bool leaf_rough_parent(size_t l) const { return info_[l] & kRoughParentBit; }
 
   const PrecisionReport& precision() const { return precision_; }
   int min_depth() const { return min_depth_; }
@@ -219,6 +235,7 @@ class CurveTree {
   double base_mass_ = 0;
   static constexpr uint8_t kFailGradeMask = 63;
   static constexpr uint8_t kPiecewiseBit = 64;
+  static constexpr uint8_t kRoughParentBit = 128;
 
   // PodArray, not std::vector: growing them moves no bytes (base/pod_array.h).
   PodArray<uint64_t> starts_;
@@ -226,7 +243,7 @@ class CurveTree {
   double mass_unit_ = 0;            // base_mass_ / 2^56
   PodArray<LeafModel> models_;
   PodArray<float> errors_;
-  PodArray<uint8_t> info_;  // fail grade | kPiecewiseBit
+  PodArray<uint8_t> info_;  // fail grade | kPiecewiseBit | kRoughParentBit
   PrecisionReport precision_;
   int min_depth_ = 0, max_depth_ = 0;
 };

@@ -195,6 +195,17 @@ struct GridFactors {
 void ComputeGridFactors(const LeafModel& model, LeafModel::Kind kind, int grid, double x0,
                         double y0, double side, int n, GridFactors* out);
 
+// The quadratic through unnormalised node values at (x, y) of the leaf's own
+// coordinates (no warp); also outside the nodes, as an extrapolation.
+inline double QuadraticAt(const double values[9], double x, double y) {
+  using leaf_model_internal::Basis;
+  double sum = 0;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) sum += values[3 * i + j] * Basis(i, x) * Basis(j, y);
+  }
+  return sum;
+}
+
 // The same for unnormalised quadratic node values (double precision) in the
 // coordinates warped by `warp` (null: none), used by the tree's error test.
 double QuadraticIntegral(const double values[9], double x0, double x1, double y0, double y1,

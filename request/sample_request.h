@@ -21,7 +21,7 @@ namespace sfc {
 // toward singular edges (LeafModel::warp), placement inside a leaf by tables
 // (core/leaf_walk.h), elementary functions from SLEEF (core/vector_math.h).
 // Its bytes are pinned by tests/pinned_bytes.txt.
-inline constexpr char kAlgorithmVersion[] = "sfcsampler-3";
+inline constexpr char kAlgorithmVersion[] = "sfcsampler-4";
 
 // Everything that shapes a curve tree (the cache key) except its grade.
 struct TreeSpec {
