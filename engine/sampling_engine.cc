@@ -87,6 +87,19 @@ absl::StatusOr<std::string> SamplingEngine::DescribeModel(const std::string& spe
   return kind->Describe(*found.model, Context({}));
 }
 
+TreeSummary SummarizeTree(const PreparedTree& t) {
+  TreeSummary s;
+  s.kind = std::string(t.kind);
+  s.key = t.key.Hex();
+  s.key_with_grade = t.key.HexWithGrade(t.grade);
+  s.canonical = t.key.canonical;
+  s.grade = t.grade;
+  s.cache_hit = t.lookup.cache_hit;
+  s.refined = t.lookup.refined;
+  t.lookup.any->FillSummary(&s);
+  return s;
+}
+
 absl::Status SamplingEngine::CheckCount(uint64_t count) const {
   if (count == 0) return absl::InvalidArgumentError("count must be >= 1");
   if (count > limits_.max_count) {

@@ -22,6 +22,7 @@
 #include "engine/tree_source.h"
 #include "request/sample_request.h"
 #include "request/tree_key.h"
+#include "request/tree_summary.h"
 
 namespace sfc {
 
@@ -32,6 +33,11 @@ struct PreparedTree {
   TreeLookup lookup;
   CursorOpener open_cursor;  // how its kind samples it
 };
+
+// The summary of `tree` (request/tree_summary.h): its request's fields, then
+// the tree's own (AnyTree::FillSummary), whatever its kind. The one place a
+// prepared tree becomes a summary, for the wire, the CLI and Python alike.
+TreeSummary SummarizeTree(const PreparedTree& tree);
 
 struct SamplingJob {
   PreparedTree tree;

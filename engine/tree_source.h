@@ -9,20 +9,32 @@
 
 #include "absl/status/statusor.h"
 #include "core/curve_tree.h"
+#include "engine/curve_tree_summary.h"
 #include "request/tree_key.h"
+#include "request/tree_summary.h"
 
 namespace sfc {
 
 // A built tree of any kind, as caches hold it: a CurveTree (catalogue and
-// expression surfaces, CAD models) or a mesh's tree. Only its size matters to
-// a cache; the engine, which made it, knows its type (TypedTree<T>).
+// expression surfaces), a CAD model's trees or a mesh's tree. A cache needs
+// only its size; the kind that made it knows its type (TypedTree<T>); every
+// front door sees it through FillSummary.
 class AnyTree {
  public:
   virtual ~AnyTree() = default;
   virtual uint64_t bytes() const = 0;
   virtual uint64_t leaves() const = 0;
+  // Fills the fields of `out` that the tree knows (request/tree_summary.h):
+  // leaves and bytes, and whatever its kind of tree adds. Leaves the
+  // request's fields (kind, key, grade, cache) alone.
+  virtual void FillSummary(TreeSummary* out) const = 0;
 };
 
+// A Tree as an AnyTree. Each Tree type describes itself by a function
+//   void FillTreeSummary(const Tree& tree, TreeSummary* out);
+// in its own namespace (found by argument-dependent lookup, and declared
+// before the TypedTree<Tree> is made), called after leaves and bytes are set:
+// engine/curve_tree_summary.h for CurveTree, the mesh and CAD kinds for theirs.
 template <typename Tree>
 class TypedTree final : public AnyTree {
  public:
@@ -30,6 +42,11 @@ class TypedTree final : public AnyTree {
       : tree_(std::move(tree)), bytes_(bytes), leaves_(leaves) {}
   uint64_t bytes() const override { return bytes_; }
   uint64_t leaves() const override { return leaves_; }
+  void FillSummary(TreeSummary* out) const override {
+    out->leaves = leaves_;
+    out->bytes = bytes_;
+    FillTreeSummary(*tree_, out);
+  }
   const std::shared_ptr<const Tree>& tree() const { return tree_; }
 
  private:
@@ -64,11 +81,9 @@ TreeFactory::Result AsAnyTree(absl::StatusOr<std::shared_ptr<const Tree>> tree) 
 }
 
 struct TreeLookup {
-  std::shared_ptr<const AnyTree> any;
-  // `any` as a CurveTree, or null for a mesh's tree.
-  std::shared_ptr<const CurveTree> tree;
-  bool cache_hit = false;    // the exact tree was cached
-  bool refined = false;      // made by refining a cached coarser tree
+  std::shared_ptr<const AnyTree> any;  // as its kind's own type: TreeAs<T>(any.get())
+  bool cache_hit = false;              // the exact tree was cached
+  bool refined = false;                // made by refining a cached coarser tree
 };
 
 class TreeSource {
@@ -90,7 +105,6 @@ class DirectTreeSource final : public TreeSource {
     if (!tree.ok()) return tree.status();
     TreeLookup lookup;
     lookup.any = *std::move(tree);
-    lookup.tree = TreeAs<CurveTree>(lookup.any.get());
     return lookup;
   }
 };

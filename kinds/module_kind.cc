@@ -148,7 +148,7 @@ std::string KindModuleAbi() {
                       sizeof(TreeSpec), ".", sizeof(KindContext), ".", sizeof(ResolvedSurface),
                       ".", sizeof(CursorSpec), ".", sizeof(KindInfo), ".", sizeof(StoredModel),
                       ".", sizeof(SampleBatch), ".", sizeof(EngineLimits), ".",
-                      sizeof(TreeLookup), ".", sizeof(BuildControl));
+                      sizeof(TreeLookup), ".", sizeof(BuildControl), ".", sizeof(TreeSummary));
 }
 
 }  // namespace sfc

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include "absl/base/config.h"
 #include "absl/strings/str_format.h"
@@ -228,7 +229,73 @@ void ShortenTo(const ColumnLengths& l, SampleBatch* b) {
     (b->*SampleBatch::ValueColumns()[c]).resize(l.values[c]);
 }
 
+void ToProto(const TreeSummary::Cell& cell, v1::DepthCapWarning* out) {
+  out->set_test(cell.test);
+  out->set_u0(cell.u0), out->set_v0(cell.v0), out->set_size(cell.size);
+  out->set_measured(cell.measured), out->set_limit(cell.limit);
+}
+
+std::vector<TreeSummary::Cell> FromProto(
+    const google::protobuf::RepeatedPtrField<v1::DepthCapWarning>& cells) {
+  std::vector<TreeSummary::Cell> out;
+  out.reserve(cells.size());
+  for (const v1::DepthCapWarning& w : cells) {
+    out.push_back({w.test(), w.u0(), w.v0(), w.size(), w.measured(), w.limit()});
+  }
+  return out;
+}
+
 }  // namespace
+
+void ToProto(const TreeSummary& s, v1::TreeInfo* out) {
+  out->set_kind(s.kind);
+  out->set_key(s.key);
+  out->set_key_with_grade(s.key_with_grade);
+  out->set_canonical(s.canonical);
+  out->set_grade(s.grade);
+  out->set_cache_hit(s.cache_hit);
+  out->set_refined(s.refined);
+  out->set_leaves(s.leaves);
+  out->set_bytes(s.bytes);
+  out->set_min_depth(s.min_depth);
+  out->set_max_depth(s.max_depth);
+  out->set_tolerance(s.tolerance);
+  out->set_flatness_capped_leaves(s.flatness_capped_leaves);
+  out->set_mass_capped_leaves(s.mass_capped_leaves);
+  for (const TreeSummary::Cell& cell : s.warnings) ToProto(cell, out->add_warnings());
+  out->set_error_samples(s.error_samples);
+  out->set_unresolved_error_samples(s.unresolved_error_samples);
+  out->set_singular_leaves(s.singular_leaves);
+  out->set_warped_leaves(s.warped_leaves);
+  out->set_small_failing_leaves(s.small_failing_leaves);
+  for (const TreeSummary::Cell& cell : s.singular) ToProto(cell, out->add_singular());
+}
+
+TreeSummary FromProto(const v1::TreeInfo& p) {
+  TreeSummary s;
+  s.kind = p.kind();
+  s.key = p.key();
+  s.key_with_grade = p.key_with_grade();
+  s.canonical = p.canonical();
+  s.grade = p.grade();
+  s.cache_hit = p.cache_hit();
+  s.refined = p.refined();
+  s.leaves = p.leaves();
+  s.bytes = p.bytes();
+  s.min_depth = p.min_depth();
+  s.max_depth = p.max_depth();
+  s.tolerance = p.tolerance();
+  s.flatness_capped_leaves = p.flatness_capped_leaves();
+  s.mass_capped_leaves = p.mass_capped_leaves();
+  s.warnings = FromProto(p.warnings());
+  s.error_samples = p.error_samples();
+  s.unresolved_error_samples = p.unresolved_error_samples();
+  s.singular_leaves = p.singular_leaves();
+  s.warped_leaves = p.warped_leaves();
+  s.small_failing_leaves = p.small_failing_leaves();
+  s.singular = FromProto(p.singular());
+  return s;
+}
 
 absl::StatusOr<TreeSpec> FromProto(const v1::TreeSpec& p) {
   TreeSpec spec;

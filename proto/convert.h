@@ -1,6 +1,7 @@
 // Conversions between the sfcsampler.v1 wire types and the request library's
 // types, shared by the server and the client library so both sides agree
-// exactly (what only a sampler has is in proto/service_convert.h).
+// exactly, a tree's summary among them (what only a sampler has is in
+// proto/service_convert.h).
 // Also the one place that maps absl::Status to and from grpc::Status.
 // Thread-safety: pure functions.
 #ifndef SFCSAMPLER_PROTO_CONVERT_H_
@@ -11,6 +12,7 @@
 #include "core/sample_batch.h"
 #include "grpcpp/support/status.h"
 #include "request/sample_request.h"
+#include "request/tree_summary.h"
 #include "sfcsampler/v1/sampler.pb.h"
 
 namespace sfc {
@@ -22,6 +24,12 @@ absl::StatusOr<TreeSpec> FromProto(const v1::TreeSpec& spec);
 absl::StatusOr<SampleRequest> FromProto(const v1::SampleRequest& request);
 v1::TreeSpec ToProto(const TreeSpec& spec);
 v1::SampleRequest ToProto(const SampleRequest& request);
+
+// A tree's summary on the wire (TreeInfo) and back: the one mapping each
+// way, so a summary reads the same in process and from a server. `out`
+// should be clear. FromProto(ToProto(s)) == s.
+void ToProto(const TreeSummary& summary, v1::TreeInfo* out);
+TreeSummary FromProto(const v1::TreeInfo& tree);
 
 // Fills `out` with `batch` in the requested precision and column encoding
 // (packed repeated fields, or little-endian bytes columns as the proto's

@@ -4,7 +4,6 @@
 
 #include "base/echo.h"
 #include "proto/convert.h"
-#include "proto/service_convert.h"
 #include "server/request_control.h"
 #include "spdlog/spdlog.h"
 
@@ -31,7 +30,7 @@ grpc::Status SamplerService::Prepare(grpc::ServerContext* context,
       if (!prepared.ok()) {
         status = ToGrpcStatus(prepared.status());
       } else {
-        ToProto(*prepared, response->mutable_tree());
+        ToProto(SummarizeTree(*prepared), response->mutable_tree());
         response->set_seconds(SecondsSince(start));
       }
     }

@@ -6,7 +6,6 @@
 #include "base/echo.h"
 #include "base/status_macros.h"
 #include "proto/convert.h"
-#include "proto/service_convert.h"
 #include "request/index_range.h"
 #include "server/message_pipeline.h"
 #include "server/request_control.h"
@@ -126,7 +125,7 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context,
   if (!job.ok()) return ToGrpcStatus(job.status());
 
   v1::StreamHeader header;
-  ToProto(job->tree, header.mutable_tree());
+  ToProto(SummarizeTree(job->tree), header.mutable_tree());
   header.set_algorithm_version(options_.algorithm_version);
   header.set_seed(parsed->seed);
   *header.mutable_request() = request;

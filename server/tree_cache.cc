@@ -36,7 +36,7 @@ absl::StatusOr<TreeLookup> TreeCache::Get(const TreeKey& key, int grade, const T
   while (true) {
     if (const Entry* cached = cached_.Touch(id)) {
       ++stats_.hits;
-      return TreeLookup{cached->tree, TreeAs<CurveTree>(cached->tree.get()), true, false};
+      return TreeLookup{cached->tree, true, false};
     }
     if (auto it = retired_.find(id); it != retired_.end()) {
       // Evicted while a stream held it: take it back rather than build a copy.
@@ -49,7 +49,7 @@ absl::StatusOr<TreeLookup> TreeCache::Get(const TreeKey& key, int grade, const T
         ++stats_.hits;
         Insert(id, tree, retired.bytes, retired.canonical, retired.grade);
         EvictOverBudget();  // may retire it again at once: it is still held
-        return TreeLookup{tree, TreeAs<CurveTree>(tree.get()), true, false};
+        return TreeLookup{tree, true, false};
       }
     }
     if (stopping_) {
@@ -118,8 +118,7 @@ absl::StatusOr<TreeLookup> TreeCache::Get(const TreeKey& key, int grade, const T
     // Joined a build just as every earlier waiter gave up on it: start over.
     if (absl::IsCancelled(job->result.status())) continue;
     if (!job->result.ok()) return job->result.status();
-    return TreeLookup{*job->result, TreeAs<CurveTree>(job->result->get()), false,
-                      job->coarser != nullptr};
+    return TreeLookup{*job->result, false, job->coarser != nullptr};
   }
 }
 

@@ -6,7 +6,6 @@
 
 #include "absl/strings/str_format.h"
 #include "base/status_macros.h"
-#include "core/curve_tree.h"
 #include "kinds/registered_kinds.h"
 
 namespace sfc {
@@ -27,46 +26,12 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-TreeSummary::Cell ToCell(const DepthCapHit& hit) {
-  TreeSummary::Cell cell;
-  cell.test = hit.test == DepthCapHit::Test::kGeometry ? "flatness"
-              : hit.test == DepthCapHit::Test::kMass   ? "mass"
-                                                       : "singular";
-  cell.u0 = hit.u0, cell.v0 = hit.v0, cell.size = hit.size;
-  cell.measured = hit.measured, cell.limit = hit.limit;
-  return cell;
-}
-
-// The summary of an in-process tree, `seconds` after it was asked for.
-TreeSummary SummarizeTree(const PreparedTree& t, double seconds) {
-  TreeSummary s;
-  s.kind = std::string(t.kind);
-  s.key_with_grade = t.key.HexWithGrade(t.grade);
-  s.grade = t.grade;
-  s.cache_hit = t.lookup.cache_hit;
-  s.refined = t.lookup.refined;
-  s.seconds = seconds;
-  if (!t.lookup.tree) {  // a mesh's or a model's trees: their size only
-    s.leaves = t.lookup.any->leaves();
-    s.bytes = t.lookup.any->bytes();
-    return s;
-  }
-  const CurveTree& tree = *t.lookup.tree;
-  const PrecisionReport& precision = tree.precision();
-  s.leaves = tree.leaf_count();
-  s.bytes = tree.bytes();
-  s.min_depth = tree.min_depth();
-  s.max_depth = tree.max_depth();
-  s.tolerance = tree.options().tolerance;
-  s.error_samples = precision.error_samples;
-  s.unresolved_error_samples = precision.unresolved_error_samples;
-  s.warped_leaves = precision.warped_leaves;
-  s.singular_leaves = precision.singular_leaves;
-  s.flatness_capped_leaves = precision.geometry_capped_leaves;
-  s.mass_capped_leaves = precision.mass_capped_leaves;
-  for (const DepthCapHit& hit : precision.singular) s.singular.push_back(ToCell(hit));
-  for (const DepthCapHit& hit : precision.worst) s.warnings.push_back(ToCell(hit));
-  return s;
+// The report of an in-process tree, `seconds` after it was asked for.
+TreeReport Report(const PreparedTree& tree, double seconds) {
+  TreeReport report;
+  report.tree = SummarizeTree(tree);
+  report.seconds = seconds;
+  return report;
 }
 
 }  // namespace
@@ -75,14 +40,14 @@ InProcessSampleSource::InProcessSampleSource(const SampleSourceOptions& options)
     : batch_size_(options.batch_size == 0 ? 65536 : options.batch_size),
       engine_(RegisteredSurfaceKinds(), LimitsFor(options), &trees_, &files_) {}
 
-absl::StatusOr<TreeSummary> InProcessSampleSource::Prepare(const TreeSpec& spec, uint64_t count,
-                                                           Progress* progress) {
+absl::StatusOr<TreeReport> InProcessSampleSource::Prepare(const TreeSpec& spec, uint64_t count,
+                                                          Progress* progress) {
   const auto start = std::chrono::steady_clock::now();
   progress->StartPhase("building the curve tree");
   auto prepared = engine_.Prepare(spec, count);
   progress->EndPhase();
   RETURN_IF_ERROR(prepared.status());
-  return SummarizeTree(*prepared, SecondsSince(start));
+  return Report(*prepared, SecondsSince(start));
 }
 
 absl::StatusOr<std::string> InProcessSampleSource::Sample(const SampleRequest& request,
@@ -94,7 +59,7 @@ absl::StatusOr<std::string> InProcessSampleSource::Sample(const SampleRequest& r
   auto job = engine_.Start(request);
   progress->EndPhase();
   RETURN_IF_ERROR(job.status());
-  if (on_tree) on_tree(SummarizeTree(job->tree, SecondsSince(start)));
+  if (on_tree) on_tree(Report(job->tree, SecondsSince(start)));
   std::optional<uint64_t> expected;
   if (request.region.kind == Region::Kind::kAll) expected = job->end - job->begin;
   SampleBatch batch;

@@ -17,8 +17,8 @@ class InProcessSampleSource final : public SampleSource {
 
   bool IsRemote() const override { return false; }
   absl::Status Connect() override { return absl::OkStatus(); }
-  absl::StatusOr<TreeSummary> Prepare(const TreeSpec& spec, uint64_t count,
-                                      Progress* progress) override;
+  absl::StatusOr<TreeReport> Prepare(const TreeSpec& spec, uint64_t count,
+                                     Progress* progress) override;
   absl::StatusOr<std::string> Sample(const SampleRequest& request, Progress* progress,
                                      const TreeCallback& on_tree,
                                      const BatchCallback& on_batch) override;

@@ -30,7 +30,7 @@ int RunPrepare(const PrepareFlags& flags) {
   progress.Done();
   if (!tree.ok()) return Fail(tree.status());
   PrintTreeSummary(*tree);
-  std::printf("%s\n", tree->key_with_grade.c_str());
+  std::printf("%s\n", tree->tree.key_with_grade.c_str());
   return 0;
 }
 

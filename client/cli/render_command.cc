@@ -31,12 +31,13 @@ struct RenderFlags {
 absl::Status DrawCurve(const RenderFlags& r, const SampleRequest& request, const View& view,
                        SampleSource& source) {
   ASSIGN_OR_RETURN(const PreparedTree prepared, source.LocalTree(request));
-  if (!prepared.lookup.tree) {
+  const std::shared_ptr<const CurveTree> curve_tree = TreeAs<CurveTree>(prepared.lookup.any.get());
+  if (!curve_tree) {
     return absl::InvalidArgumentError(
         "--what curve and param-curve draw a parameter-square curve tree; a mesh has none: "
         "draw its samples (--what samples)");
   }
-  const CurveTree& tree = *prepared.lookup.tree;
+  const CurveTree& tree = *curve_tree;
   // The surface its tree is over (a formula surface: the only kind with a CurveTree here).
   ASSIGN_OR_RETURN(const SurfaceFromSpec surface, MakeSurface(request.tree.surface));
   RETURN_IF_ERROR(r.what == "curve" ? RenderCurve(tree, *surface.surface, view, r.output)
@@ -54,7 +55,7 @@ absl::Status DrawSamples(const RenderFlags& r, const SampleRequest& request, con
   ASSIGN_OR_RETURN(const std::string provenance,
                    source.Sample(
                        request, &progress,
-                       [](const TreeSummary& tree) {
+                       [](const TreeReport& tree) {
                          PrintTreeSummary(tree, Verbosity{true, false});
                        },
                        [&all](std::optional<uint64_t>, const SampleBatch& batch) {

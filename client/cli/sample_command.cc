@@ -71,7 +71,7 @@ int RunSample(const SampleFlags& flags) {
   Progress progress(!flags.verbosity.quiet);
   auto provenance = source->Sample(
       *request, &progress,
-      [&](const TreeSummary& tree) { PrintTreeSummary(tree, flags.verbosity); },
+      [&](const TreeReport& tree) { PrintTreeSummary(tree, flags.verbosity); },
       [&](std::optional<uint64_t> expected, const SampleBatch& batch) {
         if (!writer) {
           ASSIGN_OR_RETURN(writer, SampleWriter::Open(flags.output, *format, request->fields,

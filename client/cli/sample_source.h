@@ -51,7 +51,7 @@ class SampleSource {
  public:
   // The tree once it is known: before the first batch in process, with it
   // over the wire (so not at all for a stream with no samples).
-  using TreeCallback = std::function<void(const TreeSummary&)>;
+  using TreeCallback = std::function<void(const TreeReport&)>;
   // A batch in curve order, with the set's size when known (not for a region).
   using BatchCallback =
       std::function<absl::Status(std::optional<uint64_t> expected, const SampleBatch&)>;
@@ -66,8 +66,8 @@ class SampleSource {
 
   // Builds (or warms) the tree for `spec` sized for `count` samples;
   // `progress` shows the wait.
-  virtual absl::StatusOr<TreeSummary> Prepare(const TreeSpec& spec, uint64_t count,
-                                              Progress* progress) = 0;
+  virtual absl::StatusOr<TreeReport> Prepare(const TreeSpec& spec, uint64_t count,
+                                             Progress* progress) = 0;
 
   // Streams every sample of `request` in curve order to `on_batch` (whose
   // error ends the stream and is returned); `on_tree` (may be empty) gets the

@@ -7,20 +7,12 @@
 #include "absl/strings/str_format.h"
 #include "base/status_macros.h"
 #include "engine/model_source.h"
+#include "proto/convert.h"
 
 namespace sfc {
 namespace {
 
 namespace v1 = ::sfcsampler::v1;
-
-std::vector<TreeSummary::Cell> ToCells(
-    const google::protobuf::RepeatedPtrField<v1::DepthCapWarning>& warnings) {
-  std::vector<TreeSummary::Cell> cells;
-  for (const v1::DepthCapWarning& w : warnings) {
-    cells.push_back({w.test(), w.u0(), w.v0(), w.size(), w.measured(), w.limit()});
-  }
-  return cells;
-}
 
 // The bearer token in `path`, without trailing white space.
 absl::StatusOr<std::string> ReadToken(const std::string& path) {
@@ -30,28 +22,11 @@ absl::StatusOr<std::string> ReadToken(const std::string& path) {
   return std::string(absl::StripTrailingAsciiWhitespace(token));
 }
 
-// The summary of a tree the server describes.
-TreeSummary SummarizeTree(const v1::TreeInfo& t) {
-  TreeSummary s;
-  s.kind = t.kind();
-  s.key_with_grade = t.key_with_grade();
-  s.grade = t.grade();
-  s.cache_hit = t.cache_hit();
-  s.refined = t.refined();
-  s.leaves = t.leaves();
-  s.bytes = t.bytes();
-  s.min_depth = t.min_depth();
-  s.max_depth = t.max_depth();
-  s.tolerance = t.tolerance();
-  s.error_samples = t.error_samples();
-  s.unresolved_error_samples = t.unresolved_error_samples();
-  s.warped_leaves = t.warped_leaves();
-  s.singular_leaves = t.singular_leaves();
-  s.flatness_capped_leaves = t.flatness_capped_leaves();
-  s.mass_capped_leaves = t.mass_capped_leaves();
-  s.singular = ToCells(t.singular());
-  s.warnings = ToCells(t.warnings());
-  return s;
+// The report of a tree the server describes, without a time.
+TreeReport Report(const v1::TreeInfo& tree) {
+  TreeReport report;
+  report.tree = FromProto(tree);
+  return report;
 }
 
 }  // namespace
@@ -82,17 +57,17 @@ absl::StatusOr<SamplerClient*> ServerSampleSource::Client() {
 
 absl::Status ServerSampleSource::Connect() { return Client().status(); }
 
-absl::StatusOr<TreeSummary> ServerSampleSource::Prepare(const TreeSpec& spec, uint64_t count,
-                                                        Progress* progress) {
+absl::StatusOr<TreeReport> ServerSampleSource::Prepare(const TreeSpec& spec, uint64_t count,
+                                                       Progress* progress) {
   ASSIGN_OR_RETURN(SamplerClient * client, Client());
   progress->StartPhase("waiting for " + connection_.server + " to prepare the curve tree");
   auto response = client->Prepare(spec, count);
   progress->EndPhase();
   RETURN_IF_ERROR(response.status());
-  TreeSummary summary = SummarizeTree(response->tree());
-  summary.seconds = response->seconds();
-  summary.seconds_from_server = true;
-  return summary;
+  TreeReport report = Report(response->tree());
+  report.seconds = response->seconds();
+  report.seconds_from_server = true;
+  return report;
 }
 
 absl::StatusOr<std::string> ServerSampleSource::Sample(const SampleRequest& request,
@@ -108,7 +83,7 @@ absl::StatusOr<std::string> ServerSampleSource::Sample(const SampleRequest& requ
       client->Sample(request, [&](const v1::StreamHeader& header, const SampleBatch& batch) {
         if (done == 0) {
           progress->EndPhase();
-          if (on_tree) on_tree(SummarizeTree(header.tree()));
+          if (on_tree) on_tree(Report(header.tree()));
         }
         std::optional<uint64_t> expected;
         if (header.expected_samples() >= 0) expected = header.expected_samples();

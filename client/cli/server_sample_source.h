@@ -20,8 +20,8 @@ class ServerSampleSource final : public SampleSource {
 
   bool IsRemote() const override { return true; }
   absl::Status Connect() override;
-  absl::StatusOr<TreeSummary> Prepare(const TreeSpec& spec, uint64_t count,
-                                      Progress* progress) override;
+  absl::StatusOr<TreeReport> Prepare(const TreeSpec& spec, uint64_t count,
+                                     Progress* progress) override;
   absl::StatusOr<std::string> Sample(const SampleRequest& request, Progress* progress,
                                      const TreeCallback& on_tree,
                                      const BatchCallback& on_batch) override;

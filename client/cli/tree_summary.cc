@@ -72,11 +72,11 @@ void PrintFacts(const TreeSummary& t, const Verbosity& verbosity) {
 
 }  // namespace
 
-void PrintTreeSummary(const TreeSummary& tree, const Verbosity& verbosity) {
-  PrintFacts(tree, verbosity);
-  if (tree.seconds < 0 || verbosity.quiet) return;
-  std::fprintf(stderr, "%s in %.3f s\n", tree.seconds_from_server ? "prepared" : "tree ready",
-               tree.seconds);
+void PrintTreeSummary(const TreeReport& report, const Verbosity& verbosity) {
+  PrintFacts(report.tree, verbosity);
+  if (report.seconds < 0 || verbosity.quiet) return;
+  std::fprintf(stderr, "%s in %.3f s\n", report.seconds_from_server ? "prepared" : "tree ready",
+               report.seconds);
 }
 
 }  // namespace sfc

@@ -17,6 +17,14 @@
 #include "catalog/catalog.h"
 
 namespace sfc {
+namespace cad {
+
+// A model's trees (one per face) describe themselves by their size alone,
+// which TypedTree fills (engine/tree_source.h; the size includes the parsed
+// model they keep alive).
+void FillTreeSummary(const ModelTree& tree, TreeSummary* out) {}
+
+}  // namespace cad
 namespace {
 
 // Heap bytes in use now (glibc), for what a parse keeps: OpenCASCADE's

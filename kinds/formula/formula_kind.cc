@@ -39,10 +39,10 @@ class FormulaKind final : public SurfaceKind {
     out.open_cursor = [surface = surface.surface, density = density.density](
                           const TreeLookup& lookup, Sequence sequence,
                           const CursorSpec& spec) -> absl::StatusOr<std::unique_ptr<BatchCursor>> {
-      if (!lookup.tree)
-        return absl::InternalError("a formula surface found a tree of another kind");
+      auto tree = TreeAs<CurveTree>(lookup.any.get());
+      if (!tree) return absl::InternalError("a formula surface found a tree of another kind");
       auto sampler =
-          std::make_shared<const Sampler>(lookup.tree, surface, density, std::move(sequence));
+          std::make_shared<const Sampler>(std::move(tree), surface, density, std::move(sequence));
       ASSIGN_OR_RETURN(std::unique_ptr<SampleCursor> cursor,
                        SampleCursor::Create(std::move(sampler), spec.begin, spec.end, spec.region,
                                             spec.fields, spec.threads));

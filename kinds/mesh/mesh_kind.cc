@@ -16,6 +16,11 @@
 #include "mesh/mesh_sampler.h"
 
 namespace sfc {
+
+// A mesh's tree describes itself by its size alone, which TypedTree fills
+// (engine/tree_source.h; the size includes the mesh it keeps alive).
+void FillTreeSummary(const MeshCurveTree& tree, TreeSummary* out) {}
+
 namespace {
 
 struct MeshDensityChoice {

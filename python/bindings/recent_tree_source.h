@@ -31,7 +31,7 @@ class RecentTreeSource final : public TreeSource {
     if (capacity_ > 0) {
       absl::MutexLock lock(&mu_);
       if (const auto* kept = recent_.Touch(id)) {
-        return TreeLookup{*kept, TreeAs<CurveTree>(kept->get()), true, false};
+        return TreeLookup{*kept, true, false};
       }
     }
     auto tree = factory.build(grade, caller);
@@ -41,7 +41,7 @@ class RecentTreeSource final : public TreeSource {
       recent_.Insert(id, *tree, 1);
       while (recent_.size() > capacity_) recent_.PopLeastRecent();
     }
-    return TreeLookup{*tree, TreeAs<CurveTree>(tree->get()), false, false};
+    return TreeLookup{*tree, false, false};
   }
 
  private:

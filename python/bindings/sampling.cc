@@ -30,37 +30,46 @@ namespace sfc::python {
 
 namespace {
 
-// The tree summary with the same names as the wire's TreeInfo message.
-py::dict TreeInfoDict(const PreparedTree& t) {
+py::dict CellDict(const TreeSummary::Cell& cell) {
   py::dict d;
-  d["key"] = t.key.Hex();
-  d["key_with_grade"] = t.key.HexWithGrade(t.grade);
-  d["canonical"] = t.key.canonical;
-  d["grade"] = t.grade;
-  d["cache_hit"] = t.lookup.cache_hit;
-  d["refined"] = t.lookup.refined;
-  if (!t.lookup.tree) {  // a mesh's tree: its size only
-    d["leaves"] = t.lookup.any->leaves();
-    d["bytes"] = t.lookup.any->bytes();
-    return d;
-  }
-  const CurveTree& tree = *t.lookup.tree;
-  d["leaves"] = static_cast<uint64_t>(tree.leaf_count());
-  d["bytes"] = static_cast<uint64_t>(tree.bytes());
-  d["min_depth"] = tree.min_depth();
-  d["max_depth"] = tree.max_depth();
-  d["tolerance"] = tree.options().tolerance;
-  d["flatness_capped_leaves"] = tree.precision().geometry_capped_leaves;
-  d["mass_capped_leaves"] = tree.precision().mass_capped_leaves;
-  py::list warnings;
-  for (const DepthCapHit& h : tree.precision().worst) {
-    py::dict w;
-    w["test"] = h.test == DepthCapHit::Test::kGeometry ? "flatness" : "mass";
-    w["u0"] = h.u0, w["v0"] = h.v0, w["size"] = h.size;
-    w["measured"] = h.measured, w["limit"] = h.limit;
-    warnings.append(w);
-  }
-  d["warnings"] = warnings;
+  d["test"] = cell.test;
+  d["u0"] = cell.u0, d["v0"] = cell.v0, d["size"] = cell.size;
+  d["measured"] = cell.measured, d["limit"] = cell.limit;
+  return d;
+}
+
+py::list CellList(const std::vector<TreeSummary::Cell>& cells) {
+  py::list out;
+  for (const TreeSummary::Cell& cell : cells) out.append(CellDict(cell));
+  return out;
+}
+
+// A tree's summary (request/tree_summary.h) as a dict with the wire's
+// TreeInfo names, in its order, every key for every kind: what a Client
+// gives for the same tree (sfcsampler/_wire.py message_dict).
+py::dict TreeSummaryDict(const TreeSummary& s) {
+  py::dict d;
+  d["kind"] = s.kind;
+  d["key"] = s.key;
+  d["key_with_grade"] = s.key_with_grade;
+  d["grade"] = s.grade;
+  d["cache_hit"] = s.cache_hit;
+  d["refined"] = s.refined;
+  d["leaves"] = s.leaves;
+  d["bytes"] = s.bytes;
+  d["min_depth"] = s.min_depth;
+  d["max_depth"] = s.max_depth;
+  d["tolerance"] = s.tolerance;
+  d["flatness_capped_leaves"] = s.flatness_capped_leaves;
+  d["mass_capped_leaves"] = s.mass_capped_leaves;
+  d["warnings"] = CellList(s.warnings);
+  d["canonical"] = s.canonical;
+  d["error_samples"] = s.error_samples;
+  d["unresolved_error_samples"] = s.unresolved_error_samples;
+  d["singular_leaves"] = s.singular_leaves;
+  d["singular"] = CellList(s.singular);
+  d["small_failing_leaves"] = s.small_failing_leaves;
+  d["warped_leaves"] = s.warped_leaves;
   return d;
 }
 
@@ -132,7 +141,7 @@ class PyJob {
     return out;
   }
 
-  py::dict Tree() const { return TreeInfoDict(job_.tree); }
+  py::dict Tree() const { return TreeSummaryDict(SummarizeTree(job_.tree)); }
   uint64_t begin() const { return job_.begin; }
   uint64_t end() const { return job_.end; }
   py::object Expected() const {
@@ -201,7 +210,7 @@ class PyEngine {
                              : absl::StatusOr<PreparedTree>(tree_count.status());
     }
     ThrowIfError(tree.status());
-    return TreeInfoDict(*tree);
+    return TreeSummaryDict(SummarizeTree(*tree));
   }
 
  private:

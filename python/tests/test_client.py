@@ -5,6 +5,7 @@ server's status code and message."""
 import os
 import subprocess
 import tempfile
+import warnings
 
 import numpy as np
 import pytest
@@ -288,3 +289,66 @@ def test_a_mesh_is_uploaded_once_and_samples_as_in_process(server, tmp_path):
     for name in ("x", "y", "z", "u", "v", "triangle"):
         assert np.array_equal(getattr(remote, name), getattr(local, name)), name
         assert np.array_equal(getattr(by_hash, name), getattr(local, name)), name
+
+
+def _tree_summary_cases(tmp_path):
+    """(name, request, bytes_measured) for each kind of tree: surfaces (plain, capped by the depth
+    cap, singular), a mesh and, in a build with CAD, a model (whose bytes include its parse as
+    measured on each process's heap, so they differ)."""
+    obj = tmp_path / "grid.obj"
+    n = 8
+    with open(obj, "w") as out:
+        out.writelines(f"v {i} {j} {(i * j) % 3}\n" for i in range(n + 1) for j in range(n + 1))
+        out.writelines(f"f {i * (n + 1) + j + 1} {(i + 1) * (n + 1) + j + 1} "
+                       f"{(i + 1) * (n + 1) + j + 2} {i * (n + 1) + j + 2}\n"
+                       for i in range(n) for j in range(n))
+    cases = [("surface", dict(surface="torus", count=10000), False),
+             ("capped", dict(surface="sphere", count=100000, depth_cap=4), False),
+             ("singular", dict(surface="superellipsoid", count=24576), False),
+             ("mesh", dict(surface=f"obj:{obj}", count=5000), False)]
+    fixtures = os.environ.get("SFC_CAD_FIXTURES", "build/cad/make_cad_fixtures")
+    if os.path.exists(fixtures):
+        subprocess.run([fixtures, str(tmp_path / "cad")], check=True, capture_output=True)
+        cases.append(("model", dict(surface=f"step:{tmp_path / 'cad' / 'sphere.step'}", count=2000),
+                      True))
+    return cases
+
+
+def test_a_tree_summary_has_the_same_keys_and_values_in_process_and_from_a_server(tmp_path):
+    """Samples.tree and prepare() give the same dict embedded and over the wire (the TreeInfo's
+    fields, for every kind of tree): once built (cache_hit aside: a server prepares a model's tree
+    before its stream, which then finds it cached), then found in a cache on both sides."""
+    def same(local, remote, name, bytes_measured):
+        assert list(local) == list(remote), name  # the same keys, in order
+        if bytes_measured:
+            assert local["bytes"] > 0 and remote["bytes"] > 0, name
+            local, remote = dict(local, bytes=0), dict(remote, bytes=0)
+        assert local == remote, name
+
+    with tempfile.TemporaryDirectory() as tmp:
+        proc, port = launch_server(os.path.join(tmp, "server.log"))  # a cache of its own
+        try:
+            with sfcsampler.Client(f"127.0.0.1:{port}") as client:
+                embedded = sfcsampler.Sampler()
+                for name, request, bytes_measured in _tree_summary_cases(tmp_path):
+                    with warnings.catch_warnings():
+                        warnings.simplefilter("ignore", sfcsampler.DepthCapWarning)
+                        built = embedded.sample(**request).tree
+                        remote = client.sample(**request).tree
+                        assert not built["cache_hit"], name
+                        same(built, dict(remote, cache_hit=False), name, bytes_measured)
+                        for local, remote in [(embedded.sample(**request).tree,
+                                               client.sample(**request).tree),
+                                              (embedded.prepare(**request),
+                                               client.prepare(**request))]:
+                            assert local["cache_hit"], name
+                            same(local, remote, name, bytes_measured)
+                    assert built["kind"] == {"capped": "surface", "singular": "surface"}.get(
+                        name, name)
+                    if name == "capped":
+                        assert built["warnings"]
+                        assert built["flatness_capped_leaves"] + built["mass_capped_leaves"] > 0
+                    if name == "singular":
+                        assert built["singular"] and built["warped_leaves"] > 0
+        finally:
+            stop(proc)
