@@ -13,7 +13,11 @@
 //  - plane (star discrepancy, ours against 2D jittered), sphere (spherical
 //    triangles), a sphere-shaped CAD model and mesh against the built-in;
 //  - blue-noise figures (nearest-neighbour distances relative to hexagonal
-//    packing) at N = 4096 on the plane and the sphere.
+//    packing) at N = 4096 on the plane and the sphere;
+//  - issue 33's generic features: density steps on the plane, a cube-root
+//    blow-up line and the double cone's kink at irrational positions (off the
+//    grid of every curve), strip counts and means against closed forms, and
+//    an N sweep of a step's share error with its slope.
 // Nothing here reads the curve tree: point sets come from `QualitySource`.
 //
 // Thread-safety: RunQuality is reentrant.
@@ -38,12 +42,14 @@ using QualitySource = std::function<absl::StatusOr<SampleBatch>(
 
 struct QualityOptions {
   // full: the issue's sizes (boxes N = 64..24576, strips at 200 000, Monte
-  // Carlo to 10^6; minutes). Otherwise a fast setting for tests (seconds).
+  // Carlo to 10^6; features: steps at 10^6 and 4 10^6, blow-up 2^18, cone
+  // 2^20, sweep 2^16..2^22; minutes). Otherwise a fast setting for tests
+  // (seconds; features at 2^18, sweep 2^14..2^18).
   bool full = false;
   std::vector<uint64_t> seeds = {1, 2, 3};             // slopes and Monte Carlo
   std::vector<uint64_t> strip_seeds = {5, 6, 7};       // strips (the issue's seed 5 first)
   std::vector<std::string>
-      sections;             // empty: all of boxes strips bands mc plane sphere models blue
+      sections;             // empty: all of boxes strips bands mc plane sphere models blue features
   std::string step_sphere;  // model spec of a sphere (step:/tmp/fx/sphere.step); empty: skipped
   std::string mesh_sphere;  // model spec of a sphere mesh (ply:/tmp/ico.ply); empty: skipped
   std::function<void(const std::string&)> progress;  // one line per finished item

@@ -1,8 +1,8 @@
 #!/bin/sh
 # `sfcsampler eval --sections quality` in its fast setting: it runs in
 # seconds, writes quality.md, finds the superellipsoid's singular lines (and
-# none in longitude once reparameterised), and prints every section with a
-# verdict column.
+# none in longitude once reparameterised), prints every section with a
+# verdict column, and issue 33's generic features with their closed forms.
 set -eu
 cli="$1"
 tmp=$(mktemp -d)
@@ -13,11 +13,20 @@ fail() { echo "FAIL: $*"; exit 1; }
 [ -s "$tmp/q/quality.md" ] || fail "no quality.md"
 cmp -s "$tmp/q/quality.md" "$tmp/out.md" || [ "$(wc -c < "$tmp/q/quality.md")" -gt 1000 ] || fail "quality.md differs from stdout"
 for section in "sample-anchored boxes" "strips beside the singular lines" "Stratification beside" "Monte Carlo" "Plane, star" \
-               "Sphere, spherical-triangle" "Blue noise" "## Summary"; do
+               "Sphere, spherical-triangle" "Blue noise" "Generic features: steps, blow-up and kink" \
+               "N sweep, step u<0.3" "## Summary"; do
   grep -q "$section" "$tmp/out.md" || fail "missing section: $section"
 done
 grep -q "^| superellipsoid | uniform | 0 0.5 1 / 0 0.25 0.5 0.75 1 |" "$tmp/out.md" || fail "lines of the default superellipsoid"
 grep -q "^| superellipsoid:reparam=1 | uniform | 0 1 /  |" "$tmp/out.md" || fail "lines of the reparameterised superellipsoid"
+# Issue 33's generic features: every case in the table, exact values from the closed forms
+# (share below 0.3 = 0.3/7.3; mean of z on the cone = (0.7^3 - 0.3^3)/3/0.29), checks in the summary.
+for row in "^| step u<0.3 | 262144 | share below C | 0.0410958904 |" "^| step u<1/sqrt(7) | 262144 |" \
+           "^| step v<1/sqrt(13) | 262144 |" "^| blow-up c=1/sqrt(5) | 262144 | abs(u-c) in \[0, 0.0001) left |" \
+           "^| double cone | 262144 | mean of z | 0.3632183908 |"; do
+  grep -q "$row" "$tmp/out.md" || fail "missing features row: $row"
+done
+grep -q "^| N sweep, step u<0.3, N = 16384..262144: slope" "$tmp/out.md" || fail "features sweep check"
 # Every summary row has a verdict.
 rows=$(sed -n '/## Summary/,$p' "$tmp/out.md" | grep -c '^| [a-zA-Z]' || true)
 verdicts=$(sed -n '/## Summary/,$p' "$tmp/out.md" | grep -cE '\| (PASS|\*\*FAIL\*\*|INFO) \|$' || true)

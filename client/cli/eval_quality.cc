@@ -14,11 +14,13 @@ void AddEvalQualityFlags(CLI::App* eval, EvalQualityFlags* f) {
   eval->add_option("--sections", f->sections,
                    "protocol (the paper's Tables 1-2) and/or quality (issue 19: sample-anchored "
                    "boxes, strips, "
-                   "Monte Carlo, plane, sphere, models, blue noise)")
+                   "Monte Carlo, plane, sphere, models, blue noise; issue 33: generic "
+                   "features)")
       ->delimiter(',')
       ->capture_default_str();
   eval->add_option("--quality-sections", f->quality_sections,
-                   "subset of: boxes strips bands mc plane sphere models blue (default all)")
+                   "subset of: boxes strips bands mc plane sphere models blue features "
+                   "(default all)")
       ->delimiter(',');
   eval->add_option("--quality-seeds", f->seeds,
                    "seeds of the quality report's slopes and Monte Carlo (>= 3)")
