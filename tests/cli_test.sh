@@ -51,4 +51,26 @@ odd="$tmp/it's a \$(folder) with spaces"
 "$cli" eval --setting fast --out-dir "$odd" > /dev/null 2>&1 || fail "eval into a folder with quotes and spaces"
 [ -s "$odd/discrepancy.csv" ] || fail "eval wrote no discrepancy.csv into the odd folder"
 [ ! -e "$tmp/it" ] || fail "the folder name was split by a shell"
+
+# Commands that ask a server are refused by the parser without --server.
+for command in cache health "upload ply:$tmp/none.ply"; do
+  set +e
+  "$cli" $command > /dev/null 2> "$tmp/err"; code=$?
+  set -e
+  [ "$code" -ne 0 ] && grep -q -- "--server is required" "$tmp/err" ||
+    fail "$command without --server: exit $code, $(cat "$tmp/err")"
+done
+# upload refuses a spec that names no file before it sends anything.
+set +e
+"$cli" upload --server 127.0.0.1:1 sphere > /dev/null 2> "$tmp/err"; code=$?
+set -e
+[ "$code" -eq 2 ] && grep -q "names no model file" "$tmp/err" || fail "upload of a non-model"
+# render draws the curve tree in process, and refuses it from a server.
+"$cli" render --surface torus --count 500 --what param-curve -o "$tmp/c.png" 2> /dev/null
+[ "$(head -c 4 "$tmp/c.png" | tail -c 3)" = "PNG" ] || fail "render of the curve tree"
+set +e
+"$cli" render --surface torus --what curve --server 127.0.0.1:1 -o "$tmp/c.png" 2> "$tmp/err"
+code=$?
+set -e
+[ "$code" -eq 1 ] && grep -q "stays on the server" "$tmp/err" || fail "render curve with --server"
 echo "cli_test: all checks passed"

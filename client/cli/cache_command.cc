@@ -1,12 +1,11 @@
 // `sfcsampler cache`: prints an sfcsampler-server's tree-cache statistics
-// and limits (--server only; in process there is no cache).
+// and limits (--server required; in process there is no cache).
 #include <cstdio>
 #include <memory>
 
 #include "client/cli/commands.h"
 #include "client/cli/connection_flags.h"
 #include "client/cli/exit_status.h"
-#include "client/cli/sample_source.h"
 
 namespace sfc {
 
@@ -14,11 +13,13 @@ Command AddCacheCommand(CLI::App& app) {
   auto connection = std::make_shared<ConnectionFlags>();
   CLI::App* cache =
       app.add_subcommand("cache", "print the server's tree-cache statistics and limits");
-  AddConnectionFlags(cache, connection.get());
+  AddConnectionFlags(cache, connection.get(), ServerFlag::kRequired);
   return {cache, [connection] {
-            auto stats = OpenSampleSource(*connection)->CacheStats();
+            auto client = ConnectClient(*connection);
+            if (!client.ok()) return Fail(client.status());
+            auto stats = (*client)->GetCacheStats();
             if (!stats.ok()) return Fail(stats.status());
-            std::printf("%s", stats->c_str());
+            std::printf("%s", stats->DebugString().c_str());
             return 0;
           }};
 }

@@ -2,8 +2,11 @@
 // sample_many.cc): each Add...Command adds its subcommand and flags to the
 // app and returns a Command whose `run`, called after parsing when the
 // subcommand was chosen, does the work and returns the process exit code.
-// Every subcommand with connection flags runs in process or against
-// --server through a SampleSource (sample_source.h).
+// The subcommands that sample (sample, sample-many, prepare, eval, render's
+// samples) run in process or against --server through a SampleSource
+// (sample_source.h); cache, health and upload need --server (the parser
+// requires it) and take the client (ConnectClient, connection_flags.h);
+// inspect and render's curve tree ask the in-process engine.
 #ifndef SFCSAMPLER_CLIENT_CLI_COMMANDS_H_
 #define SFCSAMPLER_CLIENT_CLI_COMMANDS_H_
 

@@ -94,11 +94,13 @@ int RunEvalModel(const EvalFlags& f, SampleSource& source) {
 }
 
 int RunEval(const EvalFlags& f) {
-  const std::unique_ptr<SampleSource> source = OpenSampleSource(f.connection);
-  if (!f.model.empty()) return RunEvalModel(f, *source);
-  if (f.setting != "fast" && f.setting != "full") {
+  if (f.model.empty() && f.setting != "fast" && f.setting != "full") {
     return Fail(absl::InvalidArgumentError("--setting must be fast or full"));
   }
+  auto opened = OpenSampleSource(f.connection);
+  if (!opened.ok()) return Fail(opened.status());
+  const std::unique_ptr<SampleSource> source = *std::move(opened);
+  if (!f.model.empty()) return RunEvalModel(f, *source);
   if (WantsSection(f.quality, "quality")) {
     // Every set of the report in full.
     auto sets = [&source](const std::string& surface, const std::string& density, uint64_t count,
@@ -116,7 +118,8 @@ int RunEval(const EvalFlags& f) {
   options.plane_methods = f.plane;
   options.sphere_methods = f.sphere;
   options.seed = f.seed;
-  return RunEvalProtocol(options, f.out_dir, *source);
+  // In process RunProtocol makes our sets itself.
+  return RunEvalProtocol(options, f.out_dir, f.connection.server.empty() ? nullptr : source.get());
 }
 
 }  // namespace

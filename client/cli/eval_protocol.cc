@@ -57,13 +57,11 @@ absl::Status WriteProtocolOutputs(const std::vector<ProtocolRow>& rows, const st
 
 }  // namespace
 
-int RunEvalProtocol(ProtocolOptions options, const std::string& out_dir, SampleSource& source) {
-  if (auto connected = source.Connect(); !connected.ok()) return Fail(connected);
-  if (source.IsRemote()) {
-    // Otherwise RunProtocol makes our sets in process itself.
-    options.our_sets = [&source](const std::string& surface, const std::string& density,
-                                 const CurveTreeOptions& tree_options, uint64_t count,
-                                 uint64_t seed) -> absl::StatusOr<SampleBatch> {
+int RunEvalProtocol(ProtocolOptions options, const std::string& out_dir, SampleSource* server) {
+  if (server != nullptr) {
+    options.our_sets = [server](const std::string& surface, const std::string& density,
+                                const CurveTreeOptions& tree_options, uint64_t count,
+                                uint64_t seed) -> absl::StatusOr<SampleBatch> {
       SampleRequest request;
       request.tree.surface = surface;
       request.tree.density = density;
@@ -71,7 +69,7 @@ int RunEvalProtocol(ProtocolOptions options, const std::string& out_dir, SampleS
       request.sequence = SequenceKind::kJittered;
       request.count = count;
       request.seed = seed;
-      return CollectSamples(source, request);
+      return CollectSamples(*server, request);
     };
   }
   const auto start = std::chrono::steady_clock::now();

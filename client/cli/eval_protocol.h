@@ -14,9 +14,10 @@
 
 namespace sfc {
 
-// Runs the protocol of `options` (its our_sets set here) and writes its
-// files into `out_dir`. Returns the process exit code.
-int RunEvalProtocol(ProtocolOptions options, const std::string& out_dir, SampleSource& source);
+// Runs the protocol of `options` and writes its files into `out_dir`, with
+// our sets from `server` (its our_sets set here) or, when it is null, made
+// in process by RunProtocol itself. Returns the process exit code.
+int RunEvalProtocol(ProtocolOptions options, const std::string& out_dir, SampleSource* server);
 
 }  // namespace sfc
 

@@ -76,25 +76,4 @@ absl::StatusOr<std::string> InProcessSampleSource::Sample(const SampleRequest& r
   return absl::StrFormat("(%s, seed %d)", kAlgorithmVersion, request.seed);
 }
 
-absl::StatusOr<std::string> InProcessSampleSource::CacheStats() {
-  return absl::FailedPreconditionError("cache statistics need --server HOST:PORT");
-}
-
-absl::StatusOr<bool> InProcessSampleSource::Serving() {
-  return absl::FailedPreconditionError("health needs --server HOST:PORT");
-}
-
-absl::StatusOr<std::string> InProcessSampleSource::UploadModel(const std::string&) {
-  return absl::FailedPreconditionError("upload needs --server HOST:PORT");
-}
-
-absl::StatusOr<std::string> InProcessSampleSource::DescribeModel(const std::string& spec) {
-  return engine_.DescribeModel(spec);
-}
-
-absl::StatusOr<PreparedTree> InProcessSampleSource::LocalTree(const SampleRequest& request) {
-  ASSIGN_OR_RETURN(SamplingJob job, engine_.Start(request));
-  return std::move(job.tree);
-}
-
 }  // namespace sfc

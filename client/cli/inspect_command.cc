@@ -9,8 +9,8 @@
 
 #include "client/cli/commands.h"
 #include "client/cli/exit_status.h"
+#include "client/cli/in_process_sample_source.h"
 #include "client/cli/model_read_flags.h"
-#include "client/cli/sample_source.h"
 
 namespace sfc {
 namespace {
@@ -19,10 +19,9 @@ int RunInspect(const std::vector<std::string>& specs, const ModelReadFlags& read
   SampleSourceOptions options;
   if (absl::Status applied = ApplyModelReadFlags(read, &options); !applied.ok())
     return Fail(applied);
-  const std::unique_ptr<SampleSource> source =
-      OpenSampleSource(ConnectionFlags{}, options);  // in process
+  InProcessSampleSource local(options);
   for (const std::string& spec : specs) {
-    auto table = source->DescribeModel(spec);
+    auto table = local.engine().DescribeModel(spec);
     if (!table.ok()) return Fail(table.status());
     std::printf("%s", table->c_str());
   }

@@ -24,9 +24,10 @@ int RunPrepare(const PrepareFlags& flags) {
   if (!request.ok()) return Fail(request.status());
   auto tree_count = ResolveTreeCount(*request);
   if (!tree_count.ok()) return Fail(tree_count.status());
-  const std::unique_ptr<SampleSource> source = OpenSampleSource(flags.connection);
+  auto source = OpenSampleSource(flags.connection);
+  if (!source.ok()) return Fail(source.status());
   Progress progress(true);
-  auto tree = source->Prepare(request->tree, *tree_count, &progress);
+  auto tree = (*source)->Prepare(request->tree, *tree_count, &progress);
   progress.Done();
   if (!tree.ok()) return Fail(tree.status());
   PrintTreeSummary(*tree);

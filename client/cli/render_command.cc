@@ -10,9 +10,10 @@
 #include "client/cli/commands.h"
 #include "client/cli/connection_flags.h"
 #include "client/cli/exit_status.h"
-#include "request/request_flags.h"
+#include "client/cli/in_process_sample_source.h"
 #include "client/cli/sample_source.h"
 #include "render/render.h"
+#include "request/request_flags.h"
 
 namespace sfc {
 namespace {
@@ -27,11 +28,17 @@ struct RenderFlags {
   ConnectionFlags connection;
 };
 
-// --what curve or param-curve: the tree drawn.
-absl::Status DrawCurve(const RenderFlags& r, const SampleRequest& request, const View& view,
-                       SampleSource& source) {
-  ASSIGN_OR_RETURN(const PreparedTree prepared, source.LocalTree(request));
-  const std::shared_ptr<const CurveTree> curve_tree = TreeAs<CurveTree>(prepared.lookup.any.get());
+// --what curve or param-curve: the tree drawn, built in process (the wire
+// carries samples, not trees).
+absl::Status DrawCurve(const RenderFlags& r, const SampleRequest& request, const View& view) {
+  if (!r.connection.server.empty()) {
+    return absl::FailedPreconditionError(
+        "--what curve and param-curve draw the curve tree, which stays on the server; run them "
+        "without --server (the tree is the same), or draw samples");
+  }
+  InProcessSampleSource local(SampleSourceOptions{});
+  ASSIGN_OR_RETURN(SamplingJob job, local.engine().Start(request));
+  const std::shared_ptr<const CurveTree> curve_tree = TreeAs<CurveTree>(job.tree.lookup.any.get());
   if (!curve_tree) {
     return absl::InvalidArgumentError(
         "--what curve and param-curve draw a parameter-square curve tree; a mesh has none: "
@@ -47,13 +54,14 @@ absl::Status DrawCurve(const RenderFlags& r, const SampleRequest& request, const
   return absl::OkStatus();
 }
 
-// --what samples or param-samples: the whole set drawn.
-absl::Status DrawSamples(const RenderFlags& r, const SampleRequest& request, const View& view,
-                         SampleSource& source) {
+// --what samples or param-samples: the whole set drawn, in process or from
+// --server.
+absl::Status DrawSamples(const RenderFlags& r, const SampleRequest& request, const View& view) {
+  ASSIGN_OR_RETURN(const std::unique_ptr<SampleSource> source, OpenSampleSource(r.connection));
   SampleBatch all;
   Progress progress(true);
   ASSIGN_OR_RETURN(const std::string provenance,
-                   source.Sample(
+                   source->Sample(
                        request, &progress,
                        [](const TreeReport& tree) {
                          PrintTreeSummary(tree, Verbosity{true, false});
@@ -80,12 +88,11 @@ int RunRender(const RenderFlags& r) {
         absl::InvalidArgumentError("--view takes AZIMUTH,ELEVATION in degrees, e.g. 35,25"));
   }
   request->fields.normal = true;
-  const std::unique_ptr<SampleSource> source = OpenSampleSource(r.connection);
   absl::Status status;
   if (r.what == "curve" || r.what == "param-curve") {
-    status = DrawCurve(r, *request, view, *source);
+    status = DrawCurve(r, *request, view);
   } else if (r.what == "samples" || r.what == "param-samples") {
-    status = DrawSamples(r, *request, view, *source);
+    status = DrawSamples(r, *request, view);
   } else {
     status =
         absl::InvalidArgumentError("--what must be samples, curve, param-samples or param-curve");

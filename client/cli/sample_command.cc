@@ -66,12 +66,12 @@ int RunSample(const SampleFlags& flags) {
   if (absl::Status read = ApplyModelReadFlags(flags.model_read, &options); !read.ok()) {
     return Fail(read);
   }
-  const std::unique_ptr<SampleSource> source = OpenSampleSource(flags.connection, options);
+  auto source = OpenSampleSource(flags.connection, options);
+  if (!source.ok()) return Fail(source.status());
   std::unique_ptr<SampleWriter> writer;
   Progress progress(!flags.verbosity.quiet);
-  auto provenance = source->Sample(
-      *request, &progress,
-      [&](const TreeReport& tree) { PrintTreeSummary(tree, flags.verbosity); },
+  auto provenance = (*source)->Sample(
+      *request, &progress, [&](const TreeReport& tree) { PrintTreeSummary(tree, flags.verbosity); },
       [&](std::optional<uint64_t> expected, const SampleBatch& batch) {
         if (!writer) {
           ASSIGN_OR_RETURN(writer, SampleWriter::Open(flags.output, *format, request->fields,

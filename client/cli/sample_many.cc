@@ -397,10 +397,9 @@ int RunSampleMany(const SampleManyFlags& flags) {
   if (absl::Status read = ApplyModelReadFlags(flags.model_read, &options); !read.ok()) {
     return Usage(std::string(read.message()));
   }
-  const std::unique_ptr<SampleSource> source = OpenSampleSource(flags.connection, options);
-  if (auto connected = source->Connect(); !connected.ok())
-    return Usage(std::string(connected.message()));
-  job.source = source.get();
+  auto source = OpenSampleSource(flags.connection, options);
+  if (!source.ok()) return Usage(std::string(source.status().message()));
+  job.source = source->get();
 
   const auto start = std::chrono::steady_clock::now();
   Bar bar(outcomes.size(), !flags.quiet);

@@ -1,14 +1,21 @@
 #include "client/cli/sample_source.h"
 
+#include "base/status_macros.h"
 #include "client/cli/in_process_sample_source.h"
 #include "client/cli/server_sample_source.h"
 
 namespace sfc {
 
-std::unique_ptr<SampleSource> OpenSampleSource(const ConnectionFlags& connection,
-                                               const SampleSourceOptions& options) {
+absl::StatusOr<std::unique_ptr<SampleSource>> OpenSampleSource(const ConnectionFlags& connection,
+                                                               const SampleSourceOptions& options) {
   if (connection.server.empty()) return std::make_unique<InProcessSampleSource>(options);
-  return std::make_unique<ServerSampleSource>(connection, options);
+  ClientOptions client;
+  client.precision = options.precision == OutputPrecision::kFloat32
+                         ? ::sfcsampler::v1::PRECISION_FLOAT32
+                         : ::sfcsampler::v1::PRECISION_FLOAT64;
+  client.batch_size = static_cast<uint32_t>(options.batch_size);
+  ASSIGN_OR_RETURN(std::unique_ptr<SamplerClient> connected, ConnectClient(connection, client));
+  return std::make_unique<ServerSampleSource>(connection.server, std::move(connected));
 }
 
 absl::StatusOr<SampleBatch> CollectSamples(SampleSource& source, const SampleRequest& request) {

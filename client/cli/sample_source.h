@@ -1,15 +1,14 @@
 // SampleSource: where the CLI's samples and trees come from, the sampler in
 // this process (InProcessSampleSource) or an sfcsampler-server over gRPC
 // (ServerSampleSource), so that a subcommand is written once for both.
-// Both give the same samples for the same request. What only one of them
-// can do (the server's cache statistics, health and uploads; the curve tree
-// itself and model inspection in process) fails on the other with
-// FAILED_PRECONDITION saying what to do instead. A server source connects
-// at the first call that needs the server (or at Connect()), so that a
-// subcommand's own checks come first; a failed connection fails that call.
+// Both give the same samples for the same request. It holds only what both
+// can do; a subcommand that needs a server (cache, health, upload) takes the
+// client itself (ConnectClient, connection_flags.h), and one that needs the
+// sampler in this process (inspect's model table, render's curve tree) takes
+// its engine (InProcessSampleSource::engine()).
 //
-// Thread-safety: Sample() may be called from several threads at once; the
-// other methods from one thread.
+// Thread-safety: Sample() may be called from several threads at once;
+// Prepare() from one thread.
 #ifndef SFCSAMPLER_CLIENT_CLI_SAMPLE_SOURCE_H_
 #define SFCSAMPLER_CLIENT_CLI_SAMPLE_SOURCE_H_
 
@@ -27,7 +26,6 @@
 #include "client/cli/tree_summary.h"
 #include "client/sample_writer.h"
 #include "core/sample_batch.h"
-#include "engine/sampling_engine.h"
 #include "request/sample_request.h"
 
 namespace sfc {
@@ -58,12 +56,6 @@ class SampleSource {
 
   virtual ~SampleSource() = default;
 
-  // True for a server: the samples are made elsewhere.
-  virtual bool IsRemote() const = 0;
-
-  // Connects now rather than at the first call that needs it; OK in process.
-  virtual absl::Status Connect() = 0;
-
   // Builds (or warms) the tree for `spec` sized for `count` samples;
   // `progress` shows the wait.
   virtual absl::StatusOr<TreeReport> Prepare(const TreeSpec& spec, uint64_t count,
@@ -76,25 +68,12 @@ class SampleSource {
   virtual absl::StatusOr<std::string> Sample(const SampleRequest& request, Progress* progress,
                                              const TreeCallback& on_tree,
                                              const BatchCallback& on_batch) = 0;
-
-  // Server only: the tree cache's statistics and limits, as text.
-  virtual absl::StatusOr<std::string> CacheStats() = 0;
-  // Server only: whether grpc.health.v1 says SERVING.
-  virtual absl::StatusOr<bool> Serving() = 0;
-  // Server only: makes the model file "FORMAT:FILE" names available there
-  // (uploading it only if the server lacks it) and returns its wire spec
-  // "FORMAT:sha256=HASH". INVALID_ARGUMENT for a spec that names no file.
-  virtual absl::StatusOr<std::string> UploadModel(const std::string& spec) = 0;
-
-  // In process only: the table of a CAD model's faces (sfcsampler inspect).
-  virtual absl::StatusOr<std::string> DescribeModel(const std::string& spec) = 0;
-  // In process only: the tree `request` samples from, itself (to draw it).
-  virtual absl::StatusOr<PreparedTree> LocalTree(const SampleRequest& request) = 0;
 };
 
-// The server `connection` names, or the in-process sampler when it names none.
-std::unique_ptr<SampleSource> OpenSampleSource(const ConnectionFlags& connection,
-                                               const SampleSourceOptions& options = {});
+// The server `connection` names, its client connected now (reading the
+// token and TLS files), or the in-process sampler when it names none.
+absl::StatusOr<std::unique_ptr<SampleSource>> OpenSampleSource(
+    const ConnectionFlags& connection, const SampleSourceOptions& options = {});
 
 // Every sample of `request`, in curve order, in one batch; nothing on stderr.
 absl::StatusOr<SampleBatch> CollectSamples(SampleSource& source, const SampleRequest& request);

@@ -1,15 +1,16 @@
 // `sfcsampler upload`: sends model files to an sfcsampler-server once (only
 // those it lacks) and prints their wire specs FORMAT:sha256=HASH, one a
-// line, for any later job to name; --server only.
+// line, for any later job to name; --server required.
 #include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "absl/strings/str_format.h"
 #include "client/cli/commands.h"
 #include "client/cli/connection_flags.h"
 #include "client/cli/exit_status.h"
-#include "client/cli/sample_source.h"
+#include "request/model_spec.h"
 
 namespace sfc {
 namespace {
@@ -20,9 +21,18 @@ struct UploadFlags {
 };
 
 int RunUpload(const UploadFlags& flags) {
-  const std::unique_ptr<SampleSource> source = OpenSampleSource(flags.connection);
+  auto client = ConnectClient(flags.connection);
+  if (!client.ok()) return Fail(client.status());
   for (const std::string& spec : flags.specs) {
-    auto wire = source->UploadModel(spec);
+    auto parsed = ParseModelSpec(spec);
+    if (!parsed.ok()) return Fail(parsed.status());
+    if (!parsed->has_value()) {
+      return Fail(absl::InvalidArgumentError(absl::StrFormat(
+          "\"%s\" names no model file; write FORMAT:FILE with FORMAT step, iges, nurbs, obj or "
+          "ply",
+          spec)));
+    }
+    auto wire = (*client)->EnsureModel(spec);
     if (!wire.ok()) return Fail(wire.status());
     std::printf("%s\n", wire->c_str());
   }
@@ -39,7 +49,7 @@ Command AddUploadCommand(CLI::App& app) {
       "specs that any job can name; sample and prepare with --server do this by themselves");
   upload->add_option("models", flags->specs, "FORMAT:FILE, FORMAT one of step iges nurbs obj ply")
       ->required();
-  AddConnectionFlags(upload, &flags->connection);
+  AddConnectionFlags(upload, &flags->connection, ServerFlag::kRequired);
   return {upload, [flags] { return RunUpload(*flags); }};
 }
 
