@@ -11,6 +11,7 @@
 #include "CLI/CLI.hpp"
 #include "absl/status/status.h"
 #include "client/cli/sample_source.h"
+#include "request/model_files.h"
 
 namespace sfc {
 
@@ -18,7 +19,8 @@ struct ModelReadFlags {
   // "auto" = sfcsampler-model-check installed with this program, else read
   // in this process; "none" = in this process; or a path.
   std::string model_check_program = "auto";
-  double model_parse_seconds = 300;  // CPU seconds one model's read may take
+  // CPU seconds one model's read may take (request/model_files.h).
+  double model_parse_seconds = kDefaultModelParseSeconds;
 };
 
 // Adds --model-check-program and --model-parse-seconds to `cmd`; `flags`

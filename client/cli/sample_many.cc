@@ -26,21 +26,18 @@
 #include "client/cli/sample_source.h"
 #include "client/sample_writer.h"
 #include "engine/model_source.h"
+#include "request/model_files.h"
 
 namespace sfc {
 namespace {
 
 namespace fs = std::filesystem;
 
-// The model format of a file name's extension (python/sfcsampler/many.py's EXTENSIONS).
+// The model format of a file name's extension (request/model_files.h), e.g. "step".
 std::optional<std::string> FormatOf(const std::string& path) {
-  const std::string ext = absl::AsciiStrToLower(fs::path(path).extension().string());
-  if (ext == ".step" || ext == ".stp") return "step";
-  if (ext == ".iges" || ext == ".igs") return "iges";
-  if (ext == ".nurbs") return "nurbs";
-  if (ext == ".obj") return "obj";
-  if (ext == ".ply") return "ply";
-  return std::nullopt;
+  const std::optional<ModelFormat> format = ModelFormatOfPath(path);
+  if (!format) return std::nullopt;
+  return std::string(ModelFormatName(*format));
 }
 
 // One model file and its name: its path relative to the input that named it
@@ -93,8 +90,8 @@ absl::StatusOr<std::vector<Named>> Expand(const std::string& input) {
           absl::StrFormat("cannot list %s: %s", input, error.message()));
     sorted();
     if (out.empty()) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "the folder %s has no model files (.step .stp .iges .igs .nurbs .obj .ply)", input));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("the folder %s has no model files (%s)", input, ModelExtensionList()));
     }
     return out;
   }
@@ -285,9 +282,9 @@ Command AddSampleManyCommand(CLI::App& app) {
       "each model's seed comes from --seed and its content hash");
   cmd->add_option(
          "inputs", f->inputs,
-         "folders (their .step .stp .iges .igs .nurbs .obj .ply files, in subfolders too), "
-         "glob patterns, list "
-         "files (a path a line) or model files")
+         "folders (their " + ModelExtensionList() +
+             " files, in subfolders too), glob patterns, list files (a path a line) or model "
+             "files")
       ->required();
   cmd->add_option("--output-dir,-O", f->out_dir,
                   "where the outputs go: one NAME.FORMAT per model, NAME its path relative to the "

@@ -8,6 +8,7 @@
 #include "python/bindings/errors.h"
 #include "python/bindings/register.h"
 #include "request/index_range.h"
+#include "request/model_files.h"
 #include "request/model_spec.h"
 #include "request/routing_key.h"
 
@@ -162,6 +163,13 @@ Raises sfcsampler.InvalidArgumentError for malformed values.)doc")
           "the resolved index range (begin, end) before the region");
   m.def("upload_cut_hint", &UploadCutHint, py::arg("message"), py::arg("bytes"),
         "what to add to an upload's error when a proxy cut it (request/model_spec.h); '' if none");
+  // The model files' facts of request/model_files.h, for python/sfcsampler/many.py.
+  py::dict extensions;
+  for (const ModelExtension& e : ModelExtensions()) {
+    extensions[py::str(std::string(e.extension))] = py::str(std::string(ModelFormatName(e.format)));
+  }
+  m.attr("MODEL_EXTENSIONS") = extensions;
+  m.attr("MODEL_PARSE_SECONDS") = kDefaultModelParseSeconds;
 }
 
 }  // namespace sfc::python

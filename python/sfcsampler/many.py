@@ -26,13 +26,13 @@ import time
 
 import numpy as np
 
-from sfcsampler import meshes
+from sfcsampler import _core, meshes
 from sfcsampler.errors import Error
 from sfcsampler.samples import column_names
 
-# File extensions of the model formats (lower case), as the CLI reads them.
-EXTENSIONS = {".step": "step", ".stp": "step", ".iges": "iges", ".igs": "iges", ".nurbs": "nurbs",
-              ".obj": "obj", ".ply": "ply"}
+# File extensions of the model formats (lower case, with the dot) and their formats, the
+# CLI's table (request/model_files.h).
+EXTENSIONS = dict(_core.MODEL_EXTENSIONS)
 _SEED_TAG = b"sfcsampler.model-seed\0"
 
 
@@ -203,8 +203,8 @@ class Results(list):
 
 
 # CPU seconds one model's parse may take in a many-model run (sample-many's
-# --model-parse-seconds default).
-MODEL_PARSE_SECONDS = 300
+# --model-parse-seconds default, request/model_files.h).
+MODEL_PARSE_SECONDS = _core.MODEL_PARSE_SECONDS
 
 
 def find_model_check_program():

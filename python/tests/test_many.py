@@ -8,6 +8,7 @@ import csv
 import filecmp
 import hashlib
 import os
+import re
 import shutil
 import subprocess
 
@@ -74,6 +75,17 @@ def alone(path, seed, out, fmt="npy"):
                "-o", out, "-q")
     assert done.returncode == 0, done.stderr
     return out
+
+
+def test_extensions_and_parse_budget_are_the_clis():
+    """many.py keeps no table of its own: its extensions and parse budget are the CLI's
+    (request/model_files.h), as `sample-many --help` shows them."""
+    shown = run("sample-many", "--help").stdout
+    assert f"their {' '.join(many.EXTENSIONS)} files" in shown, shown
+    budget = re.search(r"--model-parse-seconds FLOAT:POSITIVE=(\S+)", shown)
+    assert budget and float(budget.group(1)) == many.MODEL_PARSE_SECONDS, shown
+    assert many.model_format("a/PART.STP") == "step" and many.model_format("notes.txt") is None
+    assert set(many.EXTENSIONS.values()) == {"step", "iges", "nurbs", "obj", "ply"}
 
 
 def test_cli_folder_each_model_as_alone(folder, tmp_path):
