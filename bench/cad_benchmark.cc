@@ -14,7 +14,7 @@
 
 namespace {
 
-using sfc::cad::ModelFormat;
+using sfc::ModelFormat;
 using sfc::cad::fixtures::Solid;
 
 const std::string& FixtureBytes(Solid solid) {

@@ -71,7 +71,7 @@ int Measure(const std::string& spec, bool curvature) {
   std::string what = "ok";
   if (format == "ply" || format == "obj") {
     sfc::MeshLoadOptions options;
-    options.format = format == "ply" ? sfc::MeshFormat::kPly : sfc::MeshFormat::kObj;
+    options.format = model->format;
     auto mesh = sfc::LoadMesh(bytes, path, options);
     if (!mesh.ok()) {
       what = std::string(mesh.status().message()).substr(0, 60);
@@ -79,11 +79,8 @@ int Measure(const std::string& spec, bool curvature) {
       auto surface = sfc::MeshSurface::Create(*std::move(mesh), curvature);
     }
   } else {
-    const sfc::cad::ModelFormat f = format == "step"   ? sfc::cad::ModelFormat::kStep
-                                    : format == "iges" ? sfc::cad::ModelFormat::kIges
-                                                       : sfc::cad::ModelFormat::kNurbs;
-    auto model = sfc::cad::Load(f, bytes, path, {});
-    if (!model.ok()) what = std::string(model.status().message()).substr(0, 60);
+    auto parsed = sfc::cad::Load(model->format, bytes, path, {});
+    if (!parsed.ok()) what = std::string(parsed.status().message()).substr(0, 60);
   }
   const uint64_t peak = StatusBytes("VmHWM");
   const double growth = peak > before ? static_cast<double>(peak - before) : 0.0;
@@ -96,8 +93,8 @@ int Measure(const std::string& spec, bool curvature) {
 // STEP and IGES files of `copies` boxes with a hole side by side, in `dir`.
 bool WriteCadArrays(const std::string& dir, int copies, std::vector<std::string>* specs) {
   namespace fixtures = sfc::cad::fixtures;
-  for (auto [format, name] : {std::pair{sfc::cad::ModelFormat::kStep, "step"},
-                              std::pair{sfc::cad::ModelFormat::kIges, "iges"}}) {
+  for (auto [format, name] :
+       {std::pair{sfc::ModelFormat::kStep, "step"}, std::pair{sfc::ModelFormat::kIges, "iges"}}) {
     auto bytes = fixtures::SolidBytes(fixtures::Solid::kBoxWithHole, format, copies);
     if (!bytes.ok()) return false;
     const std::string path = dir + "/boxes." + name;

@@ -415,7 +415,7 @@ absl::StatusOr<std::vector<std::string>> WriteAll(const std::string& dir) {
     for (ModelFormat format : {ModelFormat::kStep, ModelFormat::kIges}) {
       ASSIGN_OR_RETURN(std::string bytes, SolidBytes(solid, format));
       const std::string path =
-          absl::StrCat(dir, "/", SolidName(solid), ".", ModelFormatName(format));
+          absl::StrCat(dir, "/", SolidName(solid), ".", std::string(ModelFormatName(format)));
       std::ofstream(path, std::ios::binary) << bytes;
       written.push_back(path);
     }

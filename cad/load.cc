@@ -50,6 +50,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <new>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <unordered_set>
@@ -67,9 +68,13 @@
 #include "cad/internal/occ_face.h"
 #include "cad/nurbs_patch.h"
 #include "cad/preflight.h"
+#include "request/model_files.h"
 
 namespace sfc::cad {
 namespace {
+
+// "step", "iges" or "nurbs" (request/model_spec.h's names), for messages.
+std::string FormatName(ModelFormat format) { return std::string(ModelFormatName(format)); }
 
 // The STEP and IGES readers share the kernel's global parameters
 // (Interface_Static) and its messenger; one load at a time.
@@ -77,7 +82,7 @@ absl::Mutex g_reader_mutex;
 
 absl::Status Invalid(ModelFormat format, absl::string_view name, absl::string_view what) {
   return absl::InvalidArgumentError(
-      absl::StrCat(absl::AsciiStrToUpper(ModelFormatName(format)), " file ", name, ": ", what));
+      absl::StrCat(absl::AsciiStrToUpper(FormatName(format)), " file ", name, ": ", what));
 }
 
 // The text must open with the ISO 10303-21 header and end with its trailer:
@@ -449,8 +454,11 @@ absl::StatusOr<TopoDS_Shape> ReadShape(ModelFormat format, absl::string_view byt
       return ReadIges(iges_path, census, name, options);
     case ModelFormat::kNurbs:
       return ReadNurbs(bytes, name);
+    case ModelFormat::kObj:
+    case ModelFormat::kPly:
+      break;  // refused by Prepare
   }
-  return absl::InternalError("unknown model format");
+  return absl::InternalError("not a CAD format");
 }
 
 // The model of a shape's faces, in the order TopExp::MapShapes finds them.
@@ -501,10 +509,10 @@ auto Guarded(ModelFormat format, absl::string_view name, const Work& work) -> de
                                 Echo(e.DynamicType()->Name()), ")"));
   } catch (const std::bad_alloc&) {
     return absl::ResourceExhaustedError(
-        absl::StrCat(ModelFormatName(format), " file ", name, ": out of memory while reading it"));
+        absl::StrCat(FormatName(format), " file ", name, ": out of memory while reading it"));
   } catch (const std::exception& e) {
     return absl::InternalError(
-        absl::StrCat(ModelFormatName(format), " file ", name, ": ", Echo(e.what())));
+        absl::StrCat(FormatName(format), " file ", name, ": ", Echo(e.what())));
   }
 }
 
@@ -516,9 +524,13 @@ struct Prepared {
 };
 absl::Status Prepare(ModelFormat format, absl::string_view bytes, absl::string_view name,
                      const LoadOptions& options, Prepared* prepared) {
+  if (!IsCadFormat(format)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(FormatName(format), " is a mesh format, not a CAD one"));
+  }
   if (bytes.size() > options.max_bytes) {
     return absl::ResourceExhaustedError(
-        absl::StrCat(absl::AsciiStrToUpper(ModelFormatName(format)), " file ", name, " has ",
+        absl::StrCat(absl::AsciiStrToUpper(FormatName(format)), " file ", name, " has ",
                      bytes.size(), " bytes, above the limit of ", options.max_bytes, " bytes"));
   }
   if (format == ModelFormat::kStep) {
@@ -541,25 +553,20 @@ absl::Status Prepare(ModelFormat format, absl::string_view bytes, absl::string_v
 
 }  // namespace
 
-absl::StatusOr<ModelFormat> ParseModelFormat(absl::string_view text) {
-  const std::string lower = absl::AsciiStrToLower(text);
-  if (lower == "step" || lower == "stp") return ModelFormat::kStep;
-  if (lower == "iges" || lower == "igs") return ModelFormat::kIges;
-  if (lower == "nurbs") return ModelFormat::kNurbs;
-  return absl::InvalidArgumentError(
-      absl::StrCat("unknown model format '", text, "'; expected step, iges or nurbs"));
+bool IsCadFormat(ModelFormat format) {
+  return format == ModelFormat::kStep || format == ModelFormat::kIges ||
+         format == ModelFormat::kNurbs;
 }
 
-absl::string_view ModelFormatName(ModelFormat format) {
-  switch (format) {
-    case ModelFormat::kStep:
-      return "step";
-    case ModelFormat::kIges:
-      return "iges";
-    case ModelFormat::kNurbs:
-      return "nurbs";
+absl::StatusOr<ModelFormat> ParseModelFormat(absl::string_view text) {
+  const std::string lower = absl::AsciiStrToLower(text);
+  std::optional<ModelFormat> format = ModelFormatFromName(lower);
+  for (const ModelExtension& e : ModelExtensions()) {
+    if (!format && e.extension.substr(1) == lower) format = e.format;
   }
-  return "unknown";
+  if (format && IsCadFormat(*format)) return *format;
+  return absl::InvalidArgumentError(
+      absl::StrCat("unknown model format '", text, "'; expected step, iges or nurbs"));
 }
 
 namespace {

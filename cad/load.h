@@ -21,14 +21,18 @@
 #include "absl/strings/string_view.h"
 #include "cad/model.h"
 #include "cad/preflight.h"
+#include "request/model_spec.h"
 
 namespace sfc::cad {
 
-enum class ModelFormat { kStep, kIges, kNurbs };
+// The CAD formats of request/model_spec.h's ModelFormat (the one enum of
+// model formats): kStep, kIges and kNurbs.
+bool IsCadFormat(ModelFormat format);
 
-// "step" (also "stp"), "iges" (also "igs"), "nurbs"; INVALID_ARGUMENT otherwise.
+// A CAD format by its name or a file extension of it (request/model_files.h),
+// in any case: "step" (also "stp"), "iges" (also "igs"), "nurbs";
+// INVALID_ARGUMENT otherwise.
 absl::StatusOr<ModelFormat> ParseModelFormat(absl::string_view text);
-absl::string_view ModelFormatName(ModelFormat format);
 
 struct LoadOptions {
   // Largest model accepted, in bytes; a larger one is RESOURCE_EXHAUSTED.
@@ -62,7 +66,7 @@ struct LoadOptions {
 //                       silently); unreadable or truncated STEP/IGES, a model without
 //                       faces, an unbounded face, non-finite geometry, a
 //                       malformed NURBS patch (knots, multiplicities,
-//                       weights, counts, NaN);
+//                       weights, counts, NaN); a mesh format (OBJ, PLY);
 //   INTERNAL            the kernel failed in an unexpected way (its
 //                       exception's message is passed on);
 //   options.check's status, when it stopped the load.

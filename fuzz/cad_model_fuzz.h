@@ -16,8 +16,7 @@
 
 namespace sfc::fuzz {
 
-inline int FuzzCadModel(cad::ModelFormat format, const char* name, const uint8_t* data,
-                        size_t size) {
+inline int FuzzCadModel(ModelFormat format, const char* name, const uint8_t* data, size_t size) {
   RememberInput(data, size);
   const std::string bytes(reinterpret_cast<const char*>(data), size);
   cad::LoadOptions options;

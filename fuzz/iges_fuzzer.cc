@@ -2,5 +2,5 @@
 #include "fuzz/cad_model_fuzz.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  return sfc::fuzz::FuzzCadModel(sfc::cad::ModelFormat::kIges, "fuzz.iges", data, size);
+  return sfc::fuzz::FuzzCadModel(sfc::ModelFormat::kIges, "fuzz.iges", data, size);
 }

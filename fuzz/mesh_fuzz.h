@@ -14,7 +14,7 @@
 
 namespace sfc::fuzz {
 
-inline int FuzzMesh(MeshFormat format, const char* name, const uint8_t* data, size_t size) {
+inline int FuzzMesh(ModelFormat format, const char* name, const uint8_t* data, size_t size) {
   const std::string bytes(reinterpret_cast<const char*>(data), size);
   MeshLoadOptions options;
   options.format = format;

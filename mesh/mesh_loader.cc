@@ -24,6 +24,7 @@
 #include "base/echo.h"
 #include "base/status_macros.h"
 #include "mesh/plain_ply.h"
+#include "request/model_files.h"
 
 namespace sfc {
 namespace {
@@ -564,15 +565,6 @@ absl::StatusOr<TriangleMesh> LoadPly(absl::string_view bytes, absl::string_view 
 
 }  // namespace
 
-std::optional<MeshFormat> MeshFormatFromFileName(absl::string_view file_name) {
-  const size_t dot = file_name.rfind('.');
-  if (dot == absl::string_view::npos) return std::nullopt;
-  const std::string ext = absl::AsciiStrToLower(std::string(file_name.substr(dot + 1)));
-  if (ext == "obj") return MeshFormat::kObj;
-  if (ext == "ply") return MeshFormat::kPly;
-  return std::nullopt;
-}
-
 absl::StatusOr<TriangleMesh> LoadMesh(absl::string_view bytes, absl::string_view untrusted_name,
                                       const MeshLoadOptions& options) {
   const std::string name = Echo(untrusted_name, kMaxNameEcho);
@@ -584,14 +576,16 @@ absl::StatusOr<TriangleMesh> LoadMesh(absl::string_view bytes, absl::string_view
   if (bytes.empty()) {
     return absl::InvalidArgumentError(absl::StrFormat("mesh '%s' is empty (0 bytes)", name));
   }
-  MeshFormat format = options.format;
-  if (format == MeshFormat::kAuto) {
-    format = absl::StartsWith(bytes, "ply") ? MeshFormat::kPly : MeshFormat::kObj;
+  const ModelFormat format = options.format.value_or(
+      absl::StartsWith(bytes, "ply") ? ModelFormat::kPly : ModelFormat::kObj);
+  if (format != ModelFormat::kObj && format != ModelFormat::kPly) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "mesh '%s': %s is not a mesh format (obj or ply)", name, ModelFormatName(format)));
   }
   absl::StatusOr<TriangleMesh> mesh;
   try {
-    mesh = format == MeshFormat::kPly ? LoadPly(bytes, name, options)
-                                      : LoadObj(bytes, name, options);
+    mesh =
+        format == ModelFormat::kPly ? LoadPly(bytes, name, options) : LoadObj(bytes, name, options);
   } catch (const std::bad_alloc&) {
     return absl::ResourceExhaustedError(
         absl::StrFormat("mesh '%s' needs more memory than is available", name));
@@ -618,8 +612,10 @@ absl::StatusOr<TriangleMesh> LoadMeshFile(const std::string& path, const MeshLoa
     return absl::NotFoundError(absl::StrFormat("cannot read mesh file '%s'", path));
   }
   MeshLoadOptions resolved = options;
-  if (resolved.format == MeshFormat::kAuto && !absl::StartsWith(bytes, "ply")) {
-    resolved.format = MeshFormatFromFileName(path).value_or(MeshFormat::kAuto);
+  if (!resolved.format && !absl::StartsWith(bytes, "ply")) {
+    // The file name's mesh format (request/model_files.h), if it names one.
+    const std::optional<ModelFormat> named = ModelFormatOfPath(path);
+    if (named == ModelFormat::kObj || named == ModelFormat::kPly) resolved.format = named;
   }
   return LoadMesh(bytes, path, resolved);
 }

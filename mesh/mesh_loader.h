@@ -16,27 +16,22 @@
 #include <functional>
 #include <optional>
 #include <string>
-#include "absl/strings/string_view.h"
 
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "mesh/triangle_mesh.h"
+#include "request/model_spec.h"
 
 namespace sfc {
-
-enum class MeshFormat {
-  kAuto,  // PLY when the bytes start with "ply", otherwise OBJ
-  kObj,
-  kPly,
-};
-
-// "obj", "ply" (case-insensitive) from a file name's extension; nullopt otherwise.
-std::optional<MeshFormat> MeshFormatFromFileName(absl::string_view file_name);
 
 struct MeshLoadOptions {
   // Input larger than this is refused with RESOURCE_EXHAUSTED before parsing.
   // Default 512 MiB. The parsed mesh takes at most a few times the input size.
   uint64_t max_bytes = uint64_t{512} << 20;
-  MeshFormat format = MeshFormat::kAuto;
+  // ModelFormat::kObj or kPly (request/model_spec.h's one enum of model
+  // formats; a CAD format is INVALID_ARGUMENT); nullopt: PLY when the bytes
+  // start with "ply", otherwise OBJ.
+  std::optional<ModelFormat> format = std::nullopt;
   // Name of a PLY vertex property (any numeric type) read as per-vertex
   // weights (MeshDensityKind::kVertexWeight); empty = none. OBJ has no named
   // vertex properties: naming one for an OBJ file is INVALID_ARGUMENT.

@@ -23,9 +23,9 @@ namespace {
 
 namespace fx = cad::fixtures;
 
-std::string Fixture(fx::Solid solid, cad::ModelFormat format = cad::ModelFormat::kStep) {
+std::string Fixture(fx::Solid solid, ModelFormat format = ModelFormat::kStep) {
   const std::string path = ::testing::TempDir() + "/engine_cad_" + fx::SolidName(solid) +
-                           (format == cad::ModelFormat::kStep ? ".step" : ".iges");
+                           (format == ModelFormat::kStep ? ".step" : ".iges");
   std::ifstream exists(path);
   if (!exists) {
     auto bytes = fx::SolidBytes(solid, format);
@@ -83,9 +83,9 @@ TEST(EngineCad, NoSampleOfTheBoxWithAHoleLeavesItsFace) {
 }
 
 TEST(EngineCad, FacesGetSamplesInProportionToTheirExactAreas) {
-  auto bytes = fx::SolidBytes(fx::Solid::kBoxWithHole, cad::ModelFormat::kStep);
+  auto bytes = fx::SolidBytes(fx::Solid::kBoxWithHole, ModelFormat::kStep);
   ASSERT_TRUE(bytes.ok());
-  auto model = cad::Load(cad::ModelFormat::kStep, *bytes, "box_with_hole.step");
+  auto model = cad::Load(ModelFormat::kStep, *bytes, "box_with_hole.step");
   ASSERT_TRUE(model.ok()) << model.status();
   Engine e;
   for (uint64_t n : {1000u, 20000u}) {
@@ -188,7 +188,7 @@ TEST(EngineCad, ABoxRegionIsTheFilteredFullSet) {
 
 TEST(EngineCad, MalformedModelsAreRefusedByName) {
   Engine e;
-  auto bytes = fx::SolidBytes(fx::Solid::kBoxWithHole, cad::ModelFormat::kStep);
+  auto bytes = fx::SolidBytes(fx::Solid::kBoxWithHole, ModelFormat::kStep);
   ASSERT_TRUE(bytes.ok());
   const std::string truncated =
       WriteTemp("engine_cad_truncated.step", bytes->substr(0, bytes->size() / 3));
@@ -196,7 +196,7 @@ TEST(EngineCad, MalformedModelsAreRefusedByName) {
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << status;
   EXPECT_NE(status.message().find("engine_cad_truncated.step"), std::string::npos) << status;
 
-  auto edge = fx::SolidBytes(fx::Solid::kEdgeOnly, cad::ModelFormat::kStep);
+  auto edge = fx::SolidBytes(fx::Solid::kEdgeOnly, ModelFormat::kStep);
   ASSERT_TRUE(edge.ok());
   const std::string empty = WriteTemp("engine_cad_edge_only.step", *edge);
   status = e.engine.Start(ModelRequest("step:" + empty, 100)).status();
@@ -231,9 +231,9 @@ TEST(EngineCad, EverySampleLiesOnItsFace) {
     for (size_t i = 0; i < b.size(); ++i) {
       points.push_back({static_cast<int>(b.face[i]), b.x[i], b.y[i], b.z[i]});
     }
-    auto bytes = fx::SolidBytes(solid, cad::ModelFormat::kStep);
+    auto bytes = fx::SolidBytes(solid, ModelFormat::kStep);
     ASSERT_TRUE(bytes.ok());
-    auto worst = fx::MaxDistanceToFaces(*bytes, cad::ModelFormat::kStep, points);
+    auto worst = fx::MaxDistanceToFaces(*bytes, ModelFormat::kStep, points);
     ASSERT_TRUE(worst.ok()) << worst.status();
     EXPECT_LT(*worst, 1e-6) << fx::SolidName(solid);
 
@@ -255,7 +255,7 @@ TEST(EngineCad, FacesWithoutAreaTakeNoSamplesAndAModelOfThemIsRefused) {
   EXPECT_NE(status.message().find("0, 1, 2"), std::string::npos) << status;
 
   const std::string mixed_bytes = fx::CollinearFacesStep(10, true);
-  auto here = cad::Load(cad::ModelFormat::kStep, mixed_bytes, "mixed.step");
+  auto here = cad::Load(ModelFormat::kStep, mixed_bytes, "mixed.step");
   ASSERT_TRUE(here.ok()) << here.status();
   ASSERT_EQ((*here)->faces().size(), 11u);
   int square = -1;  // the one face with area
@@ -281,13 +281,13 @@ TEST(EngineCad, FacesWithoutAreaTakeNoSamplesAndAModelOfThemIsRefused) {
         << "sample " << i << " off the square";
     points.push_back({static_cast<int>(b.face[i]), b.x[i], b.y[i], b.z[i]});
   }
-  auto worst = fx::MaxDistanceToFaces(mixed_bytes, cad::ModelFormat::kStep, points);
+  auto worst = fx::MaxDistanceToFaces(mixed_bytes, ModelFormat::kStep, points);
   ASSERT_TRUE(worst.ok()) << worst.status();
   EXPECT_LT(*worst, 1e-9);
 
-  auto brep = cad::ReadToBrep(cad::ModelFormat::kStep, mixed_bytes, "mixed.step");
+  auto brep = cad::ReadToBrep(ModelFormat::kStep, mixed_bytes, "mixed.step");
   ASSERT_TRUE(brep.ok()) << brep.status();
-  auto there = cad::LoadBrep(*brep, cad::ModelFormat::kStep, "mixed.step");
+  auto there = cad::LoadBrep(*brep, ModelFormat::kStep, "mixed.step");
   ASSERT_TRUE(there.ok()) << there.status();
   EXPECT_EQ(cad::DescribeModel(**here), cad::DescribeModel(**there));
 }

@@ -14,7 +14,7 @@ constexpr char kFourVertices[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n";
 
 absl::StatusOr<TriangleMesh> Obj(const std::string& text) {
   MeshLoadOptions options;
-  options.format = MeshFormat::kObj;
+  options.format = ModelFormat::kObj;
   return LoadMesh(text, "hostile.obj", options);
 }
 
@@ -52,7 +52,7 @@ TEST(MeshHostile, GiantTokensAreClippedInMessages) {
   ExpectRefused(Obj(absl::StrCat("v 0 0 ", std::string(100000, 'x'), "\n")), "(100000 bytes)");
   // The name too, with its control characters escaped.
   MeshLoadOptions options;
-  options.format = MeshFormat::kObj;
+  options.format = ModelFormat::kObj;
   auto mesh = LoadMesh("v 0 0 0\n", absl::StrCat("a\nforged line", std::string(1 << 20, 'n')),
                        options);
   ASSERT_FALSE(mesh.ok());
@@ -75,7 +75,7 @@ std::string AsciiPly(const std::string& face_list_type, const std::string& faces
 
 TEST(MeshHostile, PlyIndicesPastTheVerticesAreRefusedWithTheIndex) {
   MeshLoadOptions options;
-  options.format = MeshFormat::kPly;
+  options.format = ModelFormat::kPly;
   auto good = LoadMesh(AsciiPly("int", "3 0 1 2\n3 1 3 2\n", 2), "hostile.ply", options);
   ASSERT_TRUE(good.ok()) << good.status();
   EXPECT_EQ(good->triangles.size(), 2u);
@@ -93,7 +93,7 @@ TEST(MeshHostile, PlyIndicesPastTheVerticesAreRefusedWithTheIndex) {
 // naming the property, the item and the type, never wrapped.
 TEST(MeshHostile, AsciiPlyIntegersThatDoNotFitTheirTypeAreRefused) {
   MeshLoadOptions options;
-  options.format = MeshFormat::kPly;
+  options.format = ModelFormat::kPly;
   // A uchar list count of 259 would be read as 3 (then 256 corners dropped).
   std::string corners = "259";
   for (int i = 0; i < 259; ++i) absl::StrAppend(&corners, " ", i % 4);
@@ -139,7 +139,7 @@ TEST(MeshHostile, ObjHexFloatsAreRefused) {
 // through a null pointer (fuzz/ply_fuzzer).
 TEST(MeshHostile, PlyPropertyBeforeAnyElementIsRefused) {
   MeshLoadOptions options;
-  options.format = MeshFormat::kPly;
+  options.format = ModelFormat::kPly;
   auto mesh =
       LoadMesh("ply\nformat ascii 1.0\nproperty double x\nelement vertex 1\nend_header\n0\n",
                "hostile.ply", options);

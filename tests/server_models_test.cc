@@ -122,7 +122,7 @@ TEST(ServerModels, EveryRequestAboutAModelCarriesTheModelsRoutingKey) {
 // A sphere whose shell lists its one face `copies` times: small, valid, and
 // quadratic in OpenCASCADE's shell healing (20 000 copies: 2.3 s of CPU).
 std::string HostileShellStep(int copies) {
-  auto step = cad::fixtures::SolidBytes(cad::fixtures::Solid::kSphere, cad::ModelFormat::kStep);
+  auto step = cad::fixtures::SolidBytes(cad::fixtures::Solid::kSphere, ModelFormat::kStep);
   EXPECT_TRUE(step.ok()) << step.status();
   std::string text = *step;
   const size_t shell = text.find("CLOSED_SHELL('',(");
@@ -248,7 +248,7 @@ TEST(ServerModels, ASmallStepIsServedWhileHostileStepsParse) {
   options.limits.max_long_parses = 4;
   options.limits.model_parse_seconds = 30;
   Running r = StartServer(options);
-  auto sphere = cad::fixtures::SolidBytes(cad::fixtures::Solid::kSphere, cad::ModelFormat::kStep);
+  auto sphere = cad::fixtures::SolidBytes(cad::fixtures::Solid::kSphere, ModelFormat::kStep);
   ASSERT_TRUE(sphere.ok()) << sphere.status();
   int serial = 0;
   auto cold_sphere = [&] {
@@ -404,7 +404,7 @@ TEST(ServerModels, ACachedMeshTreeCountsTheMeshItKeepsAlive) {
 
 // The same for a CAD model: its cached tree counts the model it keeps alive.
 TEST(ServerModels, ACachedCadTreeCountsTheModelItKeepsAlive) {
-  auto step = cad::fixtures::SolidBytes(cad::fixtures::Solid::kSphere, cad::ModelFormat::kStep);
+  auto step = cad::fixtures::SolidBytes(cad::fixtures::Solid::kSphere, ModelFormat::kStep);
   ASSERT_TRUE(step.ok()) << step.status();
   Running r = StartServer(LoopbackOptions());
   auto info = r.client->UploadModel("step", "sphere.step", *step);
@@ -424,8 +424,7 @@ TEST(ServerModels, ACachedCadTreeCountsTheModelItKeepsAlive) {
 // process's CPU limit, above), and the next model parses on the same
 // (single) parse thread.
 TEST(ServerModels, AFileThatLoopedTheKernelIsRefusedAndTheNextModelParses) {
-  auto iges =
-      cad::fixtures::SolidBytes(cad::fixtures::Solid::kBoxWithHole, cad::ModelFormat::kIges);
+  auto iges = cad::fixtures::SolidBytes(cad::fixtures::Solid::kBoxWithHole, ModelFormat::kIges);
   ASSERT_TRUE(iges.ok()) << iges.status();
   const std::string arc = "100,0.,0.,0.,5.,0.,5.,0.;";
   const size_t at = iges->find(arc);
@@ -461,10 +460,10 @@ TEST(ServerModels, ModelsReadInTheCheckProcessGiveTheSameBytesAsInProcess) {
   std::vector<std::pair<std::string, std::string>> models;  // format, bytes
   for (auto solid : {cad::fixtures::Solid::kSphere, cad::fixtures::Solid::kCylinder,
                      cad::fixtures::Solid::kBoxWithHole}) {
-    for (auto format : {cad::ModelFormat::kStep, cad::ModelFormat::kIges}) {
+    for (auto format : {ModelFormat::kStep, ModelFormat::kIges}) {
       auto bytes = cad::fixtures::SolidBytes(solid, format);
       ASSERT_TRUE(bytes.ok()) << bytes.status();
-      models.emplace_back(format == cad::ModelFormat::kStep ? "step" : "iges", *bytes);
+      models.emplace_back(format == ModelFormat::kStep ? "step" : "iges", *bytes);
     }
   }
   models.emplace_back("nurbs", cad::fixtures::NurbsPatchText());
@@ -507,8 +506,7 @@ TEST(ServerModels, ModelsReadInTheCheckProcessGiveTheSameBytesAsInProcess) {
 // codes, in a message of bounded length.
 TEST(ServerModels, TheModelCheckPassesOnTheLoadersOwnErrors) {
   Running r = StartServer(ModelServerOptions());
-  auto truncated =
-      cad::fixtures::SolidBytes(cad::fixtures::Solid::kSphere, cad::ModelFormat::kStep);
+  auto truncated = cad::fixtures::SolidBytes(cad::fixtures::Solid::kSphere, ModelFormat::kStep);
   ASSERT_TRUE(truncated.ok());
   truncated->resize(truncated->size() / 2);
   auto info = r.client->UploadModel("step", "half.step", *truncated);

@@ -190,7 +190,7 @@ TEST(TreeSummary, AMeshTreeReadsTheSameInProcessAndFromAServer) {
 
 #ifdef SFC_TEST_CAD
 TEST(TreeSummary, ACadModelTreeReadsTheSameInProcessAndFromAServer) {
-  auto step = cad::fixtures::SolidBytes(cad::fixtures::Solid::kSphere, cad::ModelFormat::kStep);
+  auto step = cad::fixtures::SolidBytes(cad::fixtures::Solid::kSphere, ModelFormat::kStep);
   ASSERT_TRUE(step.ok()) << step.status();
   const TreeSummary model = ExpectSameModelSummary("step", *step, 2000, /*heap_bytes=*/true);
   EXPECT_EQ(model.kind, "model");

@@ -34,15 +34,6 @@ uint64_t HeapInUse() {
   return info.uordblks + info.hblkhd;
 }
 
-absl::StatusOr<cad::ModelFormat> CadFormat(ModelFormat format) {
-  switch (format) {
-    case ModelFormat::kStep: return cad::ModelFormat::kStep;
-    case ModelFormat::kIges: return cad::ModelFormat::kIges;
-    case ModelFormat::kNurbs: return cad::ModelFormat::kNurbs;
-    default: return absl::InternalError("the CAD kind was given a model of another format");
-  }
-}
-
 // A parsed model and what keeping it costs.
 struct CadParse {
   std::shared_ptr<const cad::Model> model;
@@ -69,7 +60,10 @@ absl::StatusOr<std::shared_ptr<const CadParse>> LoadCad(const StoredModel& model
   return context.loaded->Get<CadParse>(
       model.Spec(),
       [model, check_limits](const ParseCheck& check) -> absl::StatusOr<LoadedModels::Parsed> {
-        ASSIGN_OR_RETURN(const cad::ModelFormat format, CadFormat(model.format));
+        if (!cad::IsCadFormat(model.format)) {
+          return absl::InternalError("the CAD kind was given a model of another format");
+        }
+        const ModelFormat format = model.format;
         const std::string name = model.name.empty() ? model.Spec() : model.name;
         cad::LoadOptions options;
         options.max_bytes = std::max<size_t>(options.max_bytes, model.bytes->size());

@@ -120,7 +120,7 @@ absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::
   const std::string key = absl::StrCat(model.Spec(), "|curvature=", curvature,
                                        "|weights=", choice.weight_property);
   MeshLoadOptions options;
-  options.format = model.format == ModelFormat::kPly ? MeshFormat::kPly : MeshFormat::kObj;
+  options.format = model.format;
   options.weight_property = choice.weight_property;
   options.max_bytes = model.bytes->size();
   // The parse's peak memory (bench/parse_memory, docs/MODELS.md): 2.0-4.2
