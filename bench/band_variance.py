@@ -34,21 +34,25 @@ def main():
     counts = {}
     for surface in (f"superellipsoid:e={e_text}", f"superellipsoid:e={e_text};reparam=1"):
         for seed in range(1, seeds + 1):
-            out = subprocess.run([cli, "sample", "--surface", surface, "--count", str(n), "--seed", str(seed),
-                                  "-q", "-o", "-"], capture_output=True, text=True, check=True).stdout
+            out = subprocess.run([cli, "sample", "--surface", surface, "--count", str(n),
+                                  "--seed", str(seed), "-q", "-o", "-"],
+                                 capture_output=True, text=True, check=True).stdout
             a = np.loadtxt(io.StringIO(out), delimiter=",", skiprows=1)
             x, y, z = a[:, 3], a[:, 4], a[:, 5]
             root = lambda c: np.sign(c) * np.abs(c) ** (1 / e)
-            u = np.arctan2(root(z), np.hypot(np.abs(x) ** (1 / e), np.abs(y) ** (1 / e))) / np.pi + 0.5
+            u = (np.arctan2(root(z), np.hypot(np.abs(x) ** (1 / e), np.abs(y) ** (1 / e))) / np.pi
+                 + 0.5)
             v = np.arctan2(root(y), root(x)) / (2 * np.pi) + 0.5
             for name, (u0, u1, v0, v1) in boxes.items():
                 inside = (u >= u0) & (u < u1) & (v >= v0) & (v < v1)
                 counts.setdefault((surface, name), []).append(int(inside.sum()))
-    print(f"N = {n}, seeds 1..{seeds}: samples in each band, mean and standard deviation across seeds\n")
+    print(f"N = {n}, seeds 1..{seeds}: samples in each band, mean and standard deviation across "
+          "seeds\n")
     print("| surface | band | mean | SD across seeds | i.i.d. SD |\n|---|---|---:|---:|---:|")
     for (surface, name), c in counts.items():
         c = np.array(c)
-        print(f"| {surface} | {name} | {c.mean():.1f} | {c.std(ddof=1):.1f} | {np.sqrt(c.mean()):.1f} |")
+        print(f"| {surface} | {name} | {c.mean():.1f} | {c.std(ddof=1):.1f} | "
+              f"{np.sqrt(c.mean()):.1f} |")
 
 
 if __name__ == "__main__":

@@ -40,8 +40,9 @@ def nn(points, sphere, n_norm=None):
 
 
 def ours(cli, surface, seed):
-    out = subprocess.run([cli, "sample", "--surface", surface, "--count", str(N), "--seed", str(seed),
-                          "-q", "-o", "-"], check=True, capture_output=True, text=True).stdout
+    out = subprocess.run([cli, "sample", "--surface", surface, "--count", str(N), "--seed",
+                          str(seed), "-q", "-o", "-"], check=True, capture_output=True,
+                         text=True).stdout
     a = np.loadtxt(io.StringIO(out), delimiter=",", skiprows=1)
     return a[:, 1:3], a[:, 3:6]
 
@@ -99,8 +100,8 @@ def main():
             add(f"PoissonDisk r = {r:.2f}, by N = 4096", nn(p, False, N), nn(ds, True, N))
             add(f"PoissonDisk r = {r:.2f}, by its own count", nn(p, False), nn(ds, True))
         print(f"seed {seed} done", file=sys.stderr)
-    print(f"Blue noise, N = {N}, nearest-neighbour distance / hexagonal spacing, mean +- SE over seeds "
-          f"{','.join(map(str, seeds))}\n")
+    print(f"Blue noise, N = {N}, nearest-neighbour distance / hexagonal spacing, mean +- SE over "
+          f"seeds {','.join(map(str, seeds))}\n")
     print("| set | plane min | plane mean | sphere min | sphere mean |\n|---|---:|---:|---:|---:|")
     for name, v in rows.items():
         a = np.array(v)
@@ -108,7 +109,8 @@ def main():
         se = a.std(axis=0, ddof=1) / np.sqrt(len(a)) if len(a) > 1 else np.zeros(4)
         print(f"| {name} | " + " | ".join(f"{x:.3f} +- {e:.3f}" for x, e in zip(m, se)) + " |")
     for r, c in counts.items():
-        print(f"\nPoissonDisk r = {r:.2f}: points reached (plane / sphere dart throwing) per seed: {', '.join(c)}")
+        print(f"\nPoissonDisk r = {r:.2f}: points reached (plane / sphere dart throwing) per seed: "
+              f"{', '.join(c)}")
 
 
 if __name__ == "__main__":

@@ -31,11 +31,13 @@ import sys, numpy as np
 n, path = int(sys.argv[1]), sys.argv[2]
 rng = np.random.default_rng(1)
 z = rng.uniform(-1, 1, n); phi = rng.uniform(0, 2 * np.pi, n); r = np.sqrt(1 - z * z)
-rec = np.empty(n, dtype=[("x", "<f8"), ("y", "<f8"), ("z", "<f8"), ("u", "<f8"), ("v", "<f8"), ("index", "<u4")])
+rec = np.empty(n, dtype=[("x", "<f8"), ("y", "<f8"), ("z", "<f8"), ("u", "<f8"), ("v", "<f8"),
+                         ("index", "<u4")])
 rec["x"], rec["y"], rec["z"] = r * np.cos(phi), r * np.sin(phi), z
 rec["u"], rec["v"], rec["index"] = (z + 1) / 2, phi / (2 * np.pi), np.arange(n, dtype=np.uint32)
-header = ("ply\nformat binary_little_endian 1.0\nelement vertex %d\nproperty double x\nproperty double y\n"
-          "property double z\nproperty double u\nproperty double v\nproperty uint index\nend_header\n" % n)
+header = ("ply\nformat binary_little_endian 1.0\nelement vertex %d\nproperty double x\n"
+          "property double y\nproperty double z\nproperty double u\nproperty double v\n"
+          "property uint index\nend_header\n" % n)
 with open(path, "wb") as f: f.write(header.encode()); f.write(rec.tobytes())
 '''
 
@@ -64,12 +66,12 @@ def median_time(fn, repeats=3):
 def icosphere(subdivisions):
     import numpy as np
     t = (1 + 5 ** 0.5) / 2
-    verts = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t), (0, 1, -t),
-             (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
+    verts = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t),
+             (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
     verts = [np.array(v, float) / np.linalg.norm(v) for v in verts]
-    faces = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4), (11, 10, 2),
-             (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9), (4, 9, 5),
-             (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+    faces = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4),
+             (11, 10, 2), (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8),
+             (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
     for _ in range(subdivisions):
         cache, out = {}, []
 
@@ -92,7 +94,8 @@ def main():
         os.execv(DEBIAN_PYTHON, [DEBIAN_PYTHON] + sys.argv)  # Debian's modules belong to it
     build = os.path.abspath(sys.argv[1] if len(sys.argv) > 1 else "build")
     count = int(sys.argv[2]) if len(sys.argv) > 2 else 4000000
-    for module, package in (("numpy", "python3-numpy"), ("scipy", "python3-scipy"), ("open3d", "python3-open3d")):
+    for module, package in (("numpy", "python3-numpy"), ("scipy", "python3-scipy"),
+                            ("open3d", "python3-open3d")):
         ensure(module, package)
     import numpy as np
     import open3d as o3d
@@ -134,26 +137,33 @@ def main():
         sobol_t = median_time(sobol)
         iid_t = median_time(iid)
         verts, faces = icosphere(6)
-        mesh = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(verts), o3d.utility.Vector3iVector(faces))
+        mesh = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(verts),
+                                         o3d.utility.Vector3iVector(faces))
         o3d_t = median_time(lambda: mesh.sample_points_uniformly(number_of_points=count))
         poisson_n = 2000
-        poisson_t = median_time(lambda: mesh.sample_points_poisson_disk(number_of_points=poisson_n), repeats=1)
+        poisson_t = median_time(lambda: mesh.sample_points_poisson_disk(number_of_points=poisson_n),
+                                repeats=1)
 
     rate = lambda seconds, n=count: n / seconds / 1e6
-    print(f"# {count} points on the unit sphere; wall-clock medians of 3 runs, one run of this script\n")
+    print(f"# {count} points on the unit sphere; wall-clock medians of 3 runs, one run of this "
+          "script\n")
     print("| what | seconds | M points/s | ratio to ours |")
     print("|---|---:|---:|---:|")
-    print(f"| our CLI, cold (new process: tree + samples + binary PLY) | {ours_cli:.3f} | {rate(ours_cli):.2f} | 1 |")
+    print(f"| our CLI, cold (new process: tree + samples + binary PLY) | {ours_cli:.3f} | "
+          f"{rate(ours_cli):.2f} | 1 |")
     print(f"| numpy script, cold (new process: i.i.d. + the same binary PLY) | {numpy_cli:.3f} | "
           f"{rate(numpy_cli):.2f} | {numpy_cli / ours_cli:.2f} |")
     print(f"| **our CLI / numpy script** (target <= 1.0) | **{ours_cli / numpy_cli:.2f}** | | |")
-    print(f"| ours in process, cold (tree + samples, Python package) | {ours_cold:.3f} | {rate(ours_cold):.2f} | 1 |")
+    print(f"| ours in process, cold (tree + samples, Python package) | {ours_cold:.3f} | "
+          f"{rate(ours_cold):.2f} | 1 |")
     print(f"| ours in process, warm (cached tree) | {ours_warm:.3f} | {rate(ours_warm):.2f} | "
           f"{ours_warm / ours_cold:.2f} |")
-    print(f"| scipy scrambled Sobol mapped to the sphere | {sobol_t:.3f} | {rate(sobol_t):.2f} | {sobol_t / ours_cold:.2f} |")
-    print(f"| numpy i.i.d. on the sphere | {iid_t:.3f} | {rate(iid_t):.2f} | {iid_t / ours_cold:.2f} |")
-    print(f"| Open3D sample_points_uniformly, 81 920-triangle icosphere | {o3d_t:.3f} | {rate(o3d_t):.2f} | "
-          f"{o3d_t / ours_cold:.2f} |")
+    print(f"| scipy scrambled Sobol mapped to the sphere | {sobol_t:.3f} | {rate(sobol_t):.2f} | "
+          f"{sobol_t / ours_cold:.2f} |")
+    print(f"| numpy i.i.d. on the sphere | {iid_t:.3f} | {rate(iid_t):.2f} | "
+          f"{iid_t / ours_cold:.2f} |")
+    print(f"| Open3D sample_points_uniformly, 81 920-triangle icosphere | {o3d_t:.3f} | "
+          f"{rate(o3d_t):.2f} | {o3d_t / ours_cold:.2f} |")
     print(f"| Open3D sample_points_poisson_disk, {poisson_n} points | {poisson_t:.3f} | "
           f"{rate(poisson_t, poisson_n):.4f} | |")
 

@@ -212,8 +212,9 @@ class Blowup:
 
     def describe(self):
         mean, _ = self.mc_exact()
-        return (f"cube-root sheet at c = {self.c:.15g}: x uniform on [-{self.lo:.6f}, {self.hi:.6f}], "
-                f"y uniform; exact mean of exp(x)+y^2 = {mean:.12f}")
+        return (
+            f"cube-root sheet at c = {self.c:.15g}: x uniform on [-{self.lo:.6f}, {self.hi:.6f}], "
+            f"y uniform; exact mean of exp(x)+y^2 = {mean:.12f}")
 
     def metrics(self, n):
         out = []
@@ -289,7 +290,8 @@ class Cone:
                 out.append(count_metric(f"strip_{side}_{a:g}_{b:g}",
                                         f"|u| in ({a:g},{b:g}) {side}: rel", n, ff, 0.05, 3))
         mean, sd = self.mc_exact()
-        out.append(Metric("mc", "mean z: bias", "mean", mean, sd / math.sqrt(n), ("mean_abs", 5e-6)))
+        out.append(Metric("mc", "mean z: bias", "mean", mean, sd / math.sqrt(n),
+                          ("mean_abs", 5e-6)))
         return out
 
     def measure(self, s):
@@ -342,8 +344,8 @@ class CliSource:
 
     def get(self, case, n, seed):
         out = os.path.join(self.tmp, "s.npy")
-        cmd = [self.cli, "sample", "--surface", case.surface, "--count", str(n), "--seed", str(seed),
-               "--format", "npy", "--columns", "u,v,x,y,z", "-o", out]
+        cmd = [self.cli, "sample", "--surface", case.surface, "--count", str(n), "--seed",
+               str(seed), "--format", "npy", "--columns", "u,v,x,y,z", "-o", out]
         if case.density:
             cmd += ["--density", case.density]
         if self.curve:
@@ -441,7 +443,8 @@ def evaluate(case, n, seeds, source, target_n, log):
         rows.append({
             "key": m.key, "label": m.label, "kind": m.kind, "exact": m.exact,
             "values": [float(x) for x in v], "errors": errs, "mean_error": mu, "se": se,
-            "iid_sd": m.iid_sd, "iid_sd_error": (m.iid_sd / m.exact if m.kind == "count" else m.iid_sd),
+            "iid_sd": m.iid_sd,
+            "iid_sd_error": (m.iid_sd / m.exact if m.kind == "count" else m.iid_sd),
             "z_iid": zs, "z_iid_mean": z_mean, "target": m.target_text(),
             "at_target_n": n == target_n, "pass": bool(m.judge(v)),
         })
@@ -480,17 +483,20 @@ def print_block(res, out):
             seeds = " ".join(fmt_err(r["kind"], e) for e in r["errors"])
             iid = f"{r['iid_sd_error']:.1e}"
         verdict = ("PASS" if r["pass"] else "FAIL") + ("" if r["at_target_n"] else "*")
-        out(f"    {r['label']:40s} {ex:>12s} {ms:>22s} {iid:>9s} {seeds:>28s}  {r['target']:28s} {verdict}")
+        out(f"    {r['label']:40s} {ex:>12s} {ms:>22s} {iid:>9s} {seeds:>28s}  "
+            f"{r['target']:28s} {verdict}")
     if "profile" in res:
         p = res["profile"]
         e = p["edges_from_c_in_1e-3"]
-        out("    profile beside C (no target; offsets in 1e-3, mean count of seeds vs exact): " + ", ".join(
-            f"[{e[i]:g},{e[i + 1]:g}) {p['rel_error_of_mean'][i] * 100:+.1f}%" for i in range(len(e) - 1)))
+        out("    profile beside C (no target; offsets in 1e-3, mean count of seeds vs exact): " +
+            ", ".join(f"[{e[i]:g},{e[i + 1]:g}) {p['rel_error_of_mean'][i] * 100:+.1f}%"
+                      for i in range(len(e) - 1)))
     trees = sorted({re.sub(r"^tree \S+ ", "", r["tree"]) for r in res["runs"] if "tree" in r})
     if trees:
         out("    CLI tree: " + " | ".join(trees))
-    out("    sanity (max over seeds; ~0 says the columns are what the script assumes): "
-        + ", ".join(f"{k} = {v:.1e}" + (" (!)" if v > 1e-9 else "") for k, v in res["sanity"].items()))
+    out("    sanity (max over seeds; ~0 says the columns are what the script assumes): " +
+        ", ".join(f"{k} = {v:.1e}" + (" (!)" if v > 1e-9 else "")
+                  for k, v in res["sanity"].items()))
 
 
 def sweep(case, ns, seeds, source, log):
@@ -520,10 +526,12 @@ def sweep(case, ns, seeds, source, log):
 
 def print_sweep(sw, out):
     out(f"\n### N sweep: {sw['case']}, excess share below C")
-    out(f"    {'N':>9s} {'mean excess +- SE':>24s} {'RMS':>9s} {'RMS*N':>8s} {'i.i.d. SD':>9s}   {'per seed':33s} tree (seed 1)")
+    out(f"    {'N':>9s} {'mean excess +- SE':>24s} {'RMS':>9s} {'RMS*N':>8s} {'i.i.d. SD':>9s}   "
+        f"{'per seed':33s} tree (seed 1)")
     for t in sw["table"]:
-        out(f"    {t['n']:>9d} {t['mean']:+.3e} +- {t['se']:.1e} {t['rms']:9.2e} {t['rms'] * t['n']:8.1f} "
-            f"{t['iid_sd']:9.1e}   " + f"{' '.join(f'{e:+.2e}' for e in t['errors']):33s} " + t["tree"])
+        out(f"    {t['n']:>9d} {t['mean']:+.3e} +- {t['se']:.1e} {t['rms']:9.2e} "
+            f"{t['rms'] * t['n']:8.1f} {t['iid_sd']:9.1e}   "
+            + f"{' '.join(f'{e:+.2e}' for e in t['errors']):33s} " + t["tree"])
     out(f"    fitted slope of log RMS vs log N: {sw['slope']:+.3f}  (target <= -0.5; i.i.d. -0.5, "
         f"a flat bias ~0): {'PASS' if sw['pass'] else 'FAIL'}")
 
@@ -589,7 +597,8 @@ def self_test(args, out, log):
             flag = "ok" if zmax <= 4 else "FAIL"
             if zmax > 4:
                 ok = False
-            out(f"    {res['case']:22s} N={res['n']:>8d} {r['label']:40s} max|z| {zmax:5.2f} {flag}")
+            out(f"    {res['case']:22s} N={res['n']:>8d} {r['label']:40s} max|z| {zmax:5.2f} "
+                f"{flag}")
     for sw in sw_a:
         for t in sw["table"]:
             zmax = max(abs(e) / t["iid_sd"] for e in t["errors"])
@@ -600,13 +609,15 @@ def self_test(args, out, log):
                 f"{'ok' if zmax <= 4 else 'FAIL'}")
     summary["A_worst_z"] = worst
     # (B) exactly stratified marginals: every target passes.
-    out("\n## Self-test B: jittered Latin hypercube through the exact inverse CDFs (every target must PASS)")
+    out("\n## Self-test B: jittered Latin hypercube through the exact inverse CDFs "
+        "(every target must PASS)")
     res_b, sw_b = run_all(args, ExactSource("lhs"), out, None)
     b_ok = all(verdicts(res_b, sw_b))
     summary["B_all_pass"] = b_ok
     ok = ok and b_ok
     # (C) the feature displaced by 2e-4: each case fails somewhere.
-    out("\n## Self-test C: the same, feature displaced by 2e-4 in u (each case must FAIL somewhere)")
+    out("\n## Self-test C: the same, feature displaced by 2e-4 in u "
+        "(each case must FAIL somewhere)")
     res_c, sw_c = run_all(args, ExactSource("lhs", shift=2e-4), quiet, None)
     c_ok = True
     for name in sorted({res["case"] for res in res_c}):
@@ -630,7 +641,8 @@ def self_test(args, out, log):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0],
-                                 formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
+                                 formatter_class=argparse.RawDescriptionHelpFormatter,
+                                 epilog=__doc__)
     ap.add_argument("--cli", default="build/client/sfcsampler")
     ap.add_argument("--seeds", default="1,2,3")
     ap.add_argument("--quick", action="store_true", help="smaller N (a smoke run, < 1 min)")

@@ -22,11 +22,12 @@ Every side samples every mesh with --count uniform points and keeps the points:
 Sides alternate in --rounds rounds (the machine's load changes; alternating keeps
 it from favouring one side); the table gives each side's best and median wall
 seconds, the ratios of the medians, and the CPU seconds this process used (all
-threads), which a busy machine disturbs less than the wall time. Then sfcsampler.dask.sample_many over
-the same meshes on a LocalCluster of 1 and of 2 worker processes (one thread
-each; the samples stay on the workers, each task returns its count and seed),
-best of --rounds each, and the scaling ratio. Checks on the way: every result
-has exactly --count samples, and the loop and sample_many give the same bytes.
+threads), which a busy machine disturbs less than the wall time. Then
+sfcsampler.dask.sample_many over the same meshes on a LocalCluster of 1 and of 2
+worker processes (one thread each; the samples stay on the workers, each task
+returns its count and seed), best of --rounds each, and the scaling ratio. Checks on
+the way: every result has exactly --count samples, and the loop and sample_many give
+the same bytes.
 """
 
 import argparse
@@ -95,7 +96,8 @@ def dask_run(meshes, count, workers, rounds):
     client = distributed.Client(cluster)
     try:
         # Warm: the workers import sfcsampler and build their samplers.
-        sfcsampler.dask.sample_many(client, meshes[:2 * workers], count=count, keep=False, progress=False)
+        sfcsampler.dask.sample_many(client, meshes[:2 * workers], count=count, keep=False,
+                                    progress=False)
         best = None
         for _ in range(rounds):
             seconds, results = timed(lambda: sfcsampler.dask.sample_many(
@@ -122,8 +124,9 @@ def main():
     n = max(3, int(round((args.triangles / 2 / 0.625) ** 0.5)))
     m = max(3, int(round(args.triangles / 2 / n)))
     meshes = [torus(n, m, seed) for seed in range(args.meshes)]
-    print(f"{args.meshes} meshes of {2 * n * m} triangles ({n * m} vertices), {args.count} samples each; "
-          f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f}", flush=True)
+    print(f"{args.meshes} meshes of {2 * n * m} triangles ({n * m} vertices), {args.count} "
+          f"samples each; {os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f}",
+          flush=True)
 
     # Same bytes, exact counts (a few meshes).
     a, b = ours_loop(meshes[:8], args.count), ours_many(meshes[:8], args.count, args.workers)
@@ -132,7 +135,8 @@ def main():
     sides = {
         "open3d loop": lambda: open3d_loop(o3d, meshes, args.count),
         "ours, loop (1 thread)": lambda: ours_loop(meshes, args.count),
-        f"ours, sample_many ({args.workers} threads)": lambda: ours_many(meshes, args.count, args.workers),
+        f"ours, sample_many ({args.workers} threads)":
+            lambda: ours_many(meshes, args.count, args.workers),
         f"ours, sample_many ({args.workers} threads), points only": lambda: ours_many(
             meshes, args.count, args.workers, columns=("x", "y", "z")),
     }
@@ -145,7 +149,8 @@ def main():
             times[name].append(seconds)
             cpu[name].append(cpu_seconds)
             del out
-        print(f"round {r + 1}: " + ", ".join(f"{k} {v[-1]:.2f} s" for k, v in times.items()), flush=True)
+        print(f"round {r + 1}: " + ", ".join(f"{k} {v[-1]:.2f} s" for k, v in times.items()),
+              flush=True)
     # sample_many's seeds are derived per mesh; check it against the loop with those seeds.
     for mesh, many_result in zip(meshes[:8], b):
         seed = sfcsampler.model_seed(1, __import__("hashlib").sha256(
@@ -172,7 +177,8 @@ def main():
         print("|---|---:|---:|")
         print(f"| 1 worker process | {one:.2f} | {args.meshes / one:.0f} |")
         print(f"| 2 worker processes | {two:.2f} | {args.meshes / two:.0f} |")
-        print(f"\nscaling 1 -> 2 workers: {one / two:.2f}x (load average now {os.getloadavg()[0]:.1f})")
+        print(f"\nscaling 1 -> 2 workers: {one / two:.2f}x (load average now "
+              f"{os.getloadavg()[0]:.1f})")
 
 
 if __name__ == "__main__":

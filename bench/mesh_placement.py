@@ -27,12 +27,14 @@ def read_ply(path):
     nf = int(header.split("element face ")[1].split()[0])
     nprops = header.split("element face")[0].count("property double")
     v = np.frombuffer(data, dtype="<f8", count=nv * nprops, offset=end).reshape(nv, nprops)[:, :3]
-    f = np.frombuffer(data, dtype=np.dtype([("n", "u1"), ("i", "<i4", 3)]), count=nf, offset=end + nv * nprops * 8)
+    f = np.frombuffer(data, dtype=np.dtype([("n", "u1"), ("i", "<i4", 3)]), count=nf,
+                      offset=end + nv * nprops * 8)
     return v, f["i"]
 
 
 def sample(cli, surface, n, seed):
-    out = subprocess.run([cli, "sample", "--surface", surface, "--count", str(n), "--seed", str(seed), "-q", "-o", "-"]
+    out = subprocess.run([cli, "sample", "--surface", surface, "--count", str(n), "--seed",
+                          str(seed), "-q", "-o", "-"]
                          + (["--triangle"] if surface.startswith("ply:") else []),
                          check=True, capture_output=True, text=True).stdout
     return np.loadtxt(io.StringIO(out), delimiter=",", skiprows=1, ndmin=2)
@@ -53,7 +55,8 @@ def spherical_discrepancy(p, seed, triangles=128):
     triple = np.einsum("ij,ij->i", a, np.cross(b, c))
     excess = 2 * np.arctan2(triple, 1 + np.einsum("ij,ij->i", a, b) + np.einsum("ij,ij->i", b, c)
                             + np.einsum("ij,ij->i", c, a))
-    inside = ((p @ np.cross(a, b).T >= 0) & (p @ np.cross(b, c).T >= 0) & (p @ np.cross(c, a).T >= 0))
+    inside = ((p @ np.cross(a, b).T >= 0) & (p @ np.cross(b, c).T >= 0) &
+              (p @ np.cross(c, a).T >= 0))
     return np.max(np.abs(inside.mean(axis=0) - excess / (4 * np.pi)))
 
 
@@ -73,19 +76,21 @@ def main():
             m = sample(cli, "ply:" + mesh, n, seed)
             tri = faces[m[:, 6].astype(int)]
             p0, p1, p2 = verts[tri[:, 0]], verts[tri[:, 1]], verts[tri[:, 2]]
-            variants = {"mesh, as sampled": m[:, 3:6], "mesh, moved to the triangle centroid": (p0 + p1 + p2) / 3}
+            variants = {"mesh, as sampled": m[:, 3:6],
+                        "mesh, moved to the triangle centroid": (p0 + p1 + p2) / 3}
             a, b = rng.random(n), rng.random(n)
             flip = a + b > 1
             a[flip], b[flip] = 1 - a[flip], 1 - b[flip]
-            variants["mesh, moved to a random point of the triangle"] = p0 + (p1 - p0) * a[:, None] + (p2 - p0) * b[:, None]
+            variants["mesh, moved to a random point of the triangle"] = (
+                p0 + (p1 - p0) * a[:, None] + (p2 - p0) * b[:, None])
             for name, p in variants.items():
                 p = p / np.linalg.norm(p, axis=1)[:, None]
                 d.setdefault(name, []).append(spherical_discrepancy(p, seed))
         for name, ds in d.items():
             slopes.setdefault(name, []).append(np.polyfit(np.log(sizes), np.log(ds), 1)[0])
         print(f"seed {seed} done", file=sys.stderr)
-    print(f"Spherical-triangle discrepancy slope, N = {sizes[0]}..{sizes[-1]}, seeds {','.join(map(str, seeds))} "
-          f"(mean +- SE)\n\n| set | slope |\n|---|---:|")
+    print(f"Spherical-triangle discrepancy slope, N = {sizes[0]}..{sizes[-1]}, seeds "
+          f"{','.join(map(str, seeds))} (mean +- SE)\n\n| set | slope |\n|---|---:|")
     for name, v in slopes.items():
         v = np.array(v)
         se = v.std(ddof=1) / np.sqrt(len(v)) if len(v) > 1 else 0

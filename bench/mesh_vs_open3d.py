@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """sfcsampler's mesh sampling against Open3D's, side by side on one mesh.
 
-Usage: python3 bench/mesh_vs_open3d.py [BUILD_DIR=build] [COUNT=1000000] [POISSON_COUNT=2000] [THREADS=1]
+Usage: python3 bench/mesh_vs_open3d.py [BUILD_DIR=build] [COUNT=1000000] [POISSON_COUNT=2000]
+                                       [THREADS=1]
 
 Makes the 81 920-triangle icosphere (a subdivided icosahedron pushed to the
 unit sphere, built the same way as mesh/icosphere.cc, which mesh_benchmark
@@ -34,7 +35,8 @@ def ensure_open3d():
     except ImportError:
         pass
     if os.path.realpath(sys.executable) != os.path.realpath(DEBIAN_PYTHON) and \
-            subprocess.run([DEBIAN_PYTHON, "-c", "import open3d"], capture_output=True).returncode == 0:
+            subprocess.run([DEBIAN_PYTHON, "-c", "import open3d"],
+                           capture_output=True).returncode == 0:
         os.execv(DEBIAN_PYTHON, [DEBIAN_PYTHON] + sys.argv)  # another python3 is first on PATH
     sudo = [] if os.geteuid() == 0 else ["sudo"]
     print("installing python3-open3d from Debian ...", file=sys.stderr)
@@ -116,7 +118,8 @@ def main():
                              check=True, capture_output=True, text=True).stdout
         row = next(l for l in out.splitlines() if l.startswith("| uniform"))
         cells = [c.strip() for c in row.strip("|").split("|")]
-        ours = {"cold": (float(cells[5]), float(cells[7])), "warm": (float(cells[6]), float(cells[8]))}
+        ours = {"cold": (float(cells[5]), float(cells[7])),
+                "warm": (float(cells[6]), float(cells[8]))}
 
         print(f"# {count} samples on the icosphere ({len(faces)} triangles); medians of 3 runs; "
               f"our cursor on {threads} thread(s)")
@@ -126,12 +129,15 @@ def main():
               f"{ours['cold'][1]:.3f} | | |")
         print(f"| sfcsampler warm (samples from the built tree) | {ours['warm'][0]:.3f} | "
               f"{ours['warm'][1]:.3f} | | |")
-        for name, (w, c), key in (("Open3D read + sample_points_uniformly (cold)", uniform_cold, "cold"),
-                                  ("Open3D sample_points_uniformly (warm)", uniform_warm, "warm")):
-            print(f"| {name} | {w:.3f} | {c:.3f} | {ours[key][0] / w:.2f} | {ours[key][1] / c:.2f} |")
+        for name, (w, c), key in (
+                ("Open3D read + sample_points_uniformly (cold)", uniform_cold, "cold"),
+                ("Open3D sample_points_uniformly (warm)", uniform_warm, "warm")):
+            print(f"| {name} | {w:.3f} | {c:.3f} | {ours[key][0] / w:.2f} | "
+                  f"{ours[key][1] / c:.2f} |")
         est_wall, est_cpu = poisson[0] / poisson_count * count, poisson[1] / poisson_count * count
         print(f"| Open3D sample_points_poisson_disk, {poisson_count} points "
-              f"({poisson_count / poisson[0]:.0f} points/s) | {poisson[0]:.3f} | {poisson[1]:.3f} | | |")
+              f"({poisson_count / poisson[0]:.0f} points/s) | {poisson[0]:.3f} | "
+              f"{poisson[1]:.3f} | | |")
         print(f"\nPoisson disk for {count} points, extrapolated linearly: {est_wall:.0f} s wall; "
               f"our cold run is {est_wall / ours['cold'][0]:.0f}x faster (wall), "
               f"{est_cpu / ours['cold'][1]:.0f}x (cpu)")

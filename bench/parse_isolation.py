@@ -109,7 +109,8 @@ def main():
         print(f"server {address}, flags {server_flags or 'defaults'}; hostile: {KIND} {SIZE} "
               f"({os.path.getsize(polygon)} bytes) per client, each connected "
               f"{HOLD:g} s; good: the 2 KB STEP sphere, cold, 1 000 samples")
-        print(f"{'hostile':>7}  {'round':>5}  {'alone s':>8}  {'with s':>8}  {'ratio':>6}  hostile outcomes")
+        print(f"{'hostile':>7}  {'round':>5}  {'alone s':>8}  {'with s':>8}  {'ratio':>6}  hostile "
+              "outcomes")
         summary = []
         for h in HOSTILE:
             ratios = []

@@ -40,7 +40,8 @@ def cpp_best(binary):
     out = subprocess.run([binary, "--benchmark_filter=BM_SampleFromBuiltTree/0/0",
                           f"--benchmark_repetitions={PER_ROUND}", "--benchmark_format=json"],
                          capture_output=True, text=True, check=True).stdout
-    return min(b["real_time"] / 1e3 for b in json.loads(out)["benchmarks"] if b.get("run_type") == "iteration")
+    return min(b["real_time"] / 1e3 for b in json.loads(out)["benchmarks"]
+               if b.get("run_type") == "iteration")
 
 
 def wire(server):
@@ -57,7 +58,8 @@ def wire(server):
                 start = time.perf_counter()
                 client.sample(surface="torus", count=N, precision=precision)
                 times.append(time.perf_counter() - start)
-            print(f"{'cache hit, ' + precision:<34} {min(times):>7.2f} {statistics.median(times):>9.2f}")
+            print(f"{'cache hit, ' + precision:<34} {min(times):>7.2f} "
+                  f"{statistics.median(times):>9.2f}")
 
 
 def main():
@@ -83,7 +85,8 @@ def main():
         ratio = statistics.median(r[0] / r[i] for r in rounds)
         print(f"{name:<42} {min(times) * 1e3:>8.1f} {statistics.median(times) * 1e3:>10.1f}"
               f" {N / statistics.median(times) / 1e6:>12.2f} {ratio:>11.2f}")
-    print("(C++ / this: the median over rounds of the C++ time over this path's time; >= 1 is as fast)")
+    print("(C++ / this: the median over rounds of the C++ time over this path's time; >= 1 is as "
+          "fast)")
     if args.server:
         wire(args.server)
 

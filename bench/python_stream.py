@@ -33,7 +33,8 @@ def main():
             with sfcsampler.Client(target, encoding=encoding) as client:
                 client.sample(surface="sphere", count=count, precision=precision)  # warm the tree
                 seconds = best_seconds(client, precision, count)
-            print(f"| {precision}, {encoding} columns, {count} samples | {count / seconds / 1e6:.2f} |")
+            print(f"| {precision}, {encoding} columns, {count} samples | "
+                  f"{count / seconds / 1e6:.2f} |")
 
 
 if __name__ == "__main__":

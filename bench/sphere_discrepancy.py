@@ -158,7 +158,8 @@ def sphere_local_search_pool(rng, n, n_random, n_local):
     lo, hi = math.log(0.7 / math.sqrt(n)), math.log(1.2)
     size = np.exp(rng.uniform(lo, hi, n_local))[:, None, None]
     off = rng.standard_normal((n_local, 3, 2)) * size
-    tri_l = normalize(centre[:, None, :] + off[..., :1] * e1[:, None, :] + off[..., 1:] * e2[:, None, :])
+    tri_l = normalize(centre[:, None, :] + off[..., :1] * e1[:, None, :] +
+                      off[..., 1:] * e2[:, None, :])
     return np.concatenate([tri_r, tri_l], axis=0)
 
 
@@ -299,7 +300,8 @@ class BoxMeasure:
         rng = np.random.default_rng([self.seed, n, 1])
         for r in range(self.rounds):
             cand = np.repeat(bb, self.props, axis=0)
-            w = np.maximum(np.stack([cand[:, 1] - cand[:, 0]] * 2 + [cand[:, 3] - cand[:, 2]] * 2, 1), 1e-3)
+            w = np.maximum(
+                np.stack([cand[:, 1] - cand[:, 0]] * 2 + [cand[:, 3] - cand[:, 2]] * 2, 1), 1e-3)
             scale = np.exp(rng.uniform(math.log(0.002), math.log(0.3), (len(cand), 1)))
             mask = rng.random(cand.shape) < 0.5
             cand = sort_box(cand + rng.standard_normal(cand.shape) * w * scale * mask)
@@ -400,9 +402,10 @@ def summarise(ns, per_seed):
 
 
 def report(args, ns, seeds, results):
-    print("surface %s; N = %s; seeds %s; measure seed %d; %d random + %d local, search %d x %d x %d"
-          % (args.surface, ",".join(map(str, ns)), seeds, args.measure_seed, args.random, args.local,
-             args.keep, args.props, args.rounds))
+    print(
+        "surface %s; N = %s; seeds %s; measure seed %d; %d random + %d local, search %d x %d x %d" %
+        (args.surface, ",".join(map(str, ns)), seeds, args.measure_seed, args.random, args.local,
+         args.keep, args.props, args.rounds))
     for m in next(iter(results.values())):
         label = {"tri": "spherical triangles", "star": "anchored star (exact)",
                  "box": "unanchored boxes (search)"}[m]
@@ -462,7 +465,8 @@ def self_test(args):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--cli", default=DEFAULT_CLI)
     ap.add_argument("--surface", default="sphere", choices=["sphere", "plane"])
     ap.add_argument("--variant", action="append", default=[], metavar="NAME=ARGS",
@@ -487,7 +491,8 @@ def main():
         args.random, args.local, args.keep, args.props, args.rounds = 1000, 1000, 16, 16, 40
     if args.self_test:
         return self_test(args)
-    if args.surface == "sphere" and not os.path.exists(args.cli) and (not args.no_default or args.variant):
+    if (args.surface == "sphere" and not os.path.exists(args.cli)
+            and (not args.no_default or args.variant)):
         raise SystemExit("no CLI at %s (use --cli)" % args.cli)
     run(args)
     return 0

@@ -78,7 +78,8 @@ def row_python(n=4_000_000):
     rows = [(f"1. {n / 1e6:.0f} M sphere samples, cached tree, Python, 1 thread, u v x y z float64",
              f"{statistics.median(ours):.3f} s ({n / statistics.median(ours) / 1e6:.1f} M/s)",
              f"numpy i.i.d. {statistics.median(theirs):.3f} s",
-             f"speed ratio {statistics.median(ratios):.2f} (rounds {min(ratios):.2f}-{max(ratios):.2f})")]
+             f"speed ratio {statistics.median(ratios):.2f} "
+             f"(rounds {min(ratios):.2f}-{max(ratios):.2f})")]
     try:
         from scipy.stats import qmc
         sobol = qmc.Sobol(d=2, scramble=True, seed=1)
@@ -93,7 +94,8 @@ def row_python(n=4_000_000):
 
 def row_core():
     out = run(["taskset", "-c", "0", f"{BUILD}/bench/core_benchmark",
-               "--benchmark_filter=BuildTreeAndSampleSphere/1000000/1$|BuildTreeOnly|SampleFromBuiltTree/0/0",
+               "--benchmark_filter="
+               "BuildTreeAndSampleSphere/1000000/1$|BuildTreeOnly|SampleFromBuiltTree/0/0",
                "--benchmark_repetitions=3", "--benchmark_report_aggregates_only=true"])
     median = {}
     for line in out.splitlines():
@@ -139,8 +141,8 @@ def row_cold_cli(n=4_000_000):
         with open(script, "w") as f:
             f.write(NUMPY_PLY)
         ours, theirs = paired(
-            lambda: run([f"{BUILD}/client/sfcsampler", "sample", "-n", str(n), "-q", "--format", "ply",
-                         "--columns", "x,y,z", "-o", os.path.join(tmp, "a.ply")]),
+            lambda: run([f"{BUILD}/client/sfcsampler", "sample", "-n", str(n), "-q", "--format",
+                         "ply", "--columns", "x,y,z", "-o", os.path.join(tmp, "a.ply")]),
             lambda: run([sys.executable, script, str(n), os.path.join(tmp, "b.ply")]))
         same_file(os.path.join(tmp, "a.ply"), os.path.join(tmp, "b.ply"))
     return [(f"3. cold CLI, {n / 1e6:.0f} M sphere samples to a binary PLY file, 5 paired runs",

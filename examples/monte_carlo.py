@@ -48,8 +48,8 @@ def run(min_exp, max_exp, seeds, sample):
     ns = [2 ** k for k in range(min_exp, max_exp + 1)]
     rows = []
     for n in ns:
-        ours = [AREA * f(s.x, s.y, s.z).mean()
-                for s in (sample(surface="sphere", count=n, seed=seed) for seed in range(1, seeds + 1))]
+        sets = (sample(surface="sphere", count=n, seed=seed) for seed in range(1, seeds + 1))
+        ours = [AREA * f(s.x, s.y, s.z).mean() for s in sets]
         iid = [iid_estimate(n, seed) for seed in range(1, seeds + 1)]
         rms = lambda estimates: math.sqrt(np.mean((np.array(estimates) - EXACT) ** 2))
         rows.append((n, rms(iid), rms(ours)))
@@ -64,7 +64,8 @@ def plot(rows, path, slopes):
     ns = [r[0] for r in rows]
     fig, ax = plt.subplots(figsize=(6, 4.5), dpi=120)
     ax.loglog(ns, [r[1] for r in rows], "o-", label=f"i.i.d. uniform (slope {slopes[0]:.2f})")
-    ax.loglog(ns, [r[2] for r in rows], "s-", label=f"sfcsampler jittered Hilbert (slope {slopes[1]:.2f})")
+    ax.loglog(ns, [r[2] for r in rows], "s-",
+              label=f"sfcsampler jittered Hilbert (slope {slopes[1]:.2f})")
     ref = rows[0][1] * (np.array(ns) / ns[0]) ** -0.5
     ax.loglog(ns, ref, ":", color="gray", label="N^-1/2")
     ax.set_xlabel("N (samples)")
@@ -82,7 +83,8 @@ def main(argv=None):
     parser.add_argument("--max-exp", type=int, default=18, help="largest N = 2^max_exp")
     parser.add_argument("--seeds", type=int, default=16, help="repetitions per N (RMS over them)")
     parser.add_argument("--out", default="monte_carlo.png", help="the log-log plot (PNG)")
-    parser.add_argument("--server", help="HOST:PORT: sample through sfcsampler.Client instead of in-process")
+    parser.add_argument("--server",
+                        help="HOST:PORT: sample through sfcsampler.Client instead of in-process")
     args = parser.parse_args(argv)
 
     client = sfcsampler.Client(args.server) if args.server else None

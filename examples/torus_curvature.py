@@ -66,11 +66,12 @@ def main(argv=None):
     parser.add_argument("--minor", type=float, default=0.4, help="r, the tube radius")
     parser.add_argument("--floor", type=float, default=0.05, help="density floor")
     parser.add_argument("--out", default="torus", help="writes OUT.ply and OUT.png")
-    parser.add_argument("--server", help="HOST:PORT: sample through sfcsampler.Client instead of in-process")
+    parser.add_argument("--server",
+                        help="HOST:PORT: sample through sfcsampler.Client instead of in-process")
     args = parser.parse_args(argv)
 
-    request = dict(surface=f"torus:R={args.major};r={args.minor}", density=f"gaussian:floor={args.floor}",
-                   count=args.count, normals=True)
+    request = dict(surface=f"torus:R={args.major};r={args.minor}",
+                   density=f"gaussian:floor={args.floor}", count=args.count, normals=True)
     if args.server:
         with sfcsampler.Client(args.server) as client:
             s = client.sample(**request)

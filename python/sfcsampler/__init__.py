@@ -28,7 +28,8 @@ from sfcsampler.errors import (DataLossError, DeadlineExceededError, DepthCapWar
 from sfcsampler.samples import Samples
 
 __all__ = [
-    "ALGORITHM_VERSION", "Client", "Result", "Results", "model_seed", "sample_many", "write_ply", "DataLossError", "DeadlineExceededError", "DepthCapWarning",
+    "ALGORITHM_VERSION", "Client", "Result", "Results", "model_seed", "sample_many", "write_ply",
+    "DataLossError", "DeadlineExceededError", "DepthCapWarning",
     "Error", "InvalidArgumentError", "ResourceExhaustedError", "Samples", "Sampler",
     "UnauthenticatedError", "UnavailableError", "batches", "densities", "prepare", "sample",
     "surfaces",

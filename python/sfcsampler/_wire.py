@@ -69,7 +69,10 @@ def _columns(buf, dtype):
         if 1 <= number <= 10:  # packed or not, the bytes are the values
             pieces.setdefault(_COLUMN_NAMES[number], []).append(np.frombuffer(value, dtype=dtype))
     # Copies: writable arrays that do not keep the whole message alive.
-    return {name: parts[0].copy() if len(parts) == 1 else np.concatenate(parts) for name, parts in pieces.items()}
+    return {
+        name: parts[0].copy() if len(parts) == 1 else np.concatenate(parts)
+        for name, parts in pieces.items()
+    }
 
 
 def _raw_columns(buf):
@@ -87,7 +90,8 @@ def _raw_columns(buf):
     out = {}
     for name, view in views.items():
         if len(view) % dtype.itemsize:
-            raise DataLossError(15, f"a raw column {name} of {len(view)} bytes is not whole {dtype} values")
+            raise DataLossError(
+                15, f"a raw column {name} of {len(view)} bytes is not whole {dtype} values")
         out[name] = np.frombuffer(view, dtype=dtype).copy()  # writable, and frees the message
     return out
 

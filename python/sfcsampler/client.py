@@ -125,8 +125,10 @@ class Client:
                     with open(tls_roots, "rb") as f:
                         roots = f.read()
                 except OSError as e:
-                    raise InvalidArgumentError(3, f'cannot read TLS roots "{tls_roots}": {e}') from e
-            self._channel = grpc.secure_channel(target, grpc.ssl_channel_credentials(roots), options)
+                    raise InvalidArgumentError(
+                        3, f'cannot read TLS roots "{tls_roots}": {e}') from e
+            self._channel = grpc.secure_channel(target, grpc.ssl_channel_credentials(roots),
+                                                options)
         else:
             self._channel = grpc.insecure_channel(target, options)
         self._stub = sampler_pb2_grpc.SamplerStub(self._channel)
@@ -283,8 +285,8 @@ class Client:
         resume_range = None   # monotone resumes ask for the rest of the range
         backoff = self._resume_backoff
         for attempt in range(self._max_resumes + 1):
-            call = self._sample_rpc(self._wire_request(req, precision, batch_size, resume_range, requested),
-                                    timeout=self._timeout, metadata=metadata)
+            wire = self._wire_request(req, precision, batch_size, resume_range, requested)
+            call = self._sample_rpc(wire, timeout=self._timeout, metadata=metadata)
             this_stream = 0
             try:
                 for raw in call:
@@ -299,7 +301,8 @@ class Client:
                             raise DataLossError(15, (
                                 f"the resumed stream comes from tree {header.tree.key} "
                                 f"({header.algorithm_version}), the first from {first.tree.key} "
-                                f"({first.algorithm_version}); the samples would not continue the set"))
+                                f"({first.algorithm_version}); the samples would not continue "
+                                "the set"))
                     n = len(columns["index"])
                     if n and first is None:
                         raise DataLossError(15, "samples arrived before the stream's header")
@@ -343,8 +346,10 @@ class Client:
             sent = dict(call.trailing_metadata() or ()).get("x-samples-sent")
             if sent is not None and int(sent) != this_stream:
                 raise DataLossError(15, f"the server sent {sent} samples but {this_stream} arrived")
-            if first is not None and first.expected_samples >= 0 and received != first.expected_samples:
-                raise DataLossError(15, f"expected {first.expected_samples} samples, received {received}")
+            if (first is not None and first.expected_samples >= 0
+                    and received != first.expected_samples):
+                raise DataLossError(
+                    15, f"expected {first.expected_samples} samples, received {received}")
             if received == 0 and first is not None:  # e.g. a region with no samples
                 yield Samples({}, tree, first.begin, first.end, first.seed, first.algorithm_version,
                               np.float32 if precision == "float32" else np.float64, kept)
@@ -359,7 +364,8 @@ class Client:
             raise DataLossError(15, "the stream ended without a header or samples")
         last = parts[-1]
         filled = [p.columns() for p in parts if len(p)]
-        return concatenate(filled, last.tree, last.begin, last.end, last.seed, last.algorithm_version,
+        return concatenate(filled, last.tree, last.begin, last.end, last.seed,
+                           last.algorithm_version,
                            np.float32 if precision == "float32" else np.float64, kept)
 
     def prepare(self, **request):
@@ -368,7 +374,8 @@ class Client:
         w = pb.PrepareRequest(count=req.tree_count or req.count)
         _tree_spec(req, w.tree)
         try:
-            response = self._stub.Prepare(w, timeout=self._timeout, metadata=self._metadata(_routing_key(req)))
+            response = self._stub.Prepare(w, timeout=self._timeout,
+                                          metadata=self._metadata(_routing_key(req)))
         except grpc.RpcError as e:
             raise _error(e) from None
         tree = _wire.message_dict(response.tree)

@@ -132,7 +132,8 @@ def sample_many(client, models, *, seed=1, out_dir=None, keep=None, service=None
         models_per_task = max(1, min(64, len(shipped) // (4 * workers)))
     futures = []
     call = uuid.uuid4().hex[:12]  # keys unique to this call: Dask would reuse a live key's result
-    chunks = [slice(start, start + models_per_task) for start in range(0, len(shipped), models_per_task)]
+    chunks = [slice(start, start + models_per_task)
+              for start in range(0, len(shipped), models_per_task)]
     # Each chunk's models go to the workers as data (a few MB of mesh bytes), not in the graph.
     data = client.scatter([shipped[chunk] for chunk in chunks], hash=False)
     for chunk, models_data in zip(chunks, data):

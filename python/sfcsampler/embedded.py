@@ -96,7 +96,8 @@ class Sampler:
                           _core.ALGORITHM_VERSION, _dtype(precision), kept)
 
     def prepare(self, **request):
-        """Builds (or finds) the request's tree, sized for tree_count or count; returns its summary."""
+        """Builds (or finds) the request's tree, sized for tree_count or count; returns its
+        summary."""
         tree = self._held(request, self._engine.prepare)
         warn_depth_cap(tree, stacklevel=3)
         return tree

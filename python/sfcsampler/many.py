@@ -107,7 +107,8 @@ class Model:
             fmt = model_format(self.path)
             if fmt is None:
                 raise meshes.InvalidArgumentError(
-                    3, f"unknown model format (extension); use one of {', '.join(sorted(EXTENSIONS))}")
+                    3, "unknown model format (extension); use one of "
+                    f"{', '.join(sorted(EXTENSIONS))}")
             with open(self.path, "rb") as f:
                 return fmt, f.read()
         return "ply", meshes.mesh_ply(self.mesh, self.weights)
@@ -152,8 +153,8 @@ def output_names(names, fmt="npy"):
     for n in names:
         o = output_name(n, fmt, stems[output_name(n, fmt)] > 1)
         if o in seen:
-            raise meshes.InvalidArgumentError(3, f"models {seen[o]!r} and {n!r} would both write {o}; "
-                                                 "name each model once")
+            raise meshes.InvalidArgumentError(
+                3, f"models {seen[o]!r} and {n!r} would both write {o}; name each model once")
         seen[o] = n
         out.append(o)
     return out
@@ -175,7 +176,8 @@ class Result:
 
     def __init__(self, name, sha256=None, seed=None, samples=None, path=None, count=0,
                  seconds=0.0, error=None):
-        self.name, self.sha256, self.seed, self.samples, self.path = name, sha256, seed, samples, path
+        self.name, self.sha256, self.seed = name, sha256, seed
+        self.samples, self.path = samples, path
         self.count, self.seconds, self.error = count, seconds, error
 
     @property
@@ -217,8 +219,8 @@ def find_model_check_program():
     found = shutil.which("sfcsampler-model-check")
     if found:
         return found
-    beside = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, os.pardir, "server",
-                          "sfcsampler-model-check")
+    beside = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, os.pardir,
+                          "server", "sfcsampler-model-check")
     return os.path.normpath(beside) if os.access(beside, os.X_OK) else ""
 
 
@@ -277,10 +279,12 @@ def npy_bytes(samples):
     """The samples as the bytes of the CLI's NPY file (client/sample_writer.cc: format 1.0,
     the header padded to 64 bytes), so Python and the CLI write identical files."""
     array = structured(samples)
-    descr = "[" + ", ".join(f"('{name}', '{array.dtype[name].str}')" for name in array.dtype.names) + "]"
+    descr = "[" + ", ".join(f"('{name}', '{array.dtype[name].str}')"
+                            for name in array.dtype.names) + "]"
     header = f"{{'descr': {descr}, 'fortran_order': False, 'shape': ({len(array)},), }}"
     header += " " * ((64 - (10 + len(header) + 1) % 64) % 64) + "\n"
-    return b"\x93NUMPY\x01\x00" + len(header).to_bytes(2, "little") + header.encode() + array.tobytes()
+    return (b"\x93NUMPY\x01\x00" + len(header).to_bytes(2, "little") + header.encode()
+            + array.tobytes())
 
 
 def write_npy(path, samples):
@@ -306,8 +310,9 @@ class _Bar:
             if self.enabled:
                 width = 30
                 filled = width * self.done // max(self.total, 1)
-                sys.stderr.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {self.done}/{self.total} "
-                                 f"models, {self.failed} failed ")
+                sys.stderr.write(
+                    f"\r[{'#' * filled}{'.' * (width - filled)}] {self.done}/{self.total} "
+                    f"models, {self.failed} failed ")
                 sys.stderr.flush()
 
     def close(self):
@@ -325,9 +330,10 @@ def sample_many(models, *, seed=1, out_dir=None, keep=None, workers=0, progress=
       paths and meshes (anything sample(mesh=...) takes); or a dict name -> path or mesh.
     out_dir: write each model's samples to OUT_DIR/NAME.npy, NAME the model's path relative
       to the folder it came from, without its extension (the CLI's file, byte for byte:
-      numpy.load gives a structured array); keep: also keep them in the results (default: only when out_dir is
-      None). workers: models sampled at once (0 = the CPU count, at most 8); each model then
-      uses one thread. progress: a progress bar on stderr (None = when it is a terminal).
+      numpy.load gives a structured array); keep: also keep them in the results (default:
+      only when out_dir is None). workers: models sampled at once (0 = the CPU count, at
+      most 8); each model then uses one thread. progress: a progress bar on stderr (None =
+      when it is a terminal).
     server: "host:port" or a Client: sample on a server instead of in this process.
     model_check_program: in this process, read each CAD file in this program, a process of its
       own, so a file that crashes or loops the CAD kernel, or leaves it broken for the next,
@@ -336,8 +342,9 @@ def sample_many(models, *, seed=1, out_dir=None, keep=None, workers=0, progress=
     The other keywords are sample()'s (count, density, normals, columns, ...), the same for
     every model; face=True applies to the CAD models and triangle=True to the meshes.
     columns=("x", "y", "z") keeps (and writes) only those columns: the others' memory goes
-    back to the next model at once (written files then hold only those fields). Returns Results (a list of Result, in the models' order); a model that fails
-    has its error in Result.error and the others go on. Results.failed, Results.summary().
+    back to the next model at once (written files then hold only those fields). Returns
+    Results (a list of Result, in the models' order); a model that fails has its error in
+    Result.error and the others go on. Results.failed, Results.summary().
     """
     from sfcsampler.client import Client
     from sfcsampler.embedded import Sampler

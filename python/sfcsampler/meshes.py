@@ -92,7 +92,8 @@ def check_normals(normals, vertex_count):
 def check_weights(weights, vertex_count):
     w = _real_array(weights, "density weights", float_only=False)
     if w.ndim != 1 or w.shape[0] != vertex_count:
-        raise _fail(f"density weights must have shape ({vertex_count},), one per vertex, not {w.shape}")
+        raise _fail(
+            f"density weights must have shape ({vertex_count},), one per vertex, not {w.shape}")
     w = np.ascontiguousarray(w, dtype="<f8")
     _finite(w[:, None], "density weights")
     if (w < 0).any():
@@ -131,8 +132,9 @@ def mesh_arrays(mesh):
         return np.asarray(mesh.vertices), np.asarray(mesh.triangles), normals
     if hasattr(mesh, "vertices") and hasattr(mesh, "faces"):  # trimesh.Trimesh and the like
         return np.asarray(mesh.vertices), np.asarray(mesh.faces), None
-    raise TypeError("mesh must be (vertices, faces) arrays, a dict, or an object with vertices and "
-                    f"faces (trimesh) or vertices and triangles (Open3D), not {type(mesh).__name__}")
+    raise TypeError(
+        "mesh must be (vertices, faces) arrays, a dict, or an object with vertices and "
+        f"faces (trimesh) or vertices and triangles (Open3D), not {type(mesh).__name__}")
 
 
 def canonical_ply(vertices, faces, normals=None, weights=None):
@@ -161,7 +163,8 @@ def canonical_ply(vertices, faces, normals=None, weights=None):
     face["i"] = f
     header = ["ply", "format binary_little_endian 1.0", f"element vertex {v.shape[0]}"]
     header += [f"property double {name}" for name, _ in fields]
-    header += [f"element face {f.shape[0]}", "property list uchar int vertex_indices", "end_header", ""]
+    header += [f"element face {f.shape[0]}", "property list uchar int vertex_indices",
+               "end_header", ""]
     return "\n".join(header).encode() + vertex.tobytes() + face.tobytes()
 
 

@@ -55,9 +55,9 @@ class Samples:
     parameters; x, y, z: the surface point; nx, ny, nz, density,
     curve_position when asked for, else None; face (CAD models) and triangle
     (meshes; u, v are then barycentric) as uint32 when asked for. Float columns are float64, or
-    float32 with precision="float32". A column that columns=[...] left out is None. `tree` is the curve tree's summary
-    (the wire's TreeInfo fields as a dict); `begin`, `end` the resolved index
-    range; `seed` and `algorithm_version` identify the set.
+    float32 with precision="float32". A column that columns=[...] left out is None. `tree` is
+    the curve tree's summary (the wire's TreeInfo fields as a dict); `begin`, `end` the
+    resolved index range; `seed` and `algorithm_version` identify the set.
     """
 
     def __init__(self, columns, tree, begin, end, seed, algorithm_version, dtype=np.float64,
@@ -132,9 +132,10 @@ def warn_depth_cap(tree, stacklevel=3):
         where = ""
         if worst:
             w = worst[0]
-            where = (f"; worst: {w['test']} test at u in [{w['u0']:.9g}, {w['u0'] + w['size']:.9g}],"
-                     f" v in [{w['v0']:.9g}, {w['v0'] + w['size']:.9g}]:"
-                     f" {w['measured']:.6g} vs limit {w['limit']:.6g}")
+            where = (
+                f"; worst: {w['test']} test at u in [{w['u0']:.9g}, {w['u0'] + w['size']:.9g}],"
+                f" v in [{w['v0']:.9g}, {w['v0'] + w['size']:.9g}]:"
+                f" {w['measured']:.6g} vs limit {w['limit']:.6g}")
         warnings.warn(DepthCapWarning(
             f"the depth cap stopped splits the tests still wanted (paper Sect. 5.3): {flat} leaves"
             f" for flatness, {mass} for mass{where}"), stacklevel=stacklevel)

@@ -50,8 +50,9 @@ def launch_server(log_path, *extra, port=0):
     """Starts sfcsampler-server on 127.0.0.1:PORT (0 = a free port) with `extra`
     flags, logging to log_path; returns (process, port) once it listens."""
     with open(log_path, "w") as log:
-        proc = subprocess.Popen([SERVER, "--address", f"127.0.0.1:{port}", "--health-address", "127.0.0.1:0",
-                                 "--metrics-address", "127.0.0.1:0", *extra], stdout=log, stderr=log)
+        proc = subprocess.Popen([SERVER, "--address", f"127.0.0.1:{port}", "--health-address",
+                                 "127.0.0.1:0", "--metrics-address", "127.0.0.1:0", *extra],
+                                stdout=log, stderr=log)
     for _ in range(200):
         match = re.search(r" port=(\d+) health_port=", open(log_path).read())
         if match:

@@ -31,7 +31,8 @@ def test_float32_and_batches(server):
         points = client.sample(surface="torus", count=10000, columns=["x", "y", "z"])
         assert points.index is None and np.array_equal(
             points.points, sfcsampler.sample(surface="torus", count=10000).points)
-        assert [p.u for p in client.batches(surface="torus", count=5000, columns="x")] == [None, None]
+        parts = client.batches(surface="torus", count=5000, columns="x")
+        assert [p.u for p in parts] == [None, None]
         parts = list(client.batches(surface="torus", count=10000, precision="float32"))
         assert [len(p) for p in parts] == [4096, 4096, 1808]
         x = np.concatenate([p.x for p in parts])
@@ -84,7 +85,8 @@ def test_columns_left_out_are_not_sent(server, encoding):
             remote = client.sample(columns=columns, **kwargs)
             parts = list(client.batches(columns=columns, **kwargs))
         sent[columns] = total[0] / 2  # each request streamed once by sample(), once by batches()
-        kept = embedded.columns() if columns is None else {c: embedded.columns()[c] for c in columns}
+        kept = (embedded.columns() if columns is None
+                else {c: embedded.columns()[c] for c in columns})
         assert set(remote.columns()) == set(kept), columns
         for name, column in kept.items():
             assert getattr(remote, name).tobytes() == column.tobytes(), (columns, name)
@@ -102,7 +104,8 @@ def test_columns_left_out_are_not_sent(server, encoding):
 @pytest.mark.parametrize("columns", ["x,y,z", "nz,x,index", "index", "u,density"])
 def test_cli_columns_over_the_wire_write_the_in_process_file(server, columns):
     flags = ("sample", "--surface", "torus", "--density", "gaussian:floor=0.1", "--count", "3000",
-             "--normals", "--density-column", "--columns", columns, "--format", "npy", "-q", "-o", "-")
+             "--normals", "--density-column", "--columns", columns, "--format", "npy", "-q", "-o",
+             "-")
     assert run_cli(*flags, "--server", server) == run_cli(*flags)
 
 
@@ -111,7 +114,8 @@ def test_a_model_column_is_refused_on_a_surface_without_it_whatever_columns_keep
     for flag in ("--face", "--triangle"):
         for where in ((), ("--server", server)):
             done = subprocess.run([CLI, "sample", "--surface", "sphere", "--count", "10", flag,
-                                   "--columns", "x,y,z", "-q", "-o", "-", *where], capture_output=True)
+                                   "--columns", "x,y,z", "-q", "-o", "-", *where],
+                                  capture_output=True)
             assert done.returncode != 0 and b"INVALID_ARGUMENT" in done.stderr, (flag, where)
     with sfcsampler.Client(server) as client:
         for flag in ("face", "triangle"):
@@ -200,7 +204,8 @@ def test_resumes_after_the_server_restarts(sequence):
                 if i == 5:
                     first.kill()
                     first.wait()
-                    second, _ = launch_server(os.path.join(tmp, "b.log"), "--shutdown-grace", "0", port=port)
+                    second, _ = launch_server(os.path.join(tmp, "b.log"), "--shutdown-grace", "0",
+                                              port=port)
             assert client.resumes >= 1
             got = np.concatenate([p.x for p in parts])
             index = np.concatenate([p.index for p in parts])
@@ -214,16 +219,16 @@ def test_resumes_after_the_server_restarts(sequence):
 
 
 def test_cli_over_the_wire_float32_npy_is_the_embedded_file(server, tmp_path):
-    args = ["sample", "--surface", "torus", "--density", "mean:floor=0.1", "--count", "30000", "--format",
-            "npy", "--precision", "float32", "-q", "-o"]
+    args = ["sample", "--surface", "torus", "--density", "mean:floor=0.1", "--count", "30000",
+            "--format", "npy", "--precision", "float32", "-q", "-o"]
     run_cli(*args, str(tmp_path / "embedded.npy"))
     run_cli(*args, str(tmp_path / "wire.npy"), "--server", server)
     assert (tmp_path / "embedded.npy").read_bytes() == (tmp_path / "wire.npy").read_bytes()
 
 
 def test_cli_render_over_the_wire(server, tmp_path):
-    run_cli("render", "--surface", "torus", "--count", "2000", "--size", "200", "-o", str(tmp_path / "t.png"),
-            "--server", server)
+    run_cli("render", "--surface", "torus", "--count", "2000", "--size", "200", "-o",
+            str(tmp_path / "t.png"), "--server", server)
     assert (tmp_path / "t.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     failed = subprocess.run([CLI, "render", "--what", "curve", "--server", server, "-o",
                              str(tmp_path / "c.png")], capture_output=True, text=True)
@@ -245,9 +250,10 @@ def test_cli_eval_over_the_wire_gives_the_same_discrepancies(server, tmp_path):
 
 def test_tls_and_token(tmp_path):
     cert, key = tmp_path / "cert.pem", tmp_path / "key.pem"
-    subprocess.run(["openssl", "req", "-x509", "-newkey", "rsa:2048", "-nodes", "-days", "1", "-subj",
-                    "/CN=localhost", "-addext", "subjectAltName=IP:127.0.0.1,DNS:localhost",
-                    "-keyout", str(key), "-out", str(cert)], capture_output=True, check=True)
+    subprocess.run(["openssl", "req", "-x509", "-newkey", "rsa:2048", "-nodes", "-days", "1",
+                    "-subj", "/CN=localhost", "-addext",
+                    "subjectAltName=IP:127.0.0.1,DNS:localhost", "-keyout", str(key), "-out",
+                    str(cert)], capture_output=True, check=True)
     (tmp_path / "token").write_text("s3cret-token\n")
     proc, port = launch_server(tmp_path / "tls.log", "--tls-cert", str(cert), "--tls-key", str(key),
                                "--token-file", str(tmp_path / "token"))

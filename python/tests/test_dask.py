@@ -60,7 +60,8 @@ def test_sample_many_files_sent_as_bytes(client, tmp_path):
         sfcsampler.write_ply(tmp_path / f"{name}.ply", mesh)
     local = sfcsampler.sample_many(tmp_path, count=3000, seed=2)
     for send_bytes in (False, True):
-        remote = sfcsampler.dask.sample_many(client, tmp_path, count=3000, seed=2, send_bytes=send_bytes)
+        remote = sfcsampler.dask.sample_many(client, tmp_path, count=3000, seed=2,
+                                             send_bytes=send_bytes)
         for a, b in zip(local, remote):
             assert a.name == b.name
             same_samples(a.samples, b.samples)
@@ -71,7 +72,8 @@ def test_sample_shards_equal_one_run(client, tmp_path):
     whole = sfcsampler.sample(surface="torus", count=n, seed=5, normals=True)
     out = sfcsampler.dask.sample_shards(client, "torus", n, shards=4, seed=5, normals=True,
                                         out_dir=tmp_path)
-    assert [os.path.basename(o[0]) for o in out] == [f"shard-{i:05d}-of-00004.npy" for i in range(4)]
+    assert ([os.path.basename(o[0]) for o in out]
+            == [f"shard-{i:05d}-of-00004.npy" for i in range(4)])
     assert [(o[2], o[3]) for o in out] == [(i * n // 4, (i + 1) * n // 4) for i in range(4)]
     joined = sfcsampler.dask.load_shards([o[0] for o in out])
     assert len(joined) == n
@@ -88,7 +90,8 @@ def test_sample_shards_of_a_mesh_and_a_model_file(client, tmp_path):
     parts = sfcsampler.dask.sample_shards(client, mesh=(v, f), count=200000, shards=3, seed=3,
                                           triangle=True)
     for name in ("index", "x", "y", "z", "u", "v", "triangle"):
-        assert np.array_equal(np.concatenate([getattr(p, name) for p in parts]), getattr(whole, name))
+        assert np.array_equal(np.concatenate([getattr(p, name) for p in parts]),
+                              getattr(whole, name))
     sfcsampler.write_ply(tmp_path / "t.ply", (v, f))
     parts = sfcsampler.dask.sample_shards(client, f"ply:{tmp_path / 't.ply'}", 200000, shards=5,
                                           seed=3, triangle=True)
@@ -110,5 +113,6 @@ def test_workers_on_a_service(client, server):
     for a, b in zip(local, remote):
         same_samples(a.samples, b.samples)
     whole = sfcsampler.sample(surface="sphere", count=100000, seed=4)
-    parts = sfcsampler.dask.sample_shards(client, "sphere", 100000, shards=4, seed=4, service=server)
+    parts = sfcsampler.dask.sample_shards(client, "sphere", 100000, shards=4, seed=4,
+                                          service=server)
     assert np.array_equal(np.concatenate([p.x for p in parts]), whole.x)

@@ -15,16 +15,17 @@ from conftest import CLI, assert_same, cli_columns, run_cli
 CASES = [
     (dict(surface="torus", density="gaussian:floor=0.1", count=20000, seed=4),
      ["--surface", "torus", "--density", "gaussian:floor=0.1", "--count", "20000", "--seed", "4"]),
-    (dict(surface="sphere", count=20000, region="box:0,0,0,1,1,1", normals=True, curve_position=True),
+    (dict(surface="sphere", count=20000, region="box:0,0,0,1,1,1", normals=True,
+          curve_position=True),
      ["--surface", "sphere", "--count", "20000", "--region", "box:0,0,0,1,1,1", "--normals",
       "--curve-position"]),
     (dict(surface="plane", density="expr:u+v", count=5000, sequence="progressive", shard=(1, 3),
           density_column=True),
-     ["--surface", "plane", "--density", "expr:u+v", "--count", "5000", "--sequence", "progressive",
-      "--shard", "1/3", "--density-column"]),
+     ["--surface", "plane", "--density", "expr:u+v", "--count", "5000", "--sequence",
+      "progressive", "--shard", "1/3", "--density-column"]),
     (dict(surface="eight", curve="peano", count=3000, begin=1000, end=2500, sequence="random"),
-     ["--surface", "eight", "--curve", "peano", "--count", "3000", "--begin", "1000", "--end", "2500",
-      "--sequence", "random"]),
+     ["--surface", "eight", "--curve", "peano", "--count", "3000", "--begin", "1000", "--end",
+      "2500", "--sequence", "random"]),
 ]
 
 
@@ -38,7 +39,8 @@ def test_batches_concatenate_to_the_whole_set():
     parts = list(sfcsampler.batches(surface="torus", count=50000, normals=True, batch_size=7000))
     assert [len(p) for p in parts] == [7000] * 7 + [1000]
     for name in ("index", "x", "nz"):
-        assert np.array_equal(np.concatenate([getattr(p, name) for p in parts]), getattr(whole, name))
+        assert np.array_equal(np.concatenate([getattr(p, name) for p in parts]),
+                              getattr(whole, name))
 
 
 def test_float32_is_the_float64_set_rounded():
@@ -51,7 +53,8 @@ def test_float32_is_the_float64_set_rounded():
 
 def test_columns_keeps_only_the_named_columns_with_the_same_values():
     full = sfcsampler.sample(surface="torus", count=5000, normals=True)
-    points = sfcsampler.sample(surface="torus", count=5000, normals=True, columns=("x", "y", "z", "nz"))
+    points = sfcsampler.sample(surface="torus", count=5000, normals=True,
+                               columns=("x", "y", "z", "nz"))
     assert len(points) == 5000
     for name in ("x", "y", "z", "nz"):
         assert np.array_equal(getattr(points, name), getattr(full, name)), name
@@ -70,16 +73,18 @@ def test_columns_keeps_only_the_named_columns_with_the_same_values():
 
 def test_cli_columns_writes_only_those_columns(tmp_path):
     full = cli_columns("--surface", "torus", "--count", "3000", "--normals")
-    some = cli_columns("--surface", "torus", "--count", "3000", "--normals", "--columns", "nz,x,index")
+    some = cli_columns("--surface", "torus", "--count", "3000", "--normals", "--columns",
+                       "nz,x,index")
     assert list(some) == ["index", "x", "nz"]  # the file's own order, whatever the flag's
     for name in some:
         assert np.array_equal(some[name], full[name]), name
-    run_cli("sample", "--surface", "torus", "--count", "3000", "--format", "npy", "--columns", "x,y,z",
-            "-q", "-o", str(tmp_path / "p.npy"))
+    run_cli("sample", "--surface", "torus", "--count", "3000", "--format", "npy", "--columns",
+            "x,y,z", "-q", "-o", str(tmp_path / "p.npy"))
     points = np.load(tmp_path / "p.npy")
     assert points.dtype.names == ("x", "y", "z")
     assert np.array_equal(points["y"], sfcsampler.sample(surface="torus", count=3000).y)
-    for flags, words in ((["--columns", "x,w"], "unknown column"), (["--columns", "nx"], "--normals"),
+    for flags, words in ((["--columns", "x,w"], "unknown column"),
+                         (["--columns", "nx"], "--normals"),
                          (["--columns", "u,v", "--format", "ply"], "x, y and z")):
         done = subprocess.run([CLI, "sample", "--count", "10", *flags, "-q", "-o", "-"],
                               capture_output=True, text=True)
@@ -192,26 +197,29 @@ def test_cli_npy_of_a_region_counts_its_samples(tmp_path):
 
 def test_cli_float32_is_the_embedded_float32(tmp_path):
     path = tmp_path / "f.npy"
-    run_cli("sample", "--surface", "eight", "--count", "5000", "--precision", "float32", "--format", "npy",
-            "-q", "-o", str(path))
+    run_cli("sample", "--surface", "eight", "--count", "5000", "--precision", "float32", "--format",
+            "npy", "-q", "-o", str(path))
     loaded = np.load(path)
     s = sfcsampler.sample(surface="eight", count=5000, precision="float32")
     assert loaded["x"].dtype == np.float32 and np.array_equal(loaded["x"], s.x)
     # CSV in float32 prints the shortest text of each float.
-    text = run_cli("sample", "--surface", "eight", "--count", "5000", "--precision", "float32", "-q")
+    text = run_cli("sample", "--surface", "eight", "--count", "5000", "--precision", "float32",
+                   "-q")
     first = text.decode().splitlines()[1].split(",")
     assert np.float32(first[3]) == s.x[0] and len(first[3]) <= 12
 
 
 def test_quiet_keeps_warnings_and_no_warnings_drops_them():
-    args = [CLI, "sample", "--surface", "sphere", "--count", "100000", "--depth-cap", "4", "-o", "/dev/null"]
+    args = [CLI, "sample", "--surface", "sphere", "--count", "100000", "--depth-cap", "4",
+            "-o", "/dev/null"]
     quiet = subprocess.run(args + ["-q"], capture_output=True, text=True, check=True).stderr
     assert "warning: the depth cap" in quiet and "tree " not in quiet
-    silent = subprocess.run(args + ["-q", "--no-warnings"], capture_output=True, text=True, check=True).stderr
+    silent = subprocess.run(args + ["-q", "--no-warnings"], capture_output=True, text=True,
+                            check=True).stderr
     assert silent == ""
     # Not a terminal: no progress lines ('\r'), whatever the size.
-    loud = subprocess.run([CLI, "sample", "--count", "1000000", "-o", "/dev/null"], capture_output=True,
-                          text=True, check=True).stderr
+    loud = subprocess.run([CLI, "sample", "--count", "1000000", "-o", "/dev/null"],
+                          capture_output=True, text=True, check=True).stderr
     assert "\r" not in loud and "samples written" in loud
 
 

@@ -12,8 +12,8 @@ EXAMPLES = os.path.join(os.environ.get("SFC_SOURCE_DIR", "."), "examples")
 
 
 def run_example(name, *args):
-    done = subprocess.run([sys.executable, os.path.join(EXAMPLES, name), *args], capture_output=True,
-                          text=True, check=False)
+    done = subprocess.run([sys.executable, os.path.join(EXAMPLES, name), *args],
+                          capture_output=True, text=True, check=False)
     assert done.returncode == 0, done.stderr
     return done.stdout
 
@@ -47,5 +47,6 @@ def test_torus_curvature_writes_ply_and_picture(tmp_path, server):
     assert share > 0.6, out
     assert (tmp_path / "t.png").read_bytes()[:4] == b"\x89PNG"
     # The same file through a server.
-    run_example("torus_curvature.py", "--count", "30000", "--out", str(tmp_path / "w"), "--server", server)
+    run_example("torus_curvature.py", "--count", "30000", "--out", str(tmp_path / "w"), "--server",
+                server)
     assert (tmp_path / "w.ply").read_bytes() == (tmp_path / "t.ply").read_bytes()

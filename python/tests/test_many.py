@@ -21,8 +21,8 @@ from conftest import CLI
 from test_meshes import same_samples, torus_mesh
 
 FIXTURES = os.environ.get("SFC_CAD_FIXTURES", "build/cad/make_cad_fixtures")
-GOOD = ["box_with_hole.step", "cylinder.step", "ring.obj", "sphere.step", "sub/ring.obj", "torus.ply",
-        "wavy.ply"]
+GOOD = ["box_with_hole.step", "cylinder.step", "ring.obj", "sphere.step", "sub/ring.obj",
+        "torus.ply", "wavy.ply"]
 BROKEN = ["broken.ply", "broken.step"]
 FLAGS = ["--count", "3000", "--seed", "11", "--normals"]
 
@@ -46,7 +46,8 @@ def folder(tmp_path_factory):
         out.writelines("v %r %r %r\n" % tuple(r) for r in v3)
         out.writelines("f %d %d %d\n" % tuple(r + 1) for r in f3)
     (models / "sub").mkdir()
-    shutil.copy(models / "ring.obj", models / "sub" / "ring.obj")  # a subfolder, mirrored in the output
+    # A subfolder, mirrored in the output.
+    shutil.copy(models / "ring.obj", models / "sub" / "ring.obj")
     (models / "broken.ply").write_bytes((models / "torus.ply").read_bytes()[:700])  # truncated
     (models / "broken.step").write_text("ISO-10303-21;\nthis is not a STEP file\n")
     (models / "notes.txt").write_text("not a model: skipped in a folder\n")
@@ -102,7 +103,8 @@ def test_cli_folder_each_model_as_alone(folder, tmp_path):
     for name in GOOD:
         path = folder / name
         seed = many.model_seed(11, sha(path))
-        assert int(rows[name]["seed"]) == seed and rows[name]["sha256"] == sha(path)  # C++ == Python
+        # C++ == Python
+        assert int(rows[name]["seed"]) == seed and rows[name]["sha256"] == sha(path)
         got = out / (name.rsplit(".", 1)[0] + ".npy")
         assert filecmp.cmp(got, alone(path, seed, tmp_path / "alone.npy"), shallow=False), name
         assert len(np.load(got)) == 3000
@@ -125,8 +127,8 @@ def test_cli_order_and_workers_do_not_matter(folder, tmp_path):
 
 def test_cli_csv_and_ply_formats(folder, tmp_path):
     for fmt in ("csv", "ply"):
-        done = run("sample-many", folder / "torus.ply", folder / "sphere.step", "-O", tmp_path / fmt,
-                   *FLAGS, "--format", fmt, "--face", "--triangle", "-q")
+        done = run("sample-many", folder / "torus.ply", folder / "sphere.step", "-O",
+                   tmp_path / fmt, *FLAGS, "--format", fmt, "--face", "--triangle", "-q")
         assert done.returncode == 0, done.stderr
         for name in ("torus.ply", "sphere.step"):
             seed = many.model_seed(11, sha(folder / name))
@@ -139,7 +141,8 @@ def test_cli_names(folder, tmp_path):
     (tmp_path / "dup").mkdir()
     shutil.copy(folder / "torus.ply", tmp_path / "dup" / "sphere.ply")
     stems = run("sample-many", folder / "sphere.step", tmp_path / "dup", "-O", tmp_path / "o", "-q")
-    assert stems.returncode == 0 and listing(tmp_path / "o") == ["sphere.ply.npy", "sphere.step.npy"]
+    assert stems.returncode == 0
+    assert listing(tmp_path / "o") == ["sphere.ply.npy", "sphere.step.npy"]
     twice = run("sample-many", folder / "sphere.step", folder / "sphere.step", "-O", tmp_path / "o")
     assert twice.returncode == 2 and "would both write" in twice.stderr
     py = sfcsampler.sample_many([folder / "sphere.step", tmp_path / "dup"], count=3000, seed=11,
@@ -165,7 +168,8 @@ def test_cli_a_cad_file_that_holds_the_kernel_fails_alone(folder, tmp_path):
     done = run("sample-many", models, "-O", tmp_path / "out", *FLAGS, "--face", "--triangle",
                "--model-parse-seconds", "1", "-j", "2")
     assert done.returncode == 1, done.stderr
-    assert "FAILED hostile.step: RESOURCE_EXHAUSTED" in done.stderr and "model_parse_seconds" in done.stderr
+    assert "FAILED hostile.step: RESOURCE_EXHAUSTED" in done.stderr
+    assert "model_parse_seconds" in done.stderr
     assert listing(tmp_path / "out") == ["sphere.npy", "torus.npy"]
     seed = many.model_seed(11, sha(models / "sphere.step"))
     assert filecmp.cmp(tmp_path / "out" / "sphere.npy",
@@ -183,9 +187,10 @@ def test_cli_bad_usage(folder, tmp_path):
     assert empty.returncode == 2 and "matches no files" in empty.stderr
     bad = run("sample-many", folder, "-O", tmp_path / "o", "--sequence", "nonsense")
     assert bad.returncode == 2 and "--sequence must be" in bad.stderr
-    density = run("sample-many", folder / "torus.ply", "-O", tmp_path / "o", "--density", "nonsense")
-    assert density.returncode == 1 and 'FAILED torus.ply: INVALID_ARGUMENT: unknown density "nonsense"' in \
-        density.stderr
+    density = run("sample-many", folder / "torus.ply", "-O", tmp_path / "o", "--density",
+                  "nonsense")
+    assert density.returncode == 1
+    assert 'FAILED torus.ply: INVALID_ARGUMENT: unknown density "nonsense"' in density.stderr
 
 
 def test_python_sample_many_equals_sample_alone(folder, tmp_path):
@@ -275,7 +280,8 @@ def test_python_sample_many_over_the_wire(server, folder):
 
 
 def test_cli_over_the_wire_same_files(server, folder, tmp_path):
-    local = run("sample-many", folder, "-O", tmp_path / "local", *FLAGS, "--face", "--triangle", "-q")
+    local = run("sample-many", folder, "-O", tmp_path / "local", *FLAGS, "--face", "--triangle",
+                "-q")
     remote = run("sample-many", folder, "-O", tmp_path / "remote", *FLAGS, "--face", "--triangle",
                  "--server", server, "-j", "3", "-q")
     assert local.returncode == remote.returncode == 1, remote.stderr
@@ -283,10 +289,12 @@ def test_cli_over_the_wire_same_files(server, folder, tmp_path):
         assert f"FAILED {name}: INVALID_ARGUMENT" in remote.stderr, remote.stderr
     assert listing(tmp_path / "remote") == listing(tmp_path / "local") != []
     for name in listing(tmp_path / "local"):
-        assert filecmp.cmp(tmp_path / "local" / name, tmp_path / "remote" / name, shallow=False), name
+        assert filecmp.cmp(tmp_path / "local" / name, tmp_path / "remote" / name,
+                           shallow=False), name
     f32 = run("sample-many", folder / "torus.ply", "-O", tmp_path / "f32", *FLAGS, "--precision",
               "float32", "--server", server, "-q")
-    f32_local = run("sample-many", folder / "torus.ply", "-O", tmp_path / "f32l", *FLAGS, "--precision",
-                    "float32", "-q")
+    f32_local = run("sample-many", folder / "torus.ply", "-O", tmp_path / "f32l", *FLAGS,
+                    "--precision", "float32", "-q")
     assert f32.returncode == f32_local.returncode == 0
-    assert filecmp.cmp(tmp_path / "f32" / "torus.npy", tmp_path / "f32l" / "torus.npy", shallow=False)
+    assert filecmp.cmp(tmp_path / "f32" / "torus.npy", tmp_path / "f32l" / "torus.npy",
+                       shallow=False)

@@ -19,8 +19,8 @@ def torus_mesh(n=24, m=16, R=1.0, r=0.35, wobble=0.0, seed=0):
     """A closed torus grid: n*m vertices, 2*n*m triangles (float64, int64)."""
     a, b = np.meshgrid(np.arange(n) * 2 * np.pi / n, np.arange(m) * 2 * np.pi / m, indexing="ij")
     rr = r * (1 + wobble * np.random.default_rng(seed).standard_normal(a.shape))
-    v = np.stack([(R + rr * np.cos(b)) * np.cos(a), (R + rr * np.cos(b)) * np.sin(a), rr * np.sin(b)],
-                 axis=-1).reshape(-1, 3)
+    v = np.stack([(R + rr * np.cos(b)) * np.cos(a),
+                  (R + rr * np.cos(b)) * np.sin(a), rr * np.sin(b)], axis=-1).reshape(-1, 3)
     i, j = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
     p00, p10 = i * m + j, ((i + 1) % n) * m + j
     p01, p11 = i * m + (j + 1) % m, ((i + 1) % n) * m + (j + 1) % m
@@ -77,7 +77,8 @@ def test_dtypes_and_objects_are_the_same_model():
                  {"vertices": v32, "faces": f}, {"vertices": v32, "triangles": f},
                  types.SimpleNamespace(vertices=v32, faces=f)]:       # trimesh's attributes
         same_samples(sfcsampler.sample(mesh=mesh, **KW), base)
-    assert meshes.mesh_ply((v32, f)) == meshes.mesh_ply((v32.astype(np.float64), f.astype(np.int32)))
+    assert meshes.mesh_ply((v32, f)) == meshes.mesh_ply(
+        (v32.astype(np.float64), f.astype(np.int32)))
 
 
 def test_open3d_mesh():
@@ -134,22 +135,26 @@ BAD = [
     (dict(mesh=(V, np.zeros((0, 3), np.int64))), ValueError, "mesh faces is empty"),
     (dict(mesh=(V, F + 1)), ValueError, "mesh faces row"),
     (dict(mesh=(V, -F)), ValueError, "mesh faces row"),
-    (dict(mesh=(np.where(np.arange(30)[:, None] == 4, np.nan, V), F)), ValueError, "mesh vertices row 4"),
-    (dict(mesh=(np.where(np.arange(30)[:, None] == 2, np.inf, V), F)), ValueError, "mesh vertices row 2"),
+    (dict(mesh=(np.where(np.arange(30)[:, None] == 4, np.nan, V), F)), ValueError,
+     "mesh vertices row 4"),
+    (dict(mesh=(np.where(np.arange(30)[:, None] == 2, np.inf, V), F)), ValueError,
+     "mesh vertices row 2"),
     (dict(mesh=(V.astype(np.int64), F)), TypeError, "mesh vertices must be float32 or float64"),
     (dict(mesh=(V.astype(np.float16), F)), TypeError, "mesh vertices must be float32 or float64"),
     (dict(mesh=(V, F.astype(np.float64))), TypeError, "mesh faces must be int32 or int64"),
     (dict(mesh=(V[:, :2], F)), ValueError, "mesh vertices must have shape (n, 3)"),
-    (dict(mesh=(V, np.concatenate([F, F[:, :1]], 1))), ValueError, "mesh faces must have shape (n, 3)"),
+    (dict(mesh=(V, np.concatenate([F, F[:, :1]], 1))), ValueError,
+     "mesh faces must have shape (n, 3)"),
     (dict(mesh=(V.ravel(), F)), ValueError, "mesh vertices must have shape (n, 3)"),
     (dict(mesh=(V, F, V[:3])), ValueError, "mesh normals has 3 rows"),
     (dict(mesh=(V, F), density=np.ones(3)), ValueError, "density weights must have shape (30,)"),
     (dict(mesh=(V, F), density=-np.ones(30)), ValueError, "density weights row 0"),
-    (dict(mesh=(V, F), density=np.full(30, np.nan)), ValueError, "density weights row 0 is not finite"),
+    (dict(mesh=(V, F), density=np.full(30,
+                                       np.nan)), ValueError, "density weights row 0 is not finite"),
     (dict(mesh=(V, F), density=np.zeros(30)), ValueError, "density weights are all zero"),
     (dict(mesh=(V, F), surface="sphere"), TypeError, "either surface"),
     (dict(density=np.ones(30)), TypeError, "needs mesh="),
-    (dict(mesh=(V,)), ValueError, "mesh must be (vertices, faces)"),
+    (dict(mesh=(V, )), ValueError, "mesh must be (vertices, faces)"),
     (dict(mesh=42), TypeError, "mesh must be"),
     (dict(mesh=([[0, 0, 0], [1, 0], [0, 1, 0]], [[0, 1, 2]])), ValueError, "mesh vertices"),
     # Every triangle without area: the engine's own check, naming the mesh.
