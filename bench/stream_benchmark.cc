@@ -57,14 +57,15 @@ class WireOnlyService final : public v1::Sampler::Service {
     response.mutable_header()->set_begin(0);
     response.mutable_header()->set_end(request->count());
     response.mutable_header()->set_expected_samples(static_cast<int64_t>(request->count()));
+    const auto call = FromProto(*request);
+    if (!call.ok()) return ToGrpcStatus(call.status());
     SampleBatch batch = batch_;
     for (uint64_t sent = 0; sent < request->count();) {
       const size_t n = std::min<uint64_t>(batch_.size(), request->count() - sent);
       if (n < batch.size()) batch = SampleBatch(), batch.AppendFrom(batch_, 0, n);
       for (size_t i = 0; i < n; ++i) batch.index[i] = sent + i;
       response.mutable_batch()->Clear();
-      ToProto(batch, SampleFields{}, request->precision(), response.mutable_batch(),
-              request->column_encoding());
+      ToProto(batch, SampleFields{}, call->stream, response.mutable_batch());
       if (!writer->Write(response)) break;
       response.clear_header();
       sent += n;

@@ -23,15 +23,17 @@
 
 #include "absl/status/statusor.h"
 #include "core/sample_batch.h"
+#include "request/stream_options.h"
 
 namespace sfc {
 
 enum class OutputFormat { kCsv, kPlyBinary, kPlyAscii, kNpy };
 
-// Width of the floating-point columns in the file. Float32 rounds each double
-// to the nearest float (as the wire's PRECISION_FLOAT32 does), so a float32
-// file is the same from a float64 or a float32 stream.
-enum class OutputPrecision { kFloat64, kFloat32 };
+// Width of the floating-point columns in the file: the same type as a
+// stream's (request/stream_options.h). Float32 rounds each double to the
+// nearest float (as the wire's PRECISION_FLOAT32 does), so a float32 file is
+// the same from a float64 or a float32 stream.
+using OutputPrecision = ColumnPrecision;
 
 class SampleWriter {
  public:

@@ -122,15 +122,16 @@ SampleRequest SamplerClient::Shard(SampleRequest request, uint64_t i, uint64_t k
 absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
                                                     const BatchCallback& on_batch) {
   // A model file travels once: the server gets its bytes if it lacks them,
-  // and the request names them by hash.
+  // and the request names them by hash. Its spec is parsed once, for the
+  // upload and to know whether a resume may upload again.
+  const auto asked_model = ParseModelSpec(asked.tree.surface);
+  if (!asked_model.ok()) return asked_model.status();
   SampleRequest request = asked;
-  auto surface = EnsureModel(asked.tree.surface);
+  auto surface = EnsureModel(asked.tree.surface, *asked_model);
   if (!surface.ok()) return surface.status();
   request.tree.surface = *std::move(surface);
   const std::string key = RoutingKey(request.tree);
-  const auto asked_model = ParseModelSpec(asked.tree.surface);
-  const bool from_file =
-      asked_model.ok() && asked_model->has_value() && (*asked_model)->sha256.empty();
+  const bool from_file = asked_model->has_value() && (*asked_model)->sha256.empty();
   const bool monotone = SequenceIsMonotone(request.sequence);
   StreamSummary summary;
   bool have_header = false;
@@ -242,7 +243,7 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
     channel_->WaitForConnected(std::chrono::system_clock::now() + pause);
     backoff *= 2;
     if (model_moved) {
-      auto again = EnsureModel(asked.tree.surface);
+      auto again = EnsureModel(asked.tree.surface, *asked_model);
       if (!again.ok()) return again.status();
     }
     if (monotone && summary.received > 0) {
@@ -326,8 +327,13 @@ absl::StatusOr<v1::ModelInfo> SamplerClient::UploadModel(const std::string& form
 absl::StatusOr<std::string> SamplerClient::EnsureModel(const std::string& spec) {
   auto parsed = ParseModelSpec(spec);
   if (!parsed.ok()) return parsed.status();
-  if (!parsed->has_value()) return spec;
-  const ModelSpec& model_spec = **parsed;
+  return EnsureModel(spec, *parsed);
+}
+
+absl::StatusOr<std::string> SamplerClient::EnsureModel(const std::string& spec,
+                                                       const std::optional<ModelSpec>& parsed) {
+  if (!parsed.has_value()) return spec;
+  const ModelSpec& model_spec = *parsed;
   std::string sha256 = model_spec.sha256;
   StoredModel local;
   if (sha256.empty()) {

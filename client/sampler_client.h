@@ -21,11 +21,13 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "absl/status/statusor.h"
 #include "core/sample_batch.h"
 #include "grpcpp/channel.h"
+#include "request/model_spec.h"
 #include "request/sample_request.h"
 #include "sfcsampler/v1/sampler.grpc.pb.h"
 
@@ -92,6 +94,10 @@ class SamplerClient {
 
  private:
   explicit SamplerClient(const ClientOptions& options, std::shared_ptr<grpc::Channel> channel);
+  // EnsureModel(spec) with `spec` already parsed: `parsed` is
+  // ParseModelSpec(spec)'s value.
+  absl::StatusOr<std::string> EnsureModel(const std::string& spec,
+                                          const std::optional<ModelSpec>& parsed);
   void Decorate(grpc::ClientContext* context, const std::string& surface_key) const;
 
   const ClientOptions options_;

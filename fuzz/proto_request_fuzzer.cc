@@ -13,20 +13,22 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   sfc::v1::SampleRequest wire;
   if (!wire.ParseFromArray(data, static_cast<int>(size))) return 0;
-  auto request = sfc::FromProto(wire);
-  if (!request.ok()) {
-    if (request.status().code() != absl::StatusCode::kInvalidArgument) {
-      std::fprintf(stderr, "fuzz: FromProto: %s\n", request.status().ToString().c_str());
+  auto call = sfc::FromProto(wire);
+  if (!call.ok()) {
+    if (call.status().code() != absl::StatusCode::kInvalidArgument) {
+      std::fprintf(stderr, "fuzz: FromProto: %s\n", call.status().ToString().c_str());
       __builtin_trap();
     }
     return 0;
   }
-  auto round_trip = sfc::FromProto(sfc::ToProto(*request));
+  const sfc::v1::SampleRequest sent = sfc::ToProto(call->request, call->stream);
+  auto round_trip = sfc::FromProto(sent);
   if (!round_trip.ok() ||
-      sfc::ToProto(*round_trip).SerializeAsString() != sfc::ToProto(*request).SerializeAsString()) {
+      sfc::ToProto(round_trip->request, round_trip->stream).SerializeAsString() !=
+          sent.SerializeAsString()) {
     std::fprintf(stderr, "fuzz: ToProto -> FromProto does not give the same request back\n");
     __builtin_trap();
   }
-  sfc::fuzz::CheckRequest(*request);
+  sfc::fuzz::CheckRequest(call->request);
   return 0;
 }

@@ -245,6 +245,14 @@ std::vector<TreeSummary::Cell> FromProto(
   return out;
 }
 
+v1::Precision WirePrecision(ColumnPrecision precision) {
+  return precision == ColumnPrecision::kFloat32 ? v1::PRECISION_FLOAT32 : v1::PRECISION_FLOAT64;
+}
+
+v1::ColumnEncoding WireEncoding(ColumnEncoding encoding) {
+  return encoding == ColumnEncoding::kRaw ? v1::COLUMN_ENCODING_RAW : v1::COLUMN_ENCODING_PACKED;
+}
+
 }  // namespace
 
 void ToProto(const TreeSummary& s, v1::TreeInfo* out) {
@@ -345,8 +353,9 @@ v1::TreeSpec ToProto(const TreeSpec& spec) {
   return p;
 }
 
-absl::StatusOr<SampleRequest> FromProto(const v1::SampleRequest& p) {
-  SampleRequest r;
+absl::StatusOr<SampleCall> FromProto(const v1::SampleRequest& p) {
+  SampleCall call;
+  SampleRequest& r = call.request;
   ASSIGN_OR_RETURN(r.tree, FromProto(p.tree()));
   switch (p.sequence()) {
     case v1::SEQUENCE_JITTERED: r.sequence = SequenceKind::kJittered; break;
@@ -357,14 +366,21 @@ absl::StatusOr<SampleRequest> FromProto(const v1::SampleRequest& p) {
     default:
       return absl::InvalidArgumentError(absl::StrFormat("unknown sequence %d", p.sequence()));
   }
-  if (p.precision() != v1::PRECISION_FLOAT64 && p.precision() != v1::PRECISION_FLOAT32) {
-    return absl::InvalidArgumentError(absl::StrFormat("unknown precision %d", p.precision()));
+  StreamOptions& stream = call.stream;
+  switch (p.precision()) {
+    case v1::PRECISION_FLOAT64: stream.precision = ColumnPrecision::kFloat64; break;
+    case v1::PRECISION_FLOAT32: stream.precision = ColumnPrecision::kFloat32; break;
+    default:
+      return absl::InvalidArgumentError(absl::StrFormat("unknown precision %d", p.precision()));
   }
-  if (p.column_encoding() != v1::COLUMN_ENCODING_PACKED &&
-      p.column_encoding() != v1::COLUMN_ENCODING_RAW) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("unknown column encoding %d", p.column_encoding()));
+  switch (p.column_encoding()) {
+    case v1::COLUMN_ENCODING_PACKED: stream.encoding = ColumnEncoding::kPacked; break;
+    case v1::COLUMN_ENCODING_RAW: stream.encoding = ColumnEncoding::kRaw; break;
+    default:
+      return absl::InvalidArgumentError(
+          absl::StrFormat("unknown column encoding %d", p.column_encoding()));
   }
+  stream.batch_size = p.batch_size();
   r.count = p.count();
   r.seed = p.seed();
   r.tree_count = p.tree_count();
@@ -392,10 +408,10 @@ absl::StatusOr<SampleRequest> FromProto(const v1::SampleRequest& p) {
         "density "
         "or curve_position");
   }
-  return r;
+  return call;
 }
 
-v1::SampleRequest ToProto(const SampleRequest& r) {
+v1::SampleRequest ToProto(const SampleRequest& r, const StreamOptions& stream) {
   v1::SampleRequest p;
   *p.mutable_tree() = ToProto(r.tree);
   switch (r.sequence) {
@@ -427,11 +443,14 @@ v1::SampleRequest ToProto(const SampleRequest& r) {
   p.set_triangle(r.fields.triangle);
   p.set_omit_uv(!r.fields.uv);
   p.set_omit_xyz(!r.fields.xyz);
+  p.set_precision(WirePrecision(stream.precision));
+  p.set_batch_size(stream.batch_size);
+  p.set_column_encoding(WireEncoding(stream.encoding));
   return p;
 }
 
-void ToProto(const SampleBatch& b, const SampleFields& fields, v1::Precision precision,
-             v1::SampleBatch* out, v1::ColumnEncoding encoding) {
+void ToProto(const SampleBatch& b, const SampleFields& fields, const StreamOptions& stream,
+             v1::SampleBatch* out) {
   const size_t n = b.size();
   out->set_size(static_cast<uint32_t>(n));
   bool consecutive = true;
@@ -441,15 +460,16 @@ void ToProto(const SampleBatch& b, const SampleFields& fields, v1::Precision pre
     out->mutable_index()->Reserve(static_cast<int>(n));
     for (uint64_t k : b.index) out->mutable_index()->AddAlreadyReserved(k);
   }
-  if (encoding == v1::COLUMN_ENCODING_RAW) {
+  const bool float32 = stream.precision == ColumnPrecision::kFloat32;
+  if (stream.encoding == ColumnEncoding::kRaw) {
     v1::RawColumns* raw = out->mutable_raw();
-    raw->set_precision(precision);
-    if (precision == v1::PRECISION_FLOAT32) {
+    raw->set_precision(WirePrecision(stream.precision));
+    if (float32) {
       PutRawColumns<float>(b, fields, raw);
     } else {
       PutRawColumns<double>(b, fields, raw);
     }
-  } else if (precision == v1::PRECISION_FLOAT32) {
+  } else if (float32) {
     PutColumns(b, fields, out->mutable_f32());
   } else {
     PutColumns(b, fields, out->mutable_f64());
@@ -463,11 +483,11 @@ size_t WireValueColumns(const SampleFields& fields) {
          (fields.density ? 1 : 0) + (fields.curve_position ? 1 : 0);
 }
 
-uint32_t MaxSamplesPerMessage(const SampleFields& fields, v1::Precision precision,
+uint32_t MaxSamplesPerMessage(const SampleFields& fields, ColumnPrecision precision,
                               bool indices_listed, size_t reserved_bytes,
                               size_t max_message_bytes) {
   const size_t columns = WireValueColumns(fields);
-  const size_t width = precision == v1::PRECISION_FLOAT32 ? sizeof(float) : sizeof(double);
+  const size_t width = precision == ColumnPrecision::kFloat32 ? sizeof(float) : sizeof(double);
   const size_t index_columns = (fields.face ? 1 : 0) + (fields.triangle ? 1 : 0);
   const size_t per_sample = columns * width + index_columns * sizeof(uint32_t) +
                             (indices_listed ? sizeof(uint64_t) : 0);

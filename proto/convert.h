@@ -12,6 +12,7 @@
 #include "core/sample_batch.h"
 #include "grpcpp/support/status.h"
 #include "request/sample_request.h"
+#include "request/stream_options.h"
 #include "request/tree_summary.h"
 #include "sfcsampler/v1/sampler.pb.h"
 
@@ -21,9 +22,14 @@ namespace v1 = ::sfcsampler::v1;
 
 // INVALID_ARGUMENT for enum values this build does not know.
 absl::StatusOr<TreeSpec> FromProto(const v1::TreeSpec& spec);
-absl::StatusOr<SampleRequest> FromProto(const v1::SampleRequest& request);
 v1::TreeSpec ToProto(const TreeSpec& spec);
-v1::SampleRequest ToProto(const SampleRequest& request);
+// The one reading of a Sample request: which samples and how they travel
+// (precision, batch_size, column_encoding), so nothing reads those from the
+// wire beside it. INVALID_ARGUMENT for enum values this build does not know
+// and for a request that leaves no value column. ToProto(r, s) reads back
+// as {r, s}.
+absl::StatusOr<SampleCall> FromProto(const v1::SampleRequest& request);
+v1::SampleRequest ToProto(const SampleRequest& request, const StreamOptions& stream = {});
 
 // A tree's summary on the wire (TreeInfo) and back: the one mapping each
 // way, so a summary reads the same in process and from a server. `out`
@@ -31,13 +37,14 @@ v1::SampleRequest ToProto(const SampleRequest& request);
 void ToProto(const TreeSummary& summary, v1::TreeInfo* out);
 TreeSummary FromProto(const v1::TreeInfo& tree);
 
-// Fills `out` with `batch` in the requested precision and column encoding
+// Fills `out` with `batch` in the stream's precision and column encoding
 // (packed repeated fields, or little-endian bytes columns as the proto's
-// RawColumns documents). Consecutive indices are sent as first_index alone.
-// `out` should be clear; its strings and arrays keep their capacity, so a
-// message reused for the next batch allocates nothing.
-void ToProto(const SampleBatch& batch, const SampleFields& fields, v1::Precision precision,
-             v1::SampleBatch* out, v1::ColumnEncoding encoding = v1::COLUMN_ENCODING_PACKED);
+// RawColumns documents); its batch_size plays no part here. Consecutive
+// indices are sent as first_index alone. `out` should be clear; its strings
+// and arrays keep their capacity, so a message reused for the next batch
+// allocates nothing.
+void ToProto(const SampleBatch& batch, const SampleFields& fields, const StreamOptions& stream,
+             v1::SampleBatch* out);
 // The float columns a batch carries on the wire for `fields` (u v, x y z,
 // normals, density, curve_position; SampleFields::uv and ::xyz leave the
 // first two off).
@@ -47,7 +54,7 @@ size_t WireValueColumns(const SampleFields& fields);
 // precision, whether the batch lists its indices (regions and sequences not
 // in index order do) and `reserved_bytes` for the stream header. 0 when not
 // even one sample fits.
-uint32_t MaxSamplesPerMessage(const SampleFields& fields, v1::Precision precision,
+uint32_t MaxSamplesPerMessage(const SampleFields& fields, ColumnPrecision precision,
                               bool indices_listed, size_t reserved_bytes, size_t max_message_bytes);
 
 // Appends the samples of `in` to `out`, whichever encoding and precision it

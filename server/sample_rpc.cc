@@ -7,17 +7,16 @@
 #include "base/status_macros.h"
 #include "proto/convert.h"
 #include "request/index_range.h"
+#include "request/stream_options.h"
+#include "request/tree_count.h"
 #include "server/message_pipeline.h"
 #include "server/request_control.h"
 #include "spdlog/spdlog.h"
-#include "request/tree_count.h"
 
 namespace sfc {
 
 namespace v1 = ::sfcsampler::v1;
 namespace {
-
-constexpr uint32_t kDefaultBatchSize = 65536;
 
 // What a stream holds while it runs: the sort of a non-monotone sequence's
 // range (16 bytes a sample), the producer's batch (per sample the index and
@@ -27,7 +26,7 @@ constexpr uint32_t kDefaultBatchSize = 65536;
 // the wire (float32 if asked; indices listed, at most). The batch is the requested size, or the
 // largest the server would choose. An invalid range counts nothing here:
 // Start refuses it.
-uint64_t StreamWorkingBytes(const SampleRequest& request, const v1::SampleRequest& wire,
+uint64_t StreamWorkingBytes(const SampleRequest& request, const StreamOptions& stream,
                             int pipeline_depth) {
   const auto range = ResolveIndexRange(request);
   const uint64_t n = range.ok() ? range->second - range->first : 0;
@@ -37,14 +36,14 @@ uint64_t StreamWorkingBytes(const SampleRequest& request, const v1::SampleReques
   made.uv = made.xyz = true;
   const uint64_t columns = WireValueColumns(made), wire_columns = WireValueColumns(f);
   const uint64_t index_columns = (f.face ? 1 : 0) + (f.triangle ? 1 : 0);
-  const uint64_t width = wire.precision() == v1::PRECISION_FLOAT32 ? 4 : 8;
+  const uint64_t width = stream.precision == ColumnPrecision::kFloat32 ? 4 : 8;
   // The messages the stream holds, plus the serialized copy gRPC keeps of the
   // one being written until the transport has sent it.
   const uint64_t messages =
       (pipeline_depth <= 0 ? 1 : static_cast<uint64_t>(pipeline_depth) + 2) + 1;
   const uint64_t per_sample = (8 + 8 * columns + 4 * index_columns) +
                               messages * (8 + width * wire_columns + 4 * index_columns);
-  const uint64_t batch = wire.batch_size() != 0 ? wire.batch_size() : kDefaultBatchSize;
+  const uint64_t batch = stream.batch_size != 0 ? stream.batch_size : kDefaultBatchSize;
   return sort + per_sample * std::min(n, batch);
 }
 
@@ -55,7 +54,11 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
   const auto start = Clock::now();
   uint64_t sent = 0;
   grpc::Status status = Admit(*context);
-  if (status.ok()) status = PrepareModelOutsideSlot(context, *request);
+  // The request is read from the wire once, here. One that does not read is
+  // refused in its slot, as any other bad request, or before it takes one
+  // when it names a model (PrepareModelOutsideSlot).
+  const absl::StatusOr<SampleCall> call = FromProto(*request);
+  if (status.ok()) status = PrepareModelOutsideSlot(context, *request, call);
   if (status.ok()) {
     // Claim a stream slot; give it back on every path out.
     if (active_streams_.fetch_add(1) >= options_.max_concurrent_streams) {
@@ -67,7 +70,8 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
                           options_.max_concurrent_streams));
     } else {
       metrics_->StreamStarted();
-      status = RunSample(context, *request, writer, &sent);
+      status = call.ok() ? RunSample(context, *request, *call, writer, &sent)
+                         : ToGrpcStatus(call.status());
       metrics_->StreamEnded();
       active_streams_.fetch_sub(1);
     }
@@ -82,63 +86,66 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
 }
 
 grpc::Status SamplerService::PrepareModelOutsideSlot(grpc::ServerContext* context,
-                                                     const v1::SampleRequest& request) {
-  auto model = ParseModelSpec(request.tree().surface());
-  if (!model.ok() || !model->has_value()) return grpc::Status::OK;  // RunSample says why
-  auto parsed = FromProto(request);
-  if (!parsed.ok()) return ToGrpcStatus(parsed.status());
+                                                     const v1::SampleRequest& wire,
+                                                     const absl::StatusOr<SampleCall>& call) {
+  // The wire's surface: whether the request names a model comes before
+  // whether the rest of it reads.
+  auto model = ParseModelSpec(wire.tree().surface());
+  if (!model.ok() || !model->has_value()) return grpc::Status::OK;  // reported in a slot
+  if (!call.ok()) return ToGrpcStatus(call.status());
+  const SampleRequest& request = call->request;
   const auto deadline =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(
                          std::chrono::duration<double>(options_.request_deadline_seconds));
-  auto tree_count = ResolveTreeCount(*parsed);
+  auto tree_count = ResolveTreeCount(request);
   if (!tree_count.ok()) return ToGrpcStatus(tree_count.status());
   auto prepared =
-      engine_.Prepare(parsed->tree, *tree_count,
+      engine_.Prepare(request.tree, *tree_count,
                       RequestControl(context, deadline, options_.request_deadline_seconds));
   if (!prepared.ok()) return ToGrpcStatus(prepared.status());
   return grpc::Status::OK;
 }
 
 grpc::Status SamplerService::RunSample(grpc::ServerContext* context,
-                                       const v1::SampleRequest& request,
+                                       const v1::SampleRequest& wire, const SampleCall& call,
                                        grpc::ServerWriter<v1::SampleResponse>* writer,
                                        uint64_t* sent) {
   const auto start = Clock::now();
   const auto deadline =
       start + std::chrono::duration_cast<Clock::duration>(
                   std::chrono::duration<double>(options_.request_deadline_seconds));
-  auto parsed = FromProto(request);
-  if (!parsed.ok()) return ToGrpcStatus(parsed.status());
-  if (request.batch_size() > options_.max_batch_size) {
+  const SampleRequest& request = call.request;
+  const StreamOptions& stream = call.stream;
+  if (stream.batch_size > options_.max_batch_size) {
     return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
                         absl::StrFormat("batch_size %d is above the server's limit of %d "
                                         "(max_batch_size)",
-                                        request.batch_size(), options_.max_batch_size));
+                                        stream.batch_size, options_.max_batch_size));
   }
   const BuildControl control = RequestControl(context, deadline, options_.request_deadline_seconds);
   // The stream's working memory, reserved before its cursor sorts anything.
   auto memory = stream_memory_.Reserve(
-      StreamWorkingBytes(*parsed, request, options_.stream_pipeline_depth), "this stream",
+      StreamWorkingBytes(request, stream, options_.stream_pipeline_depth), "this stream",
       control.check);
   if (!memory.ok()) return ToGrpcStatus(memory.status());
-  auto job = engine_.Start(*parsed, control);
+  auto job = engine_.Start(request, control);
   if (!job.ok()) return ToGrpcStatus(job.status());
 
   v1::StreamHeader header;
   ToProto(SummarizeTree(job->tree), header.mutable_tree());
   header.set_algorithm_version(options_.algorithm_version);
-  header.set_seed(parsed->seed);
-  *header.mutable_request() = request;
+  header.set_seed(request.seed);
+  *header.mutable_request() = wire;  // echoed as it came
   header.set_begin(job->begin);
   header.set_end(job->end);
-  header.set_expected_samples(parsed->region.kind == Region::Kind::kAll
+  header.set_expected_samples(request.region.kind == Region::Kind::kAll
                                    ? static_cast<int64_t>(job->end - job->begin)
                                    : -1);
 
   // Every message, the first with its header too, fits max_message_bytes.
   const bool indices_listed =
-      parsed->region.kind != Region::Kind::kAll || !Sequence(parsed->sequence, 1, 0).monotone();
-  const uint32_t fits = MaxSamplesPerMessage(parsed->fields, request.precision(), indices_listed,
+      request.region.kind != Region::Kind::kAll || !Sequence(request.sequence, 1, 0).monotone();
+  const uint32_t fits = MaxSamplesPerMessage(request.fields, stream.precision, indices_listed,
                                              header.ByteSizeLong(), options_.max_message_bytes);
   if (fits == 0) {
     return grpc::Status(
@@ -147,16 +154,16 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context,
                         "max_message_bytes of %d; use shorter specs",
                         header.ByteSizeLong(), options_.max_message_bytes));
   }
-  if (request.batch_size() > fits) {
+  if (stream.batch_size > fits) {
     return grpc::Status(
         grpc::StatusCode::INVALID_ARGUMENT,
         absl::StrFormat("batch_size %d with these columns makes messages larger than the server's "
                         "max_message_bytes of %d; ask for at most %d samples a batch (or 0 to let "
                         "the server choose)",
-                        request.batch_size(), options_.max_message_bytes, fits));
+                        stream.batch_size, options_.max_message_bytes, fits));
   }
   const uint32_t batch_size =
-      request.batch_size() == 0 ? std::min(kDefaultBatchSize, fits) : request.batch_size();
+      stream.batch_size == 0 ? std::min(kDefaultBatchSize, fits) : stream.batch_size;
 
   const auto watch = watchdog_.Start(context);
   auto deadline_status = [&] {
@@ -189,15 +196,13 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context,
   // pipeline is declared last so that it stops before what it uses goes.
   SampleBatch batch;  // the producer's
   BatchCursor* const cursor = job->cursor.get();
-  const SampleFields fields = parsed->fields;
-  const v1::Precision precision = request.precision();
-  const v1::ColumnEncoding encoding = request.column_encoding();
+  const SampleFields fields = request.fields;
   MessagePipeline pipeline(options_.stream_pipeline_depth,
-                           [&batch, cursor, fields, precision, encoding,
+                           [&batch, cursor, fields, stream,
                             batch_size](v1::SampleBatch* out) -> absl::StatusOr<size_t> {
                              batch.Clear();
                              ASSIGN_OR_RETURN(const size_t n, cursor->Next(batch_size, &batch));
-                             ToProto(batch, fields, precision, out, encoding);
+                             ToProto(batch, fields, stream, out);
                              return n;
                            });
   bool first = true;

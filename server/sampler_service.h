@@ -23,7 +23,9 @@
 #include <atomic>
 #include <memory>
 
+#include "absl/status/statusor.h"
 #include "engine/sampling_engine.h"
+#include "request/stream_options.h"
 #include "server/metrics.h"
 #include "server/model_store.h"
 #include "server/server_options.h"
@@ -69,12 +71,16 @@ class SamplerService final : public ::sfcsampler::v1::Sampler::Service {
   // UNAVAILABLE while draining; UNAUTHENTICATED without the token.
   grpc::Status Admit(const grpc::ServerContext& context) const;
   // A Sample naming a model: its parse and tree, made (or waited for) before
-  // the stream takes a slot, so a slow or hostile parse holds none. OK for
-  // other requests (and for errors RunSample reports itself).
+  // the stream takes a slot, so a slow or hostile parse holds none; `call`
+  // is `wire` as read (proto/convert.h FromProto), its error returned here
+  // for a model. OK for other requests (their errors are reported in a slot).
   grpc::Status PrepareModelOutsideSlot(grpc::ServerContext* context,
-                                       const ::sfcsampler::v1::SampleRequest& request);
+                                       const ::sfcsampler::v1::SampleRequest& wire,
+                                       const absl::StatusOr<SampleCall>& call);
+  // Streams `call`, which `wire` reads as (the header echoes `wire`); its
+  // stream options are passed down unchanged to the batch sizing and encoding.
   grpc::Status RunSample(grpc::ServerContext* context,
-                         const ::sfcsampler::v1::SampleRequest& request,
+                         const ::sfcsampler::v1::SampleRequest& wire, const SampleCall& call,
                          grpc::ServerWriter<::sfcsampler::v1::SampleResponse>* writer,
                          uint64_t* sent);
 

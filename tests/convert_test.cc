@@ -14,6 +14,14 @@
 namespace sfc {
 namespace {
 
+// The stream options a batch is encoded with in these tests.
+StreamOptions Stream(ColumnPrecision precision, ColumnEncoding encoding = ColumnEncoding::kPacked) {
+  StreamOptions stream;
+  stream.precision = precision;
+  stream.encoding = encoding;
+  return stream;
+}
+
 SampleBatch ThreeSamples() {
   SampleBatch b;
   b.index = {7, 8, 9};
@@ -28,7 +36,7 @@ SampleBatch ThreeSamples() {
 TEST(AppendFromProto, GivesBackTheBatchThatToProtoSent) {
   const SampleBatch sent = ThreeSamples();
   v1::SampleBatch wire;
-  ToProto(sent, SampleFields{}, v1::PRECISION_FLOAT64, &wire);
+  ToProto(sent, SampleFields{}, Stream(ColumnPrecision::kFloat64), &wire);
   SampleBatch got;
   ASSERT_TRUE(AppendFromProto(wire, SampleFields{}, &got).ok());
   EXPECT_EQ(got.index, sent.index);
@@ -58,7 +66,7 @@ TEST(AppendFromProto, RefusesASizeItsColumnsDoNotHoldBeforeAppendingAnything) {
 
 TEST(AppendFromProto, RefusesAMissingRequestedColumn) {
   v1::SampleBatch wire;
-  ToProto(ThreeSamples(), SampleFields{}, v1::PRECISION_FLOAT32, &wire);
+  ToProto(ThreeSamples(), SampleFields{}, Stream(ColumnPrecision::kFloat32), &wire);
   SampleFields with_normals;
   with_normals.normal = true;
   SampleBatch got;
@@ -72,7 +80,7 @@ TEST(AppendFromProto, CarriesTheFaceAndTriangleColumnsAndRefusesAShortOne) {
   SampleFields fields;
   fields.face = fields.triangle = true;
   v1::SampleBatch wire;
-  ToProto(sent, fields, v1::PRECISION_FLOAT32, &wire);
+  ToProto(sent, fields, Stream(ColumnPrecision::kFloat32), &wire);
   SampleBatch got;
   ASSERT_TRUE(AppendFromProto(wire, fields, &got).ok());
   EXPECT_EQ(got.face, sent.face);
@@ -87,7 +95,7 @@ TEST(MaxSamplesPerMessage, AMessageOfThatManySamplesWithModelColumnsFitsTheCap) 
   SampleFields fields;
   fields.normal = fields.face = fields.triangle = true;
   const size_t cap = 1 << 16;
-  const uint32_t n = MaxSamplesPerMessage(fields, v1::PRECISION_FLOAT64, true, 0, cap);
+  const uint32_t n = MaxSamplesPerMessage(fields, ColumnPrecision::kFloat64, true, 0, cap);
   ASSERT_GT(n, 0u);
   SampleBatch b;
   for (uint32_t i = 0; i < n; ++i) {
@@ -97,7 +105,7 @@ TEST(MaxSamplesPerMessage, AMessageOfThatManySamplesWithModelColumnsFitsTheCap) 
     b.triangle.push_back(UINT32_MAX);
   }
   v1::SampleResponse response;
-  ToProto(b, fields, v1::PRECISION_FLOAT64, response.mutable_batch());
+  ToProto(b, fields, Stream(ColumnPrecision::kFloat64), response.mutable_batch());
   EXPECT_LE(response.ByteSizeLong(), cap);
 }
 
@@ -149,9 +157,9 @@ TEST(RawColumns, RoundTripBitExactlyForEveryColumnAndPrecision) {
   const SampleFields fields = AllFields();
   for (uint64_t seed = 1; seed <= 20; ++seed) {
     const SampleBatch sent = EveryColumn(1 + seed * 37, seed, seed % 2 == 0);
-    for (auto precision : {v1::PRECISION_FLOAT64, v1::PRECISION_FLOAT32}) {
+    for (auto precision : {ColumnPrecision::kFloat64, ColumnPrecision::kFloat32}) {
       v1::SampleBatch wire;
-      ToProto(sent, fields, precision, &wire, v1::COLUMN_ENCODING_RAW);
+      ToProto(sent, fields, Stream(precision, ColumnEncoding::kRaw), &wire);
       ASSERT_TRUE(wire.has_raw());
       SampleBatch got;
       ASSERT_TRUE(AppendFromProto(wire, fields, &got).ok());
@@ -162,7 +170,7 @@ TEST(RawColumns, RoundTripBitExactlyForEveryColumnAndPrecision) {
         ASSERT_EQ((got.*column).size(), sent.size());
         for (size_t i = 0; i < sent.size(); ++i) {
           // float64 exactly; float32 exactly the float the value rounds to.
-          const double expected = precision == v1::PRECISION_FLOAT64
+          const double expected = precision == ColumnPrecision::kFloat64
                                       ? (sent.*column)[i]
                                       : static_cast<double>(static_cast<float>((sent.*column)[i]));
           ASSERT_EQ(Bits((got.*column)[i]), Bits(expected)) << (sent.*column)[i];
@@ -177,8 +185,8 @@ TEST(RawColumns, AreLittleEndianIeeeValuesBackToBack) {
   // bits rather than against our own decoder.
   SampleBatch b = ThreeSamples();
   v1::SampleBatch wire64, wire32;
-  ToProto(b, SampleFields{}, v1::PRECISION_FLOAT64, &wire64, v1::COLUMN_ENCODING_RAW);
-  ToProto(b, SampleFields{}, v1::PRECISION_FLOAT32, &wire32, v1::COLUMN_ENCODING_RAW);
+  ToProto(b, SampleFields{}, Stream(ColumnPrecision::kFloat64, ColumnEncoding::kRaw), &wire64);
+  ToProto(b, SampleFields{}, Stream(ColumnPrecision::kFloat32, ColumnEncoding::kRaw), &wire32);
   EXPECT_EQ(wire32.raw().precision(), v1::PRECISION_FLOAT32);
   ASSERT_EQ(wire64.raw().x().size(), 3 * 8u);
   ASSERT_EQ(wire32.raw().x().size(), 3 * 4u);
@@ -201,10 +209,10 @@ TEST(RawColumns, AreLittleEndianIeeeValuesBackToBack) {
 TEST(RawColumns, DecodeToTheSameBatchAsPackedColumns) {
   const SampleFields fields = AllFields();
   const SampleBatch sent = EveryColumn(500, 7, false);
-  for (auto precision : {v1::PRECISION_FLOAT64, v1::PRECISION_FLOAT32}) {
+  for (auto precision : {ColumnPrecision::kFloat64, ColumnPrecision::kFloat32}) {
     v1::SampleBatch raw, packed;
-    ToProto(sent, fields, precision, &raw, v1::COLUMN_ENCODING_RAW);
-    ToProto(sent, fields, precision, &packed, v1::COLUMN_ENCODING_PACKED);
+    ToProto(sent, fields, Stream(precision, ColumnEncoding::kRaw), &raw);
+    ToProto(sent, fields, Stream(precision, ColumnEncoding::kPacked), &packed);
     // The same bytes either way, give or take the precision field.
     EXPECT_LE(raw.ByteSizeLong(), packed.ByteSizeLong() + 2);
     SampleBatch a, b;
@@ -221,7 +229,7 @@ TEST(RawColumns, AShortRaggedOrUnknownColumnIsDataLossBeforeAnythingIsAppended) 
   const SampleFields fields = AllFields();
   const SampleBatch sent = EveryColumn(10, 3, true);
   v1::SampleBatch wire;
-  ToProto(sent, fields, v1::PRECISION_FLOAT64, &wire, v1::COLUMN_ENCODING_RAW);
+  ToProto(sent, fields, Stream(ColumnPrecision::kFloat64, ColumnEncoding::kRaw), &wire);
   {
     v1::SampleBatch ragged = wire;
     ragged.mutable_raw()->mutable_u()->pop_back();  // 79 bytes for 10 samples
@@ -251,16 +259,42 @@ TEST(RawColumns, AShortRaggedOrUnknownColumnIsDataLossBeforeAnythingIsAppended) 
 
 TEST(MaxSamplesPerMessage, ARawMessageOfThatManySamplesFitsTheCap) {
   const SampleFields fields = AllFields();
-  for (auto precision : {v1::PRECISION_FLOAT64, v1::PRECISION_FLOAT32}) {
+  for (auto precision : {ColumnPrecision::kFloat64, ColumnPrecision::kFloat32}) {
     for (size_t cap : {size_t{4096}, size_t{1} << 16, size_t{4} << 20}) {
       const uint32_t n = MaxSamplesPerMessage(fields, precision, true, 0, cap);
       ASSERT_GT(n, 0u);
       SampleBatch b = EveryColumn(n, 11, false);
       v1::SampleResponse response;
-      ToProto(b, fields, precision, response.mutable_batch(), v1::COLUMN_ENCODING_RAW);
+      ToProto(b, fields, Stream(precision, ColumnEncoding::kRaw), response.mutable_batch());
       EXPECT_LE(response.ByteSizeLong(), cap);
     }
   }
+}
+
+// The stream options travel beside the request and read back as sent; a
+// request that names none gets the wire's defaults.
+TEST(FromProto, ReadsTheStreamOptionsBesideTheRequest) {
+  SampleRequest request;
+  request.count = 1000;
+  request.seed = 7;
+  StreamOptions stream = Stream(ColumnPrecision::kFloat32, ColumnEncoding::kRaw);
+  stream.batch_size = 777;
+  const auto call = FromProto(ToProto(request, stream));
+  ASSERT_TRUE(call.ok()) << call.status();
+  EXPECT_EQ(call->request.count, 1000u);
+  EXPECT_EQ(call->request.seed, 7u);
+  EXPECT_EQ(call->stream.precision, ColumnPrecision::kFloat32);
+  EXPECT_EQ(call->stream.batch_size, 777u);
+  EXPECT_EQ(call->stream.encoding, ColumnEncoding::kRaw);
+  const v1::SampleRequest wire = ToProto(request);
+  EXPECT_EQ(wire.precision(), v1::PRECISION_FLOAT64);
+  EXPECT_EQ(wire.batch_size(), 0u);
+  EXPECT_EQ(wire.column_encoding(), v1::COLUMN_ENCODING_PACKED);
+  const auto defaults = FromProto(wire);
+  ASSERT_TRUE(defaults.ok()) << defaults.status();
+  EXPECT_EQ(defaults->stream.precision, ColumnPrecision::kFloat64);
+  EXPECT_EQ(defaults->stream.batch_size, 0u);
+  EXPECT_EQ(defaults->stream.encoding, ColumnEncoding::kPacked);
 }
 
 TEST(FromProto, AnUnknownColumnEncodingIsInvalidArgument) {
@@ -281,13 +315,13 @@ TEST(WireColumns, OnlyTheAskedForColumnsTravelAndArrive) {
     fields.xyz = mask & 2;
     fields.normal = mask & 4;
     if (WireValueColumns(fields) == 0) continue;
-    for (auto encoding : {v1::COLUMN_ENCODING_PACKED, v1::COLUMN_ENCODING_RAW}) {
-      for (auto precision : {v1::PRECISION_FLOAT64, v1::PRECISION_FLOAT32}) {
+    for (auto encoding : {ColumnEncoding::kPacked, ColumnEncoding::kRaw}) {
+      for (auto precision : {ColumnPrecision::kFloat64, ColumnPrecision::kFloat32}) {
         v1::SampleBatch narrow, old_server;
-        ToProto(sent, fields, precision, &narrow, encoding);
+        ToProto(sent, fields, Stream(precision, encoding), &narrow);
         SampleFields everything = fields;
         everything.uv = everything.xyz = everything.normal = true;
-        ToProto(sent, everything, precision, &old_server, encoding);
+        ToProto(sent, everything, Stream(precision, encoding), &old_server);
         EXPECT_LT(narrow.ByteSizeLong(), old_server.ByteSizeLong() + (mask == 7 ? 1 : 0));
         for (const v1::SampleBatch* wire : {&narrow, &old_server}) {
           SampleBatch got;
@@ -299,7 +333,7 @@ TEST(WireColumns, OnlyTheAskedForColumnsTravelAndArrive) {
           EXPECT_TRUE(got.density.empty());
         }
         // The message's size follows the columns it carries.
-        const size_t width = precision == v1::PRECISION_FLOAT32 ? 4 : 8;
+        const size_t width = precision == ColumnPrecision::kFloat32 ? 4 : 8;
         EXPECT_GE(narrow.ByteSizeLong(), WireValueColumns(fields) * width * sent.size());
         EXPECT_LT(narrow.ByteSizeLong(),
                   (WireValueColumns(fields) * width + 1) * sent.size() + 100);
@@ -311,14 +345,14 @@ TEST(WireColumns, OnlyTheAskedForColumnsTravelAndArrive) {
 TEST(WireColumns, AMessageOfTheMostThatFitWithoutUvFitsTheCapAndHoldsMore) {
   SampleFields all, positions;
   positions.uv = false;
-  for (auto precision : {v1::PRECISION_FLOAT64, v1::PRECISION_FLOAT32}) {
+  for (auto precision : {ColumnPrecision::kFloat64, ColumnPrecision::kFloat32}) {
     const size_t cap = 1 << 16;
     const uint32_t n = MaxSamplesPerMessage(positions, precision, true, 0, cap);
     EXPECT_GT(n, MaxSamplesPerMessage(all, precision, true, 0, cap) * 4 /
                      3);  // 48 or 28 bytes a sample against 32 or 20
     const SampleBatch b = EveryColumn(n, 13, false);
     v1::SampleResponse response;
-    ToProto(b, positions, precision, response.mutable_batch(), v1::COLUMN_ENCODING_RAW);
+    ToProto(b, positions, Stream(precision, ColumnEncoding::kRaw), response.mutable_batch());
     EXPECT_LE(response.ByteSizeLong(), cap);
   }
 }
@@ -329,8 +363,9 @@ TEST(WireColumns, ALateBadColumnLeavesTheBatchAsItWas) {
   const SampleFields fields = AllFields();
   const SampleBatch first = EveryColumn(7, 1, true);
   v1::SampleBatch good, bad;
-  ToProto(first, fields, v1::PRECISION_FLOAT64, &good, v1::COLUMN_ENCODING_RAW);
-  ToProto(EveryColumn(9, 2, true), fields, v1::PRECISION_FLOAT64, &bad, v1::COLUMN_ENCODING_RAW);
+  ToProto(first, fields, Stream(ColumnPrecision::kFloat64, ColumnEncoding::kRaw), &good);
+  ToProto(EveryColumn(9, 2, true), fields, Stream(ColumnPrecision::kFloat64, ColumnEncoding::kRaw),
+          &bad);
   bad.mutable_triangle()->RemoveLast();
   SampleBatch got;
   ASSERT_TRUE(AppendFromProto(good, fields, &got).ok());
@@ -349,7 +384,7 @@ TEST(WireColumns, ALateBadColumnLeavesColumnsOfOtherLengthsAsTheyWere) {
   fields.uv = false;
   fields.normal = true;
   v1::SampleBatch bad;
-  ToProto(EveryColumn(2, 4, true), fields, v1::PRECISION_FLOAT64, &bad);
+  ToProto(EveryColumn(2, 4, true), fields, Stream(ColumnPrecision::kFloat64), &bad);
   bad.mutable_f64()->add_ny(1.0);  // 3 values for 2 samples
   SampleBatch got;
   got.index = {0};
@@ -373,11 +408,11 @@ TEST(WireColumns, ARequestLeavingNoValueColumnIsInvalidArgumentAndTheFlagsRoundT
   request.set_density(true);
   const auto accepted = FromProto(request);
   ASSERT_TRUE(accepted.ok()) << accepted.status();
-  EXPECT_FALSE(accepted->fields.uv || accepted->fields.xyz);
-  const v1::SampleRequest back = ToProto(*accepted);
+  EXPECT_FALSE(accepted->request.fields.uv || accepted->request.fields.xyz);
+  const v1::SampleRequest back = ToProto(accepted->request, accepted->stream);
   EXPECT_TRUE(back.omit_uv() && back.omit_xyz() && back.density());
   request.set_omit_uv(false);
-  EXPECT_TRUE(FromProto(request)->fields.uv);
+  EXPECT_TRUE(FromProto(request)->request.fields.uv);
 }
 
 }  // namespace
