@@ -18,7 +18,6 @@ subclasses carrying the status code and message.
 """
 
 from sfcsampler._core import ALGORITHM_VERSION, densities, surfaces
-from sfcsampler.client import Client
 from sfcsampler.embedded import Sampler, batches, prepare, sample
 from sfcsampler.many import Result, Results, model_seed, sample_many
 from sfcsampler.meshes import write_ply
@@ -26,6 +25,16 @@ from sfcsampler.errors import (DataLossError, DeadlineExceededError, DepthCapWar
                                InvalidArgumentError, ResourceExhaustedError, UnauthenticatedError,
                                UnavailableError)
 from sfcsampler.samples import Samples
+
+
+def __getattr__(name):
+    """Client on first use: gRPC and protobuf load only when a server is used (PEP 562)."""
+    if name == "Client":
+        from sfcsampler.client import Client
+        globals()["Client"] = Client
+        return Client
+    raise AttributeError(f"module 'sfcsampler' has no attribute {name!r}")
+
 
 __all__ = [
     "ALGORITHM_VERSION", "Client", "Result", "Results", "model_seed", "sample_many", "write_ply",

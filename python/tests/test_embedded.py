@@ -2,6 +2,7 @@
 request gives the same numbers; bad input raises clear exceptions."""
 
 import subprocess
+import sys
 import threading
 import warnings
 
@@ -238,3 +239,15 @@ def test_one_sampler_from_several_threads():
         t.join()
     for request, result in zip(requests, results):
         assert np.array_equal(result.x, sfcsampler.sample(**request).x)
+
+
+def test_import_and_embedded_sampling_load_no_grpc_until_a_client_is_used():
+    # A fresh interpreter: this test process may already hold grpc.
+    program = ("import sys, sfcsampler\n"
+               "sfcsampler.sample(surface='sphere', count=100)\n"
+               "loaded = [m for m in ('grpc', 'google.protobuf') if m in sys.modules]\n"
+               "assert not loaded, loaded\n"
+               "assert sfcsampler.Client.__module__ == 'sfcsampler.client'\n"
+               "assert 'grpc' in sys.modules\n")
+    done = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
