@@ -48,9 +48,10 @@ void PrintFacts(const TreeSummary& t, const Verbosity& verbosity) {
   if (t.singular_leaves > 0) {
     std::fprintf(
         stderr,
-        "warning: the parameterisation is singular (the area element blows up, paper Sect. "
-        "5.3) in %llu leaves that no edge power law fits; their masses come from mapped "
-        "sub-triangles and samples are spread evenly inside their sub-squares. Finest:\n",
+        "warning: the area element is not smooth (it blows up, vanishes or creases; paper Sect. "
+        "5.3) in %llu leaves that no power law fits; their masses come from mapped "
+        "sub-triangles, samples are spread evenly inside their sub-squares, and such leaves "
+        "are split until each carries a small fraction of a sample. Finest:\n",
         static_cast<unsigned long long>(t.singular_leaves));
     PrintCells(t.singular);
   }
