@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/vec3.h"
+#include "core/types/vec3.h"
 
 namespace sfc::cad {
 

@@ -26,7 +26,7 @@
 
 #include "absl/strings/string_view.h"
 #include "core/surface.h"
-#include "core/vec3.h"
+#include "core/types/vec3.h"
 
 namespace sfc::cad {
 

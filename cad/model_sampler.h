@@ -42,10 +42,10 @@
 #include "cad/model.h"
 #include "core/curve_tree.h"
 #include "core/density.h"
-#include "core/region.h"
-#include "core/sample_batch.h"
 #include "core/sampler.h"
 #include "core/sequence.h"
+#include "core/types/region.h"
+#include "core/types/sample_batch.h"
 
 namespace sfc::cad {
 

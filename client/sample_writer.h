@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/sample_batch.h"
+#include "core/types/sample_batch.h"
 #include "request/stream_options.h"
 
 namespace sfc {

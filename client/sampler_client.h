@@ -25,7 +25,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
-#include "core/sample_batch.h"
+#include "core/types/sample_batch.h"
 #include "grpcpp/channel.h"
 #include "request/model_spec.h"
 #include "request/sample_request.h"

@@ -13,7 +13,7 @@
 #include "absl/status/statusor.h"
 #include "core/density.h"
 #include "core/surface.h"
-#include "core/tree_options.h"
+#include "core/types/tree_options.h"
 
 namespace sfc {
 

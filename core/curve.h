@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "core/hilbert_batch.h"
-#include "core/tree_options.h"
+#include "core/types/tree_options.h"
 
 namespace sfc {
 

@@ -19,9 +19,9 @@
 #include <vector>
 
 #include "absl/status/status.h"
-#include "core/region.h"
-#include "core/sample_batch.h"
 #include "core/sequence.h"
+#include "core/types/region.h"
+#include "core/types/sample_batch.h"
 
 namespace sfc {
 

@@ -65,7 +65,7 @@
 #include "core/density.h"
 #include "core/leaf_model.h"
 #include "core/surface.h"
-#include "core/tree_options.h"
+#include "core/types/tree_options.h"
 
 namespace sfc {
 

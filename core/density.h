@@ -7,7 +7,7 @@
 
 #include <memory>
 
-#include "core/vec3.h"
+#include "core/types/vec3.h"
 
 namespace sfc {
 

@@ -13,8 +13,8 @@
 
 #include "absl/status/statusor.h"
 #include "core/curve_samples.h"
-#include "core/region.h"
-#include "core/sample_batch.h"
+#include "core/types/region.h"
+#include "core/types/sample_batch.h"
 
 namespace sfc {
 

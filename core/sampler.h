@@ -19,11 +19,11 @@
 #include "core/curve_samples.h"
 #include "core/curve_tree.h"
 #include "core/density.h"
-#include "core/region.h"
-#include "core/sample_batch.h"
 #include "core/sample_cursor.h"
 #include "core/sequence.h"
 #include "core/surface.h"
+#include "core/types/region.h"
+#include "core/types/sample_batch.h"
 
 namespace sfc {
 

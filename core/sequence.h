@@ -14,7 +14,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/sequence_kind.h"
+#include "core/types/sequence_kind.h"
 
 namespace sfc {
 

@@ -13,7 +13,7 @@
 #include <optional>
 
 #include "core/interval.h"
-#include "core/vec3.h"
+#include "core/types/vec3.h"
 
 namespace sfc {
 

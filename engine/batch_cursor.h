@@ -11,8 +11,8 @@
 #include <utility>
 
 #include "absl/status/statusor.h"
-#include "core/sample_batch.h"
 #include "core/sampler.h"
+#include "core/types/sample_batch.h"
 
 namespace sfc {
 

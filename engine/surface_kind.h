@@ -17,9 +17,9 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/region.h"
-#include "core/sample_batch.h"
 #include "core/sequence.h"
+#include "core/types/region.h"
+#include "core/types/sample_batch.h"
 #include "engine/batch_cursor.h"
 #include "engine/engine_limits.h"
 #include "engine/loaded_models.h"

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/vec3.h"
+#include "core/types/vec3.h"
 #include "evaluation/discrepancy.h"
 
 namespace sfc {

@@ -12,7 +12,7 @@
 #include <functional>
 #include <vector>
 
-#include "core/vec3.h"
+#include "core/types/vec3.h"
 
 namespace sfc {
 

@@ -15,7 +15,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/curve_tree.h"
-#include "core/sample_batch.h"
+#include "core/types/sample_batch.h"
 
 namespace sfc {
 

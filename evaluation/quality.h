@@ -30,7 +30,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/sample_batch.h"
+#include "core/types/sample_batch.h"
 
 namespace sfc {
 

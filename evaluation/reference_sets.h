@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "evaluation/discrepancy.h"
-#include "core/vec3.h"
+#include "core/types/vec3.h"
 
 namespace sfc {
 

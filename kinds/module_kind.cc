@@ -14,7 +14,7 @@
 #include "absl/strings/str_join.h"
 #include "base/echo.h"
 #include "base/worker_pool.h"
-#include "core/sample_batch.h"
+#include "core/types/sample_batch.h"
 #include "request/sample_request.h"
 
 namespace sfc {

@@ -47,7 +47,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/vec3.h"
+#include "core/types/vec3.h"
 #include "mesh/mesh_density.h"
 #include "mesh/mesh_surface.h"
 

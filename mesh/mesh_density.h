@@ -13,7 +13,7 @@
 #include <memory>
 #include <string>
 
-#include "core/vec3.h"
+#include "core/types/vec3.h"
 
 namespace sfc {
 

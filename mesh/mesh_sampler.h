@@ -27,10 +27,10 @@
 
 #include "absl/status/status.h"
 #include "core/curve_samples.h"
-#include "core/region.h"
-#include "core/sample_batch.h"
 #include "core/sample_cursor.h"
 #include "core/sequence.h"
+#include "core/types/region.h"
+#include "core/types/sample_batch.h"
 #include "mesh/mesh_curve_tree.h"
 
 namespace sfc {

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "absl/status/status.h"
-#include "core/vec3.h"
+#include "core/types/vec3.h"
 
 namespace sfc {
 

@@ -19,7 +19,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/vec3.h"
+#include "core/types/vec3.h"
 
 namespace sfc {
 

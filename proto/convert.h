@@ -1,7 +1,7 @@
 // Conversions between the sfcsampler.v1 wire types and the request library's
 // types, shared by the server and the client library so both sides agree
 // exactly, a tree's summary among them (what only a sampler has is in
-// proto/service_convert.h).
+// proto/service/service_convert.h).
 // Also the one place that maps absl::Status to and from grpc::Status.
 // Thread-safety: pure functions.
 #ifndef SFCSAMPLER_PROTO_CONVERT_H_
@@ -9,7 +9,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "core/sample_batch.h"
+#include "core/types/sample_batch.h"
 #include "grpcpp/support/status.h"
 #include "request/sample_request.h"
 #include "request/stream_options.h"

@@ -9,8 +9,8 @@
 
 #include "absl/status/status.h"
 #include "core/curve_tree.h"
-#include "core/sample_batch.h"
 #include "core/surface.h"
+#include "core/types/sample_batch.h"
 
 namespace sfc {
 

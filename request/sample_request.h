@@ -9,10 +9,10 @@
 #include <cstdint>
 #include <string>
 
-#include "core/region.h"
-#include "core/sample_batch.h"
-#include "core/sequence_kind.h"
-#include "core/tree_options.h"
+#include "core/types/region.h"
+#include "core/types/sample_batch.h"
+#include "core/types/sequence_kind.h"
+#include "core/types/tree_options.h"
 
 namespace sfc {
 

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <string>
 
-#include "core/tree_options.h"
+#include "core/types/tree_options.h"
 
 namespace sfc {
 

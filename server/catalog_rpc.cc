@@ -1,7 +1,7 @@
 #include "server/sampler_service.h"
 
 #include "catalog/catalog.h"
-#include "proto/service_convert.h"
+#include "proto/service/service_convert.h"
 
 namespace sfc {
 

@@ -6,7 +6,7 @@
 #include "absl/strings/str_format.h"
 #include "base/echo.h"
 #include "proto/convert.h"
-#include "proto/service_convert.h"
+#include "proto/service/service_convert.h"
 #include "server/request_control.h"
 #include "spdlog/spdlog.h"
 

@@ -6,8 +6,8 @@
 #include <random>
 #include <string>
 
-#include "core/region.h"
 #include "core/sampler.h"
+#include "core/types/region.h"
 #include "gtest/gtest.h"
 #include "tests/test_util.h"
 

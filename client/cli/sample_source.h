@@ -25,7 +25,7 @@
 #include "client/cli/progress.h"
 #include "client/cli/tree_summary.h"
 #include "client/sample_writer.h"
-#include "core/sample_batch.h"
+#include "core/types/sample_batch.h"
 #include "request/sample_request.h"
 
 namespace sfc {

@@ -2,8 +2,8 @@
 // and the options that shape the tree (paper Sect. 5). Value types and their
 // names, with no sampling code, so that the request library (request/) and
 // the client can use them without the sampler.
-#ifndef SFCSAMPLER_CORE_TREE_OPTIONS_H_
-#define SFCSAMPLER_CORE_TREE_OPTIONS_H_
+#ifndef SFCSAMPLER_CORE_TYPES_TREE_OPTIONS_H_
+#define SFCSAMPLER_CORE_TYPES_TREE_OPTIONS_H_
 
 #include <cstdint>
 #include <optional>
@@ -48,4 +48,4 @@ struct CurveTreeOptions {
 
 }  // namespace sfc
 
-#endif  // SFCSAMPLER_CORE_TREE_OPTIONS_H_
+#endif  // SFCSAMPLER_CORE_TYPES_TREE_OPTIONS_H_

@@ -1,7 +1,7 @@
 // A 3-vector of doubles with the few operations the sampler needs.
 // Value type; thread-compatible.
-#ifndef SFCSAMPLER_CORE_VEC3_H_
-#define SFCSAMPLER_CORE_VEC3_H_
+#ifndef SFCSAMPLER_CORE_TYPES_VEC3_H_
+#define SFCSAMPLER_CORE_TYPES_VEC3_H_
 
 #include <cmath>
 
@@ -32,4 +32,4 @@ inline bool IsFinite(const Vec3& a) {
 
 }  // namespace sfc
 
-#endif  // SFCSAMPLER_CORE_VEC3_H_
+#endif  // SFCSAMPLER_CORE_TYPES_VEC3_H_

@@ -1,7 +1,7 @@
 // Which 1D sequence a request places along the curve (paper Sect. 4), and
-// its name. A value type with no sampling code (see core/tree_options.h).
-#ifndef SFCSAMPLER_CORE_SEQUENCE_KIND_H_
-#define SFCSAMPLER_CORE_SEQUENCE_KIND_H_
+// its name. A value type with no sampling code (see core/types/tree_options.h).
+#ifndef SFCSAMPLER_CORE_TYPES_SEQUENCE_KIND_H_
+#define SFCSAMPLER_CORE_TYPES_SEQUENCE_KIND_H_
 
 #include <optional>
 #include <string_view>
@@ -28,4 +28,4 @@ inline bool SequenceIsMonotone(SequenceKind kind) {
 
 }  // namespace sfc
 
-#endif  // SFCSAMPLER_CORE_SEQUENCE_KIND_H_
+#endif  // SFCSAMPLER_CORE_TYPES_SEQUENCE_KIND_H_

@@ -1,4 +1,4 @@
-#include "core/sequence_kind.h"
+#include "core/types/sequence_kind.h"
 
 namespace sfc {
 

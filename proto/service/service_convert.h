@@ -2,8 +2,8 @@
 // the catalogue and stored models (a prepared tree goes on the wire as its
 // summary, engine/sampling_engine.h SummarizeTree, by proto/convert.h). Used
 // by the server; the client library does without them. Pure functions.
-#ifndef SFCSAMPLER_PROTO_SERVICE_CONVERT_H_
-#define SFCSAMPLER_PROTO_SERVICE_CONVERT_H_
+#ifndef SFCSAMPLER_PROTO_SERVICE_SERVICE_CONVERT_H_
+#define SFCSAMPLER_PROTO_SERVICE_SERVICE_CONVERT_H_
 
 #include "catalog/catalog.h"
 #include "engine/model_source.h"
@@ -17,4 +17,4 @@ void ToProto(const StoredModel& model, bool already, ::sfcsampler::v1::ModelInfo
 
 }  // namespace sfc
 
-#endif  // SFCSAMPLER_PROTO_SERVICE_CONVERT_H_
+#endif  // SFCSAMPLER_PROTO_SERVICE_SERVICE_CONVERT_H_

@@ -1,4 +1,4 @@
-#include "core/region.h"
+#include "core/types/region.h"
 
 #include <cmath>
 

@@ -1,7 +1,7 @@
 // A batch of samples as a structure of arrays, in curve order.
 // Value type; thread-compatible.
-#ifndef SFCSAMPLER_CORE_SAMPLE_BATCH_H_
-#define SFCSAMPLER_CORE_SAMPLE_BATCH_H_
+#ifndef SFCSAMPLER_CORE_TYPES_SAMPLE_BATCH_H_
+#define SFCSAMPLER_CORE_TYPES_SAMPLE_BATCH_H_
 
 #include <array>
 #include <cstdint>
@@ -73,4 +73,4 @@ struct SampleBatch {
 
 }  // namespace sfc
 
-#endif  // SFCSAMPLER_CORE_SAMPLE_BATCH_H_
+#endif  // SFCSAMPLER_CORE_TYPES_SAMPLE_BATCH_H_

@@ -1,4 +1,4 @@
-#include "core/tree_options.h"
+#include "core/types/tree_options.h"
 
 namespace sfc {
 

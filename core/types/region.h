@@ -1,10 +1,10 @@
 // Regions of interest for locality-aware requests: a parameter rectangle or
 // an axis-aligned 3D box, both closed. Value type; thread-compatible.
-#ifndef SFCSAMPLER_CORE_REGION_H_
-#define SFCSAMPLER_CORE_REGION_H_
+#ifndef SFCSAMPLER_CORE_TYPES_REGION_H_
+#define SFCSAMPLER_CORE_TYPES_REGION_H_
 
 #include "absl/status/status.h"
-#include "core/vec3.h"
+#include "core/types/vec3.h"
 
 namespace sfc {
 
@@ -48,4 +48,4 @@ struct Region {
 
 }  // namespace sfc
 
-#endif  // SFCSAMPLER_CORE_REGION_H_
+#endif  // SFCSAMPLER_CORE_TYPES_REGION_H_

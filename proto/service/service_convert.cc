@@ -1,4 +1,4 @@
-#include "proto/service_convert.h"
+#include "proto/service/service_convert.h"
 
 #include <string>
 
