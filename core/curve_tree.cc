@@ -116,6 +116,7 @@ class CurveTree::Builder {
     bool singular = false;  // the area element is not finite at a node
     bool varies = false;    // ... or varies by more than 2x over them
     double area_ratio = 1;  // the largest over the smallest at the nodes
+    bool warped() const { return warp[0].power != 1 || warp[1].power != 1; }
   };
 
   // Power laws are read at h 2^-kWarpProbeNear and h 2^-kWarpProbeFar from
@@ -505,7 +506,7 @@ class CurveTree::Builder {
   // shrinks with the leaf, and the error test governs it.
   bool IsRough(const CellEval& eval, double error) const {
     if (eval.piecewise) return true;
-    if (eval.warp[0].power != 1 || eval.warp[1].power != 1) return false;
+    if (eval.warped()) return false;
     return error > kRoughShare * options_.rho * eval.mass;
   }
 
@@ -517,11 +518,10 @@ class CurveTree::Builder {
   // (kEdgeBand of the cell) is counted as mis-modelled by that difference.
   // 0 for warped and piecewise models (their edges are singular lines).
   double EdgeError(const CellEval& eval, double u0, double v0, double h) const {
-    if (eval.piecewise || eval.warp[0].power != 1 || eval.warp[1].power != 1) return 0.0;
+    if (eval.piecewise || eval.warped()) return 0.0;
     const double at[3] = {0, 0.5, 1};
     double us[3], vs[3];
     for (int i = 0; i < 3; ++i) us[i] = u0 + at[i] * h, vs[i] = v0 + at[i] * h;
-    us[2] = u0 + h, vs[2] = v0 + h;
     SurfaceJet jets[9];
     surface_.JetGrid(us, 3, vs, 3, order_, jets);
     double top = 0;
