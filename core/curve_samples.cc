@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "absl/strings/str_format.h"
+
 namespace sfc {
 
 SampleRows SampleRows::From(size_t offset) const {
@@ -9,6 +11,17 @@ SampleRows SampleRows::From(size_t offset) const {
   return {index + offset, at(u),  at(v),  at(x),       at(y),
           at(z),          at(nx), at(ny), at(nz),      at(density),
           at(curve_position), at(triangle)};
+}
+
+absl::Status SampleFiller::FillAddressed(size_t, const CurveAddress*, const SampleRows&) {
+  return absl::UnimplementedError("this kind of surface places no two-dimensional sequence");
+}
+
+absl::Status CurveSamples::AcceptsSequence(const Sequence& sequence) const {
+  if (!sequence.two_dimensional()) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      absl::StrFormat("the %s sequence is not available for this kind of surface",
+                      SequenceName(sequence.kind())));
 }
 
 uint64_t CurveSamples::FirstIndexAtOrAbove(double m) const {

@@ -38,17 +38,36 @@ struct IndexSegment {
   uint64_t begin, end;
 };
 
+// A sample of a two-dimensional sequence (sobol) by its place on the curve:
+// the kind's leaf and the digits of the leaf's own curve below it that the
+// sample's warped point falls in. Addresses in this order are curve order;
+// the filler places a sample from its address alone.
+struct CurveAddress {
+  uint64_t digits;
+  uint32_t leaf;
+  uint32_t index;  // the sample's k (a two-dimensional sequence has k < 2^32)
+  bool operator<(const CurveAddress& o) const {
+    if (leaf != o.leaf) return leaf < o.leaf;
+    if (digits != o.digits) return digits < o.digits;
+    return index < o.index;
+  }
+};
+
 // Places samples into rows, for one thread.
 class SampleFiller {
  public:
   virtual ~SampleFiller() = default;
   // On entry out.index[i] holds sample k and out.x[i] its mass coordinate
-  // q_k S_M, i < n, not decreasing in i. Writes u, v, x, y, z (and triangle,
+  // q_k S_M, i < n, not decreasing in i (a two-dimensional sequence's
+  // filler places sample k by k alone, and out.x[i] is then only scratch). Writes u, v, x, y, z (and triangle,
   // when asked for) of every row, and the other asked columns at least of the
   // rows whose point lies in the filler's region (the cursor drops the rest
   // by Region::Contains(u, v, {x, y, z})). Errors: INVALID_ARGUMENT when the
   // surface or density is not usable at a sample.
   virtual absl::Status Fill(size_t n, const SampleRows& out) = 0;
+  // The same for a two-dimensional sequence: row i is the sample at `at[i]`
+  // (out.index[i] holds its k). UNIMPLEMENTED for kinds without a warp.
+  virtual absl::Status FillAddressed(size_t n, const CurveAddress* at, const SampleRows& out);
 };
 
 class CurveSamples {
@@ -73,6 +92,15 @@ class CurveSamples {
   // rectangle, not kAll); they may hold more. Monotone sequences only.
   virtual absl::Status PlanRegion(const Region& region, uint64_t begin, uint64_t end,
                                   std::vector<IndexSegment>* segments) const = 0;
+  // Two-dimensional sequences (Sequence::two_dimensional): sample k's
+  // address, by which the cursor sorts the whole set and the filler places
+  // it. Kinds without a warp are refused by AcceptsSequence before.
+  virtual CurveAddress AddressOf(uint64_t k) const {
+    return {0, 0, static_cast<uint32_t>(k)};
+  }
+  // OK when the kind can place `sequence`'s samples; INVALID_ARGUMENT with
+  // the reason otherwise (a kind without a warp for two-dimensional ones).
+  virtual absl::Status AcceptsSequence(const Sequence& sequence) const;
   // Whether the filler writes SampleRows::triangle.
   virtual bool has_triangles() const { return false; }
   // A filler of the columns `fields` asks for, for samples tested against

@@ -38,6 +38,7 @@ absl::StatusOr<std::unique_ptr<SampleCursor>> SampleCursor::Create(
         "count",
         begin, end, count));
   }
+  RETURN_IF_ERROR(samples->AcceptsSequence(samples->sequence()));
   RETURN_IF_ERROR(samples->AcceptsRegion(region));
   RETURN_IF_ERROR(region.Validate());
   auto cursor = std::unique_ptr<SampleCursor>(new SampleCursor(std::move(samples), region, fields));
@@ -48,6 +49,30 @@ absl::StatusOr<std::unique_ptr<SampleCursor>> SampleCursor::Create(
 
 absl::Status SampleCursor::Plan(uint64_t begin, uint64_t end) {
   const CurveSamples& samples = *samples_;
+  if (samples.sequence().two_dimensional()) {
+    // Points warped onto the surface: the whole set in curve order, of which
+    // [begin, end) are positions, so ranges and shards concatenate to it.
+    // Addresses are pure functions of k, computed in parts over the threads.
+    const Sequence& sequence = samples.sequence();
+    const uint64_t count = sequence.count();
+    // Samples outside a window get the largest address and sort last.
+    constexpr CurveAddress kOutside = {UINT64_MAX, UINT32_MAX, UINT32_MAX};
+    addresses_.resize(count);
+    const int parts = count >= 8192 ? threads_ : 1;
+    WorkerPool::Shared().ParallelFor(parts, [&](int i) {
+      for (uint64_t k = count * i / parts; k < count * (i + 1) / parts; ++k) {
+        addresses_[k] = sequence.InWindow(k) ? samples.AddressOf(k) : kOutside;
+      }
+    });
+    std::sort(addresses_.begin(), addresses_.end());
+    uint64_t kept = addresses_.size();
+    while (kept > 0 && addresses_[kept - 1].leaf == UINT32_MAX) --kept;
+    addresses_.erase(addresses_.begin() + std::min(end, kept), addresses_.end());
+    addresses_.erase(addresses_.begin(), addresses_.begin() + std::min(begin, kept));
+    addresses_.shrink_to_fit();
+    use_addresses_ = true;
+    return absl::OkStatus();
+  }
   if (!samples.sequence().monotone()) {
     // Index order is not curve order.
     const Sequence& sequence = samples.sequence();
@@ -81,7 +106,12 @@ absl::StatusOr<size_t> SampleCursor::NextRuns(size_t max, SampleBatch* batch) {
     // The next run: at most the samples still wanted, inside one segment. A
     // region keeps fewer than it is handed, so runs repeat until max are kept.
     size_t kept;
-    if (use_order_) {
+    if (use_addresses_) {
+      if (order_pos_ >= addresses_.size()) break;
+      const size_t n = std::min<size_t>(max - produced, addresses_.size() - order_pos_);
+      ASSIGN_OR_RETURN(kept, Generate(0, nullptr, n, batch, addresses_.data() + order_pos_));
+      order_pos_ += n;
+    } else if (use_order_) {
       if (order_pos_ >= order_.size()) break;
       const size_t n = std::min<size_t>(max - produced, order_.size() - order_pos_);
       ASSIGN_OR_RETURN(kept, Generate(0, order_.data() + order_pos_, n, batch));
@@ -136,8 +166,13 @@ void SampleCursor::Truncate(SampleBatch* batch, size_t rows) const {
 }
 
 absl::Status SampleCursor::Fill(uint64_t k0, const uint64_t* order, size_t n,
-                                SampleFiller& filler, const SampleRows& out) const {
+                                SampleFiller& filler, const SampleRows& out,
+                                const CurveAddress* at) const {
   const CurveSamples& samples = *samples_;
+  if (at != nullptr) {
+    for (size_t i = 0; i < n; ++i) out.index[i] = at[i].index;
+    return filler.FillAddressed(n, at, out);
+  }
   // Mass coordinates q_k S_M, in x until the filler overwrites them.
   double* m = out.x;
   if (order == nullptr) {
@@ -157,10 +192,10 @@ absl::Status SampleCursor::Fill(uint64_t k0, const uint64_t* order, size_t n,
 }
 
 absl::StatusOr<size_t> SampleCursor::Generate(uint64_t k0, const uint64_t* order, size_t n,
-                                              SampleBatch* batch) {
+                                              SampleBatch* batch, const CurveAddress* at) {
   const size_t s0 = batch->size();
   const SampleRows out = Grow(batch, n);
-  if (absl::Status st = Fill(k0, order, n, *filler_, out); !st.ok()) {
+  if (absl::Status st = Fill(k0, order, n, *filler_, out, at); !st.ok()) {
     Truncate(batch, s0);
     return st;
   }

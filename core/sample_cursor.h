@@ -20,7 +20,10 @@ namespace sfc {
 
 class SampleCursor {
  public:
-  // Samples with index in [begin, end) that lie in `region`, in curve order.
+  // Samples with index in [begin, end) that lie in `region`, in curve order;
+  // for a two-dimensional sequence (sobol), the samples at positions
+  // [begin, end) of the whole set in curve order (the whole set is placed
+  // and sorted: cost O(count log count)).
   // For monotone sequences the cost is proportional to the samples emitted
   // plus the kind's region planning (CurveSamples::PlanRegion); other
   // sequences sort the range by curve position first (cost O(n log n),
@@ -48,13 +51,14 @@ class SampleCursor {
   // Shrinks the batch's columns to `rows` rows.
   void Truncate(SampleBatch* batch, size_t rows) const;
   // Fills n rows with samples k0 + i (order null) or order[i], whose mass
-  // coordinates must not decrease, through `filler`.
+  // coordinates must not decrease, through `filler`; or, when `at` is not
+  // null, the samples at addresses at[i].
   absl::Status Fill(uint64_t k0, const uint64_t* order, size_t n, SampleFiller& filler,
-                    const SampleRows& out) const;
-  // Appends the samples k0 + i (or order[i]), i < n, that lie in the region;
-  // returns how many.
+                    const SampleRows& out, const CurveAddress* at = nullptr) const;
+  // Appends the samples k0 + i (or order[i], or at at[i]), i < n, that lie
+  // in the region; returns how many.
   absl::StatusOr<size_t> Generate(uint64_t k0, const uint64_t* order, size_t n,
-                                  SampleBatch* batch);
+                                  SampleBatch* batch, const CurveAddress* at = nullptr);
   // Appends [k0, k0 + n) (all kept: no region), split over threads_ threads.
   absl::Status GenerateParallel(uint64_t k0, size_t n, SampleBatch* batch);
 
@@ -69,6 +73,10 @@ class SampleCursor {
   std::vector<uint64_t> order_;
   size_t order_pos_ = 0;
   bool use_order_ = false;
+  // Two-dimensional sequences: the addresses of the range, in curve order
+  // (order_pos_ walks them).
+  std::vector<CurveAddress> addresses_;
+  bool use_addresses_ = false;
   // The cursor's own filler; parallel parts make their own.
   std::unique_ptr<SampleFiller> filler_;
   int threads_ = 1;

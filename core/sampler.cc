@@ -20,8 +20,13 @@ class SurfaceFiller final : public SampleFiller {
       : sampler_(sampler), fields_(fields), walk_(sampler.tree()) {}
 
   absl::Status Fill(size_t n, const SampleRows& out) override;
+  // Places each sample at its address through the sampler's TreeWarp.
+  absl::Status FillAddressed(size_t n, const CurveAddress* at, const SampleRows& out) override;
 
  private:
+  // Evaluates the surface at the rows' (u, v).
+  absl::Status Evaluate(size_t n, const SampleRows& out);
+
   const Sampler& sampler_;
   const SampleFields fields_;
   LeafWalk walk_;
@@ -29,7 +34,21 @@ class SurfaceFiller final : public SampleFiller {
 
 absl::Status SurfaceFiller::Fill(size_t n, const SampleRows& out) {
   walk_.Place(out.x, n, out.u, out.v, out.curve_position);
+  return Evaluate(n, out);
+}
 
+absl::Status SurfaceFiller::FillAddressed(size_t n, const CurveAddress* at,
+                                          const SampleRows& out) {
+  const TreeWarp& warp = *sampler_.warp();
+  for (size_t i = 0; i < n; ++i) {
+    const TreeWarp::Point p = warp.Place(at[i]);
+    out.u[i] = p.u, out.v[i] = p.v;
+    if (out.curve_position != nullptr) out.curve_position[i] = p.curve_position;
+  }
+  return Evaluate(n, out);
+}
+
+absl::Status SurfaceFiller::Evaluate(size_t n, const SampleRows& out) {
   const Surface& surface = sampler_.surface();
   const Density& density = sampler_.density();
   auto not_finite = [&](size_t i) {
@@ -75,7 +94,15 @@ Sampler::Sampler(std::shared_ptr<const CurveTree> tree, std::shared_ptr<const Su
     : CurveSamples(sequence, tree->total_mass()),
       tree_(std::move(tree)),
       surface_(std::move(surface)),
-      density_(std::move(density)) {}
+      density_(std::move(density)) {
+  if (sequence.two_dimensional()) warp_ = std::make_unique<const TreeWarp>(*tree_);
+}
+
+CurveAddress Sampler::AddressOf(uint64_t k) const {
+  CurveAddress at = warp_->Locate(sequence().At(k), sequence().Second(k));
+  at.index = static_cast<uint32_t>(k);
+  return at;
+}
 
 std::unique_ptr<SampleFiller> Sampler::NewFiller(const Region&, const SampleFields& fields) const {
   return std::make_unique<SurfaceFiller>(*this, fields);

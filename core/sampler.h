@@ -22,6 +22,7 @@
 #include "core/sample_cursor.h"
 #include "core/sequence.h"
 #include "core/surface.h"
+#include "core/tree_warp.h"
 #include "core/types/region.h"
 #include "core/types/sample_batch.h"
 
@@ -36,6 +37,15 @@ class Sampler final : public CurveSamples {
   const CurveTree& tree() const { return *tree_; }
   const Surface& surface() const { return *surface_; }
   const Density& density() const { return *density_; }
+
+  // Every sequence: a two-dimensional one (sobol) through a TreeWarp of the
+  // tree, made with the sampler (O(leaves)).
+  absl::Status AcceptsSequence(const Sequence&) const override { return absl::OkStatus(); }
+  // Sample k's point of the unit square (At(k), Second(k)), warped onto the
+  // surface. REQUIRES: a two-dimensional sequence.
+  CurveAddress AddressOf(uint64_t k) const override;
+  // The warp of a two-dimensional sequence; null for the others.
+  const TreeWarp* warp() const { return warp_.get(); }
 
   // Every region kind: a parameter rectangle or a 3D box.
   absl::Status AcceptsRegion(const Region&) const override { return absl::OkStatus(); }
@@ -52,6 +62,7 @@ class Sampler final : public CurveSamples {
   std::shared_ptr<const CurveTree> tree_;
   std::shared_ptr<const Surface> surface_;
   std::shared_ptr<const Density> density_;
+  std::unique_ptr<const TreeWarp> warp_;
 };
 
 }  // namespace sfc

@@ -10,6 +10,9 @@ constexpr uint64_t kJitterStream = 1;
 constexpr uint64_t kRandomStream = 2;
 constexpr uint64_t kOwenStream = 3;
 constexpr uint64_t kOwenTailStream = 4;
+// The sobol sequence's two coordinates: their scrambles and their tails.
+constexpr uint64_t kSobolStream[2] = {5, 6};
+constexpr uint64_t kSobolTailStream[2] = {7, 8};
 
 uint32_t ReverseBits32(uint32_t x) {
   x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
@@ -36,6 +39,38 @@ double OwenScrambledRadicalInverse(uint64_t k, uint64_t seed) {
   return (out + tail) * 0x1.0p-32;
 }
 
+// Sobol's second dimension (primitive polynomial x + 1, all m_i = 1): its
+// generator matrix is Pascal's triangle mod 2, v_0 = 2^31 and v_i = v_{i-1} xor
+// (v_{i-1} >> 1). With the base-2 radical inverse as the first dimension it
+// is a (0,2)-sequence: every 2^m-prefix is a (0,m,2)-net (Sobol 1967; Niederreiter
+// 1992, Sect. 4.5).
+uint32_t SobolSecond(uint32_t k) {
+  uint32_t out = 0, v = 0x80000000u;
+  for (; k != 0; k >>= 1, v ^= v >> 1) {
+    if (k & 1) out ^= v;
+  }
+  return out;
+}
+
+// Owen's nested uniform scramble (Owen 1995) of the 32 digits `r` of sample
+// k, as a double in [0, 1): bit i (from the top) is flipped by a random bit of
+// (seed, dimension, i, the i bits of r above it), so every 2^m-prefix of the
+// sequence stays a (0,m,2)-net. The bits below 2^-32 are uniform random bits
+// of (seed, k), as a full scramble of the all-zero tail would make them. One
+// SplitMix64 finaliser a level (Steele, Lea and Flood 2014), keyed by the
+// seed and the dimension.
+double NestedScramble(uint32_t r, uint64_t k, uint64_t seed, int dim) {
+  const uint64_t key = Mix64(seed + 0x9e3779b97f4a7c15ULL * (kSobolStream[dim] + 1));
+  uint32_t out = 0;
+  for (int i = 0; i < 32; ++i) {
+    const uint64_t prefix = i == 0 ? 0 : r >> (32 - i);
+    const uint64_t flip = Mix64(key + 0x9e3779b97f4a7c15ULL * ((prefix << 6) | i)) >> 63;
+    out |= static_cast<uint32_t>(((r >> (31 - i)) & 1) ^ flip) << (31 - i);
+  }
+  const double tail = CounterUniform(seed, kSobolTailStream[dim], k);
+  return (out + tail) * 0x1.0p-32;
+}
+
 }  // namespace
 
 double Sequence::Raw(uint64_t k) const {
@@ -51,8 +86,14 @@ double Sequence::Raw(uint64_t k) const {
       return ReverseBits32(static_cast<uint32_t>(k)) * 0x1.0p-32;
     case SequenceKind::kProgressive:
       return OwenScrambledRadicalInverse(k, seed_);
+    case SequenceKind::kSobol:
+      return NestedScramble(ReverseBits32(static_cast<uint32_t>(k)), k, seed_, 0);
   }
   return 0;
+}
+
+double Sequence::Second(uint64_t k) const {
+  return NestedScramble(SobolSecond(static_cast<uint32_t>(k)), k, seed_, 1);
 }
 
 void Sequence::AtMany(uint64_t k0, size_t n, double* out) const {

@@ -21,7 +21,7 @@ namespace sfc {
 
 class Sequence {
  public:
-  // REQUIRES: count >= 1; count <= 2^32 for the radical-inverse kinds.
+  // REQUIRES: count >= 1; count <= 2^32 for the radical-inverse kinds and sobol.
   Sequence(SequenceKind kind, uint64_t count, uint64_t seed)
       : kind_(kind), count_(count), seed_(seed) {}
 
@@ -61,6 +61,13 @@ class Sequence {
     return q >= lo_ && (q < hi_ || (hi_ == 1 && q == 1));
   }
   bool windowed() const { return windowed_; }
+
+  // Two-dimensional kinds (SequenceIsTwoDimensional, sobol): the second
+  // coordinate of point k in [0, 1); At(k) is its first. Sobol point k is the
+  // Owen-scrambled (radical inverse of k, Sobol's second dimension of k): a
+  // pure function of (seed, k), not of count. REQUIRES: k < 2^32.
+  double Second(uint64_t k) const;
+  bool two_dimensional() const { return SequenceIsTwoDimensional(kind_); }
 
  private:
   double Raw(uint64_t k) const;  // q_k

@@ -15,6 +15,9 @@ enum class SequenceKind {
   kVanDerCorput,  // q_k = base-2 radical inverse of k
   kProgressive,   // Owen-scrambled base-2 radical inverse: every prefix of
                   // length 2^m puts exactly one q in each [j/2^m, (j+1)/2^m)
+  kSobol,         // an Owen-scrambled 2D Sobol (0,2)-sequence in the unit
+                  // square, warped through the tree onto the surface
+                  // (core/tree_warp.h); q_k is its first coordinate
 };
 
 std::string_view SequenceName(SequenceKind kind);  // "jittered", "equal", ...
@@ -25,6 +28,12 @@ std::optional<SequenceKind> SequenceFromName(std::string_view name);
 inline bool SequenceIsMonotone(SequenceKind kind) {
   return kind == SequenceKind::kJittered || kind == SequenceKind::kEqual;
 }
+
+// Whether a sample is a point of the unit square warped onto the surface
+// (sobol) rather than a mass coordinate along the curve. Such a set is sorted
+// whole into curve order, and index ranges and shards select positions in
+// that order (docs/SERVICE.md, "Sobol sets").
+inline bool SequenceIsTwoDimensional(SequenceKind kind) { return kind == SequenceKind::kSobol; }
 
 }  // namespace sfc
 

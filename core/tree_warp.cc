@@ -1,0 +1,263 @@
+#include "core/tree_warp.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <functional>
+
+#include "core/leaf_model.h"
+
+namespace sfc {
+namespace {
+
+// The orientations a curve's cells take: the 8 symmetries of the square.
+constexpr int kStates = 8;
+
+// The largest double below 1: a rescaled coordinate stays in [0, 1).
+constexpr double kBelowOne = 1.0 - 0x1.0p-53;
+
+// Picks among `n` parts with masses `mass` (not all zero) by the coordinate
+// *a in [0, 1]: the part holding a x total, with *a rescaled to that part
+// (the inverse CDF of the parts, then of the uniform inside one). Zero-mass
+// parts are never picked.
+int Split(const double* mass, int n, double* a) {
+  double total = 0;
+  for (int i = 0; i < n; ++i) total += mass[i];
+  const double t = *a * total;
+  double before = 0;
+  int last = -1;
+  for (int i = 0; i < n; ++i) {
+    if (!(mass[i] > 0)) continue;
+    last = i;
+    if (before + mass[i] > t) break;
+    before += mass[i];
+  }
+  assert(last >= 0);
+  *a = std::clamp((t - before) / mass[last], 0.0, kBelowOne);
+  return last;
+}
+
+// p(s) = p0 + p1 s + p2 s^2 >= 0 on [0, 1].
+bool NotNegative(double p0, double p1, double p2) {
+  if (p0 < 0 || p0 + p1 + p2 < 0) return false;
+  if (p2 > 0) {
+    const double s = -p1 / (2 * p2);
+    if (s > 0 && s < 1 && p0 + s * (p1 + s * p2) < 0) return false;
+  }
+  return true;
+}
+
+// The s in [0, 1] where the CDF F(s) = p0 s + p1 s^2 / 2 + p2 s^3 / 3 of a
+// density p not negative on [0, 1] reaches `share` of F(1): Newton's method
+// kept inside a shrinking bracket (bisection where a step leaves it).
+double InvertCdf(double p0, double p1, double p2, double share) {
+  auto cdf = [&](double s) { return s * (p0 + s * (p1 / 2 + s * (p2 / 3))); };
+  const double target = share * cdf(1);
+  double lo = 0, hi = 1, s = share;
+  for (int iter = 0; iter < 100; ++iter) {
+    const double f = cdf(s) - target;
+    if (f == 0) return s;
+    if (f > 0) {
+      hi = s;
+    } else {
+      lo = s;
+    }
+    const double d = p0 + s * (p1 + s * p2);
+    double next = d > 0 ? s - f / d : (lo + hi) / 2;
+    if (!(next > lo && next < hi)) next = (lo + hi) / 2;
+    if (next == s || hi - lo <= 0x1.0p-52) return next;
+    s = next;
+  }
+  return s;
+}
+
+// The quadratic factor of a Lagrange combination sum_i w[i] L_i(s) as
+// coefficients of 1, s, s^2.
+void PolynomialOf(const double w[3], double* p0, double* p1, double* p2) {
+  const auto& k = leaf_model_internal::kBasisTable.k;
+  *p0 = w[0] * k[0][0] + w[1] * k[1][0] + w[2] * k[2][0];
+  *p1 = w[0] * k[0][1] + w[1] * k[1][1] + w[2] * k[2][1];
+  *p2 = w[0] * k[0][2] + w[1] * k[1][2] + w[2] * k[2][2];
+}
+
+// Exact marginal-then-conditional inverse CDF of a quadratic model in its
+// warped coordinates (s, t); false where the quadratic dips below zero on the
+// cell (the caller then splits the clamped model's sub-squares).
+bool PlaceQuadratic(const LeafModel& model, double a, double b, double* s, double* t) {
+  using leaf_model_internal::Basis;
+  // The marginal density of s: sum_i L_i(s) sum_j c_ij int L_j, and
+  // int_0^1 L_j is the Gauss weight w_j.
+  double marginal[3];
+  for (int i = 0; i < 3; ++i) {
+    marginal[i] = 0;
+    for (int j = 0; j < 3; ++j) marginal[i] += model.c[3 * i + j] * kGaussWeight[j];
+  }
+  double p0, p1, p2;
+  PolynomialOf(marginal, &p0, &p1, &p2);
+  if (!NotNegative(p0, p1, p2)) return false;
+  *s = InvertCdf(p0, p1, p2, a);
+  // The density of t at that s: sum_j L_j(t) sum_i c_ij L_i(s).
+  double basis_s[3], conditional[3];
+  for (int i = 0; i < 3; ++i) basis_s[i] = Basis(i, *s);
+  for (int j = 0; j < 3; ++j) {
+    conditional[j] = 0;
+    for (int i = 0; i < 3; ++i) conditional[j] += model.c[3 * i + j] * basis_s[i];
+  }
+  double q0, q1, q2;
+  PolynomialOf(conditional, &q0, &q1, &q2);
+  if (!NotNegative(q0, q1, q2) || !(q0 + q1 / 2 + q2 / 3 > 0)) return false;
+  *t = InvertCdf(q0, q1, q2, b);
+  return true;
+}
+
+// Leaf coordinate of the point at x of the sub-cell [x0, x0 + side] of the
+// coordinates ComputeGridFactors used: those warped by a blowing-up power law
+// map back through it; along a vanishing one they were the leaf's own, and
+// the point is uniform in warped coordinates inside the sub-cell (the model's
+// own measure there), as core/leaf_walk.cc places it.
+double OnAxis(const AxisWarp& w, double x0, double side, double x) {
+  if (w.power == 1) return x;
+  if (DescendsWarped(w)) return Warp(w, x);
+  const double s0 = Unwarp(w, x0), s1 = Unwarp(w, x0 + side);
+  return std::clamp(Warp(w, s0 + (x - x0) / side * (s1 - s0)), x0, x0 + side);
+}
+
+}  // namespace
+
+TreeWarp::TreeWarp(const CurveTree& tree)
+    : tree_(tree), curve_(tree.curve()), grid_(curve_.grid()), arity_(curve_.arity()) {
+  child_at_.assign(kStates * arity_, 0);
+  for (int s = 0; s < kStates; ++s) {
+    for (int c = 0; c < arity_; ++c) {
+      const Curve::Child& ch = curve_.ChildOf(s, c);
+      child_at_[s * arity_ + ch.dy * grid_ + ch.dx] = static_cast<uint8_t>(c);
+    }
+  }
+  // Depth-first over the cells down to the leaves, which come in curve
+  // order; a node's child masses are differences of the running sums.
+  size_t next_leaf = 0;
+  std::function<int32_t(int, uint64_t, int)> build = [&](int depth, uint64_t start,
+                                                          int state) -> int32_t {
+    if (tree.leaf_start(next_leaf) == start && tree.leaf_depth(next_leaf) == depth) {
+      return -static_cast<int32_t>(next_leaf++) - 1;
+    }
+    const int32_t node = static_cast<int32_t>(children_.size() / arity_);
+    children_.resize(children_.size() + arity_);
+    masses_.resize(masses_.size() + arity_);
+    for (int c = 0; c < arity_; ++c) {
+      const Curve::Child& ch = curve_.ChildOf(state, c);
+      const size_t first = next_leaf;
+      const int32_t child = build(depth + 1, start + c * curve_.Span(depth + 1), ch.state);
+      const int at = node * arity_ + ch.dy * grid_ + ch.dx;
+      children_[at] = child;
+      masses_[at] = tree.mass_end(next_leaf - 1) - tree.mass_begin(first);
+    }
+    return node;
+  };
+  root_ = build(0, 0, Curve::kRootState);
+  assert(next_leaf == tree.leaf_count());
+}
+
+CurveAddress TreeWarp::Locate(double a, double b) const {
+  a = std::clamp(a, 0.0, kBelowOne), b = std::clamp(b, 0.0, kBelowOne);
+  int32_t ref = root_;
+  int state = Curve::kRootState;
+  while (ref >= 0) {
+    const double* mass = &masses_[ref * arity_];
+    double column[3] = {0, 0, 0};
+    for (int dy = 0; dy < grid_; ++dy) {
+      for (int dx = 0; dx < grid_; ++dx) column[dx] += mass[dy * grid_ + dx];
+    }
+    const int dx = Split(column, grid_, &a);
+    double row[3];
+    for (int dy = 0; dy < grid_; ++dy) row[dy] = mass[dy * grid_ + dx];
+    const int dy = Split(row, grid_, &b);
+    const int at = dy * grid_ + dx;
+    ref = children_[ref * arity_ + at];
+    state = curve_.ChildOf(state, child_at_[state * arity_ + at]).state;
+  }
+  const size_t l = static_cast<size_t>(-ref - 1);
+  double x, y;
+  PlaceInLeaf(l, a, b, &x, &y);
+  CurveAddress address;
+  address.leaf = static_cast<uint32_t>(l);
+  address.digits = DigitsInLeaf(x, y, state);
+  address.index = 0;
+  return address;
+}
+
+TreeWarp::Point TreeWarp::Place(const CurveAddress& at) const {
+  const CurveTree::Cell cell = tree_.LeafCell(at.leaf);
+  const int levels = curve_.continuation_levels();
+  uint64_t cx, cy;
+  int state = cell.state;
+  curve_.Descend(at.digits, levels, &cx, &cy, &state);
+  // The centre of the sub-cell, as LeafWalk::Continue computes it.
+  const double cells = curve_.PowG(levels);
+  const double side = cell.size / cells;
+  Point p;
+  p.u = cell.u0 + (static_cast<double>(cx) + 0.5) * side;
+  p.v = cell.v0 + (static_cast<double>(cy) + 0.5) * side;
+  const double start = static_cast<double>(tree_.leaf_start(at.leaf));
+  const double span = static_cast<double>(tree_.leaf_end(at.leaf) - tree_.leaf_start(at.leaf));
+  const double fraction = static_cast<double>(at.digits) / static_cast<double>(curve_.PowW(levels));
+  p.curve_position = (start + fraction * span) / static_cast<double>(curve_.Span(0));
+  return p;
+}
+
+void TreeWarp::PlaceInLeaf(size_t l, double a, double b, double* x, double* y) const {
+  const LeafModel& model = tree_.leaf_model(l);
+  const LeafModel::Kind kind = tree_.leaf_model_kind(l);
+  if (kind == LeafModel::Kind::kQuadratic) {
+    double s, t;
+    if (PlaceQuadratic(model, a, b, &s, &t)) {
+      *x = Warp(model.warp[0], s);
+      *y = Warp(model.warp[1], t);
+      return;
+    }
+  }
+  // The clamped sub-square integrals: the piecewise model's own pieces, or
+  // the finest table of a leaf walk for a quadratic that dips below zero.
+  const bool quadratic = kind == LeafModel::Kind::kQuadratic;
+  const int n = quadratic ? static_cast<int>(curve_.PowG(curve_.table_levels())) : grid_;
+  GridFactors factors;
+  ComputeGridFactors(model, kind, grid_, 0, 0, 1, n, &factors);
+  double column[kMaxGridCells], cells[kMaxGridCells];
+  for (int i = 0; i < n; ++i) {
+    column[i] = 0;
+    for (int j = 0; j < n; ++j) column[i] += std::max(0.0, factors.Integral(i, j));
+  }
+  double total = 0;
+  for (int i = 0; i < n; ++i) total += column[i];
+  if (!(total > 0)) {  // the model vanishes: uniform over the leaf
+    *x = a, *y = b;
+    return;
+  }
+  const int i = Split(column, n, &a);
+  for (int j = 0; j < n; ++j) cells[j] = std::max(0.0, factors.Integral(i, j));
+  const int j = Split(cells, n, &b);
+  const double side = 1.0 / n;
+  *x = (i + a) * side, *y = (j + b) * side;
+  if (quadratic) {
+    *x = OnAxis(model.warp[0], i * side, side, *x);
+    *y = OnAxis(model.warp[1], j * side, side, *y);
+  }
+}
+
+uint64_t TreeWarp::DigitsInLeaf(double x, double y, int state) const {
+  x = std::clamp(x, 0.0, kBelowOne), y = std::clamp(y, 0.0, kBelowOne);
+  uint64_t digits = 0;
+  for (int level = 0; level < curve_.continuation_levels(); ++level) {
+    // The next digit of each coordinate in base g (exact for g = 2).
+    x *= grid_, y *= grid_;
+    const int dx = std::min(static_cast<int>(x), grid_ - 1);
+    const int dy = std::min(static_cast<int>(y), grid_ - 1);
+    x -= dx, y -= dy;
+    const int c = child_at_[state * arity_ + dy * grid_ + dx];
+    digits = digits * arity_ + c;
+    state = curve_.ChildOf(state, c).state;
+  }
+  return digits;
+}
+
+}  // namespace sfc

@@ -1,0 +1,88 @@
+// Hierarchical sample warping through a curve tree (docs/ALGORITHM.md,
+// "Sobol sets"): a measure-preserving map from the unit square onto the
+// surface's parameter square, with the mass of the tree as its measure. It
+// carries the points of a scrambled Sobol net (core/sequence.h, kSobol) onto
+// the surface so that their low discrepancy in the square becomes low
+// discrepancy of area x density (McCool and Harwood 1997, probability trees;
+// Clarberg, Jarosz, Akenine-Moeller and Jensen 2005, Sect. 4, hierarchical
+// sample warping).
+//
+// At a node whose cell splits into g x g children (g = 2 for Hilbert, 3 for
+// Hilbert II and Peano), the point's first coordinate a picks a column of
+// children by the columns' masses (in u) and is rescaled to it; the second
+// coordinate b then picks the row inside that column by the masses of its
+// children (in v) and is rescaled; the point descends into that child. A
+// child's mass is a difference of the tree's running sums (its leaves are
+// contiguous along the curve); children are matched to their (column, row)
+// through the curve's orientation tables (core/curve.h). Inside the leaf the
+// point is placed by the leaf model's marginal and conditional inverse CDFs
+// (core/leaf_model.h): exactly, for a quadratic that is not negative on the
+// cell (in the coordinates its power laws warp); else, and for the piecewise
+// model, by the same column/row split over the model's clamped sub-square
+// integrals (the piecewise model's own pieces, or 32 x 32 / 27 x 27 cells)
+// and uniformly inside the sub-square. Every step maps a uniform point of
+// its square to a point distributed as the mass there, so the composite map
+// sends the uniform measure to the tree's mass exactly.
+//
+// The point is then recorded by its address: its leaf and the digits of the
+// leaf's own curve, continuation_levels() below the leaf (2^-26 of the leaf
+// for Hilbert, 3^-16 for the 3x3 curves), which sort a set into curve order;
+// the sample sits at the centre of that sub-cell, as core/leaf_walk.h places
+// the samples of the 1D sequences.
+//
+// Thread-safety: immutable after construction; Map is thread-safe. The result
+// is a pure function of (tree, a, b): plain IEEE arithmetic in a fixed order.
+#ifndef SFCSAMPLER_CORE_TREE_WARP_H_
+#define SFCSAMPLER_CORE_TREE_WARP_H_
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "core/curve_samples.h"
+#include "core/curve_tree.h"
+
+namespace sfc {
+
+class TreeWarp {
+ public:
+  // O(leaves) time and 12 * arity bytes per internal node. REQUIRES: `tree`
+  // outlives the warp and has positive total mass.
+  explicit TreeWarp(const CurveTree& tree);
+
+  // The address of the image of (a, b) in [0, 1]^2 (values outside are
+  // clamped); index is left 0.
+  CurveAddress Locate(double a, double b) const;
+
+  struct Point {
+    double u, v;           // unit-square parameters
+    double curve_position;  // in [0, 1), as LeafWalk's
+  };
+  // The sample at `at`. REQUIRES: an address Locate gave.
+  Point Place(const CurveAddress& at) const;
+  // Place(Locate(a, b)).
+  Point Map(double a, double b) const { return Place(Locate(a, b)); }
+
+ private:
+  // Places (a, b) inside leaf l, in the leaf's unit coordinates.
+  void PlaceInLeaf(size_t l, double a, double b, double* x, double* y) const;
+  // The digits of the leaf's curve, continuation_levels() deep, of the
+  // sub-cell holding (x, y) of a leaf with orientation `state`.
+  uint64_t DigitsInLeaf(double x, double y, int state) const;
+
+  const CurveTree& tree_;
+  const Curve& curve_;
+  const int grid_, arity_;
+  // Internal nodes in depth-first order, arity_ entries each, by position:
+  // the child at column dx, row dy of the node's cell is entry dy * grid + dx,
+  // node children_[.] when >= 0, else leaf -children_[.] - 1; masses_ its mass.
+  std::vector<int32_t> children_;
+  std::vector<double> masses_;
+  int32_t root_ = 0;
+  // child_at_[state * arity + dy * grid + dx]: the child at (dx, dy).
+  std::vector<uint8_t> child_at_;
+};
+
+}  // namespace sfc
+
+#endif  // SFCSAMPLER_CORE_TREE_WARP_H_
