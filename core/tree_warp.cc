@@ -17,9 +17,9 @@ constexpr int kStates = 8;
 constexpr double kBelowOne = 1.0 - 0x1.0p-53;
 
 // Picks among `n` parts with masses `mass` (not all zero) by the coordinate
-// *a in [0, 1]: the part holding a x total, with *a rescaled to that part
+// *a in [0, 1): the part holding a x total, with *a rescaled to that part
 // (the inverse CDF of the parts, then of the uniform inside one). Zero-mass
-// parts are never picked.
+// parts are never picked. Used where no bounds are stored (inside leaves).
 int Split(const double* mass, int n, double* a) {
   double total = 0;
   for (int i = 0; i < n; ++i) total += mass[i];
@@ -35,6 +35,33 @@ int Split(const double* mass, int n, double* a) {
   assert(last >= 0);
   *a = std::clamp((t - before) / mass[last], 0.0, kBelowOne);
   return last;
+}
+
+// The bounds and inverse widths of parts with masses `mass` (Split's choice
+// as stored bounds): bound[i] the cumulative share up to part i, 1 from the
+// last part with mass on, so a < 1 always finds a part with mass.
+void Bounds(const double* mass, int n, double* bound, double* inverse) {
+  double total = 0;
+  for (int i = 0; i < n; ++i) total += mass[i];
+  int last = 0;
+  for (int i = 0; i < n; ++i) {
+    if (mass[i] > 0) last = i;
+  }
+  double before = 0;
+  for (int i = 0; i < n; ++i) {
+    before += mass[i];
+    bound[i] = i >= last || !(total > 0) ? 1.0 : before / total;
+    inverse[i] = mass[i] > 0 ? total / mass[i] : 0;
+  }
+}
+
+// The part of stored bounds that a falls in, and a rescaled to it.
+int Pick(const double* bound, const double* inverse, int n, double* a) {
+  int i = 0;
+  while (i + 1 < n && !(*a < bound[i])) ++i;
+  const double lower = i == 0 ? 0.0 : bound[i - 1];
+  *a = std::clamp((*a - lower) * inverse[i], 0.0, kBelowOne);
+  return i;
 }
 
 // p(s) = p0 + p1 s + p2 s^2 >= 0 on [0, 1].
@@ -65,7 +92,9 @@ double InvertCdf(double p0, double p1, double p2, double share) {
     const double d = p0 + s * (p1 + s * p2);
     double next = d > 0 ? s - f / d : (lo + hi) / 2;
     if (!(next > lo && next < hi)) next = (lo + hi) / 2;
-    if (next == s || hi - lo <= 0x1.0p-52) return next;
+    // A step below 2^-44 of the leaf is far below the address's 2^-26
+    // (Hilbert; 3^-16 for the 3x3 curves) resolution.
+    if (std::fabs(next - s) <= 0x1.0p-44 || hi - lo <= 0x1.0p-52) return next;
     s = next;
   }
   return s;
@@ -136,6 +165,7 @@ TreeWarp::TreeWarp(const CurveTree& tree)
   // Depth-first over the cells down to the leaves, which come in curve
   // order; a node's child masses are differences of the running sums.
   size_t next_leaf = 0;
+  std::vector<double> masses;  // per node, by position, like children_
   std::function<int32_t(int, uint64_t, int)> build = [&](int depth, uint64_t start,
                                                           int state) -> int32_t {
     if (tree.leaf_start(next_leaf) == start && tree.leaf_depth(next_leaf) == depth) {
@@ -143,36 +173,70 @@ TreeWarp::TreeWarp(const CurveTree& tree)
     }
     const int32_t node = static_cast<int32_t>(children_.size() / arity_);
     children_.resize(children_.size() + arity_);
-    masses_.resize(masses_.size() + arity_);
+    masses.resize(masses.size() + arity_);
     for (int c = 0; c < arity_; ++c) {
       const Curve::Child& ch = curve_.ChildOf(state, c);
       const size_t first = next_leaf;
       const int32_t child = build(depth + 1, start + c * curve_.Span(depth + 1), ch.state);
       const int at = node * arity_ + ch.dy * grid_ + ch.dx;
       children_[at] = child;
-      masses_[at] = tree.mass_end(next_leaf - 1) - tree.mass_begin(first);
+      masses[at] = tree.mass_end(next_leaf - 1) - tree.mass_begin(first);
     }
     return node;
   };
   root_ = build(0, 0, Curve::kRootState);
   assert(next_leaf == tree.leaf_count());
+  // Each node's columns and rows as stored bounds.
+  const int g = grid_;
+  stride_ = 2 * (g + g * g);
+  const size_t nodes = children_.size() / arity_;
+  splits_.resize(nodes * stride_);
+  for (size_t node = 0; node < nodes; ++node) {
+    const double* mass = &masses[node * arity_];
+    double* out = &splits_[node * stride_];
+    double column[3] = {0, 0, 0};
+    for (int dy = 0; dy < g; ++dy) {
+      for (int dx = 0; dx < g; ++dx) column[dx] += mass[dy * g + dx];
+    }
+    Bounds(column, g, out, out + g);
+    for (int dx = 0; dx < g; ++dx) {
+      double row[3];
+      for (int dy = 0; dy < g; ++dy) row[dy] = mass[dy * g + dx];
+      Bounds(row, g, out + 2 * g + 2 * g * dx, out + 2 * g + 2 * g * dx + g);
+    }
+  }
+  // The encoding table: every chunk of levels from every orientation.
+  chunk_levels_ = g == 2 ? 4 : 2;
+  chunk_cells_ = g == 2 ? 16 : 9;
+  const int cells = chunk_cells_ * chunk_cells_;
+  encode_.assign(kStates * cells, 0);
+  for (int s0 = 0; s0 < kStates; ++s0) {
+    for (int y = 0; y < chunk_cells_; ++y) {
+      for (int x = 0; x < chunk_cells_; ++x) {
+        uint64_t digits = 0;
+        int state = s0, place = chunk_cells_ / g;
+        for (int level = 0; level < chunk_levels_; ++level, place /= g) {
+          const int c = child_at_[state * arity_ + (y / place % g) * g + x / place % g];
+          digits = digits * arity_ + c;
+          state = curve_.ChildOf(state, c).state;
+        }
+        encode_[s0 * cells + y * chunk_cells_ + x] = digits | (uint64_t(state) << 56);
+      }
+    }
+  }
 }
 
 CurveAddress TreeWarp::Locate(double a, double b) const {
   a = std::clamp(a, 0.0, kBelowOne), b = std::clamp(b, 0.0, kBelowOne);
   int32_t ref = root_;
   int state = Curve::kRootState;
+  const int g = grid_;
   while (ref >= 0) {
-    const double* mass = &masses_[ref * arity_];
-    double column[3] = {0, 0, 0};
-    for (int dy = 0; dy < grid_; ++dy) {
-      for (int dx = 0; dx < grid_; ++dx) column[dx] += mass[dy * grid_ + dx];
-    }
-    const int dx = Split(column, grid_, &a);
-    double row[3];
-    for (int dy = 0; dy < grid_; ++dy) row[dy] = mass[dy * grid_ + dx];
-    const int dy = Split(row, grid_, &b);
-    const int at = dy * grid_ + dx;
+    const double* split = &splits_[ref * stride_];
+    const int dx = Pick(split, split + g, g, &a);
+    const double* rows = split + 2 * g + 2 * g * dx;
+    const int dy = Pick(rows, rows + g, g, &b);
+    const int at = dy * g + dx;
     ref = children_[ref * arity_ + at];
     state = curve_.ChildOf(state, child_at_[state * arity_ + at]).state;
   }
@@ -245,17 +309,36 @@ void TreeWarp::PlaceInLeaf(size_t l, double a, double b, double* x, double* y) c
 }
 
 uint64_t TreeWarp::DigitsInLeaf(double x, double y, int state) const {
-  x = std::clamp(x, 0.0, kBelowOne), y = std::clamp(y, 0.0, kBelowOne);
+  // The sub-cell's column and row among g^levels, then their base-g digits
+  // a chunk at a time, from the top.
+  const int levels = curve_.continuation_levels();
+  const double cells = curve_.PowG(levels);
+  const uint64_t top = static_cast<uint64_t>(cells) - 1;
+  uint64_t cx = std::min(static_cast<uint64_t>(std::max(0.0, x) * cells), top);
+  uint64_t cy = std::min(static_cast<uint64_t>(std::max(0.0, y) * cells), top);
+  const int chunks = levels / chunk_levels_, head = levels % chunk_levels_;
+  // Chunk values of cx and cy, least significant first.
+  uint32_t xs[32], ys[32];
+  for (int c = 0; c < chunks; ++c) {
+    xs[c] = static_cast<uint32_t>(cx % chunk_cells_), cx /= chunk_cells_;
+    ys[c] = static_cast<uint32_t>(cy % chunk_cells_), cy /= chunk_cells_;
+  }
   uint64_t digits = 0;
-  for (int level = 0; level < curve_.continuation_levels(); ++level) {
-    // The next digit of each coordinate in base g (exact for g = 2).
-    x *= grid_, y *= grid_;
-    const int dx = std::min(static_cast<int>(x), grid_ - 1);
-    const int dy = std::min(static_cast<int>(y), grid_ - 1);
-    x -= dx, y -= dy;
+  // The leading levels one at a time (cx, cy now hold them).
+  uint64_t place = static_cast<uint64_t>(curve_.PowG(head));
+  for (int level = 0; level < head; ++level) {
+    place /= grid_;
+    const int dx = static_cast<int>(cx / place % grid_), dy = static_cast<int>(cy / place % grid_);
     const int c = child_at_[state * arity_ + dy * grid_ + dx];
     digits = digits * arity_ + c;
     state = curve_.ChildOf(state, c).state;
+  }
+  const int cells_per_chunk = chunk_cells_ * chunk_cells_;
+  const uint64_t chunk_span = curve_.PowW(chunk_levels_);
+  for (int c = chunks - 1; c >= 0; --c) {
+    const uint64_t e = encode_[state * cells_per_chunk + ys[c] * chunk_cells_ + xs[c]];
+    digits = digits * chunk_span + (e & ((uint64_t{1} << 56) - 1));
+    state = static_cast<int>(e >> 56);
   }
   return digits;
 }

@@ -75,9 +75,21 @@ class TreeWarp {
   const int grid_, arity_;
   // Internal nodes in depth-first order, arity_ entries each, by position:
   // the child at column dx, row dy of the node's cell is entry dy * grid + dx,
-  // node children_[.] when >= 0, else leaf -children_[.] - 1; masses_ its mass.
+  // node children_[.] when >= 0, else leaf -children_[.] - 1.
   std::vector<int32_t> children_;
-  std::vector<double> masses_;
+  // Per node, stride 2 (grid + grid^2): the columns' upper bounds as shares
+  // of the node's mass (cumulative; 1 from the last column with mass on) and
+  // their inverse widths, then the same for the rows of each column (dx * grid
+  // + dy). A coordinate a picks the first part with a < bound and becomes
+  // (a - lower bound) x inverse width.
+  std::vector<double> splits_;
+  int stride_ = 0;
+  // Encoding the digits of a leaf's curve a chunk of levels at a time:
+  // encode_[(state * chunk_cells^2 + Y * chunk_cells + X)] holds the chunk's
+  // digits and (in the top byte) the orientation it ends in.
+  int chunk_levels_ = 1;
+  int chunk_cells_ = 1;  // grid^chunk_levels_
+  std::vector<uint64_t> encode_;
   int32_t root_ = 0;
   // child_at_[state * arity + dy * grid + dx]: the child at (dx, dy).
   std::vector<uint8_t> child_at_;
