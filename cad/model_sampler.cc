@@ -155,6 +155,19 @@ absl::StatusOr<std::unique_ptr<ModelSampleCursor>> ModelSampleCursor::Create(
       new ModelSampleCursor(std::move(tree), sequence, region, fields, std::max(1, threads)));
   cursor->begin_ = begin;
   cursor->end_ = end;
+  if (sequence.two_dimensional()) {
+    // [begin, end) are positions of the whole set in curve order: each
+    // piece's samples are counted, so a piece takes its part of the range.
+    const auto& pieces = cursor->tree_->pieces();
+    cursor->piece_counts_.assign(pieces.size(), 0);
+    std::vector<double> his(pieces.size());
+    for (size_t p = 0; p < pieces.size(); ++p) his[p] = pieces[p].hi;
+    // Windows [lo, hi) meet end to end, and q_k = 1 is the last piece's.
+    for (uint64_t k = 0; k < sequence.count(); ++k) {
+      const size_t p = std::upper_bound(his.begin(), his.end(), sequence.At(k)) - his.begin();
+      ++cursor->piece_counts_[std::min(p, pieces.size() - 1)];
+    }
+  }
   return cursor;
 }
 
@@ -171,6 +184,12 @@ absl::Status ModelSampleCursor::OpenPiece() {
     kb = std::max(begin_, piece_ == 0 ? 0 : first_reaching(piece.lo));
     ke = std::min(end_, piece_ == last ? sequence_.count() : first_reaching(piece.hi));
     ke = std::max(kb, ke);
+  } else if (sequence_.two_dimensional()) {
+    uint64_t before = 0;
+    for (size_t p = 0; p < piece_; ++p) before += piece_counts_[p];
+    const uint64_t here = piece_counts_[piece_];
+    kb = std::min(here, begin_ - std::min(begin_, before));
+    ke = std::max(kb, std::min(here, end_ - std::min(end_, before)));
   }
   auto sampler = std::make_shared<const Sampler>(piece.tree, piece.surface, piece.density, window);
   SampleFields core_fields = fields_;

@@ -86,7 +86,9 @@ class ModelTree {
 class ModelSampleCursor {
  public:
   // Samples [begin, end) of `sequence` on `tree` inside `region`, in curve
-  // order. Errors (INVALID_ARGUMENT): begin > end, end > count, an invalid
+  // order; for a two-dimensional sequence (sobol: split across the faces by
+  // its first coordinate, then warped through the face's tree), positions
+  // [begin, end) of the whole set in curve order. Errors (INVALID_ARGUMENT): begin > end, end > count, an invalid
   // region or a parameter rectangle (a model has one parameter square per
   // face: use a 3D box).
   static absl::StatusOr<std::unique_ptr<ModelSampleCursor>> Create(
@@ -114,6 +116,9 @@ class ModelSampleCursor {
   const SampleFields fields_;
   const int threads_;
   uint64_t begin_ = 0, end_ = 0;
+  // Two-dimensional sequences (sobol): each piece's number of samples, whose
+  // running sums turn [begin_, end_) into positions inside each piece.
+  std::vector<uint64_t> piece_counts_;
   size_t piece_ = 0;                      // the piece being read
   std::unique_ptr<SampleCursor> cursor_;  // its cursor, null until opened
   SampleBatch scratch_;

@@ -150,12 +150,20 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
                                                   const BuildControl& caller) const {
   RETURN_IF_ERROR(CheckCount(request.count));  // before anything is built for it
   const bool radical_inverse = request.sequence == SequenceKind::kVanDerCorput ||
-                               request.sequence == SequenceKind::kProgressive;
+                               request.sequence == SequenceKind::kProgressive ||
+                               request.sequence == SequenceKind::kSobol;
   if (radical_inverse && request.count > (uint64_t{1} << 32)) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "the %s sequence supports at most 2^32 samples", SequenceName(request.sequence)));
   }
   ASSIGN_OR_RETURN(const auto range, ResolveIndexRange(request));
+  if (SequenceIsTwoDimensional(request.sequence) && request.count > limits_.max_sorted_range) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the %s sequence sorts its whole set into curve order for every request (its index "
+        "ranges and shards are positions in that order), so its count may be at most %d "
+        "(max_sorted_range)",
+        SequenceName(request.sequence), limits_.max_sorted_range));
+  }
   if (!SequenceIsMonotone(request.sequence) &&
       range.second - range.first > limits_.max_sorted_range) {
     return absl::InvalidArgumentError(absl::StrFormat(

@@ -28,10 +28,34 @@ class MeshFiller final : public SampleFiller {
     return absl::OkStatus();
   }
 
+  // Places each sample at its address through the sampler's MeshWarp.
+  absl::Status FillAddressed(size_t n, const CurveAddress* at, const SampleRows& out) override {
+    const MeshWarp& warp = *sampler_.warp();
+    for (size_t i0 = 0; i0 < n; i0 += kChunk) {
+      const size_t m = std::min(kChunk, n - i0);
+      const MeshCurveTree::Cell* cells[kChunk];
+      std::array<double, 3> barys[kChunk];
+      double area_positions[kChunk];
+      chunk_cells_.clear();
+      for (size_t i = 0; i < m; ++i) {
+        MeshCurveTree::Cell cell;
+        warp.Place(at[i0 + i], &cell, &barys[i], &area_positions[i]);
+        chunk_cells_.push_back(cell);
+      }
+      for (size_t i = 0; i < m; ++i) cells[i] = &chunk_cells_[i];
+      RETURN_IF_ERROR(WriteColumns(m, cells, barys, area_positions, out.From(i0)));
+    }
+    return absl::OkStatus();
+  }
+
  private:
   static constexpr size_t kChunk = 32;
   // Fill for n <= kChunk rows.
   absl::Status FillChunk(size_t n, const SampleRows& out);
+  // The columns of n placed samples: sample i in cells[i] at barys[i].
+  absl::Status WriteColumns(size_t n, const MeshCurveTree::Cell* const* cells,
+                            const std::array<double, 3>* barys, const double* area_positions,
+                            const SampleRows& out);
 
   const MeshSampler& sampler_;
   const Region region_;
@@ -43,7 +67,6 @@ class MeshFiller final : public SampleFiller {
 
 absl::Status MeshFiller::FillChunk(size_t n, const SampleRows& out) {
   const MeshCurveTree& tree = sampler_.tree();
-  const MeshSurface& surface = tree.surface();
   const auto& ends = tree.mass_ends();
   double ts[kChunk], area_positions[kChunk];
   const MeshCurveTree::Cell* cells[kChunk];
@@ -67,6 +90,14 @@ absl::Status MeshFiller::FillChunk(size_t n, const SampleRows& out) {
     cells[i] = &chunk_cells_.back();
   }
   MeshCurveTree::DescendMany(n, cells, ts, barys, area_positions);
+  return WriteColumns(n, cells, barys, area_positions, out);
+}
+
+absl::Status MeshFiller::WriteColumns(size_t n, const MeshCurveTree::Cell* const* cells,
+                                      const std::array<double, 3>* barys,
+                                      const double* area_positions, const SampleRows& out) {
+  const MeshCurveTree& tree = sampler_.tree();
+  const MeshSurface& surface = tree.surface();
   const double triangles = static_cast<double>(tree.triangle_count());
   for (size_t i = 0; i < n; ++i) {
     const uint32_t triangle = cells[i]->triangle;
@@ -112,6 +143,13 @@ MeshSampler::MeshSampler(std::shared_ptr<const MeshCurveTree> tree, Sequence seq
          !(tree_->mass_ends()[last_positive_leaf_] > tree_->mass_begin(last_positive_leaf_))) {
     --last_positive_leaf_;
   }
+  if (sequence.two_dimensional()) warp_ = std::make_unique<const MeshWarp>(*tree_);
+}
+
+CurveAddress MeshSampler::AddressOf(uint64_t k) const {
+  CurveAddress at = warp_->Locate(sequence().At(k), sequence().Second(k));
+  at.index = static_cast<uint32_t>(k);
+  return at;
 }
 
 size_t MeshSampler::LeafForMass(double m) const {

@@ -32,6 +32,7 @@
 #include "core/types/region.h"
 #include "core/types/sample_batch.h"
 #include "mesh/mesh_curve_tree.h"
+#include "mesh/mesh_warp.h"
 
 namespace sfc {
 
@@ -77,6 +78,12 @@ class MeshSampler final : public CurveSamples {
   // Sample at mass coordinate m inside leaf l with cell `cell` (= LeafCell(l)).
   MeshSample AtMass(uint64_t k, double m, size_t l, const MeshCurveTree::Cell& cell) const;
 
+  // Every sequence: a two-dimensional one (sobol) through a MeshWarp made
+  // with the sampler (O(leaves log leaves)).
+  absl::Status AcceptsSequence(const Sequence&) const override { return absl::OkStatus(); }
+  CurveAddress AddressOf(uint64_t k) const override;
+  const MeshWarp* warp() const { return warp_.get(); }
+
   // INVALID_ARGUMENT for a parameter rectangle: a mesh has no parameter
   // square (use a 3D box).
   absl::Status AcceptsRegion(const Region& region) const override;
@@ -94,6 +101,7 @@ class MeshSampler final : public CurveSamples {
  private:
   std::shared_ptr<const MeshCurveTree> tree_;
   size_t last_positive_leaf_ = 0;
+  std::unique_ptr<const MeshWarp> warp_;  // two-dimensional sequences only
 };
 
 }  // namespace sfc

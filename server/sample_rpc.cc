@@ -19,7 +19,8 @@ namespace v1 = ::sfcsampler::v1;
 namespace {
 
 // What a stream holds while it runs: the sort of a non-monotone sequence's
-// range (16 bytes a sample), the producer's batch (per sample the index and
+// range (16 bytes a sample; a sobol set sorts its whole count, 16 bytes a
+// sample, core/curve_samples.h CurveAddress), the producer's batch (per sample the index and
 // the columns in float64, the model columns uint32), and the messages of its
 // pipeline, at most pipeline_depth + 2 (queued, being made, being written;
 // MessagePipeline; one without a pipeline), each per sample the columns on
@@ -30,7 +31,8 @@ uint64_t StreamWorkingBytes(const SampleRequest& request, const StreamOptions& s
                             int pipeline_depth) {
   const auto range = ResolveIndexRange(request);
   const uint64_t n = range.ok() ? range->second - range->first : 0;
-  const uint64_t sort = SequenceIsMonotone(request.sequence) ? 0 : 16 * n;
+  const uint64_t sorted = SequenceIsTwoDimensional(request.sequence) ? request.count : n;
+  const uint64_t sort = SequenceIsMonotone(request.sequence) ? 0 : 16 * sorted;
   const SampleFields& f = request.fields;
   SampleFields made = f;  // the engine makes u v x y z whatever the wire carries
   made.uv = made.xyz = true;

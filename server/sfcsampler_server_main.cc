@@ -79,7 +79,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--max-sorted-range", o.limits.max_sorted_range,
                  "most samples per request for sequences sorted into curve order (random, "
-                 "vandercorput, progressive)")
+                 "vandercorput, progressive), and the largest count of a sobol set (sorted "
+                 "whole)")
       ->capture_default_str();
   app.add_option("--cache-bytes", o.cache_bytes, "tree cache budget in bytes (LRU eviction)")
       ->capture_default_str();

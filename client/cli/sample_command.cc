@@ -15,6 +15,8 @@
 #include "request/request_flags.h"
 #include "client/cli/sample_source.h"
 #include "client/sample_writer.h"
+#include "core/types/region.h"
+#include "core/types/sequence_kind.h"
 
 namespace sfc {
 namespace {
@@ -93,6 +95,15 @@ int RunSample(const SampleFlags& flags) {
                  static_cast<unsigned long long>(writer->written()), flags.output.c_str(),
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
                  provenance->c_str());
+    const bool part = request->begin != 0 || (request->end != 0 && request->end != request->count) ||
+                      request->shard_count != 0 || request->region.kind != Region::Kind::kAll;
+    if (SequenceIsTwoDimensional(request->sequence) && part) {
+      std::fprintf(stderr,
+                   "%s: these are positions of the whole set in curve order, so all %llu samples "
+                   "were placed and sorted to select them (docs/SERVICE.md, \"Sobol sets\")\n",
+                   std::string(SequenceName(request->sequence)).c_str(),
+                   static_cast<unsigned long long>(request->count));
+    }
   }
   return 0;
 }

@@ -159,7 +159,7 @@ def test_server_errors_carry_code_and_message(server):
         assert "max_count" in info.value.message
         # Caught before the wire, by the same parser as the CLI's.
         with pytest.raises(sfcsampler.InvalidArgumentError):
-            client.sample(sequence="sobol")
+            client.sample(sequence="halton")
 
 
 def test_prepare_then_sample_hits_the_cache(server):

@@ -27,6 +27,10 @@ CASES = [
     (dict(surface="eight", curve="peano", count=3000, begin=1000, end=2500, sequence="random"),
      ["--surface", "eight", "--curve", "peano", "--count", "3000", "--begin", "1000", "--end",
       "2500", "--sequence", "random"]),
+    (dict(surface="monkey_saddle", density="gaussian:floor=0.05", count=6000, seed=3,
+          sequence="sobol", shard=(2, 4), curve_position=True),
+     ["--surface", "monkey_saddle", "--density", "gaussian:floor=0.05", "--count", "6000",
+      "--seed", "3", "--sequence", "sobol", "--shard", "2/4", "--curve-position"]),
 ]
 
 
