@@ -88,9 +88,9 @@ class ModelSampleCursor {
   // Samples [begin, end) of `sequence` on `tree` inside `region`, in curve
   // order; for a two-dimensional sequence (sobol: split across the faces by
   // its first coordinate, then warped through the face's tree), positions
-  // [begin, end) of the whole set in curve order. Errors (INVALID_ARGUMENT): begin > end, end > count, an invalid
-  // region or a parameter rectangle (a model has one parameter square per
-  // face: use a 3D box).
+  // [begin, end) of the whole set in curve order. Errors (INVALID_ARGUMENT):
+  // begin > end, end > count, an invalid region or a parameter rectangle (a
+  // model has one parameter square per face: use a 3D box).
   static absl::StatusOr<std::unique_ptr<ModelSampleCursor>> Create(
       std::shared_ptr<const ModelTree> tree, Sequence sequence, uint64_t begin, uint64_t end,
       const Region& region, const SampleFields& fields, int threads = 1);

@@ -58,15 +58,15 @@ class SampleFiller {
  public:
   virtual ~SampleFiller() = default;
   // On entry out.index[i] holds sample k and out.x[i] its mass coordinate
-  // q_k S_M, i < n, not decreasing in i (a two-dimensional sequence's
-  // filler places sample k by k alone, and out.x[i] is then only scratch). Writes u, v, x, y, z (and triangle,
+  // q_k S_M, i < n, not decreasing in i. Writes u, v, x, y, z (and triangle,
   // when asked for) of every row, and the other asked columns at least of the
   // rows whose point lies in the filler's region (the cursor drops the rest
   // by Region::Contains(u, v, {x, y, z})). Errors: INVALID_ARGUMENT when the
   // surface or density is not usable at a sample.
   virtual absl::Status Fill(size_t n, const SampleRows& out) = 0;
   // The same for a two-dimensional sequence: row i is the sample at `at[i]`
-  // (out.index[i] holds its k). UNIMPLEMENTED for kinds without a warp.
+  // (out.index[i] holds its k; out.x[i] is not a mass coordinate). The
+  // default is UNIMPLEMENTED, for kinds without a warp.
   virtual absl::Status FillAddressed(size_t n, const CurveAddress* at, const SampleRows& out);
 };
 

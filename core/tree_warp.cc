@@ -167,7 +167,7 @@ TreeWarp::TreeWarp(const CurveTree& tree)
   size_t next_leaf = 0;
   std::vector<double> masses;  // per node, by position, like children_
   std::function<int32_t(int, uint64_t, int)> build = [&](int depth, uint64_t start,
-                                                          int state) -> int32_t {
+                                                         int state) -> int32_t {
     if (tree.leaf_start(next_leaf) == start && tree.leaf_depth(next_leaf) == depth) {
       return -static_cast<int32_t>(next_leaf++) - 1;
     }

@@ -55,7 +55,7 @@ class TreeWarp {
   CurveAddress Locate(double a, double b) const;
 
   struct Point {
-    double u, v;           // unit-square parameters
+    double u, v;            // unit-square parameters
     double curve_position;  // in [0, 1), as LeafWalk's
   };
   // The sample at `at`. REQUIRES: an address Locate gave.

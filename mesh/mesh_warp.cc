@@ -31,9 +31,9 @@ int32_t MeshWarp::Build(size_t lo, size_t hi) {
   const double begin = tree_.mass_begin(lo), end = ends[hi - 1];
   // The first leaf whose end reaches half the node's mass closes the first
   // half; each half keeps at least one leaf.
-  const size_t j = std::lower_bound(ends.begin() + lo, ends.begin() + (hi - 1),
-                                    begin + (end - begin) / 2) -
-                   ends.begin();
+  const size_t j =
+      std::lower_bound(ends.begin() + lo, ends.begin() + (hi - 1), begin + (end - begin) / 2) -
+      ends.begin();
   const size_t mid = std::clamp(j + 1, lo + 1, hi - 1);
   const int32_t index = static_cast<int32_t>(nodes_.size());
   nodes_.push_back({});
@@ -112,8 +112,8 @@ CurveAddress MeshWarp::Locate(double a, double b) const {
   return address;
 }
 
-void MeshWarp::Place(const CurveAddress& at, MeshCurveTree::Cell* cell,
-                     std::array<double, 3>* bary, double* area_position) const {
+void MeshWarp::Place(const CurveAddress& at, MeshCurveTree::Cell* cell, std::array<double, 3>* bary,
+                     double* area_position) const {
   *cell = tree_.LeafCell(at.leaf);
   // The digits are the sub-cell's bisection choices: decoded as in a
   // uniform cell, whose choices are the digits of its fraction.

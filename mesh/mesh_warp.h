@@ -47,9 +47,9 @@ class MeshWarp {
 
  private:
   struct Node {
-    int32_t child[2];     // node index, or -(leaf + 1)
-    double split;         // the first half's share of the node's mass
-    double inverse[2];    // each half's share, inverted (0 for none)
+    int32_t child[2];   // node index, or -(leaf + 1)
+    double split;       // the first half's share of the node's mass
+    double inverse[2];  // each half's share, inverted (0 for none)
   };
   int32_t Build(size_t lo, size_t hi);
 

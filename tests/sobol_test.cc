@@ -5,13 +5,12 @@
 // regions that filter it, a prefix that a larger set on the same tree keeps;
 // the warp keeps a density's mass split; sample means of a smooth function
 // on the sphere meet the closed form at quasi-Monte Carlo rates.
-#include "core/tree_warp.h"
-
 #include <cmath>
 #include <set>
 #include <vector>
 
 #include "core/sequence.h"
+#include "core/tree_warp.h"
 #include "gtest/gtest.h"
 #include "tests/test_util.h"
 
@@ -188,8 +187,7 @@ TEST(TreeWarp, MapsTheUnitSquareOntoTheLeavesByMass) {
   }
   double worst = 0;
   for (size_t l = 0; l < tree.leaf_count(); ++l) {
-    const double expected =
-        (tree.mass_end(l) - tree.mass_begin(l)) / tree.total_mass() * g * g;
+    const double expected = (tree.mass_end(l) - tree.mass_begin(l)) / tree.total_mass() * g * g;
     worst = std::max(worst, std::fabs(hits[l] - expected) / (4 * std::sqrt(expected) + 4));
   }
   EXPECT_LT(worst, 1.0);

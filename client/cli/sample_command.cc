@@ -95,7 +95,8 @@ int RunSample(const SampleFlags& flags) {
                  static_cast<unsigned long long>(writer->written()), flags.output.c_str(),
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
                  provenance->c_str());
-    const bool part = request->begin != 0 || (request->end != 0 && request->end != request->count) ||
+    const bool part = request->begin != 0 ||
+                      (request->end != 0 && request->end != request->count) ||
                       request->shard_count != 0 || request->region.kind != Region::Kind::kAll;
     if (SequenceIsTwoDimensional(request->sequence) && part) {
       std::fprintf(stderr,
