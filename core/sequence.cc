@@ -1,5 +1,9 @@
 #include "core/sequence.h"
 
+#include <algorithm>
+#include <iterator>
+#include <memory>
+
 #include "base/counter_hash.h"
 
 namespace sfc {
@@ -52,20 +56,63 @@ uint32_t SobolSecond(uint32_t k) {
   return out;
 }
 
+// The flip of bit i (from the top) of the sobol coordinate `dim`, whose i
+// bits above it are `prefix`: a random bit of (seed, dimension, i, prefix).
+// One SplitMix64 finaliser (Steele, Lea and Flood 2014), keyed by the seed and
+// the dimension.
+uint64_t SobolKey(uint64_t seed, int dim) {
+  return Mix64(seed + 0x9e3779b97f4a7c15ULL * (kSobolStream[dim] + 1));
+}
+uint32_t SobolFlip(uint64_t key, uint64_t prefix, int i) {
+  return static_cast<uint32_t>(Mix64(key + 0x9e3779b97f4a7c15ULL * ((prefix << 6) | i)) >> 63);
+}
+
+// Levels whose flips a sequence keeps in a table (2^12 - 1 bits a coordinate).
+constexpr int kTableLevels = 12;
+
+}  // namespace
+
+// Bit (2^i - 1 + prefix) of flips[dim] is the flip of level i < kTableLevels.
+struct OwenFlips {
+  uint64_t key[2];
+  uint64_t flips[2][(1 << kTableLevels) / 64];
+};
+
+std::shared_ptr<const OwenFlips> Sequence::MakeOwenFlips(uint64_t seed) {
+  auto t = std::make_shared<OwenFlips>();
+  for (int dim = 0; dim < 2; ++dim) {
+    t->key[dim] = SobolKey(seed, dim);
+    std::fill(std::begin(t->flips[dim]), std::end(t->flips[dim]), 0);
+    for (int i = 0; i < kTableLevels; ++i) {
+      for (uint64_t prefix = 0; prefix < (uint64_t{1} << i); ++prefix) {
+        const uint64_t bit = (uint64_t{1} << i) - 1 + prefix;
+        t->flips[dim][bit / 64] |= uint64_t{SobolFlip(t->key[dim], prefix, i)} << (bit % 64);
+      }
+    }
+  }
+  return t;
+}
+
+namespace {
+
 // Owen's nested uniform scramble (Owen 1995) of the 32 digits `r` of sample
-// k, as a double in [0, 1): bit i (from the top) is flipped by a random bit of
-// (seed, dimension, i, the i bits of r above it), so every 2^m-prefix of the
-// sequence stays a (0,m,2)-net. The bits below 2^-32 are uniform random bits
-// of (seed, k), as a full scramble of the all-zero tail would make them. One
-// SplitMix64 finaliser a level (Steele, Lea and Flood 2014), keyed by the
-// seed and the dimension.
-double NestedScramble(uint32_t r, uint64_t k, uint64_t seed, int dim) {
-  const uint64_t key = Mix64(seed + 0x9e3779b97f4a7c15ULL * (kSobolStream[dim] + 1));
+// k, as a double in [0, 1): bit i (from the top) is flipped by SobolFlip of
+// the i bits of r above it, so every 2^m-prefix of the sequence stays a
+// (0,m,2)-net. The bits below 2^-32 are uniform random bits of (seed, k), as
+// a full scramble of the all-zero tail would make them. The top levels' flips
+// come from the sequence's table, the same bits.
+double NestedScramble(uint32_t r, uint64_t k, uint64_t seed, int dim, const OwenFlips& table) {
   uint32_t out = 0;
   for (int i = 0; i < 32; ++i) {
     const uint64_t prefix = i == 0 ? 0 : r >> (32 - i);
-    const uint64_t flip = Mix64(key + 0x9e3779b97f4a7c15ULL * ((prefix << 6) | i)) >> 63;
-    out |= static_cast<uint32_t>(((r >> (31 - i)) & 1) ^ flip) << (31 - i);
+    uint32_t flip;
+    if (i < kTableLevels) {
+      const uint64_t bit = (uint64_t{1} << i) - 1 + prefix;
+      flip = static_cast<uint32_t>(table.flips[dim][bit / 64] >> (bit % 64)) & 1;
+    } else {
+      flip = SobolFlip(table.key[dim], prefix, i);
+    }
+    out |= (((r >> (31 - i)) & 1) ^ flip) << (31 - i);
   }
   const double tail = CounterUniform(seed, kSobolTailStream[dim], k);
   return (out + tail) * 0x1.0p-32;
@@ -87,13 +134,13 @@ double Sequence::Raw(uint64_t k) const {
     case SequenceKind::kProgressive:
       return OwenScrambledRadicalInverse(k, seed_);
     case SequenceKind::kSobol:
-      return NestedScramble(ReverseBits32(static_cast<uint32_t>(k)), k, seed_, 0);
+      return NestedScramble(ReverseBits32(static_cast<uint32_t>(k)), k, seed_, 0, *flips_);
   }
   return 0;
 }
 
 double Sequence::Second(uint64_t k) const {
-  return NestedScramble(SobolSecond(static_cast<uint32_t>(k)), k, seed_, 1);
+  return NestedScramble(SobolSecond(static_cast<uint32_t>(k)), k, seed_, 1, *flips_);
 }
 
 void Sequence::AtMany(uint64_t k0, size_t n, double* out) const {

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string_view>
 #include <utility>
@@ -19,11 +20,17 @@
 namespace sfc {
 
 
+// The sobol scramble's flips of its top levels, computed once per sequence
+// (core/sequence.cc).
+struct OwenFlips;
+
 class Sequence {
  public:
   // REQUIRES: count >= 1; count <= 2^32 for the radical-inverse kinds and sobol.
   Sequence(SequenceKind kind, uint64_t count, uint64_t seed)
-      : kind_(kind), count_(count), seed_(seed) {}
+      : kind_(kind), count_(count), seed_(seed) {
+    if (kind == SequenceKind::kSobol) flips_ = MakeOwenFlips(seed);
+  }
 
   SequenceKind kind() const { return kind_; }
   uint64_t count() const { return count_; }
@@ -71,12 +78,14 @@ class Sequence {
 
  private:
   double Raw(uint64_t k) const;  // q_k
+  static std::shared_ptr<const OwenFlips> MakeOwenFlips(uint64_t seed);
 
   SequenceKind kind_;
   uint64_t count_;
   uint64_t seed_;
   bool windowed_ = false;
   double lo_ = 0, hi_ = 1;
+  std::shared_ptr<const OwenFlips> flips_;  // sobol only: shared by copies and windows
 };
 
 // The first k in [0, count) for which reached(k) holds, for a predicate that

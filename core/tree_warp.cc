@@ -57,8 +57,10 @@ void Bounds(const double* mass, int n, double* bound, double* inverse) {
 
 // The part of stored bounds that a falls in, and a rescaled to it.
 int Pick(const double* bound, const double* inverse, int n, double* a) {
+  // The count of bounds at or below a, without branches: bounds do not
+  // decrease, and the last is 1 > a.
   int i = 0;
-  while (i + 1 < n && !(*a < bound[i])) ++i;
+  for (int j = 0; j + 1 < n; ++j) i += *a >= bound[j];
   const double lower = i == 0 ? 0.0 : bound[i - 1];
   *a = std::clamp((*a - lower) * inverse[i], 0.0, kBelowOne);
   return i;
@@ -162,6 +164,12 @@ TreeWarp::TreeWarp(const CurveTree& tree)
       child_at_[s * arity_ + ch.dy * grid_ + ch.dx] = static_cast<uint8_t>(c);
     }
   }
+  state_at_.assign(kStates * arity_, 0);
+  for (int s = 0; s < kStates; ++s) {
+    for (int at = 0; at < arity_; ++at) {
+      state_at_[s * arity_ + at] = curve_.ChildOf(s, child_at_[s * arity_ + at]).state;
+    }
+  }
   // Depth-first over the cells down to the leaves, which come in curve
   // order; a node's child masses are differences of the running sums.
   size_t next_leaf = 0;
@@ -238,7 +246,7 @@ CurveAddress TreeWarp::Locate(double a, double b) const {
     const int dy = Pick(rows, rows + g, g, &b);
     const int at = dy * g + dx;
     ref = children_[ref * arity_ + at];
-    state = curve_.ChildOf(state, child_at_[state * arity_ + at]).state;
+    state = state_at_[state * arity_ + at];
   }
   const size_t l = static_cast<size_t>(-ref - 1);
   double x, y;
@@ -317,11 +325,19 @@ uint64_t TreeWarp::DigitsInLeaf(double x, double y, int state) const {
   uint64_t cx = std::min(static_cast<uint64_t>(std::max(0.0, x) * cells), top);
   uint64_t cy = std::min(static_cast<uint64_t>(std::max(0.0, y) * cells), top);
   const int chunks = levels / chunk_levels_, head = levels % chunk_levels_;
-  // Chunk values of cx and cy, least significant first.
+  // Chunk values of cx and cy, least significant first (constant divisors:
+  // 16 for Hilbert, 9 for the 3x3 curves).
   uint32_t xs[32], ys[32];
-  for (int c = 0; c < chunks; ++c) {
-    xs[c] = static_cast<uint32_t>(cx % chunk_cells_), cx /= chunk_cells_;
-    ys[c] = static_cast<uint32_t>(cy % chunk_cells_), cy /= chunk_cells_;
+  if (grid_ == 2) {
+    for (int c = 0; c < chunks; ++c) {
+      xs[c] = static_cast<uint32_t>(cx & 15), cx >>= 4;
+      ys[c] = static_cast<uint32_t>(cy & 15), cy >>= 4;
+    }
+  } else {
+    for (int c = 0; c < chunks; ++c) {
+      xs[c] = static_cast<uint32_t>(cx % 9), cx /= 9;
+      ys[c] = static_cast<uint32_t>(cy % 9), cy /= 9;
+    }
   }
   uint64_t digits = 0;
   // The leading levels one at a time (cx, cy now hold them).

@@ -93,6 +93,8 @@ class TreeWarp {
   int32_t root_ = 0;
   // child_at_[state * arity + dy * grid + dx]: the child at (dx, dy).
   std::vector<uint8_t> child_at_;
+  // state_at_[state * arity + dy * grid + dx]: that child's orientation.
+  std::vector<uint8_t> state_at_;
 };
 
 }  // namespace sfc
