@@ -51,7 +51,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (in.ConsumeBool()) r.tree.options.rho = in.ConsumeFloatingPoint<double>();
   r.sequence = in.PickValueInArray({sfc::SequenceKind::kJittered, sfc::SequenceKind::kEqual,
                                     sfc::SequenceKind::kRandom, sfc::SequenceKind::kVanDerCorput,
-                                    sfc::SequenceKind::kProgressive});
+                                    sfc::SequenceKind::kProgressive, sfc::SequenceKind::kSobol});
   r.count = Count(in);
   r.seed = in.ConsumeIntegral<uint64_t>();
   if (in.ConsumeBool()) r.tree_count = Count(in);
