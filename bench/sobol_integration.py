@@ -21,6 +21,9 @@ It prints the issue's 'What must hold':
      most a fifth of jittered's;
   3. speed: the CLI writing 10^6 sphere samples (NPY to /dev/null), best of 3, sobol within
      2x of jittered.
+With --step-sphere FILE (a STEP sphere centred at the origin, of radius --step-radius, as
+build/cad/make_cad_fixtures writes: radius 10) it also reports f on that CAD model, its points
+scaled to the unit sphere, against the sphere's closed form (N = 8192 and 2^16, seeds 1-3).
 The plane's rectangle discrepancy is bench/sphere_discrepancy.py's:
   /usr/bin/python3 bench/sphere_discrepancy.py --surface plane --variant sobol="--sequence sobol"
 
@@ -148,12 +151,13 @@ class Cli:
                         "-o", self.out], check=True)
         return np.load(self.out)
 
-    def mean_error(self, surface, n, seeds, sequence, func, exact):
+    def mean_error(self, surface, n, seeds, sequence, func, exact, scale=1.0):
         errs = []
         for seed in seeds:
             a = self.sample(surface, n, seed, sequence)
             assert len(a) == n, (surface, n, len(a))
-            errs.append(abs(float(func(a["x"], a["y"], a["z"]).mean()) - exact))
+            x, y, z = a["x"] / scale, a["y"] / scale, a["z"] / scale
+            errs.append(abs(float(func(x, y, z).mean()) - exact))
         errs = np.array(errs)
         return errs.mean(), errs.std(ddof=1) / math.sqrt(len(errs)) if len(errs) > 1 else 0.0
 
@@ -173,6 +177,8 @@ def main():
     ap.add_argument("--cli", default=os.path.join(os.path.dirname(__file__), "..", "build",
                                                   "client", "sfcsampler"))
     ap.add_argument("--quick", action="store_true", help="smaller N, for a smoke test")
+    ap.add_argument("--step-sphere", help="a STEP sphere centred at the origin")
+    ap.add_argument("--step-radius", type=float, default=10.0)
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         cli = Cli(args.cli, tmp)
@@ -207,6 +213,14 @@ def main():
             check(f"{name}, N = {n2}, seeds 1-3", f"sobol {m:.2e} +- {se:.1e}, jittered "
                   f"{mj:.2e} +- {sej:.1e}: {mj / m:.1f}x", "sobol <= jittered / 5",
                   m <= mj / 5)
+        if args.step_sphere:
+            for n in ((1024, 8192) if args.quick else (8192, 1 << 16)):
+                m, se = cli.mean_error(f"step:{args.step_sphere}", n, range(1, 4), "sobol",
+                                       f_smooth, exact["sphere"], args.step_radius)
+                mj, sej = cli.mean_error(f"step:{args.step_sphere}", n, range(1, 4), "jittered",
+                                         f_smooth, exact["sphere"], args.step_radius)
+                print(f"| STEP sphere, f, N = {n}, seeds 1-3 | sobol {m:.2e} +- {se:.1e}, "
+                      f"jittered {mj:.2e} +- {sej:.1e}: {mj / m:.1f}x | (no target) | INFO |")
         n3 = 100000 if args.quick else 1000000
         ts, tj = cli.seconds("sphere", n3, "sobol"), cli.seconds("sphere", n3, "jittered")
         check(f"speed, sphere, N = {n3}, best of 3", f"sobol {ts:.3f} s, jittered {tj:.3f} s: "
