@@ -176,6 +176,28 @@ TEST(Engine, UnorderedSequencesAreBoundedPerRequest) {
   EXPECT_TRUE(engine.Start(r).ok());
 }
 
+// A sobol set sorts its whole count for every request: a range of it does not
+// escape the bound, and a count within it is served.
+TEST(Engine, SobolSetsAreBoundedByTheirWholeCount) {
+  DirectTreeSource source;
+  EngineLimits limits;
+  limits.max_sorted_range = 1000;
+  limits.max_count = uint64_t{1} << 40;
+  SamplingEngine engine(RegisteredSurfaceKinds(), limits, &source);
+  SampleRequest r;
+  r.tree.surface = "plane";
+  r.count = 5000;
+  r.sequence = SequenceKind::kSobol;
+  r.begin = 1000;
+  r.end = 1500;
+  ExpectError(engine.Start(r).status(), absl::StatusCode::kInvalidArgument, "whole set");
+  r.count = 1000;
+  r.begin = r.end = 0;
+  EXPECT_TRUE(engine.Start(r).ok());
+  r.count = (uint64_t{1} << 32) + 1;
+  ExpectError(engine.Start(r).status(), absl::StatusCode::kInvalidArgument, "2^32");
+}
+
 TEST(Engine, ShardsPartitionTheIndexRange) {
   SampleRequest r;
   r.count = 1001;
