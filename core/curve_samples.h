@@ -46,11 +46,12 @@ struct CurveAddress {
   uint64_t digits;
   uint32_t leaf;
   uint32_t index;  // the sample's k (a two-dimensional sequence has k < 2^32)
-  bool operator<(const CurveAddress& o) const {
-    if (leaf != o.leaf) return leaf < o.leaf;
-    if (digits != o.digits) return digits < o.digits;
-    return index < o.index;
+  // By leaf, then digits (below 2^52), then index: one 128-bit comparison.
+  unsigned __int128 Key() const {
+    return static_cast<unsigned __int128>(uint64_t{leaf} << 20 | digits >> 32) << 64 |
+           (digits << 32 | index);
   }
+  bool operator<(const CurveAddress& o) const { return Key() < o.Key(); }
 };
 
 // Places samples into rows, for one thread.

@@ -63,12 +63,20 @@ uint32_t SobolSecond(uint32_t k) {
 uint64_t SobolKey(uint64_t seed, int dim) {
   return Mix64(seed + 0x9e3779b97f4a7c15ULL * (kSobolStream[dim] + 1));
 }
+uint64_t BlockHash(uint64_t key, uint64_t prefix, int i) {
+  return Mix64(key + 0x9e3779b97f4a7c15ULL * ((prefix << 6) | i));
+}
 uint32_t SobolFlip(uint64_t key, uint64_t prefix, int i) {
-  return static_cast<uint32_t>(Mix64(key + 0x9e3779b97f4a7c15ULL * ((prefix << 6) | i)) >> 63);
+  return static_cast<uint32_t>(BlockHash(key, prefix, i) >> 63);
 }
 
 // Levels whose flips a sequence keeps in a table (2^12 - 1 bits a coordinate).
 constexpr int kTableLevels = 12;
+// Below the table, one hash of a node at level 12 + 4 j gives the flips of
+// the 15 nodes of the 4 levels from it (a node at depth d under it, with
+// path p, takes bit 2^d - 1 + p): every node of the scramble's tree still gets
+// a bit of its own.
+constexpr int kBlockLevels = 4;
 
 }  // namespace
 
@@ -96,26 +104,31 @@ std::shared_ptr<const OwenFlips> Sequence::MakeOwenFlips(uint64_t seed) {
 namespace {
 
 // Owen's nested uniform scramble (Owen 1995) of the 32 digits `r` of sample
-// k, as a double in [0, 1): bit i (from the top) is flipped by SobolFlip of
-// the i bits of r above it, so every 2^m-prefix of the sequence stays a
-// (0,m,2)-net. The bits below 2^-32 are uniform random bits of (seed, k), as
-// a full scramble of the all-zero tail would make them. The top levels' flips
-// come from the sequence's table, the same bits.
+// k, as a double in [0, 1): bit i (from the top) is flipped by a random bit
+// of its node in the binary tree of prefixes (the i bits of r above it), so
+// every 2^m-prefix of the sequence stays a (0,m,2)-net. The top levels' bits
+// come from the sequence's table, the others a block of levels per hash. The
+// bits below 2^-32 are uniform random bits of (seed, k), as a full scramble of
+// the all-zero tail would make them.
 double NestedScramble(uint32_t r, uint64_t k, uint64_t seed, int dim, const OwenFlips& table) {
-  uint32_t out = 0;
-  for (int i = 0; i < 32; ++i) {
+  // The flips of all 32 levels as one mask, then one xor.
+  uint32_t flips = 0;
+  for (int i = 0; i < kTableLevels; ++i) {
     const uint64_t prefix = i == 0 ? 0 : r >> (32 - i);
-    uint32_t flip;
-    if (i < kTableLevels) {
-      const uint64_t bit = (uint64_t{1} << i) - 1 + prefix;
-      flip = static_cast<uint32_t>(table.flips[dim][bit / 64] >> (bit % 64)) & 1;
-    } else {
-      flip = SobolFlip(table.key[dim], prefix, i);
+    const uint64_t bit = (uint64_t{1} << i) - 1 + prefix;
+    flips |= static_cast<uint32_t>((table.flips[dim][bit / 64] >> (bit % 64)) & 1) << (31 - i);
+  }
+  for (int root = kTableLevels; root < 32; root += kBlockLevels) {
+    const uint64_t block = BlockHash(table.key[dim], r >> (32 - root), root);
+    for (int depth = 0; depth < kBlockLevels; ++depth) {
+      const int i = root + depth;
+      const uint64_t path = (r >> (32 - i)) & ((uint64_t{1} << depth) - 1);
+      flips |= static_cast<uint32_t>((block >> ((uint64_t{1} << depth) - 1 + path)) & 1)
+               << (31 - i);
     }
-    out |= (((r >> (31 - i)) & 1) ^ flip) << (31 - i);
   }
   const double tail = CounterUniform(seed, kSobolTailStream[dim], k);
-  return (out + tail) * 0x1.0p-32;
+  return ((r ^ flips) + tail) * 0x1.0p-32;
 }
 
 }  // namespace
