@@ -35,9 +35,8 @@ using testing::Running;
 using testing::StartServer;
 
 absl::Status SampleStatus(SamplerClient& client, const SampleRequest& request) {
-  auto s = client.Sample(request, [](const v1::StreamHeader&, const SampleBatch&) {
-    return absl::OkStatus();
-  });
+  auto s = client.Sample(request,
+                         [](const StreamInfo&, const SampleBatch&) { return absl::OkStatus(); });
   return s.status();
 }
 
@@ -481,7 +480,7 @@ TEST(ServerModels, ModelsReadInTheCheckProcessGiveTheSameBytesAsInProcess) {
       request.tree.density = "gaussian:floor=0.1";
       request.fields.normal = true;
       request.fields.face = true;
-      auto s = r->client->Sample(request, [&](const v1::StreamHeader&, const SampleBatch& batch) {
+      auto s = r->client->Sample(request, [&](const StreamInfo&, const SampleBatch& batch) {
         for (size_t i = 0; i < batch.size(); ++i) {
           for (const auto* c : {&batch.u, &batch.v, &batch.x, &batch.y, &batch.z, &batch.nx,
                                 &batch.ny, &batch.nz}) {
