@@ -7,7 +7,6 @@
 #define SFCSAMPLER_PYTHON_BINDINGS_BATCH_COLUMNS_H_
 
 #include <array>
-#include <cstddef>  // core/types/sample_batch.h uses size_t without including it
 #include <vector>
 
 #include "core/types/sample_batch.h"
