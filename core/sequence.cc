@@ -1,5 +1,8 @@
 #include "core/sequence.h"
 
+#include <cassert>
+#include <cstring>
+
 #include "base/counter_hash.h"
 
 namespace sfc {
@@ -51,6 +54,9 @@ double Sequence::Raw(uint64_t k) const {
       return ReverseBits32(static_cast<uint32_t>(k)) * 0x1.0p-32;
     case SequenceKind::kProgressive:
       return OwenScrambledRadicalInverse(k, seed_);
+    case SequenceKind::kBlue:
+      assert(table_ != nullptr && "a blue sequence is made by Sequence::FromTable");
+      return (*table_)[k];
   }
   return 0;
 }
@@ -66,6 +72,10 @@ void Sequence::AtMany(uint64_t k0, size_t n, double* out) const {
       break;
     case SequenceKind::kEqual:
       for (size_t i = 0; i < n; ++i) out[i] = (static_cast<double>(k0 + i) + 0.5) / count;
+      break;
+    case SequenceKind::kBlue:
+      assert(table_ != nullptr && "a blue sequence is made by Sequence::FromTable");
+      std::memcpy(out, table_->data() + k0, n * sizeof(double));
       break;
     default:
       for (size_t i = 0; i < n; ++i) out[i] = Raw(k0 + i);

@@ -81,6 +81,10 @@ int main(int argc, char** argv) {
                  "most samples per request for sequences sorted into curve order (random, "
                  "vandercorput, progressive)")
       ->capture_default_str();
+  app.add_option("--max-blue-count", o.limits.max_blue_count,
+                 "largest N of the blue sequence (each request relaxes the whole set in memory, "
+                 "up to 128 bytes a sample)")
+      ->capture_default_str();
   app.add_option("--cache-bytes", o.cache_bytes, "tree cache budget in bytes (LRU eviction)")
       ->capture_default_str();
   app.add_option("--model-bytes", o.model_bytes, "uploaded models kept, bytes (LRU eviction)")

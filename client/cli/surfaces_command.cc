@@ -30,7 +30,8 @@ int RunSurfaces() {
   std::printf(
       "\ncurves (--curve): hilbert (2x2), hilbert2 (3x3 meander), peano (3x3 serpentine)\n");
   std::printf(
-      "sequences (--sequence): jittered (default), equal, random, vandercorput, progressive\n");
+      "sequences (--sequence): jittered (default), equal, random, vandercorput, progressive, "
+      "blue\n");
   std::printf("estimators (--estimator): triangle (a), square (b), fff (c, default), quadrature\n");
   return 0;
 }

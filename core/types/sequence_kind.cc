@@ -14,13 +14,16 @@ std::string_view SequenceName(SequenceKind kind) {
       return "vandercorput";
     case SequenceKind::kProgressive:
       return "progressive";
+    case SequenceKind::kBlue:
+      return "blue";
   }
   return "jittered";
 }
 
 std::optional<SequenceKind> SequenceFromName(std::string_view name) {
   for (SequenceKind k : {SequenceKind::kJittered, SequenceKind::kEqual, SequenceKind::kRandom,
-                         SequenceKind::kVanDerCorput, SequenceKind::kProgressive}) {
+                         SequenceKind::kVanDerCorput, SequenceKind::kProgressive,
+                         SequenceKind::kBlue}) {
     if (name == SequenceName(k)) return k;
   }
   return std::nullopt;

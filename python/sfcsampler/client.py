@@ -31,7 +31,7 @@ _ESTIMATORS = {"fff": pb.AREA_ESTIMATOR_FFF, "triangle": pb.AREA_ESTIMATOR_TRIAN
                "square": pb.AREA_ESTIMATOR_SQUARE, "quadrature": pb.AREA_ESTIMATOR_QUADRATURE}
 _SEQUENCES = {"jittered": pb.SEQUENCE_JITTERED, "equal": pb.SEQUENCE_EQUAL,
               "random": pb.SEQUENCE_RANDOM, "vandercorput": pb.SEQUENCE_VAN_DER_CORPUT,
-              "progressive": pb.SEQUENCE_PROGRESSIVE}
+              "progressive": pb.SEQUENCE_PROGRESSIVE, "blue": pb.SEQUENCE_BLUE}
 _PRECISIONS = {"float64": pb.PRECISION_FLOAT64, "float32": pb.PRECISION_FLOAT32}
 _ENCODINGS = {"raw": pb.COLUMN_ENCODING_RAW, "packed": pb.COLUMN_ENCODING_PACKED}
 _MODEL_FORMATS = ("step", "iges", "nurbs", "obj", "ply")

@@ -27,6 +27,9 @@ CASES = [
     (dict(surface="eight", curve="peano", count=3000, begin=1000, end=2500, sequence="random"),
      ["--surface", "eight", "--curve", "peano", "--count", "3000", "--begin", "1000", "--end",
       "2500", "--sequence", "random"]),
+    (dict(surface="torus", count=6000, sequence="blue", shard="2/5", normals=True),
+     ["--surface", "torus", "--count", "6000", "--sequence", "blue", "--shard", "2/5",
+      "--normals"]),
 ]
 
 
