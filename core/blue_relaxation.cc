@@ -25,48 +25,71 @@ constexpr double kMaxSpacingRatio = 8;
 // first that clears wins, so most samples need one or two rounds).
 constexpr int kRound = 4;
 
-// Points in a hash grid of cubic cells of side `cell`: a bucket array of
-// cell lists in CSR form. The lists may hold points that have since moved
-// (distances are always taken to the current point), so a grid is complete
-// for the points it was built from plus those listed in a second grid of the
-// moved ones.
+// Points in a grid of cubic cells of side `cell`, hashed by Morton code: a
+// bucket array of cell lists in CSR form, each entry a copy of its point and radius (so a
+// query reads contiguous memory). An entry can be killed when its point
+// moves; the moved points are listed in a second grid.
 class HashGrid {
  public:
+  // The low 21 bits of x, two zero bits between each.
+  static uint64_t Spread(int64_t x) {
+    uint64_t v = static_cast<uint64_t>(x) & 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffULL;
+    v = (v | v << 16) & 0x1f0000ff0000ffULL;
+    v = (v | v << 8) & 0x100f00f00f00f00fULL;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+    v = (v | v << 2) & 0x1249249249249249ULL;
+    return v;
+  }
+
+  static constexpr uint32_t kDead = ~uint32_t{0};
+  struct Entry {
+    Vec3 p;
+    double r;
+    uint32_t id;  // kDead: the point has moved
+  };
+
   explicit HashGrid(double cell) : inv_cell_(1 / cell) {}
 
-  // Lists the points ids[i] at p[ids[i]].
-  void Build(const std::vector<Vec3>& p, const std::vector<uint32_t>& ids) {
+  // Lists the points ids[i] at p[ids[i]] with radius r[ids[i]]; when `slots`
+  // is not null, (*slots)[ids[i]] is set to the point's entry.
+  void Build(const std::vector<Vec3>& p, const std::vector<double>& r,
+             const std::vector<uint32_t>& ids, std::vector<uint32_t>* slots) {
     size_t buckets = 16;
     while (buckets < 2 * ids.size()) buckets *= 2;
     mask_ = buckets - 1;
     start_.assign(buckets + 1, 0);
     keys_.resize(ids.size());
     for (size_t i = 0; i < ids.size(); ++i) {
-      keys_[i] = Bucket(Cell(p[ids[i]].x), Cell(p[ids[i]].y), Cell(p[ids[i]].z));
+      const Vec3& x = p[ids[i]];
+      keys_[i] = Bucket(Cell(x.x), Cell(x.y), Cell(x.z));
       ++start_[keys_[i] + 1];
     }
     for (size_t b = 0; b < buckets; ++b) start_[b + 1] += start_[b];
-    items_.resize(ids.size());
+    entries_.resize(ids.size());
     std::vector<uint32_t> fill(start_.begin(), start_.end() - 1);
-    for (size_t i = 0; i < ids.size(); ++i) items_[fill[keys_[i]]++] = ids[i];
+    for (size_t i = 0; i < ids.size(); ++i) {
+      const uint32_t slot = fill[keys_[i]]++;
+      entries_[slot] = {p[ids[i]], r[ids[i]], ids[i]};
+      if (slots) (*slots)[ids[i]] = slot;
+    }
   }
-  bool empty() const { return items_.empty(); }
+  void Kill(uint32_t slot) { entries_[slot].id = kDead; }
 
   int64_t Cell(double x) const { return static_cast<int64_t>(std::floor(x * inv_cell_)); }
+  // The cell's Morton code, cut to the table: neighbouring cells share
+  // cache lines, and so do the cells of queries made in curve order.
   uint32_t Bucket(int64_t cx, int64_t cy, int64_t cz) const {
-    const uint64_t h = Mix64(static_cast<uint64_t>(cx) * 0x9e3779b97f4a7c15ULL ^
-                             static_cast<uint64_t>(cy) * 0xc2b2ae3d27d4eb4fULL ^
-                             static_cast<uint64_t>(cz) * 0x165667b19e3779f9ULL);
-    return static_cast<uint32_t>(h & mask_);
+    return static_cast<uint32_t>((Spread(cx) | Spread(cy) << 1 | Spread(cz) << 2) & mask_);
   }
-  // Calls f(id) for every id listed in the bucket of cell (cx, cy, cz) (and
-  // those of the cells sharing it); stops and returns true when f does.
+  // Calls f(entry) for every live entry in the bucket of cell (cx, cy, cz)
+  // (and of the cells sharing it); stops and returns true when f does.
   template <typename F>
   bool AnyIn(int64_t cx, int64_t cy, int64_t cz, const F& f) const {
-    if (items_.empty()) return false;
+    if (entries_.empty()) return false;
     const uint32_t b = Bucket(cx, cy, cz);
     for (uint32_t t = start_[b]; t < start_[b + 1]; ++t) {
-      if (f(items_[t])) return true;
+      if (entries_[t].id != kDead && f(entries_[t])) return true;
     }
     return false;
   }
@@ -74,7 +97,8 @@ class HashGrid {
  private:
   double inv_cell_;
   uint64_t mask_ = 0;
-  std::vector<uint32_t> start_, keys_, items_;
+  std::vector<uint32_t> start_, keys_;
+  std::vector<Entry> entries_;
 };
 
 class Relaxation {
@@ -149,12 +173,12 @@ bool Relaxation::AnyNear(uint32_t i, const Vec3& x, const F& f) const {
   const int64_t x0 = main_.Cell(x.x - ri), x1 = main_.Cell(x.x + ri);
   const int64_t y0 = main_.Cell(x.y - ri), y1 = main_.Cell(x.y + ri);
   const int64_t z0 = main_.Cell(x.z - ri), z1 = main_.Cell(x.z + ri);
-  const auto visit = [&](uint32_t j) {
-    if (j == i) return false;
-    const double r = std::min(ri, r_[j]);
-    const Vec3 d = p_[j] - x;
+  const auto visit = [&](const HashGrid::Entry& e) {
+    if (e.id == i) return false;
+    const double r = std::min(ri, e.r);
+    const Vec3 d = e.p - x;
     const double d2 = Dot(d, d);
-    return d2 < r * r && f(j, d2 / (r * r));
+    return d2 < r * r && f(e.id, d2 / (r * r));
   };
   for (int64_t a = x0; a <= x1; ++a) {
     for (int64_t b = y0; b <= y1; ++b) {
@@ -327,15 +351,19 @@ absl::StatusOr<BlueNoiseSet> Relaxation::Run(double total_mass) {
 
   suspect_.assign(n_, 1);
   in_todo_.assign(n_, 0);
-  std::vector<uint32_t> all(n_), moved_since_build, colour, moved;
+  // The points in `main_` as they were at its build, but for those that
+  // moved since (moved_since_build, listed at their current place in
+  // moved_grid_).
+  std::vector<uint32_t> all(n_), slot(n_), moved_since_build, colour, moved;
+  std::vector<uint8_t> moved_flag(n_, 0), ever_moved(n_, 0);
   for (uint32_t i = 0; i < n_; ++i) all[i] = i;
   main_ = HashGrid(cell);
   moved_grid_ = HashGrid(cell);
-  main_.Build(p_, all);
-  std::vector<uint8_t> ever_moved(n_, 0);
+  main_.Build(p_, r_, all, &slot);
   for (int sweep = 0; sweep < options_.sweeps; ++sweep) {
     if (moved_since_build.size() > n_ / 8) {
-      main_.Build(p_, all);
+      main_.Build(p_, r_, all, &slot);
+      for (uint32_t i : moved_since_build) moved_flag[i] = 0;
       moved_since_build.clear();
       moved_grid_ = HashGrid(cell);
     }
@@ -350,9 +378,14 @@ absl::StatusOr<BlueNoiseSet> Relaxation::Run(double total_mass) {
       RETURN_IF_ERROR(HalfSweep(sweep, colour, &moved));
       for (uint32_t i : colour) in_todo_[i] = 0;
       if (moved.empty()) continue;
-      for (uint32_t i : moved) ever_moved[i] = 1;
-      moved_since_build.insert(moved_since_build.end(), moved.begin(), moved.end());
-      moved_grid_.Build(p_, moved_since_build);
+      for (uint32_t i : moved) {
+        ever_moved[i] = 1;
+        if (moved_flag[i]) continue;
+        moved_flag[i] = 1;
+        main_.Kill(slot[i]);
+        moved_since_build.push_back(i);
+      }
+      moved_grid_.Build(p_, r_, moved_since_build, nullptr);
       // A sample that moved to a place clearing every neighbour can be too
       // close only to another that moved with it; one that moved to its
       // least crowded candidate is too close to some: both are suspects.
