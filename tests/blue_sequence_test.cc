@@ -106,14 +106,15 @@ TEST(BlueSequence, EverySampleStaysInItsStratum) {
 }
 
 TEST(BlueSequence, DensityKeepsItsMassSplit) {
-  // delta = u + v on the unit square: u < 1/2 holds 3/8 of the mass.
+  // delta = u + v on the unit square: u < 0.3 holds 0.195 of the mass (not
+  // u < 1/2, a union of whole runs of the curve, exact for any strata).
   Engine e;
   const uint64_t n = 20000;
   const SampleBatch b = DrawAll(e.engine, Blue("plane", n, 4, "expr:u+v"));
   ASSERT_EQ(b.size(), n);
   size_t left = 0;
-  for (double u : b.u) left += u < 0.5;
-  EXPECT_NEAR(static_cast<double>(left) / n, 0.375, 0.003);
+  for (double u : b.u) left += u < 0.3;
+  EXPECT_NEAR(static_cast<double>(left) / n, 0.195, 0.001);
 }
 
 TEST(BlueSequence, SameBytesForAnyThreadCount) {
