@@ -24,6 +24,9 @@ constexpr double kMaxSpacingRatio = 8;
 // Candidates are placed in rounds of this many per searching sample (the
 // first that clears wins, so most samples need one or two rounds).
 constexpr int kRound = 4;
+// A candidate whose density differs from the density at its sample's
+// jittered place by more than this factor is not taken.
+constexpr double kDensityJump = 1.25;
 
 // Points in a grid of cubic cells of side `cell`, hashed by Morton code: a
 // bucket array of cell lists in CSR form, each entry a copy of its point and radius (so a
@@ -151,6 +154,8 @@ class Relaxation {
   std::vector<double> r_;         // rho d_i
   std::vector<uint8_t> suspect_;  // may be too close to a neighbour
   std::vector<uint8_t> in_todo_;  // in the half-sweep's list (constant during it)
+  std::vector<double> delta_;     // the density at each sample's jittered place
+  bool uniform_density_ = true;   // all of delta_ alike: candidates need none
   HashGrid main_, moved_grid_;
 };
 
@@ -242,6 +247,7 @@ absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
     std::vector<double> cq;
     std::vector<int> cj;
     std::vector<Vec3> cp;
+    std::vector<double> cd;
     std::vector<Search> still;
     for (uint64_t j0 = 0; j0 < tries && !searching.empty(); j0 += kRound) {
       const int m = static_cast<int>(std::min<uint64_t>(kRound, tries - j0));
@@ -261,7 +267,9 @@ absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
         }
       }
       cp.resize(cq.size());
-      RETURN_IF_ERROR(place_(cq.data(), cq.size(), cp.data(), nullptr));
+      cd.resize(uniform_density_ ? 0 : cq.size());
+      RETURN_IF_ERROR(
+          place_(cq.data(), cq.size(), cp.data(), uniform_density_ ? nullptr : cd.data()));
       // A sample takes its first candidate, in j order, that clears every
       // neighbour; failing that, after all C, the least crowded one.
       still.clear();
@@ -273,12 +281,18 @@ absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
           const size_t c = s * m + j;
           if (!IsFinite(cp[c])) return absl::InvalidArgumentError("a candidate is not finite");
           if (first >= 0 && cj[c] > cj[s * m + first]) continue;
+          // Across a density step a stratum's sample would drift to the
+          // sparse side, where it is less crowded: it stays where the
+          // density is within kDensityJump of its jittered place's.
+          if (!uniform_density_ &&
+              !(cd[c] * kDensityJump >= delta_[k] && cd[c] <= kDensityJump * delta_[k])) {
+            continue;
+          }
           const double crowding = Crowding(k, cp[c], search.best);
           if (crowding >= 1) {
             first = j;
           } else if (first < 0 && crowding > search.best) {
-            // Ties between candidates go to the smaller j: the order they
-            // are looked at must not matter.
+            // Ties go to the first in the batch's (hashed) order.
             search.best = crowding, search.q = cq[c], search.p = cp[c];
           }
         }
@@ -321,10 +335,13 @@ absl::StatusOr<BlueNoiseSet> Relaxation::Run(double total_mass) {
   Sequence(SequenceKind::kJittered, n_, seed_).AtMany(0, n_, q_.data());
 
   p_.resize(n_);
-  std::vector<double> delta(n_);
+  std::vector<double>& delta = delta_;
+  delta.resize(n_);
   RETURN_IF_ERROR(ForParts(n_, [&](int, size_t begin, size_t end) {
     return place_(q_.data() + begin, end - begin, p_.data() + begin, delta.data() + begin);
   }));
+  uniform_density_ =
+      std::all_of(delta.begin(), delta.end(), [&](double x) { return x == delta[0]; });
   // Spacing: the hexagonal packing's nearest-neighbour distance for the area
   // a sample has at its density, sqrt(2 a / sqrt 3) with a = S_M / (N delta).
   const double per_sample = total_mass / static_cast<double>(n_);

@@ -10,7 +10,10 @@
 // then odd k), every sample of the colour that is too close to a neighbour
 // tries candidates h = hash(seed, sweep, k, j), j = 0, 1, ... in its stratum
 // and takes the first whose point clears every other sample; if none of them
-// does, the least crowded one, when it is less crowded than its place. All
+// does, the least crowded one, when it is less crowded than its place
+// (candidates where the density differs from the density at the sample's
+// jittered place by more than 1.25x are not taken: across a density step a
+// sample would drift to the sparse side, where it is less crowded). All
 // samples of a colour decide on the points as they were when the colour's
 // half-sweep began, so the result depends neither on the order they are
 // visited in nor on threads; of two samples of one colour that are too close

@@ -78,14 +78,14 @@ TEST(BlueSequence, SphereChordSpacing) {
 TEST(BlueSequence, EverySampleStaysInItsStratum) {
   // The blue set's q_k against its strata: sample k's mass coordinate lies
   // in [k/N, (k+1)/N], so every prefix of the curve holds exactly its share.
-  const uint64_t n = 5000;
+  const uint64_t n = 2000;
   const MassPlacer plane = [](const double* q, size_t m, Vec3* p, double* density) {
-    // The unit interval wound onto a 50 x 100 strip of rows: a surface whose
-    // curve is far from its 3D neighbours at every row's end.
+    // The unit interval wound onto 40 rows of the unit square: a surface
+    // whose curve is far from its 3D neighbours at every row's end.
     for (size_t i = 0; i < m; ++i) {
-      const double t = q[i] * 50, row = std::floor(t);
+      const double t = q[i] * 40, row = std::floor(t);
       const double along = (static_cast<int>(row) % 2 == 0) ? t - row : 1 - (t - row);
-      p[i] = {along, row / 50, 0};
+      p[i] = {along, row / 40, 0};
       if (density) density[i] = 1;
     }
     return absl::OkStatus();
@@ -119,15 +119,15 @@ TEST(BlueSequence, DensityKeepsItsMassSplit) {
 
 TEST(BlueSequence, SameBytesForAnyThreadCount) {
   Engine one(1), three(3);
-  const SampleRequest r = Blue("torus:R=1;r=0.4", 30000, 6, "gaussian:floor=0.1");
+  const SampleRequest r = Blue("torus:R=1;r=0.4", 20000, 6, "gaussian:floor=0.1");
   ExpectSameBytes(DrawAll(one.engine, r), DrawAll(three.engine, r));
 }
 
 TEST(BlueSequence, ShardsRangesAndRegionsAreTheWholeRun) {
   Engine e(2);
-  const SampleRequest whole_request = Blue("torus:R=1;r=0.4", 12000, 9);
+  const SampleRequest whole_request = Blue("torus:R=1;r=0.4", 6000, 9);
   const SampleBatch whole = DrawAll(e.engine, whole_request);
-  ASSERT_EQ(whole.size(), 12000u);
+  ASSERT_EQ(whole.size(), 6000u);
   SampleBatch shards;
   for (uint32_t s = 0; s < 8; ++s) {
     SampleRequest r = whole_request;
@@ -137,9 +137,9 @@ TEST(BlueSequence, ShardsRangesAndRegionsAreTheWholeRun) {
   ExpectSameBytes(whole, shards);
 
   SampleRequest range = whole_request;
-  range.begin = 3001, range.end = 7777;
+  range.begin = 1501, range.end = 3777;
   SampleBatch expected;
-  expected.AppendFrom(whole, 3001, 7777);
+  expected.AppendFrom(whole, 1501, 3777);
   ExpectSameBytes(DrawAll(e.engine, range), expected);
 
   SampleRequest box = whole_request;
