@@ -19,10 +19,15 @@ Prints, each as a table row with the mean and standard error over seeds:
     radius, N = 4096 and 20 000): Open3D's sample_points_poisson_disk and
     ours (ply: mesh, --sequence blue), seconds and the two distances; scipy's
     qmc.PoissonDisk on the unit square at N = 4096 (it returns fewer points
-    than asked: the count is shown).
+    than asked: the count is shown);
+  - the radially averaged power spectrum (periodogram over integer wave
+    vectors, white noise P = 1) of the plane sets at N = 4096: ours blue and
+    jittered, 2D jittered, scrambled Sobol and scipy's PoissonDisk: the mean P
+    below f = sqrt(N)/2 and the peak beyond it (Open3D's sets lie on a mesh,
+    where a periodogram of the square does not apply).
 
 Usage: PYTHONPATH=build/python /usr/bin/python3 bench/blue_mode.py [--build build]
-       [--seeds 1,2,3] [--quick]
+       [--seeds 1,2,3] [--quick] [--only figures,speed,peers,spectra]
 Needs Debian's python3-numpy, python3-scipy and python3-open3d.
 """
 import argparse
@@ -77,16 +82,75 @@ def icosphere_ply(path, subdivisions):
     return mesh, area
 
 
+def spectrum(points, fmax):
+    """P(f), f = 1 .. fmax: |sum_j exp(-2 pi i k.x_j)|^2 / N averaged over |k| rounding to f."""
+    k = np.arange(-fmax, fmax + 1)
+    ex = np.exp(-2j * np.pi * np.outer(k, points[:, 0]))
+    ey = np.exp(-2j * np.pi * np.outer(np.arange(0, fmax + 1), points[:, 1]))
+    p = np.abs(ex @ ey.T) ** 2 / len(points)  # [kx + fmax, ky]
+    kx, ky = np.meshgrid(k, np.arange(0, fmax + 1), indexing="ij")
+    f = np.rint(np.hypot(kx, ky)).astype(int)
+    keep = (ky > 0) | (kx > 0)
+    out = np.zeros(fmax + 1)
+    for i in range(1, fmax + 1):
+        sel = keep & (f == i)
+        out[i] = p[sel].mean()
+    return out[1:]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--build", default="build")
     ap.add_argument("--seeds", default="1,2,3")
     ap.add_argument("--quick", action="store_true", help="fewer seeds for the bias, no N = 20 000")
+    ap.add_argument("--only", default="figures,speed,peers,spectra")
     args = ap.parse_args()
+    only = set(args.only.split(","))
     cli = os.path.join(args.build, "client", "sfcsampler")
     seeds = [int(s) for s in args.seeds.split(",")]
     n = 4096
 
+    if "figures" in only:
+        figures(cli, seeds, n, args)
+    if "speed" in only:
+        speed()
+    if "peers" in only:
+        peers(cli, n, args)
+    if "spectra" in only:
+        spectra(cli, seeds, n)
+
+
+def spectra(cli, seeds, n):
+    from scipy.stats import qmc
+    fmax = int(1.5 * np.sqrt(n))
+    print(f"\n## Radially averaged power spectrum, plane, N = {n}, seeds {seeds}, f to {fmax}\n")
+    print("| set | mean P, f < sqrt(N)/2 | peak P | peak at f / sqrt(N) |\n|---|---:|---:|---:|")
+    sets = {}
+    for seed in seeds:
+        rng = np.random.default_rng(seed)
+        for seq in ("blue", "jittered"):
+            a, _ = cli_npy(cli, ["--surface", "plane", "--count", str(n), "--seed", str(seed),
+                                 "--sequence", seq])
+            sets.setdefault(f"ours, {seq}", []).append(np.stack([a["u"], a["v"]], axis=1))
+        k = int(np.sqrt(n))
+        i, j = np.meshgrid(np.arange(k), np.arange(k), indexing="ij")
+        sets.setdefault("2D jittered", []).append(
+            np.stack([(i.ravel() + rng.random(n)) / k, (j.ravel() + rng.random(n)) / k], axis=1))
+        sets.setdefault("scrambled Sobol (scipy)", []).append(
+            qmc.Sobol(d=2, scramble=True, seed=seed).random(n))
+        sets.setdefault("scipy PoissonDisk r = 0.80 (its own count)", []).append(
+            qmc.PoissonDisk(d=2, radius=0.80 * hex_spacing(n, 1.0), seed=seed).random(n))
+    root = np.sqrt(n)
+    for name, pts in sets.items():
+        p = np.mean([spectrum(x, fmax) for x in pts], axis=0)
+        f = np.arange(1, fmax + 1)
+        low = p[f < root / 2].mean()
+        hi = f >= root / 2
+        peak = f[hi][np.argmax(p[hi])]
+        print(f"| {name} | {low:.3f} | {p[peak - 1]:.2f} | {peak / root:.2f} |")
+
+
+def figures(cli, seeds, n, args):
     print(f"## Blue sequence (issue 35), seeds {args.seeds}\n")
     print("| figure | blue | jittered | must hold (blue) |\n|---|---:|---:|---|")
     for surface, area, need in (("plane", 1.0, "min >= 0.75, mean >= 0.80"),
@@ -142,7 +206,10 @@ def main():
         print(f"| {surface} N = {n}, {len(bias_seeds)} seeds: {label} | {fmt(err['blue'], 7)} | "
               f"{fmt(err['jittered'], 7)} | measured, reported |")
 
-    # Speed in process.
+
+
+def speed():
+    """10^6 sphere samples in process, one thread, tree cached."""
     try:
         import sfcsampler
         s = sfcsampler.Sampler(threads=1)
@@ -162,7 +229,9 @@ def main():
     except ImportError:
         print("| sphere 10^6 in process | (PYTHONPATH=build/python needed) | | |")
 
-    # Peers.
+
+
+def peers(cli, n, args):
     print("\n## Peers: speed and nearest-neighbour distances / hexagonal\n")
     print("| set | surface | N asked | N given | seconds | min | mean |\n|---|---|---:|---:|---:|"
           "---:|---:|")
