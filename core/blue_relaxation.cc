@@ -21,9 +21,12 @@ constexpr uint64_t kPriorityStream = 0x626c7566;
 // A sample's spacing is at most this many times the median spacing (where the
 // density vanishes at a point the spacing would be infinite).
 constexpr double kMaxSpacingRatio = 8;
-// Candidates are placed in rounds of this many per searching sample (the
-// first that clears wins, so most samples need one or two rounds).
-constexpr int kRound = 4;
+// Candidates are placed in rounds of this many per searching sample. Each
+// round is one batch through the cursor, which enters (and tabulates) the
+// leaf of every searching sample again: 16 took 35 % less time than 4 on the
+// sphere at 2*10^5, with the same set (a sample's choice depends on the
+// rounds only through exact ties of crowding between candidates).
+constexpr int kRound = 16;
 // A candidate whose density differs from the density at its sample's
 // jittered place by more than this factor is not taken.
 constexpr double kDensityJump = 1.25;
