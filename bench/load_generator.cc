@@ -409,7 +409,7 @@ class Worker {
     const SampleRequest request = ValidRequest(rng_);
     SampleBatch received;
     const bool check = (++completes_ % flags_.check_every) == 0;
-    auto summary = client_->Sample(request, [&](const v1::StreamHeader&, const SampleBatch& b) {
+    auto summary = client_->Sample(request, [&](const StreamInfo&, const SampleBatch& b) {
       tally_->Samples(b.size());
       if (check) received.Append(b);
       return absl::OkStatus();
@@ -457,7 +457,7 @@ class Worker {
     absl::StatusOr<StreamSummary> summary;
     for (int attempt = 0; attempt < 4; ++attempt) {
       received = SampleBatch();
-      summary = client_->Sample(request, [&](const v1::StreamHeader&, const SampleBatch& b) {
+      summary = client_->Sample(request, [&](const StreamInfo&, const SampleBatch& b) {
         tally_->Samples(b.size());
         if (check) received.Append(b);
         return absl::OkStatus();
@@ -503,7 +503,7 @@ class Worker {
     request.tree.surface = info->spec();
     request.count = 1000;
     uint64_t got = 0;
-    auto summary = client_->Sample(request, [&](const v1::StreamHeader&, const SampleBatch& b) {
+    auto summary = client_->Sample(request, [&](const StreamInfo&, const SampleBatch& b) {
       got += b.size();
       return absl::OkStatus();
     });
@@ -528,9 +528,8 @@ class Worker {
     SampleRequest request;
     request.tree.surface = "ply:sha256=" + std::string(63, 'a') + "0123456789abcdef"[rng_() % 16];
     request.count = 1000;
-    auto summary = client_->Sample(request, [](const v1::StreamHeader&, const SampleBatch&) {
-      return absl::OkStatus();
-    });
+    auto summary = client_->Sample(
+        request, [](const StreamInfo&, const SampleBatch&) { return absl::OkStatus(); });
     const absl::StatusCode code = summary.ok() ? absl::StatusCode::kOk : summary.status().code();
     Report("unknown model", ToGrpcCode(code), code == absl::StatusCode::kNotFound,
            summary.ok() ? "" : std::string(summary.status().message()));
@@ -708,7 +707,7 @@ int Main(int argc, char** argv) {
 
   ClientOptions options;
   options.target = flags.server;
-  options.batch_size = flags.batch_size;
+  options.stream.batch_size = flags.batch_size;
   options.deadline_seconds = flags.stream_deadline_seconds;
   auto client = SamplerClient::Connect(options);
   if (!client.ok()) {

@@ -128,7 +128,7 @@ SampleRequest Request(const std::string& surface, const std::string& density, ui
 double StreamSeconds(SamplerClient& client, const SampleRequest& request, uint64_t* received) {
   const auto start = Clock::now();
   double sink = 0;
-  auto s = client.Sample(request, [&](const v1::StreamHeader&, const SampleBatch& b) {
+  auto s = client.Sample(request, [&](const StreamInfo&, const SampleBatch& b) {
     for (size_t i = 0; i < b.size(); i += 4096) sink += b.x[i];
     return absl::OkStatus();
   });
@@ -195,16 +195,16 @@ int Run(uint64_t n) {
   struct Case {
     const char* surface;
     const SampleRequest* request;
-    v1::Precision precision;
-  } cases[] = {{"sphere", &sphere, v1::PRECISION_FLOAT32},
-               {"sphere", &sphere, v1::PRECISION_FLOAT64}};
+    ColumnPrecision precision;
+  } cases[] = {{"sphere", &sphere, ColumnPrecision::kFloat32},
+               {"sphere", &sphere, ColumnPrecision::kFloat64}};
   for (const Case& c : cases) {
-    const v1::Precision precision = c.precision;
+    const ColumnPrecision precision = c.precision;
     const SampleRequest& request = *c.request;
-    const std::string label =
-        std::string(c.surface) + (precision == v1::PRECISION_FLOAT32 ? ", float32" : ", float64");
+    const std::string label = std::string(c.surface) +
+                              (precision == ColumnPrecision::kFloat32 ? ", float32" : ", float64");
     const char* name = label.c_str();
-    const size_t value_bytes = precision == v1::PRECISION_FLOAT32 ? 4 : 8;
+    const size_t value_bytes = precision == ColumnPrecision::kFloat32 ? 4 : 8;
     const uint64_t payload = n * 5 * value_bytes;
     const double raw_seconds = Best([&] {
       return RawSeconds(raw_target, payload, static_cast<uint32_t>(batch * 5 * value_bytes));
@@ -224,17 +224,17 @@ int Run(uint64_t n) {
     struct Setup {
       const char* how;
       const std::string* target;
-      v1::ColumnEncoding encoding;
-    } setups[] = {{"no pipeline, packed columns (as before)", &unpipelined_target,
-                   v1::COLUMN_ENCODING_PACKED},
-                  {"pipelined, packed columns", &target, v1::COLUMN_ENCODING_PACKED},
-                  {"pipelined, raw columns", &target, v1::COLUMN_ENCODING_RAW}};
+      ColumnEncoding encoding;
+    } setups[] = {
+        {"no pipeline, packed columns (as before)", &unpipelined_target, ColumnEncoding::kPacked},
+        {"pipelined, packed columns", &target, ColumnEncoding::kPacked},
+        {"pipelined, raw columns", &target, ColumnEncoding::kRaw}};
     for (const Setup& setup : setups) {
       ClientOptions co;
       co.target = *setup.target;
-      co.precision = precision;
-      co.batch_size = batch;
-      co.column_encoding = setup.encoding;
+      co.stream.precision = precision;
+      co.stream.batch_size = batch;
+      co.stream.encoding = setup.encoding;
       auto client = *SamplerClient::Connect(co);
       uint64_t received = 0;
       StreamSeconds(*client, request, &received);  // warm: build and cache the tree
@@ -253,9 +253,9 @@ int Run(uint64_t n) {
       points.fields.uv = false;
       ClientOptions co;
       co.target = target;
-      co.precision = precision;
-      co.batch_size = batch;
-      co.column_encoding = v1::COLUMN_ENCODING_RAW;
+      co.stream.precision = precision;
+      co.stream.batch_size = batch;
+      co.stream.encoding = ColumnEncoding::kRaw;
       auto client = *SamplerClient::Connect(co);
       uint64_t received = 0;
       StreamSeconds(*client, points, &received);
@@ -266,12 +266,12 @@ int Run(uint64_t n) {
           name, static_cast<unsigned long long>(received), received / seconds / 1e6,
           received * 3.0 * value_bytes / seconds / 1e6);
     }
-    for (auto encoding : {v1::COLUMN_ENCODING_PACKED, v1::COLUMN_ENCODING_RAW}) {
+    for (auto encoding : {ColumnEncoding::kPacked, ColumnEncoding::kRaw}) {
       ClientOptions co;
       co.target = wire_target;
-      co.precision = precision;
-      co.batch_size = batch;
-      co.column_encoding = encoding;
+      co.stream.precision = precision;
+      co.stream.batch_size = batch;
+      co.stream.encoding = encoding;
       auto wire_client = *SamplerClient::Connect(co);
       uint64_t received = 0;
       const double wire_seconds =
@@ -279,7 +279,7 @@ int Run(uint64_t n) {
       std::printf(
           "| %s, %s: wire path only (no generation), ratio to raw bytes | %.2f (%.1f M samples/s) "
           "|\n",
-          name, encoding == v1::COLUMN_ENCODING_RAW ? "raw columns" : "packed columns",
+          name, encoding == ColumnEncoding::kRaw ? "raw columns" : "packed columns",
           raw_seconds / wire_seconds, received / wire_seconds / 1e6);
     }
   }

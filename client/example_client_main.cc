@@ -30,8 +30,8 @@ int main(int argc, char** argv) {
   }
   double sum[3] = {0, 0, 0}, first[3] = {0, 0, 0};
   uint64_t seen = 0;
-  auto summary = (*client)->Sample(
-      request, [&](const sfcsampler::v1::StreamHeader&, const sfc::SampleBatch& batch) {
+  auto summary =
+      (*client)->Sample(request, [&](const sfc::StreamInfo&, const sfc::SampleBatch& batch) {
         for (size_t i = 0; i < batch.size(); ++i, ++seen) {
           const double p[3] = {batch.x[i], batch.y[i], batch.z[i]};
           for (int c = 0; c < 3; ++c) {
@@ -46,8 +46,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::printf("%llu samples of %s (tree %s, %s)\n", static_cast<unsigned long long>(seen),
-              request.tree.surface.c_str(), summary->header.tree().key().c_str(),
-              summary->header.algorithm_version().c_str());
+              request.tree.surface.c_str(), summary->header.tree.key.c_str(),
+              summary->header.algorithm_version.c_str());
   std::printf("first (%.17g, %.17g, %.17g)\n", first[0], first[1], first[2]);
   if (seen > 0)
     std::printf("mean (%.6f, %.6f, %.6f)\n", sum[0] / seen, sum[1] / seen, sum[2] / seen);

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <thread>
 
@@ -119,7 +120,13 @@ SampleRequest SamplerClient::Shard(SampleRequest request, uint64_t i, uint64_t k
   return request;
 }
 
+absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& request,
+                                                    const BatchCallback& on_batch) {
+  return Sample(request, options_.stream, on_batch);
+}
+
 absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
+                                                    const StreamOptions& stream,
                                                     const BatchCallback& on_batch) {
   // A model file travels once: the server gets its bytes if it lacks them,
   // and the request names them by hash. Its spec is parsed once, for the
@@ -134,6 +141,7 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
   const bool from_file = asked_model->has_value() && (*asked_model)->sha256.empty();
   const bool monotone = SequenceIsMonotone(request.sequence);
   StreamSummary summary;
+  v1::StreamHeader first_header;  // summary.header as it came, to check resumes against
   bool have_header = false;
   // What to ask for next: monotone sets resume at the index after the last
   // one received (indices grow along the stream); others are re-requested
@@ -144,10 +152,7 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
   double backoff = options_.resume_backoff_seconds;
   SampleBatch batch;
   for (int attempt = 0;; ++attempt) {
-    v1::SampleRequest wire = ToProto(next);
-    wire.set_precision(options_.precision);
-    wire.set_batch_size(options_.batch_size);
-    wire.set_column_encoding(options_.column_encoding);
+    const v1::SampleRequest wire = ToProto(next, stream);
     grpc::ClientContext context;
     Decorate(&context, key);
     auto reader = stub_->Sample(&context, wire);
@@ -155,14 +160,15 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
     uint64_t this_stream = 0;
     absl::Status callback_error;
     while (reader->Read(&response)) {
+      summary.wire_bytes += response.ByteSizeLong();
       if (response.has_header() && !have_header) {
-        summary.header = response.header();
+        first_header = response.header();
+        summary.header = FromProto(first_header);
         have_header = true;
       } else if (response.has_header()) {
         // A resumed stream must continue the same set: same tree, same
         // algorithm, same seed (a rolling upgrade could mix two sets).
-        if (absl::Status s =
-                CheckResumedHeader(summary.header, response.header(), summary.received);
+        if (absl::Status s = CheckResumedHeader(first_header, response.header(), summary.received);
             !s.ok()) {
           callback_error = s;
           break;
@@ -171,6 +177,10 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
       batch.Clear();
       if (absl::Status s = AppendFromProto(response.batch(), request.fields, &batch); !s.ok()) {
         callback_error = s;
+        break;
+      }
+      if (batch.size() > 0 && !have_header) {
+        callback_error = absl::DataLossError("samples arrived before the stream's header");
         break;
       }
       this_stream += batch.size();
@@ -183,12 +193,15 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
         batch = std::move(rest);
       }
       if (batch.size() == 0) continue;
+      // Read before the callback, which may take the columns.
+      const uint64_t n = batch.size();
+      const uint64_t last = batch.index.back();
       if (absl::Status s = on_batch(summary.header, batch); !s.ok()) {
         callback_error = s;
         break;
       }
-      summary.received += batch.size();
-      last_index = batch.index.back();
+      summary.received += n;
+      last_index = last;
     }
     if (!callback_error.ok()) {
       context.TryCancel();
@@ -197,6 +210,8 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
     }
     const grpc::Status status = reader->Finish();
     if (status.ok()) {
+      // Every stream the server answers OK begins with its header.
+      if (!have_header) return absl::DataLossError("the stream ended without its header");
       // Nothing silently lost: the server says how many it sent.
       const auto& trailers = context.GetServerTrailingMetadata();
       auto it = trailers.find("x-samples-sent");
@@ -206,11 +221,10 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
             absl::StrFormat("the server sent %s samples but %d arrived",
                             std::string(it->second.data(), it->second.size()), this_stream));
       }
-      if (have_header && summary.header.expected_samples() >= 0 &&
-          summary.received != static_cast<uint64_t>(summary.header.expected_samples())) {
-        return absl::DataLossError(absl::StrFormat("expected %d samples, received %d",
-                                                   summary.header.expected_samples(),
-                                                   summary.received));
+      if (summary.header.expected_samples >= 0 &&
+          summary.received != static_cast<uint64_t>(summary.header.expected_samples)) {
+        return absl::DataLossError(absl::StrFormat(
+            "expected %d samples, received %d", summary.header.expected_samples, summary.received));
       }
       return summary;
     }
@@ -256,7 +270,7 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
   }
 }
 
-absl::StatusOr<v1::PrepareResponse> SamplerClient::Prepare(const TreeSpec& asked, uint64_t count) {
+absl::StatusOr<PreparedSummary> SamplerClient::Prepare(const TreeSpec& asked, uint64_t count) {
   TreeSpec spec = asked;
   auto surface = EnsureModel(asked.surface);
   if (!surface.ok()) return surface.status();
@@ -269,7 +283,7 @@ absl::StatusOr<v1::PrepareResponse> SamplerClient::Prepare(const TreeSpec& asked
   v1::PrepareResponse response;
   const grpc::Status status = stub_->Prepare(&context, request, &response);
   if (!status.ok()) return FromGrpcStatus(status);
-  return response;
+  return PreparedSummary{FromProto(response.tree()), response.seconds()};
 }
 
 absl::StatusOr<v1::ListCatalogResponse> SamplerClient::ListCatalog() {
@@ -333,37 +347,51 @@ absl::StatusOr<std::string> SamplerClient::EnsureModel(const std::string& spec) 
 absl::StatusOr<std::string> SamplerClient::EnsureModel(const std::string& spec,
                                                        const std::optional<ModelSpec>& parsed) {
   if (!parsed.has_value()) return spec;
-  const ModelSpec& model_spec = *parsed;
-  std::string sha256 = model_spec.sha256;
+  if (!parsed->sha256.empty()) return FindOrUpload(parsed->format, parsed->sha256, nullptr);
+  auto read = ReadModelFile(*parsed, kMaxModelFileBytes);
+  if (!read.ok()) return read.status();
+  return FindOrUpload(parsed->format, read->sha256, &*read);
+}
+
+absl::StatusOr<std::string> SamplerClient::EnsureModelBytes(ModelFormat format,
+                                                            const std::string& name,
+                                                            std::string bytes) {
   StoredModel local;
-  if (sha256.empty()) {
-    auto read = ReadModelFile(model_spec, kMaxModelFileBytes);
-    if (!read.ok()) return read.status();
-    local = *std::move(read);
-    sha256 = local.sha256;
-  }
+  local.format = format;
+  local.sha256 = Sha256Hex(bytes);
+  local.bytes = std::make_shared<const std::string>(std::move(bytes));
+  local.name = name;
+  return FindOrUpload(format, local.sha256, &local);
+}
+
+absl::StatusOr<std::string> SamplerClient::FindOrUpload(ModelFormat format,
+                                                        const std::string& sha256,
+                                                        const StoredModel* local) {
   v1::FindModelRequest find;
   find.set_sha256(sha256);
-  find.set_format(std::string(ModelFormatName(model_spec.format)));
+  find.set_format(std::string(ModelFormatName(format)));
   grpc::ClientContext context;
-  Decorate(&context, ModelRoutingKey(model_spec.format, sha256));
+  Decorate(&context, ModelRoutingKey(format, sha256));
   v1::ModelInfo info;
   const grpc::Status found = stub_->FindModel(&context, find, &info);
   if (found.ok()) return info.spec();
-  if (found.error_code() != grpc::StatusCode::NOT_FOUND || !local.bytes)
+  if (found.error_code() != grpc::StatusCode::NOT_FOUND || local == nullptr || !local->bytes) {
     return FromGrpcStatus(found);
-  auto uploaded = UploadModel(find.format(), local.name, *local.bytes);
+  }
+  auto uploaded = UploadModel(find.format(), local->name, *local->bytes);
   if (!uploaded.ok()) return uploaded.status();
   return uploaded->spec();
 }
 
-absl::StatusOr<bool> SamplerClient::CheckHealth(const std::string& service) {
+absl::StatusOr<bool> SamplerClient::CheckHealth(const std::string& service,
+                                                double deadline_seconds) {
   auto stub = grpc::health::v1::Health::NewStub(channel_);
   grpc::ClientContext context;
+  if (deadline_seconds <= 0) {
+    deadline_seconds = options_.deadline_seconds > 0 ? options_.deadline_seconds : 5;
+  }
   context.set_deadline(std::chrono::system_clock::now() +
-                       std::chrono::seconds(options_.deadline_seconds > 0
-                                                ? static_cast<int>(options_.deadline_seconds)
-                                                : 5));
+                       std::chrono::milliseconds(static_cast<int64_t>(deadline_seconds * 1000)));
   grpc::health::v1::HealthCheckRequest request;
   request.set_service(service);
   grpc::health::v1::HealthCheckResponse response;

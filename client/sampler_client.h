@@ -15,6 +15,10 @@
 // that meets NOT_FOUND because the model's replica died uploads the model
 // again (when the request named a local file) and goes on.
 //
+// The API speaks the request library's types (a request, its stream options,
+// a tree's summary); only ListCatalog, GetCacheStats and UploadModel hand
+// back wire messages.
+//
 // Thread-safety: a SamplerClient may be used from several threads at once.
 #ifndef SFCSAMPLER_CLIENT_SAMPLER_CLIENT_H_
 #define SFCSAMPLER_CLIENT_SAMPLER_CLIENT_H_
@@ -29,6 +33,9 @@
 #include "grpcpp/channel.h"
 #include "request/model_spec.h"
 #include "request/sample_request.h"
+#include "request/stream_info.h"
+#include "request/stream_options.h"
+#include "request/tree_summary.h"
 #include "sfcsampler/v1/sampler.grpc.pb.h"
 
 namespace sfc {
@@ -44,32 +51,46 @@ struct ClientOptions {
   // client waits up to as long again for the connection to come back.
   double resume_backoff_seconds = 0.2;
   double deadline_seconds = 0;             // per RPC; 0 = none
-  ::sfcsampler::v1::Precision precision = ::sfcsampler::v1::PRECISION_FLOAT64;
-  uint32_t batch_size = 0;                 // samples per message; 0 = the server chooses
-  // How columns travel: raw little-endian bytes (one memcpy a column at each
-  // end) or packed repeated fields. Servers that predate raw columns send
-  // packed ones whatever is asked; the client reads both.
-  ::sfcsampler::v1::ColumnEncoding column_encoding = ::sfcsampler::v1::COLUMN_ENCODING_RAW;
+  // How Sample()'s samples travel unless a call says otherwise. Raw columns
+  // (one memcpy a column at each end) rather than the wire's default, packed
+  // repeated fields: servers that predate raw columns send packed ones
+  // whatever is asked, and the client reads both.
+  StreamOptions stream = {ColumnPrecision::kFloat64, /*batch_size=*/0, ColumnEncoding::kRaw};
 };
 
 struct StreamSummary {
-  ::sfcsampler::v1::StreamHeader header;  // from the first stream
+  StreamInfo header;  // from the first stream
   uint64_t received = 0;
   int resumes = 0;
+  uint64_t wire_bytes = 0;  // serialised size of the messages received, resumes included
+};
+
+// What Prepare() gives: the tree's summary and the seconds the call took on
+// the server, any wait for a build included.
+struct PreparedSummary {
+  TreeSummary tree;
+  double seconds = 0;
 };
 
 class SamplerClient {
  public:
   static absl::StatusOr<std::unique_ptr<SamplerClient>> Connect(const ClientOptions& options);
 
-  using BatchCallback =
-      std::function<absl::Status(const ::sfcsampler::v1::StreamHeader&, const SampleBatch&)>;
-  // Streams `request`; a callback error cancels the stream and is returned.
-  // A surface naming a model file ("step:part.step") is uploaded first if the
-  // server lacks it (EnsureModel) and named by its hash.
+  // Called with each batch that holds samples, in curve order. The callback
+  // may take the batch's columns (std::move): the client refills the batch
+  // from the next message.
+  using BatchCallback = std::function<absl::Status(const StreamInfo&, SampleBatch&)>;
+  // Streams `request`, its samples travelling as `stream` says (the first
+  // form: as the options' `stream`); a callback error cancels the stream and
+  // is returned. A surface naming a model file ("step:part.step") is uploaded
+  // first if the server lacks it (EnsureModel) and named by its hash.
   absl::StatusOr<StreamSummary> Sample(const SampleRequest& request, const BatchCallback& on_batch);
+  absl::StatusOr<StreamSummary> Sample(const SampleRequest& request, const StreamOptions& stream,
+                                       const BatchCallback& on_batch);
 
-  absl::StatusOr<::sfcsampler::v1::PrepareResponse> Prepare(const TreeSpec& spec, uint64_t count);
+  // Builds (or finds in the server's cache) the tree of `spec` for `count`
+  // samples; a model file is uploaded first as for Sample().
+  absl::StatusOr<PreparedSummary> Prepare(const TreeSpec& spec, uint64_t count);
   absl::StatusOr<::sfcsampler::v1::ListCatalogResponse> ListCatalog();
   absl::StatusOr<::sfcsampler::v1::CacheStats> GetCacheStats();
 
@@ -79,12 +100,18 @@ class SamplerClient {
   // (FindModel first); a "FORMAT:sha256=..." spec is checked with FindModel. A
   // spec that names no model (a catalogue surface) comes back unchanged.
   absl::StatusOr<std::string> EnsureModel(const std::string& spec);
+  // The same for a model given as its file's bytes (`name` for messages):
+  // uploaded only if the server does not hold them.
+  absl::StatusOr<std::string> EnsureModelBytes(ModelFormat format, const std::string& name,
+                                               std::string bytes);
   // Uploads `bytes` as a model of `format` ("step", "obj", ...).
   absl::StatusOr<::sfcsampler::v1::ModelInfo> UploadModel(const std::string& format,
                                                           const std::string& name,
                                                           const std::string& bytes);
-  // grpc.health.v1 Check of `service` ("" = the whole server): true when SERVING.
-  absl::StatusOr<bool> CheckHealth(const std::string& service = "");
+  // grpc.health.v1 Check of `service` ("" = the whole server): true when
+  // SERVING. It sends no token. `deadline_seconds` 0: the options' deadline,
+  // or 5 s without one.
+  absl::StatusOr<bool> CheckHealth(const std::string& service = "", double deadline_seconds = 0);
 
   // Range and shard helpers: the same request restricted to [begin, end) or
   // to shard i of k.
@@ -98,6 +125,10 @@ class SamplerClient {
   // ParseModelSpec(spec)'s value.
   absl::StatusOr<std::string> EnsureModel(const std::string& spec,
                                           const std::optional<ModelSpec>& parsed);
+  // FindModel of `sha256`; when the server lacks it, UploadModel of `local`
+  // (null: NOT_FOUND). Returns the server's spec of the model.
+  absl::StatusOr<std::string> FindOrUpload(ModelFormat format, const std::string& sha256,
+                                           const StoredModel* local);
   void Decorate(grpc::ClientContext* context, const std::string& surface_key) const;
 
   const ClientOptions options_;

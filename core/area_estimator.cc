@@ -1,6 +1,7 @@
 #include "core/area_estimator.h"
 
 #include <cmath>
+#include <vector>
 
 #include "absl/strings/str_format.h"
 #include "base/status_macros.h"
@@ -62,6 +63,26 @@ SurfacePoint PointFromJet(const SurfaceJet& jet, double u, double v, bool curvat
     *area_element = Norm(Cross(jet.fu, jet.fv));
   }
   return point;
+}
+
+void MassDensityGrid(const Surface& surface, const Density& density, const double* us, int nu,
+                     const double* vs, int nv, double* out) {
+  const bool curvature = density.NeedsCurvature();
+  std::vector<SurfaceJet> jets(static_cast<size_t>(nu) * nv);
+  surface.JetGrid(us, nu, vs, nv, curvature ? 2 : 1, jets.data());
+  for (int i = 0; i < nu; ++i) {
+    for (int j = 0; j < nv; ++j) {
+      const SurfaceJet& jet = jets[static_cast<size_t>(i) * nv + j];
+      double& m = out[static_cast<size_t>(i) * nv + j];
+      m = INFINITY;
+      if (!IsFinite(jet.p)) continue;
+      double area;
+      const SurfacePoint point = PointFromJet(jet, us[i], vs[j], curvature, &area);
+      if (!std::isfinite(area)) continue;
+      const double delta = density.Value(point);
+      if (std::isfinite(delta)) m = delta * area;
+    }
+  }
 }
 
 absl::Status CheckDensityValue(double delta, double u, double v) {
@@ -129,14 +150,13 @@ absl::StatusOr<double> CellMass(const Surface& surface, const Density& density,
     }
     case AreaEstimator::kQuadrature: {
       // 3-point Gauss-Legendre on [0,1]: exact for polynomials of degree 5.
-      static constexpr double kNode[3] = {0.5 - 0.3872983346207417, 0.5,
-                                          0.5 + 0.3872983346207417};
+      static constexpr double kNode[3] = {0.5 - 0.3872983346207417, 0.5, 0.5 + 0.3872983346207417};
       static constexpr double kWeight[3] = {5.0 / 18, 8.0 / 18, 5.0 / 18};
       double sum = 0;
       for (int i = 0; i < 3; ++i) {
         for (int j = 0; j < 3; ++j) {
-          ASSIGN_OR_RETURN(const DensityAt d, EvaluateDensity(surface, density, u0 + kNode[i] * h,
-                                                              v0 + kNode[j] * h));
+          ASSIGN_OR_RETURN(const DensityAt d,
+                           EvaluateDensity(surface, density, u0 + kNode[i] * h, v0 + kNode[j] * h));
           sum += kWeight[i] * kWeight[j] * d.delta * d.area_element;
         }
       }
@@ -159,6 +179,5 @@ absl::StatusOr<double> TriangleMass(const Surface& surface, const Density& densi
                                    (prev_v + cur_v + next_v) / 3));
   return d.delta * TriangleArea(a, b, c);
 }
-
 
 }  // namespace sfc

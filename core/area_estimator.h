@@ -17,7 +17,6 @@
 
 namespace sfc {
 
-
 // INVALID_ARGUMENT saying the surface is not finite at (u, v) and what to fix.
 absl::Status SurfaceNotFiniteError(double u, double v);
 
@@ -29,6 +28,14 @@ SurfacePoint PointFromJet(const SurfaceJet& jet, double u, double v, bool curvat
 
 // INVALID_ARGUMENT unless delta (the density at (u, v)) is finite and >= 0.
 absl::Status CheckDensityValue(double delta, double u, double v);
+
+// The mass density m = delta |f_u x f_v| at the grid points (us[i], vs[j]),
+// i < nu, j < nv: out[i * nv + j], through Surface::JetGrid (jets of the
+// order the density needs). +infinity where the point, its area element or
+// delta is not finite (a pole or singular line); delta is not checked for
+// sign (CheckDensityValue).
+void MassDensityGrid(const Surface& surface, const Density& density, const double* us, int nu,
+                     const double* vs, int nv, double* out);
 
 // delta and the area element at one parameter point.
 struct DensityAt {

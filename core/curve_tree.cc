@@ -18,9 +18,8 @@ constexpr int kMassBits = 56;
 void RecordHit(const DepthCapHit& hit, std::vector<DepthCapHit>* worst) {
   auto ratio = [](const DepthCapHit& h) { return h.limit > 0 ? h.measured / h.limit : INFINITY; };
   if (worst->size() == PrecisionReport::kMaxReported && ratio(hit) <= ratio(worst->back())) return;
-  auto pos = std::upper_bound(worst->begin(), worst->end(), hit, [&](const auto& a, const auto& b) {
-    return ratio(a) > ratio(b);
-  });
+  auto pos = std::upper_bound(worst->begin(), worst->end(), hit,
+                              [&](const auto& a, const auto& b) { return ratio(a) > ratio(b); });
   worst->insert(pos, hit);
   if (worst->size() > PrecisionReport::kMaxReported) worst->pop_back();
 }
@@ -48,8 +47,7 @@ static_assert(CurveTree::kErrorFloorPower == 0.5, "the floors are square roots (
 bool FailsAt(int g, double error, double mass, double base, double rho) {
   const double n = std::ldexp(1.0, g);
   const double mu = mass / base;
-  return mu * n >= std::max(CurveTree::kMinSamples,
-                           CurveTree::kErrorFloor * RootN(n)) &&
+  return mu * n >= std::max(CurveTree::kMinSamples, CurveTree::kErrorFloor * RootN(n)) &&
          error / base * n > rho * CurveTree::kErrorShare * FourthRootN(n) * mu;
 }
 
@@ -108,7 +106,7 @@ class CurveTree::Builder {
   // One cell's mass estimate and model (file comment of curve_tree.h).
   struct CellEval {
     double mass = 0;
-    double area = 0;  // the same for delta = 1 (quadrature of the area element)
+    double area = 0;   // the same for delta = 1 (quadrature of the area element)
     double values[9];  // quadratic: m at the Gauss nodes; piecewise: sub-square masses
     double delta[9];   // the density at the nodes (NaN where singular)
     AxisWarp warp[2] = {kNoWarp, kNoWarp};  // the quadratic's power laws (LeafModel::warp)
@@ -368,14 +366,10 @@ class CurveTree::Builder {
   // surface or its area element is not finite.
   absl::StatusOr<double> AxisDensity(double u0, double v0, double h, int axis, double x) const {
     const double u = axis == 0 ? u0 + x * h : u0 + h / 2, v = axis == 0 ? v0 + h / 2 : v0 + x * h;
-    const SurfaceJet jet = surface_.Jet(u, v, order_);
     // The searches close in on the line itself, where a pole is not finite.
-    if (!IsFinite(jet.p)) return INFINITY;
-    double area;
-    const SurfacePoint point = PointFromJet(jet, u, v, order_ == 2, &area);
-    if (!std::isfinite(area)) return INFINITY;
-    const double delta = density_.Value(point);
-    return std::isfinite(delta) ? delta * area : INFINITY;
+    double m;
+    MassDensityGrid(surface_, density_, &u, 1, &v, 1, &m);
+    return m;
   }
 
   // The exponent p in m ~ t^p at distance t from the singular point `centre`
@@ -520,25 +514,17 @@ class CurveTree::Builder {
   double EdgeError(const CellEval& eval, double u0, double v0, double h) const {
     if (eval.piecewise || eval.warped()) return 0.0;
     const double at[3] = {0, 0.5, 1};
-    double us[3], vs[3];
+    double us[3], vs[3], m[9];
     for (int i = 0; i < 3; ++i) us[i] = u0 + at[i] * h, vs[i] = v0 + at[i] * h;
-    SurfaceJet jets[9];
-    surface_.JetGrid(us, 3, vs, 3, order_, jets);
+    MassDensityGrid(surface_, density_, us, 3, vs, 3, m);
     double top = 0;
     for (int k = 0; k < 9; ++k) top = std::max(top, std::fabs(eval.values[k]));
     double worst = 0;
     for (int i = 0; i < 3; ++i) {
       for (int j = 0; j < 3; ++j) {
-        if (i == 1 && j == 1) continue;
-        const SurfaceJet& jet = jets[3 * i + j];
-        // A pole or singular line on the edge: the warps' business.
-        if (!IsFinite(jet.p)) continue;
-        double area;
-        const SurfacePoint point = PointFromJet(jet, us[i], vs[j], order_ == 2, &area);
-        if (!std::isfinite(area)) continue;
-        const double delta = density_.Value(point);
-        if (!std::isfinite(delta)) continue;
-        const double gap = std::fabs(delta * area - QuadraticAt(eval.values, at[i], at[j]));
+        // A pole or singular line on the edge (m infinite): the warps' business.
+        if ((i == 1 && j == 1) || !std::isfinite(m[3 * i + j])) continue;
+        const double gap = std::fabs(m[3 * i + j] - QuadraticAt(eval.values, at[i], at[j]));
         if (gap > kEdgeJump * top) worst = std::max(worst, gap);
       }
     }
@@ -549,9 +535,10 @@ class CurveTree::Builder {
   double ModelOverChild(const CellEval& eval, int cx, int cy, double h) const {
     const int g = curve_.grid();
     if (eval.piecewise) return eval.values[cx * g + cy];
-    return h * h * QuadraticIntegral(eval.values, static_cast<double>(cx) / g,
-                                     static_cast<double>(cx + 1) / g, static_cast<double>(cy) / g,
-                                     static_cast<double>(cy + 1) / g, eval.warp);
+    return h * h *
+           QuadraticIntegral(eval.values, static_cast<double>(cx) / g,
+                             static_cast<double>(cx + 1) / g, static_cast<double>(cy) / g,
+                             static_cast<double>(cy + 1) / g, eval.warp);
   }
 
   absl::Status Refine(int depth, uint64_t start, uint64_t x, uint64_t y, int state,
@@ -633,8 +620,8 @@ class CurveTree::Builder {
   absl::Status ComputeTriangleMasses() {
     const size_t n = starts_.size();
     auto centre = [&](size_t l) {
-      const CurveTree::Cell cell = CellOfRange(curve_, starts_[l],
-                                               l + 1 < n ? starts_[l + 1] : curve_.Span(0));
+      const CurveTree::Cell cell =
+          CellOfRange(curve_, starts_[l], l + 1 < n ? starts_[l + 1] : curve_.Span(0));
       return std::pair<double, double>{cell.u0 + cell.size / 2, cell.v0 + cell.size / 2};
     };
     if (n < 3) return absl::OkStatus();  // too few vertices for (a): keep the model's masses
@@ -730,9 +717,9 @@ absl::StatusOr<CurveTreeOptions> ResolveOptions(const Surface& surface, CurveTre
         absl::StrFormat("tolerance must be >= 0 (0 = automatic), got %g", options.tolerance));
   }
   if (options.depth_cap < 0 || options.depth_cap > curve.max_depth()) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "depth cap must be in [0, %d] for the %s curve (0 = deepest), got %d", curve.max_depth(),
-        CurveName(options.curve), options.depth_cap));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("depth cap must be in [0, %d] for the %s curve (0 = deepest), got %d",
+                        curve.max_depth(), CurveName(options.curve), options.depth_cap));
   }
   if (!(options.rho > 0) || !std::isfinite(options.rho)) {
     return absl::InvalidArgumentError(absl::StrFormat("rho must be > 0, got %g", options.rho));

@@ -4,12 +4,28 @@
 #include <cmath>
 #include <limits>
 
+#include "core/area_estimator.h"
+
 namespace sfc {
 
-LeafWalk::LeafWalk(const CurveTree& tree)
+namespace {
+
+// The fewest curve levels whose cells number at least `cells` a side.
+int LevelsForCells(const Curve& curve, int cells) {
+  int levels = 1;
+  while (curve.PowG(levels) < static_cast<uint64_t>(cells)) ++levels;
+  return levels;
+}
+
+}  // namespace
+
+LeafWalk::LeafWalk(const CurveTree& tree, const Surface& surface, const Density& density)
     : tree_(tree),
+      surface_(surface),
+      density_(density),
       curve_(tree.curve()),
       grid_(curve_.grid()),
+      exact_levels_(LevelsForCells(curve_, kExactCells)),
       continuation_levels_(curve_.continuation_levels()),
       continuation_scale_(curve_.PowW(continuation_levels_)),
       continuation_cells_(curve_.PowG(continuation_levels_)),
@@ -58,6 +74,10 @@ void LeafWalk::Enter(size_t l) {
   // Samples' worth at the tree's grade, not the sequence's count: a
   // progressive set extended on the same tree keeps its prefix.
   samples_ = leaf_mass_ / total_mass_ * grade_samples_;
+  // Below the rough floor a leaf under a rough parent was never examined:
+  // a step may cut it. Above it, it passed the rough test and its model holds.
+  exact_ = tree_.leaf_rough_parent(l) && samples_ < CurveTree::kRoughFloor &&
+           kind_ == LeafModel::Kind::kQuadratic && !warped_;
 }
 
 double LeafWalk::PlaceOnAxis(const AxisWarp& w, double x0, double side, double x) {
@@ -99,6 +119,34 @@ int LeafWalk::Tabulate(const Square& square, int levels, std::vector<double>& bo
   const double scale = (square.t1 - square.t0) / sum;
   for (int k = 0; k < last; ++k) bounds[k] = std::min(square.t0 + bounds[k] * scale, square.t1);
   for (int k = last; k < cells; ++k) bounds[k] = square.t1;
+  return last;
+}
+
+int LeafWalk::TabulateExact(const Square& leaf, int levels, std::vector<double>& bounds) {
+  const int n = static_cast<int>(curve_.PowG(levels));
+  cell_us_.resize(n), cell_vs_.resize(n), cell_m_.resize(static_cast<size_t>(n) * n);
+  for (int i = 0; i < n; ++i) {
+    const double centre = (i + 0.5) / n;
+    cell_us_[i] = cell_.u0 + centre * cell_.size;
+    cell_vs_[i] = cell_.v0 + centre * cell_.size;
+  }
+  MassDensityGrid(surface_, density_, cell_us_.data(), n, cell_vs_.data(), n, cell_m_.data());
+  const Curve::Child* order = curve_.CellsInOrder(leaf.state, levels);
+  const int cells = n * n;
+  bounds.assign(cells + kScanWidth, std::numeric_limits<double>::infinity());
+  // Running sums in curve order (the cells are equal, so densities will do).
+  double sum = 0;
+  for (int k = 0; k < cells; ++k) {
+    const double m = cell_m_[static_cast<size_t>(order[k].dx) * n + order[k].dy];
+    if (!(m >= 0 && m < INFINITY)) return -1;
+    sum += m;
+    bounds[k] = sum;
+  }
+  if (!(sum > 0)) return -1;
+  int last = cells - 1;
+  while (last > 0 && bounds[last - 1] == sum) --last;
+  for (int k = 0; k < last; ++k) bounds[k] = std::min(bounds[k] / sum, 1.0);
+  for (int k = last; k < cells; ++k) bounds[k] = 1;
   return last;
 }
 
@@ -147,9 +195,14 @@ void LeafWalk::Reached(const Square& square, uint32_t begin, uint32_t end) {
 }
 
 void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end, int level) {
-  const int levels = TableLevels((square.t1 - square.t0) * samples_, square.depth);
+  int levels = TableLevels((square.t1 - square.t0) * samples_, square.depth);
   std::vector<double>& bounds = tables_[level];
-  const int last = levels > 0 ? Tabulate(square, levels, bounds) : -1;
+  int last = -1;
+  if (exact_ && level == 0) {
+    last = TabulateExact(square, exact_levels_, bounds);
+    if (last >= 0) levels = exact_levels_;
+  }
+  if (last < 0 && levels > 0) last = Tabulate(square, levels, bounds);
   if (last < 0) {
     Reached(square, begin, end);
     return;

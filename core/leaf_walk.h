@@ -20,6 +20,15 @@
 // vanishes, the tables stay in leaf coordinates and the continuation inside
 // the last cell is uniform in warped ones (DescendsWarped).
 //
+// A leaf whose parent was rough (CurveTree::leaf_rough_parent) and whose
+// quadratic is not warped may be cut by a step or crease that its quadratic
+// cannot see when it carries less than CurveTree::kRoughFloor samples: the
+// tree does not examine it, and its model would spread a step's mass across
+// the whole leaf. The first table of such a leaf is made of the true mass
+// density at the centres of its cells (kExactCells a side), so samples land
+// on the right side of a step to an eighth of the leaf (docs/ALGORITHM.md,
+// "Features inside a leaf").
+//
 // Coordinates handed over in non-decreasing order make this a merge: the
 // leaf advances by a forward step, a table is made once for the samples of
 // its square, and they are matched to its cells by a forward step too. The
@@ -37,6 +46,8 @@
 #include <vector>
 
 #include "core/curve_tree.h"
+#include "core/density.h"
+#include "core/surface.h"
 
 namespace sfc {
 
@@ -55,8 +66,14 @@ class LeafWalk {
   // Tables stop this many curve levels below the leaf in any case.
   static constexpr int kMaxModelLevels = 40;
 
-  // REQUIRES: `tree` outlives the walk and has positive total mass.
-  explicit LeafWalk(const CurveTree& tree);
+  // Cells a side of the first table of a leaf under a rough parent: the
+  // curve levels that reach at least this many (8 for Hilbert, 9 for the
+  // 3x3 curves).
+  static constexpr int kExactCells = 8;
+
+  // REQUIRES: `tree` was built from `surface` and `density`, has positive
+  // total mass, and all three outlive the walk.
+  LeafWalk(const CurveTree& tree, const Surface& surface, const Density& density);
 
   // Places the n mass coordinates m[0..n) (each in [0, S_M]): u[i], v[i] get
   // sample i's unit-square parameters and, when `curve_position` is not
@@ -92,6 +109,9 @@ class LeafWalk {
   // it ending at t1); returns the index of the last cell with mass, or -1
   // where the model vanishes.
   int Tabulate(const Square& square, int levels, std::vector<double>& bounds);
+  // The same for the whole leaf from the true mass density at the cells'
+  // centres; -1 where it is not finite or vanishes (the model's table then).
+  int TabulateExact(const Square& leaf, int levels, std::vector<double>& bounds);
   // Places the current leaf's samples [begin, end), which lie in `square` in
   // t order, using the table of recursion `level`.
   void PlaceInSquare(const Square& square, uint32_t begin, uint32_t end, int level);
@@ -110,16 +130,19 @@ class LeafWalk {
   void PlaceInLeaf(const double* m, size_t n, double* u, double* v, double* curve_position);
 
   const CurveTree& tree_;
+  const Surface& surface_;
+  const Density& density_;
   const Curve& curve_;
   const int grid_;
+  const int exact_levels_;  // curve levels of an exact table (kExactCells)
   const int continuation_levels_;
   const uint64_t continuation_scale_;  // w^continuation_levels
   const double continuation_cells_;    // g^continuation_levels
   const double inverse_cells_;         // its inverse, exact when it is a power of two
   bool cells_power_of_two_ = false;
-  const double total_mass_;            // S_M
-  const double grade_samples_;         // 2^grade: samples in S_M at the tree's grade
-  size_t last_positive_leaf_ = 0;      // where m = S_M belongs
+  const double total_mass_;        // S_M
+  const double grade_samples_;     // 2^grade: samples in S_M at the tree's grade
+  size_t last_positive_leaf_ = 0;  // where m = S_M belongs
 
   size_t leaf_ = SIZE_MAX;  // the current leaf, SIZE_MAX before the first
   double begin_mass_ = 0, end_mass_ = 0, leaf_mass_ = 0, samples_ = 0;
@@ -128,15 +151,17 @@ class LeafWalk {
   const LeafModel* model_ = nullptr;
   LeafModel::Kind kind_ = LeafModel::Kind::kQuadratic;
   bool warped_ = false;  // the model has a power law (LeafModel::warp)
+  bool exact_ = false;   // the first table follows the true mass density (kExactCells)
   // Scratch of PlaceInLeaf, kept to reuse its memory.
-  std::vector<double> t_;                     // each sample's fraction of the leaf's mass
-  std::vector<std::vector<double>> tables_;  // cell bounds, one table per recursion level
-  GridFactors factors_;                       // a table's cell integrals, as factors
-  std::vector<Square> reached_;               // the squares samples end in
-  std::vector<uint32_t> reached_of_;          // each sample's square in reached_
-  std::vector<double> fraction_;              // each sample's fraction of its square's t
-  std::vector<uint64_t> digits_, cx_, cy_;    // its curve digits and the cell they reach
-  std::vector<uint64_t> states_;              // its square's orientation, then the cell's
+  std::vector<double> t_;                           // each sample's fraction of the leaf's mass
+  std::vector<std::vector<double>> tables_;         // cell bounds, one table per recursion level
+  GridFactors factors_;                             // a table's cell integrals, as factors
+  std::vector<double> cell_us_, cell_vs_, cell_m_;  // an exact table's centres and densities
+  std::vector<Square> reached_;                     // the squares samples end in
+  std::vector<uint32_t> reached_of_;                // each sample's square in reached_
+  std::vector<double> fraction_;                    // each sample's fraction of its square's t
+  std::vector<uint64_t> digits_, cx_, cy_;          // its curve digits and the cell they reach
+  std::vector<uint64_t> states_;                    // its square's orientation, then the cell's
   // The run being placed: output columns (curve_position_ may be null).
   double *u_ = nullptr, *v_ = nullptr, *curve_position_ = nullptr;
 };

@@ -17,7 +17,9 @@ namespace {
 class SurfaceFiller final : public SampleFiller {
  public:
   SurfaceFiller(const Sampler& sampler, const SampleFields& fields)
-      : sampler_(sampler), fields_(fields), walk_(sampler.tree()) {}
+      : sampler_(sampler),
+        fields_(fields),
+        walk_(sampler.tree(), sampler.surface(), sampler.density()) {}
 
   absl::Status Fill(size_t n, const SampleRows& out) override;
 

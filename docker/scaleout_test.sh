@@ -177,8 +177,8 @@ stored=$(sum_stat models)
 [ "$stored" -eq 2 ] || fail "each model should be stored on exactly one replica ($stored copies of 2 models)"
 [ "$(sum_stat model_uploads)" -eq 2 ] || fail "each model should travel once ($(sum_stat model_uploads) uploads)"
 echo "models: a STEP part and an OBJ mesh, 2 densities each, through the proxy on 3 replicas; each stored once; byte-identical to in-process"
-# The Python client routes models by the same key (python/sfcsampler/client.py).
-# Debian's python3 has python3-grpcio (tools/setup-debian.sh).
+# The Python client routes models by the same key: it is the C++ client library,
+# bound as sfcsampler._client (python/bindings/client.cc).
 py=/usr/bin/python3; [ -x "$py" ] || py=python3
 if PYTHONPATH="$build/python" "$py" -c "import sfcsampler" 2> /dev/null; then
   PYTHONPATH="$build/python" timeout 120 "$py" - "$proxy" "$mdir/torus.obj" "$mdir/box_with_hole.step" <<'PY' || fail "the Python client's models through the proxy"

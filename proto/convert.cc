@@ -305,6 +305,17 @@ TreeSummary FromProto(const v1::TreeInfo& p) {
   return s;
 }
 
+StreamInfo FromProto(const v1::StreamHeader& p) {
+  StreamInfo info;
+  info.tree = FromProto(p.tree());
+  info.algorithm_version = p.algorithm_version();
+  info.seed = p.seed();
+  info.begin = p.begin();
+  info.end = p.end();
+  info.expected_samples = p.expected_samples();
+  return info;
+}
+
 absl::StatusOr<TreeSpec> FromProto(const v1::TreeSpec& p) {
   TreeSpec spec;
   if (!p.surface().empty()) spec.surface = p.surface();

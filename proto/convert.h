@@ -12,6 +12,7 @@
 #include "core/types/sample_batch.h"
 #include "grpcpp/support/status.h"
 #include "request/sample_request.h"
+#include "request/stream_info.h"
 #include "request/stream_options.h"
 #include "request/tree_summary.h"
 #include "sfcsampler/v1/sampler.pb.h"
@@ -36,6 +37,9 @@ v1::SampleRequest ToProto(const SampleRequest& request, const StreamOptions& str
 // should be clear. FromProto(ToProto(s)) == s.
 void ToProto(const TreeSummary& summary, v1::TreeInfo* out);
 TreeSummary FromProto(const v1::TreeInfo& tree);
+// What a stream's header says (its tree through the mapping above; the
+// echoed request is left out).
+StreamInfo FromProto(const v1::StreamHeader& header);
 
 // Fills `out` with `batch` in the stream's precision and column encoding
 // (packed repeated fields, or little-endian bytes columns as the proto's

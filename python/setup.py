@@ -1,8 +1,9 @@
-"""Builds sfcsampler._core with the repository's CMake, for pip and python3 -m build.
+"""Builds sfcsampler._core and sfcsampler._client with the repository's CMake, for pip
+and python3 -m build.
 
-Where the extension comes from, first match wins:
-  SFCSAMPLER_PREBUILT=DIR          copy DIR/sfcsampler/_core*.so, DIR/sfcsampler/v1 and the
-                                   kind modules DIR/sfcsampler/libsfcsampler-*.so
+Where the extensions come from, first match wins:
+  SFCSAMPLER_PREBUILT=DIR          copy DIR/sfcsampler/_core*.so, DIR/sfcsampler/_client*.so
+                                   and the kind modules DIR/sfcsampler/libsfcsampler-*.so
                                    (a configured build's python/ folder; no compiling)
   SFCSAMPLER_CMAKE_BUILD_DIR=DIR   build the target sfcsampler_python in that CMake build
   (neither)                        configure and build the repository in build/cmake
@@ -35,7 +36,7 @@ class CMakeBuild(build_ext):
             self.build_extension(ext)
 
     def _package_dir(self):
-        """DIR with DIR/sfcsampler/_core*.so and DIR/sfcsampler/v1, built if needed."""
+        """DIR with DIR/sfcsampler/_core*.so and _client*.so, built if needed."""
         prebuilt = os.environ.get("SFCSAMPLER_PREBUILT")
         if prebuilt:
             return os.path.abspath(prebuilt)
@@ -57,25 +58,23 @@ class CMakeBuild(build_ext):
 
     def build_extension(self, ext):
         package = os.path.join(self._package_dir(), "sfcsampler")
-        cores = glob.glob(os.path.join(package, "_core*.so"))
-        if len(cores) != 1:
-            raise RuntimeError(f"expected one _core*.so in {package}, found {cores}")
+        stem = ext.name.rsplit(".", 1)[-1]
+        built = glob.glob(os.path.join(package, stem + "*.so"))
+        if len(built) != 1:
+            raise RuntimeError(f"expected one {stem}*.so in {package}, found {built}")
         target = self.get_ext_fullpath(ext.name)
         os.makedirs(os.path.dirname(target), exist_ok=True)
-        shutil.copyfile(cores[0], target)
+        shutil.copyfile(built[0], target)
         os.chmod(target, 0o755)
         # Kinds built as modules (libsfcsampler-cad.so: CAD models), which
         # _core loads from its own folder when a request first needs them.
-        for module in glob.glob(os.path.join(package, "libsfcsampler-*.so")):
+        modules = glob.glob(os.path.join(package, "libsfcsampler-*.so")) if stem == "_core" else []
+        for module in modules:
             copy = os.path.join(os.path.dirname(target), os.path.basename(module))
             shutil.copyfile(module, copy)
             os.chmod(copy, 0o755)
-        # The gRPC stubs generated from proto/ at build time: sfcsampler.v1.
-        v1 = os.path.join(os.path.dirname(target), "v1")
-        os.makedirs(v1, exist_ok=True)
-        for name in ("__init__.py", "sampler_pb2.py", "sampler_pb2_grpc.py"):
-            shutil.copyfile(os.path.join(package, "v1", name), os.path.join(v1, name))
 
 
-setup(packages=["sfcsampler"], ext_modules=[CMakeExtension("sfcsampler._core")],
+setup(packages=["sfcsampler"],
+      ext_modules=[CMakeExtension("sfcsampler._core"), CMakeExtension("sfcsampler._client")],
       cmdclass={"build_ext": CMakeBuild})

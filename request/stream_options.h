@@ -9,7 +9,9 @@
 #define SFCSAMPLER_REQUEST_STREAM_OPTIONS_H_
 
 #include <cstdint>
+#include <string_view>
 
+#include "absl/status/statusor.h"
 #include "request/sample_request.h"
 
 namespace sfc {
@@ -23,6 +25,12 @@ enum class ColumnPrecision { kFloat64, kFloat32 };
 // little-endian bytes (one memcpy a column at each end; the proto's
 // RawColumns).
 enum class ColumnEncoding { kPacked, kRaw };
+
+// "float64" or "float32" (the CLI's --precision, Python's precision=);
+// INVALID_ARGUMENT otherwise.
+absl::StatusOr<ColumnPrecision> ParseColumnPrecision(std::string_view name);
+// "raw" or "packed" (Python's encoding=); INVALID_ARGUMENT otherwise.
+absl::StatusOr<ColumnEncoding> ParseColumnEncoding(std::string_view name);
 
 // The samples a message carries when a request leaves the choice to the
 // server (batch_size 0), unless fewer fit its max_message_bytes.

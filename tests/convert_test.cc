@@ -415,5 +415,27 @@ TEST(WireColumns, ARequestLeavingNoValueColumnIsInvalidArgumentAndTheFlagsRoundT
   EXPECT_TRUE(FromProto(request)->request.fields.uv);
 }
 
+TEST(StreamHeader, ReadsAsTheStreamInfoItCarries) {
+  TreeSummary tree;
+  tree.kind = "surface";
+  tree.key = "0123456789abcdef";
+  tree.leaves = 42;
+  v1::StreamHeader header;
+  ToProto(tree, header.mutable_tree());
+  header.set_algorithm_version("sfcsampler-4");
+  header.set_seed(9);
+  header.set_begin(100);
+  header.set_end(200);
+  header.set_expected_samples(-1);
+  const StreamInfo info = FromProto(header);
+  EXPECT_EQ(info.tree.key, "0123456789abcdef");
+  EXPECT_EQ(info.tree.leaves, 42u);
+  EXPECT_EQ(info.algorithm_version, "sfcsampler-4");
+  EXPECT_EQ(info.seed, 9u);
+  EXPECT_EQ(info.begin, 100u);
+  EXPECT_EQ(info.end, 200u);
+  EXPECT_EQ(info.expected_samples, -1);
+}
+
 }  // namespace
 }  // namespace sfc

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/leaf_walk.h"
 #include "gtest/gtest.h"
 #include "tests/test_util.h"
 
@@ -61,8 +62,8 @@ TEST(GenericFeatures, ABlowUpLineOffTheGridKeepsItsStripsAndMeans) {
   // x = cbrt(u - c): under the area measure x is uniform on
   // [-cbrt(c), cbrt(1 - c)] and y on [0, 1].
   const double c = 1 / std::sqrt(5.0);
-  const std::string surface = "expr:x=sign(u-" + Number(c) + ")*abs(u-" + Number(c) +
-                              ")^(1/3);y=v;z=0;u0=0;u1=1;v0=0;v1=1";
+  const std::string surface =
+      "expr:x=sign(u-" + Number(c) + ")*abs(u-" + Number(c) + ")^(1/3);y=v;z=0;u0=0;u1=1;v0=0;v1=1";
   const double x0 = -std::cbrt(c), x1 = std::cbrt(1 - c), width = x1 - x0;
   const double exact_mean = (std::exp(x1) - std::exp(x0)) / width + 1.0 / 3;
   const uint64_t n = 1 << 18;
@@ -129,6 +130,53 @@ TEST(GenericFeatures, ARefinedTreeAcrossAStepEqualsAFreshBuild) {
     ASSERT_EQ((*refined)->leaf_start(l), (*fresh)->leaf_start(l)) << l;
     ASSERT_EQ((*refined)->mass_end(l), (*fresh)->mass_end(l)) << l;
     ASSERT_EQ((*refined)->leaf_fail_grade(l), (*fresh)->leaf_fail_grade(l)) << l;
+  }
+}
+
+TEST(GenericFeatures, SamplesInALeafCutByAStepLandOnItsHeavySide) {
+  // Density 0 on one side of a line at a generic position, along an axis and
+  // oblique: a leaf the line cuts carries a tiny fraction of a sample, and its
+  // quadratic spreads the mass over the whole leaf. Its first table follows
+  // the true density at the centres of LeafWalk::kExactCells^2 cells, so a
+  // sample where the density is 0 lies within one such cell of the line:
+  // closer than side / kExactCells * sqrt(2) for its leaf's side.
+  const uint64_t n = 1 << 20;
+  struct Case {
+    std::string line;  // f(u, v) = 0 on the line, density 1 where f >= 0
+    double gu, gv;     // the gradient of f (f is linear)
+  };
+  const double c = 1 / std::sqrt(7.0);
+  for (const Case& k : {Case{"u-" + Number(c), 1, 0},
+                        Case{"u+" + Number(1 / std::sqrt(11.0)) + "*v-" + Number(0.61803398874989),
+                             1, 1 / std::sqrt(11.0)}}) {
+    const std::string density = "expr:" + k.line + "<0 ? 0 : 1";
+    const auto setup = testing::MakeSetup("plane", density, n);
+    const CurveTree& tree = *setup.tree;
+    const double offset = k.line == "u-" + Number(c) ? -c : -0.61803398874989;
+    const double norm = std::hypot(k.gu, k.gv);
+    for (uint64_t seed : {1, 2, 3}) {
+      const SampleBatch s = testing::Collect(
+          testing::MakeSampler(setup, SequenceKind::kJittered, n, seed), 0, n, {}, {}, 1 << 16);
+      ASSERT_EQ(s.size(), n);
+      int wrong_side = 0;
+      for (size_t i = 0; i < n; ++i) {
+        const double f = k.gu * s.u[i] + k.gv * s.v[i] + offset;
+        if (f >= 0) continue;
+        ++wrong_side;
+        // The leaf holding the sample: the smallest cell that contains it.
+        double side = 1;
+        for (size_t l = 0; l < tree.leaf_count(); ++l) {
+          const CurveTree::Cell cell = tree.LeafCell(l);
+          if (s.u[i] >= cell.u0 && s.u[i] <= cell.u0 + cell.size && s.v[i] >= cell.v0 &&
+              s.v[i] <= cell.v0 + cell.size) {
+            side = std::min(side, cell.size);
+          }
+        }
+        EXPECT_LT(-f / norm, side / LeafWalk::kExactCells * std::sqrt(2.0))
+            << density << ", seed " << seed << ", sample " << s.index[i];
+      }
+      EXPECT_LE(wrong_side, 3) << density << ", seed " << seed;
+    }
   }
 }
 

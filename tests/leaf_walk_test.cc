@@ -21,9 +21,9 @@ struct Placed {
 };
 
 // Places m[order[i]] one group at a time, the groups cut at `cuts`.
-Placed PlaceInGroups(const CurveTree& tree, const std::vector<double>& m,
+Placed PlaceInGroups(const testing::Setup& setup, const std::vector<double>& m,
                      const std::vector<size_t>& order, const std::vector<size_t>& cuts) {
-  LeafWalk walk(tree);
+  LeafWalk walk(*setup.tree, *setup.surface, *setup.density);
   Placed out;
   out.u.assign(m.size(), 0), out.v.assign(m.size(), 0), out.position.assign(m.size(), 0);
   std::vector<double> group, u, v, position;
@@ -76,7 +76,7 @@ TEST(LeafWalk, PlacementIsAPureFunctionOfTheMassCoordinate) {
 
     std::vector<size_t> in_order(m.size());
     for (size_t i = 0; i < m.size(); ++i) in_order[i] = i;
-    const Placed whole = PlaceInGroups(tree, m, in_order, {m.size()});
+    const Placed whole = PlaceInGroups(setup, m, in_order, {m.size()});
 
     // One at a time, and in random groups: the same bits.
     std::vector<size_t> singles(m.size()), random_cuts;
@@ -88,9 +88,9 @@ TEST(LeafWalk, PlacementIsAPureFunctionOfTheMassCoordinate) {
     // Shuffled: every step may go back and start a search.
     std::vector<size_t> shuffled = in_order;
     std::shuffle(shuffled.begin(), shuffled.end(), rng);
-    for (const Placed& other : {PlaceInGroups(tree, m, in_order, singles),
-                                PlaceInGroups(tree, m, in_order, random_cuts),
-                                PlaceInGroups(tree, m, shuffled, random_cuts)}) {
+    for (const Placed& other : {PlaceInGroups(setup, m, in_order, singles),
+                                PlaceInGroups(setup, m, in_order, random_cuts),
+                                PlaceInGroups(setup, m, shuffled, random_cuts)}) {
       ExpectBitIdentical(whole.u, other.u);
       ExpectBitIdentical(whole.v, other.v);
       ExpectBitIdentical(whole.position, other.position);

@@ -20,6 +20,7 @@
 #include "engine/model_source.h"
 #include "gtest/gtest.h"
 #include "proto/convert.h"
+#include "request/model_spec.h"
 #include "request/routing_key.h"
 #include "server/sampler_server.h"
 #include "tests/server_test_util.h"
@@ -35,9 +36,8 @@ using testing::Running;
 using testing::StartServer;
 
 absl::Status SampleStatus(SamplerClient& client, const SampleRequest& request) {
-  auto s = client.Sample(request, [](const v1::StreamHeader&, const SampleBatch&) {
-    return absl::OkStatus();
-  });
+  auto s = client.Sample(request,
+                         [](const StreamInfo&, const SampleBatch&) { return absl::OkStatus(); });
   return s.status();
 }
 
@@ -65,6 +65,22 @@ TEST(ServerModels, AGiantTokenGivesABoundedInvalidArgument) {
   EXPECT_NE(s.message().find("(100000 bytes)"), std::string::npos) << s.message();
   // The server still serves.
   EXPECT_TRUE(SampleStatus(*r.client, Request("sphere", 100)).ok());
+}
+
+// A model given as bytes travels once: the first EnsureModelBytes uploads it,
+// the second finds it by its hash; both name it by that hash.
+TEST(ServerModels, ModelBytesAreUploadedOnlyWhenTheServerLacksThem) {
+  Running r = StartServer(LoopbackOptions());
+  const std::string spec = "obj:sha256=" + Sha256Hex(kSquareObj);
+  auto first = r.client->EnsureModelBytes(ModelFormat::kObj, "square.obj", kSquareObj);
+  ASSERT_TRUE(first.ok()) << first.status();
+  EXPECT_EQ(*first, spec);
+  EXPECT_EQ(r.server->models().stats().uploads, 1u);
+  auto again = r.client->EnsureModelBytes(ModelFormat::kObj, "other name.obj", kSquareObj);
+  ASSERT_TRUE(again.ok()) << again.status();
+  EXPECT_EQ(*again, spec);
+  EXPECT_EQ(r.server->models().stats().uploads, 1u);
+  EXPECT_TRUE(SampleStatus(*r.client, Request(spec, 100)).ok());
 }
 
 // Any status, however long, leaves the server clipped to 1 KB.
@@ -481,7 +497,7 @@ TEST(ServerModels, ModelsReadInTheCheckProcessGiveTheSameBytesAsInProcess) {
       request.tree.density = "gaussian:floor=0.1";
       request.fields.normal = true;
       request.fields.face = true;
-      auto s = r->client->Sample(request, [&](const v1::StreamHeader&, const SampleBatch& batch) {
+      auto s = r->client->Sample(request, [&](const StreamInfo&, const SampleBatch& batch) {
         for (size_t i = 0; i < batch.size(); ++i) {
           for (const auto* c : {&batch.u, &batch.v, &batch.x, &batch.y, &batch.z, &batch.nx,
                                 &batch.ny, &batch.nz}) {

@@ -53,7 +53,7 @@ std::unique_ptr<SamplerServer> ReplaceOnSamePort(SamplerServer& server, ServerOp
 absl::StatusOr<SampleBatch> Fetch(SamplerClient& client, const SampleRequest& request,
                                   StreamSummary* summary = nullptr) {
   SampleBatch all;
-  auto s = client.Sample(request, [&](const v1::StreamHeader&, const SampleBatch& b) {
+  auto s = client.Sample(request, [&](const StreamInfo&, const SampleBatch& b) {
     all.Append(b);
     return absl::OkStatus();
   });
@@ -100,7 +100,7 @@ TEST(Server, AStreamCutByTheClientResumesByteIdentical) {
   ASSERT_TRUE(uncut.ok());
   // Cut after 7000 samples: the callback refuses more, which cancels.
   SampleBatch first;
-  auto cut = r.client->Sample(request, [&](const v1::StreamHeader&, const SampleBatch& b) {
+  auto cut = r.client->Sample(request, [&](const StreamInfo&, const SampleBatch& b) {
     first.AppendFrom(b, 0, std::min<size_t>(b.size(), 7000 - first.size()));
     return first.size() < 7000 ? absl::OkStatus() : absl::CancelledError("cut");
   });
@@ -118,7 +118,7 @@ TEST(Server, TheClientResumesAcrossAServerRestart) {
   const int port = server->port();
   ClientOptions co;
   co.target = "127.0.0.1:" + std::to_string(port);
-  co.batch_size = 1000;
+  co.stream.batch_size = 1000;
   co.resume_backoff_seconds = 0.3;
   auto client = *SamplerClient::Connect(co);
   const SampleRequest request = LongStream(2'000'000, 8);  // still streaming when the server dies
@@ -129,7 +129,7 @@ TEST(Server, TheClientResumesAcrossAServerRestart) {
   std::unique_ptr<SamplerServer> second;
   SampleBatch got;
   StreamSummary summary;
-  auto result = client->Sample(request, [&](const v1::StreamHeader&, const SampleBatch& b) {
+  auto result = client->Sample(request, [&](const StreamInfo&, const SampleBatch& b) {
     got.index.insert(got.index.end(), b.index.begin(), b.index.end());
     got.u.insert(got.u.end(), b.u.begin(), b.u.end());
     if (!restarted && got.size() >= 50000) {
@@ -151,14 +151,14 @@ TEST(Server, AResumeOnAServerOfAnotherReleaseFailsInsteadOfMixingSets) {
   const int port = server->port();
   ClientOptions co;
   co.target = "127.0.0.1:" + std::to_string(port);
-  co.batch_size = 1000;
+  co.stream.batch_size = 1000;
   co.resume_backoff_seconds = 0.3;
   auto client = *SamplerClient::Connect(co);
   std::unique_ptr<SamplerServer> upgraded;
   uint64_t received = 0;
   bool restarted = false;
   auto result =
-      client->Sample(LongStream(2'000'000, 8), [&](const v1::StreamHeader&, const SampleBatch& b) {
+      client->Sample(LongStream(2'000'000, 8), [&](const StreamInfo&, const SampleBatch& b) {
         received += b.size();
         if (!restarted && received >= 50000) {
           // The replica is replaced by one of the current release mid-stream.
@@ -208,13 +208,13 @@ TEST(Server, EveryEncodingAndPrecisionCarriesTheEmbeddedEnginesSamples) {
     request.tree.density = "gaussian:floor=0.1";
     request.fields.normal = request.fields.density = request.fields.curve_position = true;
     const SampleBatch local = Embedded(request);
-    for (auto encoding : {v1::COLUMN_ENCODING_RAW, v1::COLUMN_ENCODING_PACKED}) {
-      for (auto precision : {v1::PRECISION_FLOAT64, v1::PRECISION_FLOAT32}) {
+    for (auto encoding : {ColumnEncoding::kRaw, ColumnEncoding::kPacked}) {
+      for (auto precision : {ColumnPrecision::kFloat64, ColumnPrecision::kFloat32}) {
         ClientOptions co;
         co.target = "127.0.0.1:" + std::to_string(r.server->port());
-        co.column_encoding = encoding;
-        co.precision = precision;
-        co.batch_size = 777;
+        co.stream.encoding = encoding;
+        co.stream.precision = precision;
+        co.stream.batch_size = 777;
         auto wire = Fetch(**SamplerClient::Connect(co), request);
         ASSERT_TRUE(wire.ok()) << wire.status();
         ASSERT_EQ(wire->index, local.index);
@@ -224,7 +224,7 @@ TEST(Server, EveryEncodingAndPrecisionCarriesTheEmbeddedEnginesSamples) {
           ASSERT_EQ(((*wire).*column).size(), local.size());
           for (size_t i = 0; i < local.size(); ++i) {
             const double expected =
-                precision == v1::PRECISION_FLOAT64
+                precision == ColumnPrecision::kFloat64
                     ? (local.*column)[i]
                     : static_cast<double>(static_cast<float>((local.*column)[i]));
             ASSERT_EQ(((*wire).*column)[i], expected) << "sample " << i << " depth " << depth;
@@ -254,7 +254,7 @@ TEST(Server, ASecondRequestHitsAndEightConcurrentFirstRequestsBuildOnce) {
 
   StreamSummary summary;
   ASSERT_TRUE(Fetch(*r.client, Request("eight", 200000, 99), &summary).ok());
-  EXPECT_TRUE(summary.header.tree().cache_hit());
+  EXPECT_TRUE(summary.header.tree.cache_hit);
   EXPECT_EQ(r.client->GetCacheStats()->builds(), 1u);
 }
 
@@ -265,7 +265,7 @@ TEST(Server, ALargerCountRefinesTheCachedTree) {
   ASSERT_TRUE(r.client->Prepare(spec, 1000).ok());
   StreamSummary summary;
   ASSERT_TRUE(Fetch(*r.client, Request("torus", 100000), &summary).ok());
-  EXPECT_TRUE(summary.header.tree().refined());
+  EXPECT_TRUE(summary.header.tree.refined);
   const auto stats = *r.client->GetCacheStats();
   EXPECT_EQ(stats.builds(), 1u);
   EXPECT_EQ(stats.refinements(), 1u);
@@ -275,14 +275,14 @@ TEST(Server, EvictionUnderASmallBudgetLosesNoInFlightStream) {
   ServerOptions options = LoopbackOptions();
   options.cache_bytes = 1 << 20;  // smaller than any of these trees
   ClientOptions co;
-  co.batch_size = 500;
+  co.stream.batch_size = 500;
   Running r = StartServer(options, co);
   const SampleRequest slow = Request("sphere", 60000, 4);
   auto reference = Fetch(*r.client, slow);
   ASSERT_TRUE(reference.ok());
   SampleBatch got;
   bool evicted = false;
-  auto result = r.client->Sample(slow, [&](const v1::StreamHeader&, const SampleBatch& b) {
+  auto result = r.client->Sample(slow, [&](const StreamInfo&, const SampleBatch& b) {
     got.index.insert(got.index.end(), b.index.begin(), b.index.end());
     got.x.insert(got.x.end(), b.x.begin(), b.x.end());
     if (!evicted) {
@@ -300,20 +300,19 @@ TEST(Server, EvictionUnderASmallBudgetLosesNoInFlightStream) {
 
 TEST(Server, ASlowReaderDoesNotMakeTheServerGenerateAhead) {
   ClientOptions co;
-  co.batch_size = 16384;  // 655 KB a message in float64
+  co.stream.batch_size = 16384;  // 655 KB a message in float64
   Running r = StartServer(LoopbackOptions(), co);
   const uint64_t n = 4'000'000;
   int batches = 0;
   double streamed_after_stall = 0;
-  auto result =
-      r.client->Sample(Request("plane", n), [&](const v1::StreamHeader&, const SampleBatch&) {
-        if (++batches == 2) {
-          std::this_thread::sleep_for(milliseconds(1000));
-          streamed_after_stall = r.server->metrics().samples_streamed();
-          return absl::CancelledError("done");
-        }
-        return absl::OkStatus();
-      });
+  auto result = r.client->Sample(Request("plane", n), [&](const StreamInfo&, const SampleBatch&) {
+    if (++batches == 2) {
+      std::this_thread::sleep_for(milliseconds(1000));
+      streamed_after_stall = r.server->metrics().samples_streamed();
+      return absl::CancelledError("done");
+    }
+    return absl::OkStatus();
+  });
   EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled);
   // Only what HTTP/2 flow control admits was produced: a few MB, not 4 M samples.
   EXPECT_LT(streamed_after_stall, 40 * 16384.0);
@@ -322,13 +321,13 @@ TEST(Server, ASlowReaderDoesNotMakeTheServerGenerateAhead) {
 
 TEST(Server, ACancelledStreamIsFreedAtOnce) {
   ClientOptions co;
-  co.batch_size = 1000;
+  co.stream.batch_size = 1000;
   Running r = StartServer(LoopbackOptions(), co);
-  auto result = r.client->Sample(Request("sphere", 1'000'000),
-                                 [&](const v1::StreamHeader&, const SampleBatch&) {
-                                   EXPECT_EQ(r.server->service().active_streams(), 1u);
-                                   return absl::CancelledError("enough");
-                                 });
+  auto result =
+      r.client->Sample(Request("sphere", 1'000'000), [&](const StreamInfo&, const SampleBatch&) {
+        EXPECT_EQ(r.server->service().active_streams(), 1u);
+        return absl::CancelledError("enough");
+      });
   EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled);
   // "At once": well within 200 ms of the cancel, not after the 10^6 samples.
   const auto until = std::chrono::steady_clock::now() + milliseconds(200);
@@ -488,7 +487,7 @@ TEST(Server, AStockClientReceivesEveryColumnWithinItsDefaultMessageLimit) {
   // Asking for more than fits names the cap and the largest batch that fits.
   ClientOptions co;
   co.target = "127.0.0.1:" + std::to_string(r.server->port());
-  co.batch_size = 100000;
+  co.stream.batch_size = 100000;
   auto client = *SamplerClient::Connect(co);
   SampleRequest all = Request("torus", 300000);
   all.fields.normal = all.fields.density = all.fields.curve_position = true;
@@ -618,7 +617,7 @@ TEST(Server, EveryBadInputGetsItsStatusCode) {
   options.limits.max_spec_length = 200;
   options.max_batch_size = 10000;
   ClientOptions co;
-  co.batch_size = 1000;
+  co.stream.batch_size = 1000;
   Running r = StartServer(options, co);
   auto fetch = [&](SampleRequest q) { return Fetch(*r.client, q).status(); };
   const auto kInvalid = absl::StatusCode::kInvalidArgument;
@@ -643,7 +642,7 @@ TEST(Server, EveryBadInputGetsItsStatusCode) {
 
   ClientOptions big_batches;
   big_batches.target = "127.0.0.1:" + std::to_string(r.server->port());
-  big_batches.batch_size = 20000;
+  big_batches.stream.batch_size = 20000;
   auto client = *SamplerClient::Connect(big_batches);
   ExpectStatus(Fetch(*client, Request("sphere", 10)).status(), kInvalid, "max_batch_size");
 }
@@ -652,15 +651,14 @@ TEST(Server, StreamsBeyondTheConcurrencyLimitAreResourceExhausted) {
   ServerOptions options = LoopbackOptions();
   options.max_concurrent_streams = 1;
   ClientOptions co;
-  co.batch_size = 1000;
+  co.stream.batch_size = 1000;
   Running r = StartServer(options, co);
   absl::Status second;
   // The server is still writing the first stream when the second request comes.
-  auto first =
-      r.client->Sample(LongStream(4'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
-        second = Fetch(*r.client, Request("torus", 10)).status();
-        return absl::CancelledError("checked");
-      });
+  auto first = r.client->Sample(LongStream(4'000'000), [&](const StreamInfo&, const SampleBatch&) {
+    second = Fetch(*r.client, Request("torus", 10)).status();
+    return absl::CancelledError("checked");
+  });
   EXPECT_EQ(first.status().code(), absl::StatusCode::kCancelled) << first.status();
   ExpectStatus(second, absl::StatusCode::kResourceExhausted, "max_concurrent_streams");
 }
@@ -669,14 +667,13 @@ TEST(Server, TheServerDeadlineEndsLongStreams) {
   ServerOptions options = LoopbackOptions();
   options.request_deadline_seconds = 0.2;
   ClientOptions co;
-  co.batch_size = 100;
+  co.stream.batch_size = 100;
   Running r = StartServer(options, co);
   // A tree that builds at once, and a stream that runs past the deadline.
-  auto result =
-      r.client->Sample(LongStream(4'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
-        std::this_thread::sleep_for(milliseconds(2));
-        return absl::OkStatus();
-      });
+  auto result = r.client->Sample(LongStream(4'000'000), [&](const StreamInfo&, const SampleBatch&) {
+    std::this_thread::sleep_for(milliseconds(2));
+    return absl::OkStatus();
+  });
   ExpectStatus(result.status(), absl::StatusCode::kDeadlineExceeded, "resume after the last index");
 }
 
@@ -689,12 +686,12 @@ TEST(Server, AReaderThatStopsReadingIsCutAndFreesItsSlot) {
     options.max_concurrent_streams = 1;
     options.stream_pipeline_depth = depth;
     ClientOptions co;
-    co.batch_size = 16384;
+    co.stream.batch_size = 16384;
     Running r = StartServer(options, co);
     std::atomic<bool> freed{false};
     std::atomic<double> stalled{0};
-    auto result = r.client->Sample(
-        Request("plane", 4'000'000), [&](const v1::StreamHeader&, const SampleBatch&) {
+    auto result =
+        r.client->Sample(Request("plane", 4'000'000), [&](const StreamInfo&, const SampleBatch&) {
           // Stop reading: the server's writes block on flow control. Its slot
           // must come free while this client still holds the stream open.
           const auto until = std::chrono::steady_clock::now() + milliseconds(5000);
@@ -751,11 +748,11 @@ TEST(Server, TheStreamHeaderSaysWhereTheParameterisationIsSingularAndThePrecisio
   StreamSummary hard, smooth;
   ASSERT_TRUE(Fetch(*r.client, Request("superellipsoid", 24576), &hard).ok());
   ASSERT_TRUE(Fetch(*r.client, Request("torus", 24576), &smooth).ok());
-  const v1::TreeInfo& t = hard.header.tree();
-  EXPECT_GT(t.warped_leaves(), 0u);
-  ASSERT_GT(t.singular_size(), 0);
-  for (const v1::DepthCapWarning& w : t.singular()) {
-    EXPECT_EQ(w.test(), "singular");
+  const TreeSummary& t = hard.header.tree;
+  EXPECT_GT(t.warped_leaves, 0u);
+  ASSERT_FALSE(t.singular.empty());
+  for (const TreeSummary::Cell& w : t.singular) {
+    EXPECT_EQ(w.test, "singular");
     // The superellipsoid's area element blows up where cos or sin of an
     // angle vanishes: on the parameter lines u, v in {0, 1/4, 1/2, 3/4, 1}.
     auto on_quarter_line = [](double lo, double hi) {
@@ -764,16 +761,15 @@ TEST(Server, TheStreamHeaderSaysWhereTheParameterisationIsSingularAndThePrecisio
       }
       return false;
     };
-    EXPECT_TRUE(on_quarter_line(w.u0(), w.u0() + w.size()) ||
-                on_quarter_line(w.v0(), w.v0() + w.size()))
-        << w.u0() << " " << w.v0() << " " << w.size();
+    EXPECT_TRUE(on_quarter_line(w.u0, w.u0 + w.size) || on_quarter_line(w.v0, w.v0 + w.size))
+        << w.u0 << " " << w.v0 << " " << w.size;
   }
   // The precision reached stays below the jittered set's own discrepancy
   // (about N^(1/4) = 12.5 samples here), on the hard surface as on a smooth one.
-  EXPECT_LT(t.error_samples(), 12.5);
-  EXPECT_EQ(smooth.header.tree().singular_leaves(), 0u);
-  EXPECT_EQ(smooth.header.tree().warped_leaves(), 0u);
-  EXPECT_LT(smooth.header.tree().error_samples(), 12.5);
+  EXPECT_LT(t.error_samples, 12.5);
+  EXPECT_EQ(smooth.header.tree.singular_leaves, 0u);
+  EXPECT_EQ(smooth.header.tree.warped_leaves, 0u);
+  EXPECT_LT(smooth.header.tree.error_samples, 12.5);
 }
 
 TEST(Server, ATokenIsRequiredWhenSetButHealthStaysOpen) {
@@ -792,14 +788,14 @@ TEST(Server, ATokenIsRequiredWhenSetButHealthStaysOpen) {
 
 TEST(Server, AGracefulShutdownFinishesStreamsAndTurnsNewCallsAway) {
   ClientOptions co;
-  co.batch_size = 1000;
+  co.stream.batch_size = 1000;
   co.max_resumes = 0;
   Running r = StartServer(LoopbackOptions(), co);
   const SampleRequest request = Request("sphere", 300000, 3);
   std::thread stopper;
   absl::Status refused;
   uint64_t received = 0;
-  auto result = r.client->Sample(request, [&](const v1::StreamHeader&, const SampleBatch& b) {
+  auto result = r.client->Sample(request, [&](const StreamInfo&, const SampleBatch& b) {
     received += b.size();
     if (!stopper.joinable()) {
       stopper = std::thread([&] { r.server->Shutdown(30, 1); });
@@ -818,7 +814,7 @@ TEST(Server, AGracefulShutdownFinishesStreamsAndTurnsNewCallsAway) {
 
 TEST(Server, Float32PayloadsCarryTheSameSamplesRounded) {
   ClientOptions co;
-  co.precision = v1::PRECISION_FLOAT32;
+  co.stream.precision = ColumnPrecision::kFloat32;
   Running r = StartServer(LoopbackOptions(), co);
   auto f32 = Fetch(*r.client, Request("torus", 3000));
   ClientOptions co64;

@@ -16,6 +16,8 @@
 #include "engine/model_source.h"
 #include "engine/sampling_engine.h"
 #include "google/protobuf/util/message_differencer.h"
+#include "grpcpp/create_channel.h"
+#include "grpcpp/security/credentials.h"
 #include "gtest/gtest.h"
 #include "kinds/registered_kinds.h"
 #include "proto/convert.h"
@@ -89,11 +91,19 @@ TreeSummary ExpectSameInProcessAndFromServer(Running& server, const TreeSpec& lo
   if (!prepared.ok()) return {};
   const TreeSummary in_process = SummarizeTree(*prepared);
 
-  auto response = server.client->Prepare(remote, count);
-  EXPECT_TRUE(response.ok()) << response.status();
-  if (!response.ok()) return {};
-  TreeSummary from_server = FromProto(response->tree());
-  v1::TreeInfo sent = response->tree();
+  // The server's message itself (the client hands over FromProto of it).
+  auto stub = v1::Sampler::NewStub(grpc::CreateChannel(
+      "127.0.0.1:" + std::to_string(server.server->port()), grpc::InsecureChannelCredentials()));
+  grpc::ClientContext context;
+  v1::PrepareRequest request;
+  *request.mutable_tree() = ToProto(remote);
+  request.set_count(count);
+  v1::PrepareResponse response;
+  const grpc::Status status = stub->Prepare(&context, request, &response);
+  EXPECT_TRUE(status.ok()) << status.error_message();
+  if (!status.ok()) return {};
+  TreeSummary from_server = FromProto(response.tree());
+  v1::TreeInfo sent = response.tree();
   if (heap_bytes) {
     EXPECT_GT(from_server.bytes, 0u);
     from_server.bytes = in_process.bytes;

@@ -32,9 +32,9 @@ packages=(
                                                  # assimp keeps only PLY properties it knows; PCL/VTK are far heavier
   openssl                                        # a self-signed certificate for the TLS test
   nginx                                          # the consistent-hash gRPC proxy of the scale-out test
-  python3-dev pybind11-dev                       # the Python extension sfcsampler._core (embedded engine)
+  python3-dev pybind11-dev                       # the Python extensions sfcsampler._core (embedded engine) and
+                                                 # _client (the C++ client library: no Python gRPC or protobuf)
   python3-numpy                                  # samples come to Python as NumPy arrays
-  python3-grpcio python3-protobuf                # sfcsampler.Client: gRPC and the generated *_pb2.py
   python3-pytest                                 # the Python tests in the suite
   python3-matplotlib                             # the examples' plots (Monte Carlo error, torus picture)
   python3-distributed                            # sfcsampler.dask: tasks on a Dask cluster (its tests start a

@@ -7,6 +7,7 @@
 #include "absl/strings/str_format.h"
 #include "base/status_macros.h"
 #include "kinds/registered_kinds.h"
+#include "request/stream_options.h"
 
 namespace sfc {
 namespace {
@@ -37,7 +38,7 @@ TreeReport Report(const PreparedTree& tree, double seconds) {
 }  // namespace
 
 InProcessSampleSource::InProcessSampleSource(const SampleSourceOptions& options)
-    : batch_size_(options.batch_size == 0 ? 65536 : options.batch_size),
+    : batch_size_(options.batch_size == 0 ? kDefaultBatchSize : options.batch_size),
       engine_(RegisteredSurfaceKinds(), LimitsFor(options), &trees_, &files_) {}
 
 absl::StatusOr<TreeReport> InProcessSampleSource::Prepare(const TreeSpec& spec, uint64_t count,

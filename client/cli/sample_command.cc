@@ -7,14 +7,16 @@
 #include <string>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
 #include "base/status_macros.h"
 #include "client/cli/commands.h"
 #include "client/cli/connection_flags.h"
 #include "client/cli/exit_status.h"
 #include "client/cli/model_read_flags.h"
-#include "request/request_flags.h"
 #include "client/cli/sample_source.h"
 #include "client/sample_writer.h"
+#include "request/request_flags.h"
+#include "request/stream_options.h"
 
 namespace sfc {
 namespace {
@@ -24,7 +26,7 @@ struct SampleFlags {
   std::string format = "csv";
   bool ascii = false;
   std::string output = "-";
-  size_t batch_size = 0;  // 0: 65536 in-process, the server's choice over the wire
+  size_t batch_size = 0;  // 0: SampleSourceOptions::batch_size's default
   std::string precision = "float64";
   std::vector<std::string> columns;  // --columns (empty: every column)
   Verbosity verbosity;
@@ -39,18 +41,12 @@ absl::StatusOr<OutputFormat> ParseFormat(const std::string& format, bool ascii) 
   return absl::InvalidArgumentError("--format must be csv, ply or npy");
 }
 
-absl::StatusOr<OutputPrecision> ParsePrecision(const std::string& text) {
-  if (text == "float64") return OutputPrecision::kFloat64;
-  if (text == "float32") return OutputPrecision::kFloat32;
-  return absl::InvalidArgumentError("--precision must be float64 or float32");
-}
-
 int RunSample(const SampleFlags& flags) {
   auto request = ToSampleRequest(flags.request);
   if (!request.ok()) return Fail(request.status());
   auto format = ParseFormat(flags.format, flags.ascii);
   if (!format.ok()) return Fail(format.status());
-  auto precision = ParsePrecision(flags.precision);
+  auto precision = ParseColumnPrecision(flags.precision);
   if (!precision.ok()) return Fail(precision.status());
   if (auto s = SampleWriter::CheckColumns(*format, request->fields, flags.columns); !s.ok()) {
     return Fail(s);
@@ -114,8 +110,9 @@ Command AddSampleCommand(CLI::App& app) {
       ->capture_default_str();
   sample
       ->add_option("--batch-size", flags->batch_size,
-                   "samples per batch; 0 = 65536 in-process, or as many as fit the server's "
-                   "max_message_bytes (a larger value is refused with the largest that fits)")
+                   absl::StrCat("samples per batch; 0 = ", kDefaultBatchSize,
+                                " in-process, or as many as fit the server's max_message_bytes "
+                                "(a larger value is refused with the largest that fits)"))
       ->capture_default_str()
       ->check(CLI::Range(0, 1 << 24));
   sample

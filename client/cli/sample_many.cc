@@ -27,6 +27,7 @@
 #include "client/sample_writer.h"
 #include "engine/model_source.h"
 #include "request/model_files.h"
+#include "request/stream_options.h"
 
 namespace sfc {
 namespace {
@@ -341,11 +342,9 @@ int RunSampleMany(const SampleManyFlags& flags) {
   } else {
     return Usage("--format must be npy, csv or ply");
   }
-  if (flags.precision != "float64" && flags.precision != "float32") {
-    return Usage("--precision must be float64 or float32");
-  }
-  job.precision =
-      flags.precision == "float32" ? OutputPrecision::kFloat32 : OutputPrecision::kFloat64;
+  const auto precision = ParseColumnPrecision(flags.precision);
+  if (!precision.ok()) return Usage(std::string(precision.status().message()));
+  job.precision = *precision;
   {  // the shared flags, checked once on a stand-in surface
     RequestFlags probe = flags.request;
     probe.surface = "sphere";

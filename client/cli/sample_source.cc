@@ -10,10 +10,8 @@ absl::StatusOr<std::unique_ptr<SampleSource>> OpenSampleSource(const ConnectionF
                                                                const SampleSourceOptions& options) {
   if (connection.server.empty()) return std::make_unique<InProcessSampleSource>(options);
   ClientOptions client;
-  client.precision = options.precision == OutputPrecision::kFloat32
-                         ? ::sfcsampler::v1::PRECISION_FLOAT32
-                         : ::sfcsampler::v1::PRECISION_FLOAT64;
-  client.batch_size = static_cast<uint32_t>(options.batch_size);
+  client.stream.precision = options.precision;
+  client.stream.batch_size = static_cast<uint32_t>(options.batch_size);
   ASSIGN_OR_RETURN(std::unique_ptr<SamplerClient> connected, ConnectClient(connection, client));
   return std::make_unique<ServerSampleSource>(connection.server, std::move(connected));
 }

@@ -31,8 +31,9 @@
 namespace sfc {
 
 struct SampleSourceOptions {
-  size_t batch_size =
-      0;  // samples per batch; 0: 65536 in process, the server's choice over the wire
+  // Samples per batch; 0: kDefaultBatchSize in process (request/stream_options.h),
+  // the server's choice over the wire.
+  size_t batch_size = 0;
   // The precision the samples are written in: float32 lets a server send
   // float32 columns (half the bytes; the writer rounds the same way).
   OutputPrecision precision = OutputPrecision::kFloat64;

@@ -4,21 +4,8 @@
 
 #include "absl/strings/str_format.h"
 #include "base/status_macros.h"
-#include "proto/convert.h"
 
 namespace sfc {
-namespace {
-
-namespace v1 = ::sfcsampler::v1;
-
-// The report of a tree the server describes, without a time.
-TreeReport Report(const v1::TreeInfo& tree) {
-  TreeReport report;
-  report.tree = FromProto(tree);
-  return report;
-}
-
-}  // namespace
 
 ServerSampleSource::ServerSampleSource(std::string server, std::unique_ptr<SamplerClient> client)
     : server_(std::move(server)), client_(std::move(client)) {}
@@ -29,8 +16,9 @@ absl::StatusOr<TreeReport> ServerSampleSource::Prepare(const TreeSpec& spec, uin
   auto response = client_->Prepare(spec, count);
   progress->EndPhase();
   RETURN_IF_ERROR(response.status());
-  TreeReport report = Report(response->tree());
-  report.seconds = response->seconds();
+  TreeReport report;
+  report.tree = std::move(response->tree);
+  report.seconds = response->seconds;
   report.seconds_from_server = true;
   return report;
 }
@@ -43,20 +31,20 @@ absl::StatusOr<std::string> ServerSampleSource::Sample(const SampleRequest& requ
   progress->StartPhase("waiting for " + server_ + " (it may be building the curve tree)");
   ASSIGN_OR_RETURN(
       const StreamSummary summary,
-      client_->Sample(request, [&](const v1::StreamHeader& header, const SampleBatch& batch) {
+      client_->Sample(request, [&](const StreamInfo& header, const SampleBatch& batch) {
         if (done == 0) {
           progress->EndPhase();
-          if (on_tree) on_tree(Report(header.tree()));
+          if (on_tree) on_tree(TreeReport{header.tree});
         }
         std::optional<uint64_t> expected;
-        if (header.expected_samples() >= 0) expected = header.expected_samples();
+        if (header.expected_samples >= 0) expected = header.expected_samples;
         done += batch.size();
         progress->Samples(done, expected.value_or(0));
         return on_batch(expected, batch);
       }));
   progress->Done();
   return absl::StrFormat("from %s (%s, seed %d, %d resumes)", server_,
-                         summary.header.algorithm_version(), request.seed, summary.resumes);
+                         summary.header.algorithm_version, request.seed, summary.resumes);
 }
 
 }  // namespace sfc

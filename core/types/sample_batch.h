@@ -4,6 +4,7 @@
 #define SFCSAMPLER_CORE_TYPES_SAMPLE_BATCH_H_
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 

@@ -1,16 +1,10 @@
 #include "python/bindings/request.h"
 
 #include "absl/strings/str_format.h"
-#include "catalog/catalog.h"
-#include "core/curve.h"
-#include "core/sequence.h"
-#include "engine/sampling_engine.h"
 #include "python/bindings/errors.h"
 #include "python/bindings/register.h"
-#include "request/index_range.h"
 #include "request/model_files.h"
 #include "request/model_spec.h"
-#include "request/routing_key.h"
 
 namespace py = pybind11;
 
@@ -96,74 +90,7 @@ Raises sfcsampler.InvalidArgumentError for malformed values.)doc")
            py::arg("shard") = py::none(), py::arg("region") = d.region,
            py::arg("normals") = d.normals, py::arg("density_column") = d.density_column,
            py::arg("curve_position") = d.curve_position, py::arg("face") = d.face,
-           py::arg("triangle") = d.triangle)
-      // The parsed request, field by field, for building the wire message.
-      .def_property_readonly("surface", [](const PyRequest& r) { return r.request.tree.surface; })
-      .def_property_readonly("density", [](const PyRequest& r) { return r.request.tree.density; })
-      .def_property_readonly(
-          "curve",
-          [](const PyRequest& r) { return std::string(CurveName(r.request.tree.options.curve)); })
-      .def_property_readonly(
-          "estimator",
-          [](const PyRequest& r) {
-            return std::string(AreaEstimatorName(r.request.tree.options.estimator));
-          })
-      .def_property_readonly("tolerance",
-                             [](const PyRequest& r) { return r.request.tree.options.tolerance; })
-      .def_property_readonly("depth_cap",
-                             [](const PyRequest& r) { return r.request.tree.options.depth_cap; })
-      .def_property_readonly("rho", [](const PyRequest& r) { return r.request.tree.options.rho; })
-      .def_property_readonly(
-          "sequence",
-          [](const PyRequest& r) { return std::string(SequenceName(r.request.sequence)); })
-      .def_property_readonly("count", [](const PyRequest& r) { return r.request.count; })
-      .def_property_readonly("seed", [](const PyRequest& r) { return r.request.seed; })
-      .def_property_readonly("tree_count", [](const PyRequest& r) { return r.request.tree_count; })
-      .def_property_readonly("begin", [](const PyRequest& r) { return r.request.begin; })
-      .def_property_readonly("end", [](const PyRequest& r) { return r.request.end; })
-      .def_property_readonly("shard_index",
-                             [](const PyRequest& r) { return r.request.shard_index; })
-      .def_property_readonly("shard_count",
-                             [](const PyRequest& r) { return r.request.shard_count; })
-      .def_property_readonly("region",
-                             [](const PyRequest& r) -> py::object {
-                               const Region& g = r.request.region;
-                               switch (g.kind) {
-                                 case Region::Kind::kAll:
-                                   return py::none();
-                                 case Region::Kind::kParameterRect:
-                                   return py::make_tuple("uv", g.u0, g.u1, g.v0, g.v1);
-                                 case Region::Kind::kBox:
-                                   return py::make_tuple("box", g.lo.x, g.lo.y, g.lo.z, g.hi.x,
-                                                         g.hi.y, g.hi.z);
-                               }
-                               return py::none();
-                             })
-      .def_property_readonly("normals", [](const PyRequest& r) { return r.request.fields.normal; })
-      .def_property_readonly("density_column",
-                             [](const PyRequest& r) { return r.request.fields.density; })
-      .def_property_readonly("curve_position",
-                             [](const PyRequest& r) { return r.request.fields.curve_position; })
-      .def_property_readonly("face", [](const PyRequest& r) { return r.request.fields.face; })
-      .def_property_readonly("triangle",
-                             [](const PyRequest& r) { return r.request.fields.triangle; })
-      .def_property_readonly(
-          "surface_key", [](const PyRequest& r) { return RoutingKey(r.request.tree); },
-          "the routing key sent as x-surface-key for consistent-hash proxies "
-          "(request/routing_key.h)")
-      .def_property_readonly(
-          "monotone", [](const PyRequest& r) { return SequenceIsMonotone(r.request.sequence); },
-          "whether indices grow along the stream (a broken stream resumes after the last index)")
-      .def_property_readonly(
-          "index_range",
-          [](const PyRequest& r) {
-            auto range = ResolveIndexRange(r.request);
-            ThrowIfError(range.status());
-            return py::make_tuple(range->first, range->second);
-          },
-          "the resolved index range (begin, end) before the region");
-  m.def("upload_cut_hint", &UploadCutHint, py::arg("message"), py::arg("bytes"),
-        "what to add to an upload's error when a proxy cut it (request/model_spec.h); '' if none");
+           py::arg("triangle") = d.triangle);
   // The model files' facts of request/model_files.h, for python/sfcsampler/many.py.
   py::dict extensions;
   for (const ModelExtension& e : ModelExtensions()) {

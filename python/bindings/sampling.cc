@@ -8,7 +8,6 @@
 // Thread-safety: an Engine may be used from several Python threads at once
 // (its tree source is locked); a Job serialises calls to next().
 #include <algorithm>
-#include <array>
 #include <mutex>
 #include <thread>
 
@@ -16,12 +15,14 @@
 #include "core/vector_math.h"
 #include "engine/sampling_engine.h"
 #include "kinds/registered_kinds.h"
-#include "python/bindings/arrays.h"
+#include "python/bindings/batch_columns.h"
 #include "python/bindings/errors.h"
 #include "python/bindings/memory_models.h"
 #include "python/bindings/recent_tree_source.h"
 #include "python/bindings/register.h"
 #include "python/bindings/request.h"
+#include "python/bindings/tree_summary_dict.h"
+#include "request/stream_options.h"
 #include "request/tree_count.h"
 
 namespace py = pybind11;
@@ -29,56 +30,6 @@ namespace py = pybind11;
 namespace sfc::python {
 
 namespace {
-
-py::dict CellDict(const TreeSummary::Cell& cell) {
-  py::dict d;
-  d["test"] = cell.test;
-  d["u0"] = cell.u0, d["v0"] = cell.v0, d["size"] = cell.size;
-  d["measured"] = cell.measured, d["limit"] = cell.limit;
-  return d;
-}
-
-py::list CellList(const std::vector<TreeSummary::Cell>& cells) {
-  py::list out;
-  for (const TreeSummary::Cell& cell : cells) out.append(CellDict(cell));
-  return out;
-}
-
-// A tree's summary (request/tree_summary.h) as a dict with the wire's
-// TreeInfo names, in its order, every key for every kind: what a Client
-// gives for the same tree (sfcsampler/_wire.py message_dict).
-py::dict TreeSummaryDict(const TreeSummary& s) {
-  py::dict d;
-  d["kind"] = s.kind;
-  d["key"] = s.key;
-  d["key_with_grade"] = s.key_with_grade;
-  d["grade"] = s.grade;
-  d["cache_hit"] = s.cache_hit;
-  d["refined"] = s.refined;
-  d["leaves"] = s.leaves;
-  d["bytes"] = s.bytes;
-  d["min_depth"] = s.min_depth;
-  d["max_depth"] = s.max_depth;
-  d["tolerance"] = s.tolerance;
-  d["flatness_capped_leaves"] = s.flatness_capped_leaves;
-  d["mass_capped_leaves"] = s.mass_capped_leaves;
-  d["warnings"] = CellList(s.warnings);
-  d["canonical"] = s.canonical;
-  d["error_samples"] = s.error_samples;
-  d["unresolved_error_samples"] = s.unresolved_error_samples;
-  d["singular_leaves"] = s.singular_leaves;
-  d["singular"] = CellList(s.singular);
-  d["small_failing_leaves"] = s.small_failing_leaves;
-  d["warped_leaves"] = s.warped_leaves;
-  return d;
-}
-
-std::vector<float> Narrow(const std::vector<double>& column) {
-  std::vector<float> out(column.size());
-  std::transform(column.begin(), column.end(), out.begin(),
-                 [](double d) { return static_cast<float>(d); });
-  return out;
-}
 
 class PyJob {
  public:
@@ -95,8 +46,8 @@ class PyJob {
     if (max_samples == 0) {
       throw StatusException(absl::InvalidArgumentError("max_samples must be >= 1"));
     }
-    SampleBatch batch;
-    std::vector<float> narrowed[10];
+    BatchColumns filled;
+    SampleBatch& batch = filled.batch;
     {
       py::gil_scoped_release release;
       std::lock_guard<std::mutex> lock(mu_);
@@ -105,7 +56,9 @@ class PyJob {
       const size_t reserve =
           static_cast<size_t>(std::min(max_samples, region_ ? uint64_t{1} << 16 : left));
       batch.index.reserve(reserve);
-      for (auto* c : Columns(&batch)) c->reserve(reserve);
+      for (SampleBatch::ValueColumn column : SampleBatch::ValueColumns()) {
+        (batch.*column).reserve(reserve);
+      }
       uint64_t got = 0;
       while (got < max_samples) {
         // A region may drop samples, so ask for what is still wanted.
@@ -115,30 +68,10 @@ class PyJob {
         got += *n;
       }
       produced_ += got;
-      if (float32_) {
-        auto columns = Columns(&batch);
-        for (size_t i = 0; i < columns.size(); ++i) {
-          narrowed[i] = Narrow(*columns[i]);
-          std::vector<double>().swap(*columns[i]);
-        }
-      }
+      if (float32_) Narrow(&filled);
     }
     if (batch.size() == 0) return py::none();
-    py::dict out;
-    static const char* const kNames[] = {"u",  "v",  "x",  "y",       "z",
-                                         "nx", "ny", "nz", "density", "curve_position"};
-    out["index"] = ToNumpy(std::move(batch.index));
-    if (fields_.face) out["face"] = ToNumpy(std::move(batch.face));
-    if (fields_.triangle) out["triangle"] = ToNumpy(std::move(batch.triangle));
-    auto columns = Columns(&batch);
-    for (size_t i = 0; i < columns.size(); ++i) {
-      if (float32_) {
-        if (!narrowed[i].empty()) out[kNames[i]] = ToNumpy(std::move(narrowed[i]));
-      } else if (!columns[i]->empty()) {
-        out[kNames[i]] = ToNumpy(std::move(*columns[i]));
-      }
-    }
-    return out;
+    return ColumnsDict(std::move(filled), fields_);
   }
 
   py::dict Tree() const { return TreeSummaryDict(SummarizeTree(job_.tree)); }
@@ -151,11 +84,6 @@ class PyJob {
   uint64_t seed() const { return seed_; }
 
  private:
-  static std::array<std::vector<double>*, 10> Columns(SampleBatch* b) {
-    return {&b->u,  &b->v,  &b->x,  &b->y,       &b->z,
-            &b->nx, &b->ny, &b->nz, &b->density, &b->curve_position};
-  }
-
   std::mutex mu_;
   SamplingJob job_;
   const SampleFields fields_;
@@ -189,16 +117,16 @@ class PyEngine {
   void ReleaseModel(const std::string& spec) { models_.Release(spec); }
 
   std::unique_ptr<PyJob> Start(const PyRequest& r, const std::string& precision) {
-    if (precision != "float64" && precision != "float32") {
-      throw StatusException(absl::InvalidArgumentError("precision must be float64 or float32"));
-    }
+    const absl::StatusOr<ColumnPrecision> parsed = ParseColumnPrecision(precision);
+    ThrowIfError(parsed.status());
     absl::StatusOr<SamplingJob> job;
     {
       py::gil_scoped_release release;
       job = engine_.Start(r.request);
     }
     ThrowIfError(job.status());
-    return std::make_unique<PyJob>(*std::move(job), r.request, precision == "float32");
+    return std::make_unique<PyJob>(*std::move(job), r.request,
+                                   *parsed == ColumnPrecision::kFloat32);
   }
 
   py::dict Prepare(const PyRequest& r) {

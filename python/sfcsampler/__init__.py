@@ -28,7 +28,8 @@ from sfcsampler.samples import Samples
 
 
 def __getattr__(name):
-    """Client on first use: gRPC and protobuf load only when a server is used (PEP 562)."""
+    """Client on first use: the client extension (_client, with gRPC) loads only when a
+    server is used (PEP 562)."""
     if name == "Client":
         from sfcsampler.client import Client
         globals()["Client"] = Client

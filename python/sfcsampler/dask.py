@@ -52,7 +52,7 @@ def _sampler():
 
 
 def _client(service):
-    """A Client to `service`, one per worker thread (grpc channels are thread-safe, but one per
+    """A Client to `service`, one per worker thread (a Client is thread-safe, but one per
     thread keeps the streams apart)."""
     clients = getattr(_local, "clients", None)
     if clients is None:
@@ -149,7 +149,7 @@ def _shard_task(model, surface, count, index, shards, out_path, request, service
     if service:
         c = _client(service)
         if model is not None:
-            surface = c._upload_bytes(model[0], model[1], model[2], "shard model")
+            surface = c.upload_bytes(model[0], model[1], "shard model")
         samples = c.sample(surface=surface, count=count, shard=(index, shards), **request)
     elif model is not None:
         samples = _sampler().sample_bytes(model[0], model[1], "shard model", count=count,
@@ -198,8 +198,6 @@ def sample_shards(client, surface=None, count=10000, *, shards, out_dir=None, me
             with open(reference, "rb") as f:
                 model = (fmt, f.read())
     if model is not None:
-        import hashlib
-        model = (model[0], model[1], hashlib.sha256(model[1]).hexdigest())
         # Once to each worker, not per task; hash=False: a fresh key (a scatter of the same bytes
         # would share the key of an earlier call's future, which Dask may be releasing).
         [model] = client.scatter([model], broadcast=True, hash=False)

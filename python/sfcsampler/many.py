@@ -250,9 +250,10 @@ def sample_one(model, request, base_seed, sampler=None, out_path=None, keep=True
                     3, f"columns: this model has no {other!r} column ({other} is for "
                        f"{'CAD models' if mesh else 'meshes'}); name a column it has")
         if client is not None:
-            result.sha256 = hashlib.sha256(data).hexdigest()
+            # The server's spec carries the bytes' SHA-256 (hashed once, in C++).
+            spec = client.upload_bytes(fmt, data, model.name)
+            result.sha256 = spec.rsplit("sha256=", 1)[1]
             result.seed = model_seed(base_seed, result.sha256)
-            spec = client._upload_bytes(fmt, data, result.sha256, model.name)
             samples = client.sample(surface=spec, seed=result.seed, **request)
         else:
             from sfcsampler.embedded import Sampler
@@ -346,7 +347,6 @@ def sample_many(models, *, seed=1, out_dir=None, keep=None, workers=0, progress=
     Results (a list of Result, in the models' order); a model that fails has its error in
     Result.error and the others go on. Results.failed, Results.summary().
     """
-    from sfcsampler.client import Client
     from sfcsampler.embedded import Sampler
     for bad in ("surface", "mesh"):
         if bad in request:
@@ -360,7 +360,11 @@ def sample_many(models, *, seed=1, out_dir=None, keep=None, workers=0, progress=
     keep = out_dir is None if keep is None else keep
     workers = workers or min(8, os.cpu_count() or 1)
     own_client = isinstance(server, str)
-    client = Client(server) if own_client else server
+    if own_client:
+        from sfcsampler.client import Client  # loads gRPC: only for a server
+        client = Client(server)
+    else:
+        client = server
     if model_check_program == "auto":
         model_check_program = find_model_check_program()
     # Each model is parsed and sampled once: the engine keeps no parsed model (their

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The Python package installed like any other, in virtual environments
-# (python3 -m venv --system-site-packages: Debian's NumPy, gRPC and Dask),
+# (python3 -m venv --system-site-packages: Debian's NumPy and Dask),
 # with Debian's build tools and no PyPI:
 #   1. pip install --no-build-isolation ./python
 #   2. python3 -m build --no-isolation --wheel, then pip install of that wheel
@@ -46,9 +46,9 @@ check_env() {  # VENV LABEL [TESTS]: imports from the environment, runs the test
   local venv=$1 label=$2 tests=${3:-1}
   (cd "$work" && "$venv/bin/python" - "$venv" <<'PY'
 import os, sys
-import sfcsampler, sfcsampler.dask, sfcsampler._core, sfcsampler.v1.sampler_pb2
+import sfcsampler, sfcsampler.dask, sfcsampler._core, sfcsampler._client
 venv = os.path.realpath(sys.argv[1])
-for m in (sfcsampler, sfcsampler._core):
+for m in (sfcsampler, sfcsampler._core, sfcsampler._client):
     assert os.path.realpath(m.__file__).startswith(venv), m.__file__
 s = sfcsampler.sample(surface="torus", count=12345)
 assert len(s) == 12345

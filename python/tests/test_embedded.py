@@ -245,12 +245,18 @@ def test_one_sampler_from_several_threads():
 
 
 def test_import_and_embedded_sampling_load_no_grpc_until_a_client_is_used():
-    # A fresh interpreter: this test process may already hold grpc.
+    # A fresh interpreter: this test process may already hold the client.
     program = ("import sys, sfcsampler\n"
+               "def grpc():\n"
+               "    return [line.split()[-1] for line in open('/proc/self/maps')\n"
+               "            if 'libgrpc' in line or 'libprotobuf' in line]\n"
                "sfcsampler.sample(surface='sphere', count=100)\n"
-               "loaded = [m for m in ('grpc', 'google.protobuf') if m in sys.modules]\n"
-               "assert not loaded, loaded\n"
+               "import numpy as np\n"
+               "mesh = (np.eye(3), np.array([[0, 1, 2]]))\n"
+               "assert not sfcsampler.sample_many([mesh], count=10).failed\n"
+               "assert not grpc(), grpc()\n"
+               "assert 'sfcsampler._client' not in sys.modules\n"
                "assert sfcsampler.Client.__module__ == 'sfcsampler.client'\n"
-               "assert 'grpc' in sys.modules\n")
+               "assert 'sfcsampler._client' in sys.modules and grpc()\n")
     done = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
