@@ -133,6 +133,7 @@ absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
   }
   tree->leaves_ = leaves;
   tree->bytes_ = bytes;
+  tree->total_mass_ = total;
   return std::shared_ptr<const ModelTree>(std::move(tree));
 }
 

@@ -74,6 +74,7 @@ class ModelTree {
   size_t skipped_faces() const { return skipped_faces_; }
   uint64_t leaf_count() const { return leaves_; }
   uint64_t bytes() const { return bytes_; }
+  double total_mass() const { return total_mass_; }  // S: the faces' masses summed
 
  private:
   ModelTree() = default;
@@ -81,6 +82,7 @@ class ModelTree {
   std::vector<Piece> pieces_;
   size_t skipped_faces_ = 0;
   uint64_t leaves_ = 0, bytes_ = 0;
+  double total_mass_ = 0;
 };
 
 class ModelSampleCursor {

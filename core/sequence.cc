@@ -1,6 +1,8 @@
 #include "core/sequence.h"
 
 #include <algorithm>
+#include <cassert>
+#include <cstring>
 #include <iterator>
 #include <memory>
 
@@ -146,6 +148,9 @@ double Sequence::Raw(uint64_t k) const {
       return ReverseBits32(static_cast<uint32_t>(k)) * 0x1.0p-32;
     case SequenceKind::kProgressive:
       return OwenScrambledRadicalInverse(k, seed_);
+    case SequenceKind::kBlue:
+      assert(table_ != nullptr && "a blue sequence is made by Sequence::FromTable");
+      return (*table_)[k];
     case SequenceKind::kSobol:
       return NestedScramble(ReverseBits32(static_cast<uint32_t>(k)), k, seed_, 0, *flips_);
   }
@@ -167,6 +172,10 @@ void Sequence::AtMany(uint64_t k0, size_t n, double* out) const {
       break;
     case SequenceKind::kEqual:
       for (size_t i = 0; i < n; ++i) out[i] = (static_cast<double>(k0 + i) + 0.5) / count;
+      break;
+    case SequenceKind::kBlue:
+      assert(table_ != nullptr && "a blue sequence is made by Sequence::FromTable");
+      std::memcpy(out, table_->data() + k0, n * sizeof(double));
       break;
     default:
       for (size_t i = 0; i < n; ++i) out[i] = Raw(k0 + i);

@@ -26,10 +26,20 @@ struct OwenFlips;
 
 class Sequence {
  public:
-  // REQUIRES: count >= 1; count <= 2^32 for the radical-inverse kinds and sobol.
+  // REQUIRES: count >= 1; count <= 2^32 for the radical-inverse kinds and
+  // sobol; not kBlue (its values come from a relaxation: FromTable).
   Sequence(SequenceKind kind, uint64_t count, uint64_t seed)
       : kind_(kind), count_(count), seed_(seed) {
     if (kind == SequenceKind::kSobol) flips_ = MakeOwenFlips(seed);
+  }
+
+  // A kBlue sequence whose q_k is (*q)[k], shared: the result of
+  // RelaxBlueNoise (core/blue_relaxation.h), or any mass coordinates to
+  // place. REQUIRES: q non-empty, non-decreasing, in [0, 1].
+  static Sequence FromTable(std::shared_ptr<const std::vector<double>> q, uint64_t seed) {
+    Sequence s(SequenceKind::kBlue, q->size(), seed);
+    s.table_ = std::move(q);
+    return s;
   }
 
   SequenceKind kind() const { return kind_; }
@@ -83,6 +93,7 @@ class Sequence {
   SequenceKind kind_;
   uint64_t count_;
   uint64_t seed_;
+  std::shared_ptr<const std::vector<double>> table_;  // kBlue's q_k
   bool windowed_ = false;
   double lo_ = 0, hi_ = 1;
   std::shared_ptr<const OwenFlips> flips_;  // sobol only: shared by copies and windows

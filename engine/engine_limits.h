@@ -18,6 +18,10 @@ struct EngineLimits {
   // Sequences that are not monotone in k are sorted into curve order per
   // request (16 bytes a sample): at most this many samples per request.
   uint64_t max_sorted_range = uint64_t{1} << 24;
+  // The blue sequence relaxes the whole set in memory (up to 128 bytes a
+  // sample, core/blue_relaxation.h) for every request: at most this many
+  // samples.
+  uint64_t max_blue_count = uint64_t{1} << 24;
   // Model files (CAD, meshes) are parsed on threads of their own
   // (engine/loaded_models.h): parsed models kept, bytes (LRU past it);
   // parses at once; parses that may wait for a thread; CPU seconds one parse

@@ -2,6 +2,7 @@
 
 #include "absl/strings/str_format.h"
 #include "base/status_macros.h"
+#include "engine/blue_sequence.h"
 #include "engine/model_source.h"
 #include "request/index_range.h"
 #include "request/tree_count.h"
@@ -171,6 +172,12 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
         "%d samples (max_sorted_range); ask for index ranges of that size",
         SequenceName(request.sequence), limits_.max_sorted_range));
   }
+  if (request.sequence == SequenceKind::kBlue && request.count > limits_.max_blue_count) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the blue sequence relaxes the whole set of %d samples in memory for every request (also "
+        "for a shard, range or region of it), so it takes at most %d samples (max_blue_count)",
+        request.count, limits_.max_blue_count));
+  }
   RETURN_IF_ERROR(request.region.Validate());
   if (request.fields.face || request.fields.triangle) {
     ASSIGN_OR_RETURN(const std::optional<ModelSpec> model, ParseModelSpec(request.tree.surface));
@@ -192,10 +199,15 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
   cursor.region = request.region;
   cursor.fields = request.fields;
   cursor.threads = limits_.generation_threads;
-  ASSIGN_OR_RETURN(
-      job.cursor,
-      job.tree.open_cursor(job.tree.lookup, Sequence(request.sequence, request.count, request.seed),
-                           cursor));
+  Sequence sequence(SequenceKind::kJittered, request.count, request.seed);
+  if (request.sequence == SequenceKind::kBlue) {
+    // The whole set, whatever part of it the request covers.
+    ASSIGN_OR_RETURN(sequence, BlueSequence(job.tree.lookup, job.tree.open_cursor, request.count,
+                                            request.seed, limits_.generation_threads));
+  } else {
+    sequence = Sequence(request.sequence, request.count, request.seed);
+  }
+  ASSIGN_OR_RETURN(job.cursor, job.tree.open_cursor(job.tree.lookup, sequence, cursor));
   return job;
 }
 

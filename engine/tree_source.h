@@ -24,13 +24,16 @@ class AnyTree {
   virtual ~AnyTree() = default;
   virtual uint64_t bytes() const = 0;
   virtual uint64_t leaves() const = 0;
+  // S_M: the mass (area x density) along the whole curve.
+  virtual double total_mass() const = 0;
   // Fills the fields of `out` that the tree knows (request/tree_summary.h):
   // leaves and bytes, and whatever its kind of tree adds. Leaves the
   // request's fields (kind, key, grade, cache) alone.
   virtual void FillSummary(TreeSummary* out) const = 0;
 };
 
-// A Tree as an AnyTree. Each Tree type describes itself by a function
+// A Tree as an AnyTree (a Tree has total_mass()). Each Tree type describes
+// itself by a function
 //   void FillTreeSummary(const Tree& tree, TreeSummary* out);
 // in its own namespace (found by argument-dependent lookup, and declared
 // before the TypedTree<Tree> is made), called after leaves and bytes are set:
@@ -42,6 +45,7 @@ class TypedTree final : public AnyTree {
       : tree_(std::move(tree)), bytes_(bytes), leaves_(leaves) {}
   uint64_t bytes() const override { return bytes_; }
   uint64_t leaves() const override { return leaves_; }
+  double total_mass() const override { return tree_->total_mass(); }
   void FillSummary(TreeSummary* out) const override {
     out->leaves = leaves_;
     out->bytes = bytes_;

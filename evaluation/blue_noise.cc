@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <random>
 
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "evaluation/reference_sets.h"
 
 namespace sfc {
@@ -140,6 +143,83 @@ std::vector<Vec3> DartThrowingSphere(uint64_t n, double radius, uint64_t seed) {
     out.push_back(c);
   }
   return out;
+}
+
+std::vector<double> RadialPowerSpectrum(const std::vector<Point2>& points, int max_frequency) {
+  const int m = max_frequency;
+  std::vector<double> sum(m + 1, 0.0);
+  std::vector<int> count(m + 1, 0);
+  // Half the wave vectors (P(k) = P(-k)): ky > 0, or ky = 0 and kx > 0.
+  const size_t width = 2 * static_cast<size_t>(m) + 1;
+  std::vector<std::complex<double>> acc(width * (m + 1));
+  std::vector<std::complex<double>> ex(width);
+  for (const Point2& p : points) {
+    const std::complex<double> wx = std::polar(1.0, -2 * kPi * p.x);
+    const std::complex<double> wy = std::polar(1.0, -2 * kPi * p.y);
+    // ex[kx + m] = wx^kx for kx in [-m, m].
+    ex[m] = 1;
+    for (int k = 1; k <= m; ++k) {
+      ex[m + k] = ex[m + k - 1] * wx;
+      ex[m - k] = std::conj(ex[m + k]);
+    }
+    std::complex<double> ey = 1;
+    for (int ky = 0; ky <= m; ++ky) {
+      std::complex<double>* row = &acc[ky * width];
+      for (size_t kx = 0; kx < width; ++kx) row[kx] += ex[kx] * ey;
+      ey *= wy;
+    }
+  }
+  for (int ky = 0; ky <= m; ++ky) {
+    for (int kx = -m; kx <= m; ++kx) {
+      if (ky == 0 && kx <= 0) continue;
+      const int f = static_cast<int>(std::lround(std::sqrt(double(kx) * kx + double(ky) * ky)));
+      if (f < 1 || f > m) continue;
+      sum[f] += std::norm(acc[ky * width + kx + m]) / static_cast<double>(points.size());
+      ++count[f];
+    }
+  }
+  std::vector<double> out(m);
+  for (int f = 1; f <= m; ++f) out[f - 1] = count[f] ? sum[f] / count[f] : 0;
+  return out;
+}
+
+std::string PointsAndSpectrumSvg(const std::string& title, const std::vector<Point2>& points,
+                                 const std::vector<double>& spectrum) {
+  const double side = 400, gap = 40, plot_w = 400, plot_h = 400;
+  std::string svg = absl::StrFormat(
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\">\n"
+      "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n"
+      "<text x=\"10\" y=\"20\" font-family=\"sans-serif\" font-size=\"14\">%s</text>\n"
+      "<g transform=\"translate(10,30)\"><rect width=\"%g\" height=\"%g\" fill=\"none\" "
+      "stroke=\"black\"/>\n",
+      static_cast<int>(side + gap + plot_w + 20), static_cast<int>(plot_h + 60), title, side, side);
+  for (const Point2& p : points) {
+    absl::StrAppendFormat(&svg, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"1.2\"/>\n", p.x * side,
+                          (1 - p.y) * side);
+  }
+  absl::StrAppend(&svg, "</g>\n");
+  // The spectrum: f / sqrt(N) on x (0 .. max), P on y (0 .. 4).
+  const double root_n = std::sqrt(static_cast<double>(points.size()));
+  const double x_max = spectrum.size() / root_n, y_max = 4;
+  absl::StrAppendFormat(&svg,
+                        "<g transform=\"translate(%g,30)\"><rect width=\"%g\" height=\"%g\" "
+                        "fill=\"none\" stroke=\"black\"/>\n",
+                        10 + side + gap, plot_w, plot_h);
+  absl::StrAppendFormat(&svg,
+                        "<line x1=\"0\" y1=\"%.1f\" x2=\"%g\" y2=\"%.1f\" stroke=\"gray\" "
+                        "stroke-dasharray=\"4 4\"/>\n",
+                        plot_h * (1 - 1 / y_max), plot_w, plot_h * (1 - 1 / y_max));
+  absl::StrAppend(&svg, "<polyline fill=\"none\" stroke=\"blue\" points=\"");
+  for (size_t f = 1; f <= spectrum.size(); ++f) {
+    absl::StrAppendFormat(&svg, "%.1f,%.1f ", plot_w * (f / root_n) / x_max,
+                          plot_h * (1 - std::min(spectrum[f - 1], y_max) / y_max));
+  }
+  absl::StrAppendFormat(
+      &svg,
+      "\"/>\n<text x=\"5\" y=\"15\" font-family=\"sans-serif\" font-size=\"12\">P(f), "
+      "0 .. %g; f / sqrt(N), 0 .. %.2f (dashed: P = 1)</text>\n</g>\n</svg>\n",
+      y_max, x_max);
+  return svg;
 }
 
 }  // namespace sfc

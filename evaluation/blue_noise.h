@@ -6,6 +6,7 @@
 #define SFCSAMPLER_EVALUATION_BLUE_NOISE_H_
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "core/types/vec3.h"
@@ -22,6 +23,19 @@ struct NearestNeighbour {
 NearestNeighbour PlaneNearestNeighbour(const std::vector<Point2>& points);
 // Unit sphere, chord distance; hexagonal spacing sqrt(8 pi / (sqrt(3) N)).
 NearestNeighbour SphereNearestNeighbour(const std::vector<Vec3>& points);
+
+// The radially averaged power spectrum of points in the unit square (taken
+// as periodic): P(f) = mean over the integer wave vectors k with
+// f - 1/2 <= |k| < f + 1/2 of |sum_j exp(-2 pi i k.x_j)|^2 / N, for
+// f = 1 .. max_frequency (out[f - 1]). White noise has P = 1; blue noise is
+// low at low f; a stratified set peaks near its strata's frequency
+// (sqrt(N) for N strata of a square). Cost O(N max_frequency^2).
+std::vector<double> RadialPowerSpectrum(const std::vector<Point2>& points, int max_frequency);
+
+// A picture of a plane set and its spectrum side by side, as SVG: the points
+// in the unit square, and P(f) against f / sqrt(N) with P = 1 dashed.
+std::string PointsAndSpectrumSvg(const std::string& title, const std::vector<Point2>& points,
+                                 const std::vector<double>& spectrum);
 
 // The 2D Sobol points with Owen scrambling (nested uniform, Burley 2020's
 // hash on the bit-reversed coordinate), one independent scramble per axis.

@@ -31,14 +31,16 @@
 
 #include "absl/status/statusor.h"
 #include "core/types/sample_batch.h"
+#include "core/types/sequence_kind.h"
 
 namespace sfc {
 
-// Our jittered set of `count` samples with `seed` on catalogue specs
-// (model specs such as step:FILE or ply:FILE included), all of it, with
-// u, v, x, y, z.
+// Our set of `count` samples with `seed` of `sequence` (jittered unless a
+// section says otherwise) on catalogue specs (model specs such as step:FILE
+// or ply:FILE included), all of it, with u, v, x, y, z.
 using QualitySource = std::function<absl::StatusOr<SampleBatch>(
-    const std::string& surface, const std::string& density, uint64_t count, uint64_t seed)>;
+    const std::string& surface, const std::string& density, uint64_t count, uint64_t seed,
+    SequenceKind sequence)>;
 
 struct QualityOptions {
   // full: the sizes (boxes N = 64..24576, strips at 200 000, Monte
@@ -65,6 +67,8 @@ struct QualityCheck {
 struct QualityReport {
   std::vector<QualityCheck> checks;
   std::string tables;  // markdown: every figure with its seeds
+  // Pictures (file name, SVG text) the tables refer to, for the output folder.
+  std::vector<std::pair<std::string, std::string>> pictures;
 };
 
 absl::StatusOr<QualityReport> RunQuality(const QualityOptions& options,

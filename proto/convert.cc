@@ -374,6 +374,7 @@ absl::StatusOr<SampleCall> FromProto(const v1::SampleRequest& p) {
     case v1::SEQUENCE_RANDOM: r.sequence = SequenceKind::kRandom; break;
     case v1::SEQUENCE_VAN_DER_CORPUT: r.sequence = SequenceKind::kVanDerCorput; break;
     case v1::SEQUENCE_PROGRESSIVE: r.sequence = SequenceKind::kProgressive; break;
+    case v1::SEQUENCE_BLUE: r.sequence = SequenceKind::kBlue; break;
     case v1::SEQUENCE_SOBOL: r.sequence = SequenceKind::kSobol; break;
     default:
       return absl::InvalidArgumentError(absl::StrFormat("unknown sequence %d", p.sequence()));
@@ -432,6 +433,7 @@ v1::SampleRequest ToProto(const SampleRequest& r, const StreamOptions& stream) {
     case SequenceKind::kRandom: p.set_sequence(v1::SEQUENCE_RANDOM); break;
     case SequenceKind::kVanDerCorput: p.set_sequence(v1::SEQUENCE_VAN_DER_CORPUT); break;
     case SequenceKind::kProgressive: p.set_sequence(v1::SEQUENCE_PROGRESSIVE); break;
+    case SequenceKind::kBlue: p.set_sequence(v1::SEQUENCE_BLUE); break;
     case SequenceKind::kSobol: p.set_sequence(v1::SEQUENCE_SOBOL); break;
   }
   p.set_count(r.count);

@@ -72,7 +72,8 @@ void AddSampleFlags(CLI::App* cmd, RequestFlags* f) {
       ->check(kWholeNumber);
   cmd->add_option("--seed", f->seed, "random seed")->capture_default_str()->check(kWholeNumber);
   cmd->add_option("--sequence", f->sequence,
-                  "jittered | equal | random | vandercorput | progressive | sobol")
+                  "jittered | equal | random | vandercorput | progressive | blue (evenly "
+                  "spaced; biased for integration) | sobol (integration)")
       ->capture_default_str();
   cmd->add_option(
          "--tree-count", f->tree_count,
@@ -125,7 +126,7 @@ absl::StatusOr<SampleRequest> ToSampleRequest(const RequestFlags& f) {
   const auto sequence = SequenceFromName(f.sequence);
   if (!sequence) {
     return absl::InvalidArgumentError(
-        "--sequence must be jittered, equal, random, vandercorput, progressive or sobol");
+        "--sequence must be jittered, equal, random, vandercorput, progressive, blue or sobol");
   }
   r.sequence = *sequence;
   r.count = f.count;

@@ -5,6 +5,7 @@
 #include "absl/strings/str_format.h"
 #include "base/echo.h"
 #include "base/status_macros.h"
+#include "core/blue_relaxation.h"
 #include "proto/convert.h"
 #include "request/index_range.h"
 #include "request/stream_options.h"
@@ -20,8 +21,9 @@ namespace {
 
 // What a stream holds while it runs: the sort of a non-monotone sequence's
 // range (16 bytes a sample; a sobol set sorts its whole count, 16 bytes a
-// sample, core/curve_samples.h CurveAddress), the producer's batch (per sample the index and
-// the columns in float64, the model columns uint32), and the messages of its
+// sample, core/curve_samples.h CurveAddress), a blue set's relaxation (the
+// whole set), the producer's batch (per sample the index and the columns in
+// float64, the model columns uint32), and the messages of its
 // pipeline, at most pipeline_depth + 2 (queued, being made, being written;
 // MessagePipeline; one without a pipeline), each per sample the columns on
 // the wire (float32 if asked; indices listed, at most). The batch is the requested size, or the
@@ -31,6 +33,9 @@ uint64_t StreamWorkingBytes(const SampleRequest& request, const StreamOptions& s
                             int pipeline_depth) {
   const auto range = ResolveIndexRange(request);
   const uint64_t n = range.ok() ? range->second - range->first : 0;
+  // A blue set is relaxed whole, whatever part of it the stream sends.
+  const uint64_t blue =
+      request.sequence == SequenceKind::kBlue ? kBlueNoiseBytesPerSample * request.count : 0;
   const uint64_t sorted = SequenceIsTwoDimensional(request.sequence) ? request.count : n;
   const uint64_t sort = SequenceIsMonotone(request.sequence) ? 0 : 16 * sorted;
   const SampleFields& f = request.fields;
@@ -46,7 +51,7 @@ uint64_t StreamWorkingBytes(const SampleRequest& request, const StreamOptions& s
   const uint64_t per_sample = (8 + 8 * columns + 4 * index_columns) +
                               messages * (8 + width * wire_columns + 4 * index_columns);
   const uint64_t batch = stream.batch_size != 0 ? stream.batch_size : kDefaultBatchSize;
-  return sort + per_sample * std::min(n, batch);
+  return sort + blue + per_sample * std::min(n, batch);
 }
 
 }  // namespace

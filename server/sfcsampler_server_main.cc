@@ -82,6 +82,10 @@ int main(int argc, char** argv) {
                  "vandercorput, progressive), and the largest count of a sobol set (sorted "
                  "whole)")
       ->capture_default_str();
+  app.add_option("--max-blue-count", o.limits.max_blue_count,
+                 "largest N of the blue sequence (each request relaxes the whole set in memory, "
+                 "up to 128 bytes a sample)")
+      ->capture_default_str();
   app.add_option("--cache-bytes", o.cache_bytes, "tree cache budget in bytes (LRU eviction)")
       ->capture_default_str();
   app.add_option("--model-bytes", o.model_bytes, "uploaded models kept, bytes (LRU eviction)")

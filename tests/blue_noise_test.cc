@@ -36,6 +36,30 @@ TEST(BlueNoise, DartThrowingKeepsItsRadius) {
   EXPECT_LT(PlaneNearestNeighbour(JitteredSquare(2000, 3)).min, 0.4);
 }
 
+TEST(BlueNoise, PowerSpectrumOfALatticeAndOfWhiteNoise) {
+  // A 32 x 32 lattice: every wave vector off 32 Z^2 cancels, so P(f) = 0
+  // below f = 32 and P(32) > 0.
+  std::vector<Point2> lattice;
+  for (int i = 0; i < 32; ++i) {
+    for (int j = 0; j < 32; ++j) lattice.push_back({(i + 0.5) / 32, (j + 0.5) / 32});
+  }
+  const std::vector<double> p = RadialPowerSpectrum(lattice, 40);
+  for (int f = 1; f < 32; ++f) ASSERT_LT(p[f - 1], 1e-9) << f;
+  EXPECT_GT(p[31], 10);
+  // Independent uniform points: P = 1 on average at every f.
+  std::vector<Point2> white;
+  uint64_t state = 12345;
+  auto next = [&] {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(state >> 11) * 0x1.0p-53;
+  };
+  for (int i = 0; i < 2000; ++i) white.push_back({next(), next()});
+  const std::vector<double> w = RadialPowerSpectrum(white, 40);
+  double mean = 0;
+  for (int f = 10; f <= 40; ++f) mean += w[f - 1] / 31;
+  EXPECT_NEAR(mean, 1, 0.1);
+}
+
 TEST(BlueNoise, ScrambledSobolIsStillANet) {
   // Owen scrambling keeps the (0, m, 2)-net property: every elementary box
   // of area 2^-m holds exactly one of the first 2^m points.

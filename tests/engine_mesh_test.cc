@@ -3,6 +3,7 @@
 // triangle column and the barycentric u, v place every sample on its
 // triangle; densities reach the mesh tree; bad specs and files are refused
 // with the file named.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -82,6 +83,46 @@ TEST(EngineMesh, AFileAndItsHashGiveTheSameSamplesOnTheirTriangles) {
     ASSERT_NEAR(p.y, a.y[i], 1e-12);
     ASSERT_NEAR(p.z, a.z[i], 1e-12);
   }
+}
+
+TEST(EngineMesh, BlueSpreadsTheSamplesForAnyThreadCount) {
+  // A unit icosphere: chord distances against the hexagonal spacing on its
+  // own area (a little under 4 pi).
+  const TriangleMesh sphere = MakeIcosphere(4);
+  double area = 0;
+  for (const auto& t : sphere.triangles) {
+    const Vec3& a = sphere.positions[t[0]];
+    area += Norm(Cross(sphere.positions[t[1]] - a, sphere.positions[t[2]] - a)) / 2;
+  }
+  const std::string path = WriteTemp("engine_mesh_blue.ply", MeshToPly(sphere, true));
+  DirectTreeSource source;
+  FileModelSource files;
+  EngineLimits one, three;
+  one.generation_threads = 1, three.generation_threads = 3;
+  SamplingEngine a(RegisteredSurfaceKinds(), {one}, &source, &files);
+  SamplingEngine b(RegisteredSurfaceKinds(), {three}, &source, &files);
+  SampleRequest r = MeshRequest("ply:" + path, 4096);
+  r.sequence = SequenceKind::kBlue;
+  const SampleBatch x = DrawAll(a, r);
+  const SampleBatch y = DrawAll(b, r);
+  ASSERT_EQ(x.size(), 4096u);
+  EXPECT_EQ(x.x, y.x);
+  EXPECT_EQ(x.triangle, y.triangle);
+  double nearest_min = 1e300, nearest_sum = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    double nearest = 1e300;
+    for (size_t j = 0; j < x.size(); ++j) {
+      if (j == i) continue;
+      const Vec3 d{x.x[i] - x.x[j], x.y[i] - x.y[j], x.z[i] - x.z[j]};
+      nearest = std::min(nearest, Dot(d, d));
+    }
+    nearest_min = std::min(nearest_min, std::sqrt(nearest));
+    nearest_sum += std::sqrt(nearest);
+  }
+  const double hex = std::sqrt(2 * area / (std::sqrt(3.0) * 4096));
+  // Jittered: about 0.06 and 0.56.
+  EXPECT_GE(nearest_min / hex, 0.72);
+  EXPECT_GE(nearest_sum / 4096 / hex, 0.79);
 }
 
 TEST(EngineMesh, LargeBatchesOnTwoThreadsAreTheSameSamples) {

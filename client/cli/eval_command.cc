@@ -35,10 +35,12 @@ struct EvalFlags {
   ConnectionFlags connection;
 };
 
-// The whole jittered set of `count` samples (seed `seed`) of the surface and density.
+// The whole set of `count` samples (seed `seed`) of the surface and density.
 absl::StatusOr<SampleBatch> WholeSet(SampleSource& source, const std::string& surface,
-                                     const std::string& density, uint64_t count, uint64_t seed) {
+                                     const std::string& density, uint64_t count, uint64_t seed,
+                                     SequenceKind sequence = SequenceKind::kJittered) {
   SampleRequest request;
+  request.sequence = sequence;
   request.tree.surface = surface;
   request.tree.density = density;
   request.count = count;
@@ -104,8 +106,8 @@ int RunEval(const EvalFlags& f) {
   if (WantsSection(f.quality, "quality")) {
     // Every set of the report in full.
     auto sets = [&source](const std::string& surface, const std::string& density, uint64_t count,
-                          uint64_t seed) {
-      return WholeSet(*source, surface, density, count, seed);
+                          uint64_t seed, SequenceKind sequence) {
+      return WholeSet(*source, surface, density, count, seed, sequence);
     };
     if (const int rc = RunEvalQuality(f.quality, f.setting == "full", f.out_dir, sets); rc != 0)
       return rc;

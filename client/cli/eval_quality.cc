@@ -58,9 +58,9 @@ int RunEvalQuality(const EvalQualityFlags& flags, bool full, const std::string& 
     std::fprintf(stderr, "error: %s\n", std::string(report.status().message()).c_str());
     return 1;
   }
-  const std::string text = absl::StrFormat(
-      "# Quality report (issue 19), setting %s\n\n%s## Summary\n\n%s", full ? "full" : "fast",
-      report->tables, QualitySummary(report->checks));
+  const std::string text =
+      absl::StrFormat("# Quality report (issue 19), setting %s\n\n%s## Summary\n\n%s",
+                      full ? "full" : "fast", report->tables, QualitySummary(report->checks));
   std::printf("%s\n", text.c_str());
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
@@ -69,7 +69,16 @@ int RunEvalQuality(const EvalQualityFlags& flags, bool full, const std::string& 
     std::fprintf(stderr, "error: cannot write %s/quality.md\n", out_dir.c_str());
     return 1;
   }
-  std::fprintf(stderr, "wrote %s/quality.md\n", out_dir.c_str());
+  for (const auto& [name, svg] : report->pictures) {
+    const std::string path = out_dir + "/" + name;
+    std::FILE* picture = std::fopen(path.c_str(), "w");
+    if (!picture || std::fputs(svg.c_str(), picture) < 0 || std::fclose(picture) != 0) {
+      std::fprintf(stderr, "error: cannot write %s\n", path.c_str());
+      return 1;
+    }
+  }
+  std::fprintf(stderr, "wrote %s/quality.md and %d pictures\n", out_dir.c_str(),
+               static_cast<int>(report->pictures.size()));
   return 0;
 }
 

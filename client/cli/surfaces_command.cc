@@ -31,7 +31,7 @@ int RunSurfaces() {
       "\ncurves (--curve): hilbert (2x2), hilbert2 (3x3 meander), peano (3x3 serpentine)\n");
   std::printf(
       "sequences (--sequence): jittered (default), equal, random, vandercorput, progressive, "
-      "sobol\n");
+      "blue, sobol\n");
   std::printf("estimators (--estimator): triangle (a), square (b), fff (c, default), quadrature\n");
   return 0;
 }

@@ -14,6 +14,8 @@ std::string_view SequenceName(SequenceKind kind) {
       return "vandercorput";
     case SequenceKind::kProgressive:
       return "progressive";
+    case SequenceKind::kBlue:
+      return "blue";
     case SequenceKind::kSobol:
       return "sobol";
   }
@@ -23,7 +25,7 @@ std::string_view SequenceName(SequenceKind kind) {
 std::optional<SequenceKind> SequenceFromName(std::string_view name) {
   for (SequenceKind k : {SequenceKind::kJittered, SequenceKind::kEqual, SequenceKind::kRandom,
                          SequenceKind::kVanDerCorput, SequenceKind::kProgressive,
-                         SequenceKind::kSobol}) {
+                         SequenceKind::kBlue, SequenceKind::kSobol}) {
     if (name == SequenceName(k)) return k;
   }
   return std::nullopt;

@@ -15,6 +15,9 @@ enum class SequenceKind {
   kVanDerCorput,  // q_k = base-2 radical inverse of k
   kProgressive,   // Owen-scrambled base-2 radical inverse: every prefix of
                   // length 2^m puts exactly one q in each [j/2^m, (j+1)/2^m)
+  kBlue,          // q_k = (k + h_k) / N, h_k in [0, 1) chosen by a relaxation of
+                  // the whole set so that samples keep apart in 3D (blue noise;
+                  // core/blue_relaxation.h)
   kSobol,         // an Owen-scrambled 2D Sobol (0,2)-sequence in the unit
                   // square, warped through the tree onto the surface
                   // (core/tree_warp.h); q_k is its first coordinate
@@ -23,10 +26,11 @@ enum class SequenceKind {
 std::string_view SequenceName(SequenceKind kind);  // "jittered", "equal", ...
 std::optional<SequenceKind> SequenceFromName(std::string_view name);
 
-// Whether q_k grows with k (jittered, equal): such a sequence is in curve
+// Whether q_k grows with k (jittered, equal, blue): such a sequence is in curve
 // order as it is; the others are sorted per request.
 inline bool SequenceIsMonotone(SequenceKind kind) {
-  return kind == SequenceKind::kJittered || kind == SequenceKind::kEqual;
+  return kind == SequenceKind::kJittered || kind == SequenceKind::kEqual ||
+         kind == SequenceKind::kBlue;
 }
 
 // Whether a sample is a point of the unit square warped onto the surface

@@ -73,7 +73,8 @@ curve: hilbert | hilbert2 | peano.  estimator: triangle | square | fff | quadrat
 tolerance: the paper's a (0 = 1% of the bounding-box diagonal).  depth_cap: the
 paper's r (0 = deepest).  rho: max samples' worth of mass per leaf.
 count: N, the size of the whole set.  seed: random seed.
-sequence: jittered | equal | random | vandercorput | progressive | sobol.
+sequence: jittered | equal | random | vandercorput | progressive | blue
+(evenly spaced, biased for integration) | sobol (integration).
 tree_count: size the tree for this many samples (0 = count).
 begin, end: index range [begin, end) (end 0 = count); or shard "i/K" or (i, K).
 region: "uv:U0,U1,V0,V1" or "box:X0,Y0,Z0,X1,Y1,Z1" (only samples inside).

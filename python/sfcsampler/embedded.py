@@ -124,7 +124,8 @@ def sample(*, precision="float64", threads=0, **request):
       curve="hilbert"                       hilbert | hilbert2 | peano
       sequence="jittered"                   jittered | equal | random |
                                             vandercorput | progressive |
-                                            sobol
+                                            blue (evenly spaced; not for
+                                            integration) | sobol
       estimator="fff", tolerance=0, depth_cap=0, rho=1.0, tree_count=0
       begin=0, end=0                        the index range [begin, end) (0 = count)
       shard=None                            "i/K" or (i, K)

@@ -1,0 +1,450 @@
+#include "core/blue_relaxation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include "absl/strings/str_format.h"
+#include "base/counter_hash.h"
+#include "base/status_macros.h"
+#include "base/worker_pool.h"
+#include "core/sequence.h"
+
+namespace sfc {
+namespace {
+
+// The counter-hash stream of the candidates (core/sequence.cc's streams are
+// small integers; this one is "blue" in ASCII, apart from them).
+constexpr uint64_t kCandidateStream = 0x626c7565;
+constexpr uint64_t kPriorityStream = 0x626c7566;
+// A sample's spacing is at most this many times the median spacing (where the
+// density vanishes at a point the spacing would be infinite).
+constexpr double kMaxSpacingRatio = 8;
+// Candidates are placed in rounds of this many per searching sample. Each
+// round is one batch through the cursor, which enters (and tabulates) the
+// leaf of every searching sample again: 16 took 35 % less time than 4 on the
+// sphere at 2*10^5, with the same set (a sample's choice depends on the
+// rounds only through exact ties of crowding between candidates).
+constexpr int kRound = 16;
+// A candidate whose density differs from the density at its sample's
+// jittered place by more than this factor is not taken.
+constexpr double kDensityJump = 1.25;
+
+// Points in a grid of cubic cells of side `cell`, hashed by Morton code: a
+// bucket array of cell lists in CSR form, each entry a copy of its point and radius (so a
+// query reads contiguous memory). An entry can be killed when its point
+// moves; the moved points are listed in a second grid.
+class HashGrid {
+ public:
+  // The low 21 bits of x, two zero bits between each.
+  static uint64_t Spread(int64_t x) {
+    uint64_t v = static_cast<uint64_t>(x) & 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffULL;
+    v = (v | v << 16) & 0x1f0000ff0000ffULL;
+    v = (v | v << 8) & 0x100f00f00f00f00fULL;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+    v = (v | v << 2) & 0x1249249249249249ULL;
+    return v;
+  }
+
+  static constexpr uint32_t kDead = ~uint32_t{0};
+  struct Entry {
+    Vec3 p;
+    double r;
+    uint32_t id;  // kDead: the point has moved
+  };
+
+  explicit HashGrid(double cell) : inv_cell_(1 / cell) {}
+
+  // Lists the points ids[i] at p[ids[i]] with radius r[ids[i]]; when `slots`
+  // is not null, (*slots)[ids[i]] is set to the point's entry.
+  void Build(const std::vector<Vec3>& p, const std::vector<double>& r,
+             const std::vector<uint32_t>& ids, std::vector<uint32_t>* slots) {
+    size_t buckets = 16;
+    while (buckets < 2 * ids.size()) buckets *= 2;
+    mask_ = buckets - 1;
+    start_.assign(buckets + 1, 0);
+    keys_.resize(ids.size());
+    for (size_t i = 0; i < ids.size(); ++i) {
+      const Vec3& x = p[ids[i]];
+      keys_[i] = Bucket(Cell(x.x), Cell(x.y), Cell(x.z));
+      ++start_[keys_[i] + 1];
+    }
+    for (size_t b = 0; b < buckets; ++b) start_[b + 1] += start_[b];
+    entries_.resize(ids.size());
+    std::vector<uint32_t> fill(start_.begin(), start_.end() - 1);
+    for (size_t i = 0; i < ids.size(); ++i) {
+      const uint32_t slot = fill[keys_[i]]++;
+      entries_[slot] = {p[ids[i]], r[ids[i]], ids[i]};
+      if (slots) (*slots)[ids[i]] = slot;
+    }
+  }
+  void Kill(uint32_t slot) { entries_[slot].id = kDead; }
+
+  int64_t Cell(double x) const { return static_cast<int64_t>(std::floor(x * inv_cell_)); }
+  // The cell's Morton code, cut to the table: neighbouring cells share
+  // cache lines, and so do the cells of queries made in curve order.
+  uint32_t Bucket(int64_t cx, int64_t cy, int64_t cz) const {
+    return static_cast<uint32_t>((Spread(cx) | Spread(cy) << 1 | Spread(cz) << 2) & mask_);
+  }
+  // Calls f(entry) for every live entry in the bucket of cell (cx, cy, cz)
+  // (and of the cells sharing it); stops and returns true when f does.
+  template <typename F>
+  bool AnyIn(int64_t cx, int64_t cy, int64_t cz, const F& f) const {
+    if (entries_.empty()) return false;
+    const uint32_t b = Bucket(cx, cy, cz);
+    for (uint32_t t = start_[b]; t < start_[b + 1]; ++t) {
+      if (entries_[t].id != kDead && f(entries_[t])) return true;
+    }
+    return false;
+  }
+
+ private:
+  double inv_cell_;
+  uint64_t mask_ = 0;
+  std::vector<uint32_t> start_, keys_;
+  std::vector<Entry> entries_;
+};
+
+class Relaxation {
+ public:
+  Relaxation(uint64_t count, uint64_t seed, const MassPlacer& place, int threads,
+             const BlueNoiseOptions& options)
+      : n_(count),
+        seed_(seed),
+        place_(place),
+        threads_(std::max(1, threads)),
+        options_(options),
+        main_(1),
+        moved_grid_(1) {}
+
+  absl::StatusOr<BlueNoiseSet> Run(double total_mass);
+
+ private:
+  // Calls f(j, (|x - p_j| / t_ij)^2) for the points p_j, j != i, of the
+  // grids closer to x than t_ij = rho min(d_i, d_j), x being the place of
+  // sample i (its own or a candidate's), until f returns true; returns
+  // whether it did.
+  template <typename F>
+  bool AnyNear(uint32_t i, const Vec3& x, const F& f) const;
+  // min(1, min_j (|x - p_j| / t_ij)^2): 1 when x clears every neighbour. May
+  // stop early with any value <= floor once one is found.
+  double Crowding(uint32_t i, const Vec3& x, double floor) const;
+  // Who of two samples of a colour that are too close moves in `sweep`.
+  uint64_t Priority(int sweep, uint32_t k) const {
+    return CounterHash(seed_, kPriorityStream, static_cast<uint64_t>(k) * options_.sweeps + sweep);
+  }
+  bool Conflicts(uint32_t i, const Vec3& x) const {
+    return AnyNear(i, x, [](uint32_t, double) { return true; });
+  }
+  // Runs f(part, begin, end) over at most `threads_` contiguous parts of
+  // [0, n), in parallel.
+  absl::Status ForParts(size_t n, const std::function<absl::Status(int, size_t, size_t)>& f) const;
+  // Half-sweep `sweep` of the samples `todo` (one colour): each either clears
+  // (suspect_ = 0), moves (new place in q_/p_, listed in *moved: to a place
+  // that clears every neighbour or, if none of its candidates does, to the
+  // least crowded one) or stays.
+  absl::Status HalfSweep(int sweep, const std::vector<uint32_t>& todo,
+                         std::vector<uint32_t>* moved);
+
+  const uint64_t n_, seed_;
+  const MassPlacer& place_;
+  const int threads_;
+  const BlueNoiseOptions options_;
+  std::vector<double> q_;
+  std::vector<Vec3> p_;
+  std::vector<double> r_;         // rho d_i
+  std::vector<uint8_t> suspect_;  // may be too close to a neighbour
+  std::vector<uint8_t> in_todo_;  // in the half-sweep's list (constant during it)
+  std::vector<double> delta_;     // the density at each sample's jittered place
+  bool uniform_density_ = true;   // all of delta_ alike: candidates need none
+  HashGrid main_, moved_grid_;
+};
+
+absl::Status Relaxation::ForParts(size_t n,
+                                  const std::function<absl::Status(int, size_t, size_t)>& f) const {
+  const int parts = static_cast<int>(std::min<size_t>(threads_, std::max<size_t>(1, n / 1024)));
+  if (parts <= 1) return f(0, 0, n);
+  std::vector<absl::Status> status(parts);
+  WorkerPool::Shared().ParallelFor(
+      parts, [&](int t) { status[t] = f(t, n * t / parts, n * (t + 1) / parts); });
+  for (const absl::Status& st : status) RETURN_IF_ERROR(st);
+  return absl::OkStatus();
+}
+
+template <typename F>
+bool Relaxation::AnyNear(uint32_t i, const Vec3& x, const F& f) const {
+  const double ri = r_[i];
+  // Every cell that meets the cube of side 2 r_i around x (two a side when
+  // r_i is at most half a cell).
+  const int64_t x0 = main_.Cell(x.x - ri), x1 = main_.Cell(x.x + ri);
+  const int64_t y0 = main_.Cell(x.y - ri), y1 = main_.Cell(x.y + ri);
+  const int64_t z0 = main_.Cell(x.z - ri), z1 = main_.Cell(x.z + ri);
+  const auto visit = [&](const HashGrid::Entry& e) {
+    if (e.id == i) return false;
+    const double r = std::min(ri, e.r);
+    const Vec3 d = e.p - x;
+    const double d2 = Dot(d, d);
+    return d2 < r * r && f(e.id, d2 / (r * r));
+  };
+  for (int64_t a = x0; a <= x1; ++a) {
+    for (int64_t b = y0; b <= y1; ++b) {
+      for (int64_t c = z0; c <= z1; ++c) {
+        if (main_.AnyIn(a, b, c, visit) || moved_grid_.AnyIn(a, b, c, visit)) return true;
+      }
+    }
+  }
+  return false;
+}
+
+double Relaxation::Crowding(uint32_t i, const Vec3& x, double floor) const {
+  double worst = 1;
+  AnyNear(i, x, [&](uint32_t, double ratio2) {
+    worst = std::min(worst, ratio2);
+    return worst <= floor;
+  });
+  return worst;
+}
+
+absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
+                                   std::vector<uint32_t>* moved) {
+  const uint64_t candidates = static_cast<uint64_t>(options_.candidates);
+  // Most samples are crowded in the first sweeps, and few candidates help
+  // them as much as many; the few left later get all C.
+  const uint64_t tries = std::min<uint64_t>(
+      candidates, static_cast<uint64_t>(options_.first_candidates) << std::min(sweep, 20));
+  std::vector<uint8_t> moves(todo.size(), 0);
+  std::vector<double> new_q(todo.size());
+  std::vector<Vec3> new_p(todo.size());
+  RETURN_IF_ERROR(ForParts(todo.size(), [&](int, size_t begin, size_t end) -> absl::Status {
+    // The part's samples that are too close, in index order, with the
+    // crowding of their best place so far (their own at first).
+    struct Search {
+      uint32_t t;
+      double best;
+      double q;
+      Vec3 p;
+    };
+    std::vector<Search> searching;
+    for (size_t t = begin; t < end; ++t) {
+      const uint32_t k = todo[t];
+      // Two samples of the colour that are too close would both move, each
+      // away from where the other was, and may meet again: only the one of
+      // higher priority moves this sweep.
+      double c = 1;
+      bool waits = false;
+      const uint64_t mine = Priority(sweep, k);
+      AnyNear(k, p_[k], [&](uint32_t j, double ratio2) {
+        c = std::min(c, ratio2);
+        waits = in_todo_[j] && Priority(sweep, j) > mine;
+        return waits;
+      });
+      if (c >= 1) {
+        suspect_[k] = 0;
+      } else if (!waits) {
+        searching.push_back({static_cast<uint32_t>(t), c, q_[k], p_[k]});
+      }
+    }
+    std::vector<std::pair<double, int>> h(kRound);
+    std::vector<double> cq;
+    std::vector<int> cj;
+    std::vector<Vec3> cp;
+    std::vector<double> cd;
+    std::vector<Search> still;
+    for (uint64_t j0 = 0; j0 < tries && !searching.empty(); j0 += kRound) {
+      const int m = static_cast<int>(std::min<uint64_t>(kRound, tries - j0));
+      // Candidates j0 .. j0 + m - 1 of every searching sample, sorted inside
+      // each sample's stratum so that the batch's q do not decrease.
+      cq.clear(), cj.clear();
+      for (const Search& s : searching) {
+        const uint64_t k = todo[s.t];
+        for (int j = 0; j < m; ++j) {
+          const uint64_t counter = (k * options_.sweeps + sweep) * candidates + j0 + j;
+          h[j] = {CounterUniform(seed_, kCandidateStream, counter), j};
+        }
+        std::sort(h.begin(), h.begin() + m);
+        for (int j = 0; j < m; ++j) {
+          cq.push_back((static_cast<double>(k) + h[j].first) / static_cast<double>(n_));
+          cj.push_back(h[j].second);
+        }
+      }
+      cp.resize(cq.size());
+      cd.resize(uniform_density_ ? 0 : cq.size());
+      RETURN_IF_ERROR(
+          place_(cq.data(), cq.size(), cp.data(), uniform_density_ ? nullptr : cd.data()));
+      // A sample takes its first candidate, in j order, that clears every
+      // neighbour; failing that, after all C, the least crowded one.
+      still.clear();
+      for (size_t s = 0; s < searching.size(); ++s) {
+        Search& search = searching[s];
+        const uint32_t k = todo[search.t];
+        int first = -1;
+        for (int j = 0; j < m; ++j) {
+          const size_t c = s * m + j;
+          if (!IsFinite(cp[c])) return absl::InvalidArgumentError("a candidate is not finite");
+          if (first >= 0 && cj[c] > cj[s * m + first]) continue;
+          // Across a density step a stratum's sample would drift to the
+          // sparse side, where it is less crowded: it stays where the
+          // density is within kDensityJump of its jittered place's.
+          if (!uniform_density_ &&
+              !(cd[c] * kDensityJump >= delta_[k] && cd[c] <= kDensityJump * delta_[k])) {
+            continue;
+          }
+          const double crowding = Crowding(k, cp[c], search.best);
+          if (crowding >= 1) {
+            first = j;
+          } else if (first < 0 && crowding > search.best) {
+            // Ties go to the first in the batch's (hashed) order.
+            search.best = crowding, search.q = cq[c], search.p = cp[c];
+          }
+        }
+        if (first >= 0) {
+          moves[search.t] = 1, new_q[search.t] = cq[s * m + first];
+          new_p[search.t] = cp[s * m + first];
+        } else {
+          still.push_back(search);
+        }
+      }
+      std::swap(searching, still);
+    }
+    for (const Search& search : searching) {
+      if (search.q == q_[todo[search.t]]) continue;  // nothing less crowded than its place
+      moves[search.t] = 1, new_q[search.t] = search.q, new_p[search.t] = search.p;
+    }
+    return absl::OkStatus();
+  }));
+  // Jacobi: the colour's moves take effect together.
+  for (size_t t = 0; t < todo.size(); ++t) {
+    if (!moves[t]) continue;
+    q_[todo[t]] = new_q[t], p_[todo[t]] = new_p[t];
+    moved->push_back(todo[t]);
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<BlueNoiseSet> Relaxation::Run(double total_mass) {
+  if (!(options_.rho > 0 && options_.rho <= 0.9) || options_.sweeps < 1 ||
+      options_.candidates < 1 || options_.first_candidates < 1) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "blue noise needs 0 < rho <= 0.9, sweeps >= 1 and candidates >= 1 (got %g, %d, %d, %d)",
+        options_.rho, options_.sweeps, options_.first_candidates, options_.candidates));
+  }
+  if (n_ >= std::numeric_limits<uint32_t>::max()) {
+    return absl::InvalidArgumentError("blue noise takes fewer than 2^32 samples");
+  }
+  // The jittered set and the density at its points.
+  q_.resize(n_);
+  Sequence(SequenceKind::kJittered, n_, seed_).AtMany(0, n_, q_.data());
+
+  p_.resize(n_);
+  std::vector<double>& delta = delta_;
+  delta.resize(n_);
+  RETURN_IF_ERROR(ForParts(n_, [&](int, size_t begin, size_t end) {
+    return place_(q_.data() + begin, end - begin, p_.data() + begin, delta.data() + begin);
+  }));
+  uniform_density_ =
+      std::all_of(delta.begin(), delta.end(), [&](double x) { return x == delta[0]; });
+  // Spacing: the hexagonal packing's nearest-neighbour distance for the area
+  // a sample has at its density, sqrt(2 a / sqrt 3) with a = S_M / (N delta).
+  const double per_sample = total_mass / static_cast<double>(n_);
+  std::vector<double> d(n_);
+  for (uint64_t i = 0; i < n_; ++i) {
+    if (!IsFinite(p_[i]) || !std::isfinite(delta[i]) || delta[i] < 0) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("blue noise: sample %d has a point or density that is not finite", i));
+    }
+    d[i] = delta[i] > 0 ? std::sqrt(2 * per_sample / (std::sqrt(3.0) * delta[i]))
+                        : std::numeric_limits<double>::infinity();
+  }
+  std::vector<double> sorted = d;
+  std::nth_element(sorted.begin(), sorted.begin() + n_ / 2, sorted.end());
+  const double median = sorted[n_ / 2];
+  if (!(median > 0 && std::isfinite(median))) {
+    return absl::InvalidArgumentError("blue noise: the density is zero at most samples");
+  }
+  r_.resize(n_);
+  for (uint64_t i = 0; i < n_; ++i)
+    r_[i] = options_.rho * std::min(d[i], kMaxSpacingRatio * median);
+  // Cells of twice the median radius: a query meets 2 x 2 x 2 of them.
+  const double cell = 2 * options_.rho * median;
+
+  suspect_.assign(n_, 1);
+  in_todo_.assign(n_, 0);
+  // The points in `main_` as they were at its build, but for those that
+  // moved since (moved_since_build, listed at their current place in
+  // moved_grid_).
+  std::vector<uint32_t> all(n_), slot(n_), moved_since_build, colour, moved;
+  std::vector<uint8_t> moved_flag(n_, 0), ever_moved(n_, 0);
+  for (uint32_t i = 0; i < n_; ++i) all[i] = i;
+  main_ = HashGrid(cell);
+  moved_grid_ = HashGrid(cell);
+  main_.Build(p_, r_, all, &slot);
+  for (int sweep = 0; sweep < options_.sweeps; ++sweep) {
+    if (moved_since_build.size() > n_ / 8) {
+      main_.Build(p_, r_, all, &slot);
+      for (uint32_t i : moved_since_build) moved_flag[i] = 0;
+      moved_since_build.clear();
+      moved_grid_ = HashGrid(cell);
+    }
+    for (uint32_t c = 0; c < 2; ++c) {
+      colour.clear();
+      for (uint32_t i = c; i < n_; i += 2) {
+        if (suspect_[i]) colour.push_back(i);
+      }
+      if (colour.empty()) continue;
+      moved.clear();
+      for (uint32_t i : colour) in_todo_[i] = 1;
+      RETURN_IF_ERROR(HalfSweep(sweep, colour, &moved));
+      for (uint32_t i : colour) in_todo_[i] = 0;
+      if (moved.empty()) continue;
+      for (uint32_t i : moved) {
+        ever_moved[i] = 1;
+        if (moved_flag[i]) continue;
+        moved_flag[i] = 1;
+        main_.Kill(slot[i]);
+        moved_since_build.push_back(i);
+      }
+      moved_grid_.Build(p_, r_, moved_since_build, nullptr);
+      // A sample that moved to a place clearing every neighbour can be too
+      // close only to another that moved with it; one that moved to its
+      // least crowded candidate is too close to some: both are suspects.
+      std::vector<std::vector<uint32_t>> close(threads_);
+      RETURN_IF_ERROR(ForParts(moved.size(), [&](int part, size_t begin, size_t end) {
+        std::vector<uint32_t>& mine = close[part];
+        for (size_t t = begin; t < end; ++t) {
+          const uint32_t k = moved[t];
+          suspect_[k] = 0;
+          AnyNear(k, p_[k], [&](uint32_t j, double) {
+            mine.push_back(k), mine.push_back(j);
+            return false;
+          });
+        }
+        return absl::OkStatus();
+      }));
+      for (const std::vector<uint32_t>& part : close) {
+        for (uint32_t k : part) suspect_[k] = 1;
+      }
+    }
+  }
+  BlueNoiseSet out;
+  for (uint64_t i = 0; i < n_; ++i) {
+    out.moved += ever_moved[i];
+    // Suspects are re-checked: one may have been cleared by a neighbour's move.
+    if (suspect_[i] && Conflicts(static_cast<uint32_t>(i), p_[i])) ++out.unresolved;
+  }
+  out.q = std::make_shared<const std::vector<double>>(std::move(q_));
+  return out;
+}
+
+}  // namespace
+
+absl::StatusOr<BlueNoiseSet> RelaxBlueNoise(uint64_t count, uint64_t seed, double total_mass,
+                                            const MassPlacer& place, int threads,
+                                            const BlueNoiseOptions& options) {
+  if (count == 0) return absl::InvalidArgumentError("blue noise needs count >= 1");
+  Relaxation relaxation(count, seed, place, threads, options);
+  return relaxation.Run(total_mass);
+}
+
+}  // namespace sfc

@@ -1,0 +1,168 @@
+// The blue sequence through the engine (issue 35): exact N and strata kept,
+// samples apart by the hexagonal spacing's share asked for (plane, sphere),
+// the density's mass split kept, the same bytes for any thread count, and
+// shards, ranges and regions equal to the whole run's samples.
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "core/blue_relaxation.h"
+#include "engine/sampling_engine.h"
+#include "evaluation/blue_noise.h"
+#include "gtest/gtest.h"
+#include "kinds/registered_kinds.h"
+#include "tests/engine_helpers.h"
+
+namespace sfc {
+namespace {
+
+struct Engine {
+  DirectTreeSource source;
+  SamplingEngine engine;
+  explicit Engine(int threads = 1) : engine(RegisteredSurfaceKinds(), Limits(threads), &source) {}
+  static EngineLimits Limits(int threads) {
+    EngineLimits limits;
+    limits.generation_threads = threads;
+    return limits;
+  }
+};
+
+SampleRequest Blue(const std::string& surface, uint64_t count, uint64_t seed,
+                   const std::string& density = "uniform") {
+  SampleRequest r;
+  r.tree.surface = surface;
+  r.tree.density = density;
+  r.count = count;
+  r.seed = seed;
+  r.sequence = SequenceKind::kBlue;
+  return r;
+}
+
+void ExpectSameBytes(const SampleBatch& a, const SampleBatch& b) {
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(a.index, b.index);
+  EXPECT_EQ(a.u, b.u);
+  EXPECT_EQ(a.v, b.v);
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(a.y, b.y);
+  EXPECT_EQ(a.z, b.z);
+}
+
+TEST(BlueSequence, PlaneKeepsExactCountAndSpacing) {
+  Engine e;
+  for (uint64_t seed : {1, 2}) {
+    const SampleBatch b = DrawAll(e.engine, Blue("plane", 4096, seed));
+    ASSERT_EQ(b.size(), 4096u);
+    for (size_t i = 0; i < b.size(); ++i) ASSERT_EQ(b.index[i], i);
+    std::vector<Point2> p;
+    for (size_t i = 0; i < b.size(); ++i) p.push_back({b.u[i], b.v[i]});
+    const NearestNeighbour blue = PlaneNearestNeighbour(p);
+    // rho = 0.8 asked; the issue's figures are 0.75 and 0.80 (jittered:
+    // 0.04 and 0.59).
+    EXPECT_GE(blue.min, 0.75) << "seed " << seed;
+    EXPECT_GE(blue.mean, 0.80) << "seed " << seed;
+  }
+}
+
+TEST(BlueSequence, SphereChordSpacing) {
+  Engine e;
+  const SampleBatch b = DrawAll(e.engine, Blue("sphere", 4096, 3));
+  ASSERT_EQ(b.size(), 4096u);
+  std::vector<Vec3> p;
+  for (size_t i = 0; i < b.size(); ++i) p.push_back({b.x[i], b.y[i], b.z[i]});
+  const NearestNeighbour blue = SphereNearestNeighbour(p);
+  EXPECT_GE(blue.min, 0.72);
+  EXPECT_GE(blue.mean, 0.79);
+}
+
+TEST(BlueSequence, EverySampleStaysInItsStratum) {
+  // The blue set's q_k against its strata: sample k's mass coordinate lies
+  // in [k/N, (k+1)/N], so every prefix of the curve holds exactly its share.
+  const uint64_t n = 2000;
+  const MassPlacer plane = [](const double* q, size_t m, Vec3* p, double* density) {
+    // The unit interval wound onto 40 rows of the unit square: a surface
+    // whose curve is far from its 3D neighbours at every row's end.
+    for (size_t i = 0; i < m; ++i) {
+      const double t = q[i] * 40, row = std::floor(t);
+      const double along = (static_cast<int>(row) % 2 == 0) ? t - row : 1 - (t - row);
+      p[i] = {along, row / 40, 0};
+      if (density) density[i] = 1;
+    }
+    return absl::OkStatus();
+  };
+  auto set = RelaxBlueNoise(n, 5, 1.0, plane, 2);
+  ASSERT_TRUE(set.ok()) << set.status();
+  ASSERT_EQ(set->q->size(), n);
+  for (uint64_t k = 0; k < n; ++k) {
+    ASSERT_GE((*set->q)[k], static_cast<double>(k) / n) << k;
+    ASSERT_LE((*set->q)[k], static_cast<double>(k + 1) / n) << k;
+  }
+  EXPECT_GT(set->moved, n / 4);
+  // Dependence on threads: none.
+  auto one = RelaxBlueNoise(n, 5, 1.0, plane, 1);
+  ASSERT_TRUE(one.ok());
+  EXPECT_EQ(*one->q, *set->q);
+  EXPECT_EQ(one->unresolved, set->unresolved);
+}
+
+TEST(BlueSequence, DensityKeepsItsMassSplit) {
+  // delta = u + v on the unit square: u < 0.3 holds 0.195 of the mass (not
+  // u < 1/2, a union of whole runs of the curve, exact for any strata).
+  Engine e;
+  const uint64_t n = 20000;
+  const SampleBatch b = DrawAll(e.engine, Blue("plane", n, 4, "expr:u+v"));
+  ASSERT_EQ(b.size(), n);
+  size_t left = 0;
+  for (double u : b.u) left += u < 0.3;
+  EXPECT_NEAR(static_cast<double>(left) / n, 0.195, 0.001);
+}
+
+TEST(BlueSequence, SameBytesForAnyThreadCount) {
+  Engine one(1), three(3);
+  const SampleRequest r = Blue("torus:R=1;r=0.4", 20000, 6, "gaussian:floor=0.1");
+  ExpectSameBytes(DrawAll(one.engine, r), DrawAll(three.engine, r));
+}
+
+TEST(BlueSequence, ShardsRangesAndRegionsAreTheWholeRun) {
+  Engine e(2);
+  const SampleRequest whole_request = Blue("torus:R=1;r=0.4", 6000, 9);
+  const SampleBatch whole = DrawAll(e.engine, whole_request);
+  ASSERT_EQ(whole.size(), 6000u);
+  SampleBatch shards;
+  for (uint32_t s = 0; s < 8; ++s) {
+    SampleRequest r = whole_request;
+    r.shard_index = s, r.shard_count = 8;
+    shards.Append(DrawAll(e.engine, r));
+  }
+  ExpectSameBytes(whole, shards);
+
+  SampleRequest range = whole_request;
+  range.begin = 1501, range.end = 3777;
+  SampleBatch expected;
+  expected.AppendFrom(whole, 1501, 3777);
+  ExpectSameBytes(DrawAll(e.engine, range), expected);
+
+  SampleRequest box = whole_request;
+  box.region.kind = Region::Kind::kBox;
+  box.region.lo = {0, 0, -1}, box.region.hi = {2, 2, 1};
+  SampleBatch inside;
+  for (size_t i = 0; i < whole.size(); ++i) {
+    if (whole.x[i] >= 0 && whole.x[i] <= 2 && whole.y[i] >= 0 && whole.y[i] <= 2)
+      inside.AppendFrom(whole, i, i + 1);
+  }
+  ExpectSameBytes(DrawAll(e.engine, box), inside);
+}
+
+TEST(BlueSequence, TooLargeACountIsInvalidArgument) {
+  DirectTreeSource source;
+  EngineLimits limits;
+  limits.max_blue_count = 1000;
+  SamplingEngine engine(RegisteredSurfaceKinds(), limits, &source);
+  const auto job = engine.Start(Blue("plane", 1001, 1));
+  ASSERT_FALSE(job.ok());
+  EXPECT_EQ(job.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(job.status().message().find("max_blue_count"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sfc
