@@ -64,8 +64,9 @@ class LeafWalk {
   static constexpr double kNegligibleSamples = 1.0 / 8;
   // A table's cells carry at most this many samples on average. Inside a
   // cell the sample follows the curve and the mass's slope (FollowSlope);
-  // what it misses is of second order in the cell's side (docs/QUALITY.md,
-  // the Monte Carlo check beside singular lines).
+  // what it misses is of second order in the cell's side: the Monte Carlo
+  // check beside singular lines gives the same figures at 1/4, 1, 2 and 4
+  // samples a cell (docs/QUALITY.md, "Placement that follows the slope").
   static constexpr double kCellSamples = 2;
   // A table cell carrying at least this many samples gets a table of its own.
   static constexpr double kTableSamples = 4 * kCellSamples;
@@ -94,9 +95,9 @@ class LeafWalk {
   // the coordinates the walk descends in), its orientation, its start and
   // share along the leaf's curve (fractions of the leaf's span), and how many
   // curve levels below the leaf it is.
-  // mass, gx, gy: the slope of the mass across the square along each axis
-  // is gx / mass, gy / mass, for FollowSlope (gx = gy = 0: uniform, where no
-  // model table reached it).
+  // mass, gx, gy: FollowSlope's p and q along x and y, the density across
+  // the square along x being 1 + (gx / mass)(2s - 1) at fraction s (gx = gy
+  // = 0: uniform, where no model table reached the square).
   struct Square {
     double t0, t1, x0, y0, side, pos, span, mass, gx, gy;
     int state;
