@@ -5,6 +5,7 @@
 #include <string>
 
 #include "benchmark/benchmark.h"
+#include "catalog/catalog.h"
 #include "core/builtin_surfaces.h"
 #include "core/curve_tree.h"
 #include "core/density.h"
@@ -90,6 +91,32 @@ BENCHMARK(BM_SampleFromBuiltTree)
     ->Args({static_cast<int>(CurveType::kHilbert), 0})
     ->Args({static_cast<int>(CurveType::kHilbert), 1})
     ->Args({static_cast<int>(CurveType::kHilbert2), 0})
+    ->Unit(benchmark::kMillisecond);
+
+// Per-sample cost from a built tree on several surfaces (uniform density,
+// Hilbert, one thread), at N = 10^6 and just above a power of two, N = 2^23 + 1
+// (a tree of grade 2^24: tables sized for twice the samples). First argument:
+// the surface, kSpecSurfaces[i]; second: N.
+constexpr const char* kSpecSurfaces[] = {"sphere", "torus", "superellipsoid",
+                                         "expr:x=u;y=v;z=0.3*sin(6*u)*cos(4*v)"};
+void BM_SampleSurface(benchmark::State& state) {
+  const char* spec = kSpecSurfaces[state.range(0)];
+  const uint64_t n = static_cast<uint64_t>(state.range(1));
+  auto surface = MakeSurface(spec)->surface;
+  auto density = Uniform();
+  auto tree = *CurveTree::Build(*surface, *density, {}, CurveTree::GradeFor(n));
+  auto sampler = std::make_shared<const Sampler>(tree, surface, density,
+                                                 Sequence(SequenceKind::kJittered, n, 1));
+  SampleBatch batch;
+  for (auto _ : state) {
+    auto cursor = *SampleCursor::Create(sampler, 0, n, {}, {});
+    benchmark::DoNotOptimize(Drain(*cursor, batch));
+  }
+  state.SetItemsProcessed(state.iterations() * n);
+  state.SetLabel(spec);
+}
+BENCHMARK(BM_SampleSurface)
+    ->ArgsProduct({{0, 1, 2, 3}, {kMillion, (1 << 23) + 1}})
     ->Unit(benchmark::kMillisecond);
 
 // The same generation on `threads` threads of the shared pool (wall time):

@@ -90,35 +90,51 @@ void ComputeGridFactors(const LeafModel& model, LeafModel::Kind kind, int grid, 
   const int factors = quadratic ? 3 : grid;
   out->factors = factors;
   const double step = side / n;
-  // f[axis][b][k]: the integral of factor b along `axis` over its cell k.
-  double f[2][3][kMaxGridCells];
+  // f[axis][b][k]: the integral of factor b along `axis` over its cell k;
+  // low[axis][b][k] over the cell's lower half.
+  double f[2][3][kMaxGridCells], low[2][3][kMaxGridCells];
+  auto integrals = [&](double a, double b, double* out_factors) {
+    if (quadratic) {
+      leaf_model_internal::BasisIntegrals(a, b, out_factors);
+    } else {
+      const double piece = 1.0 / grid;
+      for (int c = 0; c < grid; ++c) out_factors[c] = Overlap(a, b, c * piece, (c + 1) * piece);
+    }
+  };
   for (int axis = 0; axis < 2; ++axis) {
     const double origin = axis == 0 ? x0 : y0;
     double edge[kMaxGridCells + 1];
     for (int k = 0; k <= n; ++k) edge[k] = origin + k * step;
-    if (quadratic && model.warp[axis].power < 1) {
-      // Descended in leaf coordinates: the cells' images in warped ones.
+    // Descended in leaf coordinates: the cells' images in warped ones, and
+    // no halves (the walk places uniformly in warped coordinates there).
+    const bool unwarp = quadratic && model.warp[axis].power < 1;
+    if (unwarp) {
       for (int k = 0; k <= n; ++k) edge[k] = Unwarp(model.warp[axis], edge[k]);
     }
+    out->halves[axis] = !unwarp;
     for (int k = 0; k < n; ++k) {
-      if (quadratic) {
-        double basis[3];
-        leaf_model_internal::BasisIntegrals(edge[k], edge[k + 1], basis);
-        for (int b = 0; b < 3; ++b) f[axis][b][k] = basis[b];
-      } else {
-        const double piece = 1.0 / grid;
-        for (int b = 0; b < grid; ++b)
-          f[axis][b][k] = Overlap(edge[k], edge[k + 1], b * piece, (b + 1) * piece);
-      }
+      double values[3];
+      integrals(edge[k], edge[k + 1], values);
+      for (int b = 0; b < factors; ++b) f[axis][b][k] = values[b];
+      if (unwarp) continue;
+      integrals(edge[k], origin + (k + 0.5) * step, values);
+      for (int b = 0; b < factors; ++b) low[axis][b][k] = values[b];
     }
   }
   for (int a = 0; a < factors; ++a) {
     for (int i = 0; i < n; ++i) out->x[a][i] = f[0][a][i];
+    if (out->halves[0]) {
+      for (int i = 0; i < n; ++i) out->x_low[a][i] = low[0][a][i];
+    }
     for (int j = 0; j < n; ++j) {
-      double sum = 0;
-      for (int b = 0; b < factors; ++b)
-        sum += static_cast<double>(model.c[a * factors + b]) * f[1][b][j];
+      double sum = 0, sum_low = 0;
+      for (int b = 0; b < factors; ++b) {
+        const double c = model.c[a * factors + b];
+        sum += c * f[1][b][j];
+        if (out->halves[1]) sum_low += c * low[1][b][j];
+      }
       out->row[a][j] = sum;
+      out->row_low[a][j] = sum_low;
     }
   }
 }

@@ -181,13 +181,31 @@ inline constexpr int kMaxGridCells = 32;
 // the piecewise model), so ComputeGridFactors does the 1D integrals along
 // each axis once, and Integral(i, j) (sub-square i along x, j along y) is 3
 // products; a quadratic may give negative values where it dips below zero.
+// Along an axis the walk descends in (every axis but one whose power law
+// vanishes) it also keeps the integrals over each sub-square's lower half,
+// for the slope of the mass across it (LowerX, LowerY).
 struct GridFactors {
-  int factors;                     // 3 (quadratic) or the piecewise grid
-  double x[3][kMaxGridCells];      // x[a][i]: factor a's integral over column i
-  double row[3][kMaxGridCells];    // row[a][j] = sum_b c[a, b] (factor b's integral over row j)
+  int factors;                       // 3 (quadratic) or the piecewise grid
+  bool halves[2];                    // whether x_low (axis 0) and row_low (axis 1) are filled
+  double x[3][kMaxGridCells];        // x[a][i]: factor a's integral over column i
+  double row[3][kMaxGridCells];      // row[a][j] = sum_b c[a, b] (factor b's integral over row j)
+  double x_low[3][kMaxGridCells];    // the same over the lower half of column i
+  double row_low[3][kMaxGridCells];  // and of row j
   double Integral(int i, int j) const {
     double sum = 0;
     for (int a = 0; a < factors; ++a) sum += x[a][i] * row[a][j];
+    return sum;
+  }
+  // The integrals over the lower half of sub-square (i, j) along x and along
+  // y. REQUIRES: halves[0], halves[1] respectively.
+  double LowerX(int i, int j) const {
+    double sum = 0;
+    for (int a = 0; a < factors; ++a) sum += x_low[a][i] * row[a][j];
+    return sum;
+  }
+  double LowerY(int i, int j) const {
+    double sum = 0;
+    for (int a = 0; a < factors; ++a) sum += x[a][i] * row_low[a][j];
     return sum;
   }
 };

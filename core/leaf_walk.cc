@@ -10,6 +10,34 @@ namespace sfc {
 
 namespace {
 
+// The point at fraction f of [0, 1] under the linear density 1 + g (2s - 1)
+// with g = q / p (mean 1, slope 2g; p > 0 and |q| <= p keep it >= 0): the
+// root in [0, 1] of g s^2 + (1 - g) s = f, in the form without cancellation,
+// times p / p so that no division by p is needed per cell. Monotone in f, 0
+// at 0 and 1 at 1, and f itself for q = 0 (2fp / 2p, exact).
+double FollowSlope(double f, double p, double q) {
+  const double a = p - q;
+  return std::min(2 * f * p / (a + std::sqrt(a * a + 4 * q * f * p)), 1.0);
+}
+
+// Below this mass a cell is placed uniformly: FollowSlope squares p.
+constexpr double kLeastSlopedMass = 1e-150;
+
+// The q of FollowSlope, with p = mass, for a cell with `mass` and `lower` on
+// its lower half: the linear density with the same halves, clamped to stay
+// >= 0.
+double SlopeOf(double mass, double lower) {
+  return std::clamp(2 * (mass - 2 * lower), -mass, mass);
+}
+
+// Sizes `bounds` for `cells` cells and the scan_width entries of +inf past
+// them that LeafWalk::CellsAtOrBelow reads in whole windows; the cells'
+// entries are left for the caller to write, so its memory is reused as is.
+void SizeBounds(std::vector<double>& bounds, int cells, int scan_width) {
+  bounds.resize(cells + scan_width);
+  std::fill(bounds.begin() + cells, bounds.end(), std::numeric_limits<double>::infinity());
+}
+
 // The fewest curve levels whose cells number at least `cells` a side.
 int LevelsForCells(const Curve& curve, int cells) {
   int levels = 1;
@@ -35,6 +63,7 @@ LeafWalk::LeafWalk(const CurveTree& tree, const Surface& surface, const Density&
   int exponent;
   cells_power_of_two_ = std::frexp(continuation_cells_, &exponent) == 0.5;
   tables_.resize(kMaxModelLevels + 1);
+  factors_.resize(kMaxModelLevels + 1);
   last_positive_leaf_ = tree.leaf_count() - 1;
   while (last_positive_leaf_ > 0 &&
          !(tree.mass_end(last_positive_leaf_) > tree.mass_begin(last_positive_leaf_))) {
@@ -80,12 +109,13 @@ void LeafWalk::Enter(size_t l) {
            kind_ == LeafModel::Kind::kQuadratic && !warped_;
 }
 
-double LeafWalk::PlaceOnAxis(const AxisWarp& w, double x0, double side, double x) {
+double LeafWalk::PlaceOnAxis(const AxisWarp& w, double x0, double side, double f) {
+  const double x = x0 + f * side;
   if (w.power == 1) return x;
   if (DescendsWarped(w)) return Warp(w, x);  // the curve ran in warped coordinates
   // Uniform in warped coordinates inside the sub-cell [x0, x0 + side].
   const double s0 = Unwarp(w, x0), s1 = Unwarp(w, x0 + side);
-  return std::clamp(Warp(w, s0 + (x - x0) / side * (s1 - s0)), x0, x0 + side);
+  return std::clamp(Warp(w, s0 + f * (s1 - s0)), x0, x0 + side);
 }
 
 int LeafWalk::TableLevels(double carried, int depth) const {
@@ -97,19 +127,18 @@ int LeafWalk::TableLevels(double carried, int depth) const {
   return std::max(0, std::min(levels, most));
 }
 
-int LeafWalk::Tabulate(const Square& square, int levels, std::vector<double>& bounds) {
+int LeafWalk::Tabulate(const Square& square, int levels, std::vector<double>& bounds,
+                       GridFactors& factors) {
   const int n = static_cast<int>(curve_.PowG(levels));
   const int cells = n * n;
-  ComputeGridFactors(*model_, kind_, grid_, square.x0, square.y0, square.side, n, &factors_);
+  ComputeGridFactors(*model_, kind_, grid_, square.x0, square.y0, square.side, n, &factors);
   const Curve::Child* order = curve_.CellsInOrder(square.state, levels);
-  // kScanWidth more entries past the cells, +inf: LeafWalk::CellsAtOrBelow
-  // reads whole windows.
-  bounds.assign(cells + kScanWidth, std::numeric_limits<double>::infinity());
+  SizeBounds(bounds, cells, kScanWidth);
   // Running sums in curve order of the cells' integrals (GridFactors;
   // a quadratic's dips below zero count as no mass).
   double sum = 0;
   for (int k = 0; k < cells; ++k) {
-    sum += std::max(0.0, factors_.Integral(order[k].dx, order[k].dy));
+    sum += std::max(0.0, factors.Integral(order[k].dx, order[k].dy));
     bounds[k] = sum;
   }
   if (!(sum > 0)) return -1;  // the model vanishes here: pure curve bits
@@ -133,7 +162,7 @@ int LeafWalk::TabulateExact(const Square& leaf, int levels, std::vector<double>&
   MassDensityGrid(surface_, density_, cell_us_.data(), n, cell_vs_.data(), n, cell_m_.data());
   const Curve::Child* order = curve_.CellsInOrder(leaf.state, levels);
   const int cells = n * n;
-  bounds.assign(cells + kScanWidth, std::numeric_limits<double>::infinity());
+  SizeBounds(bounds, cells, kScanWidth);
   // Running sums in curve order (the cells are equal, so densities will do).
   double sum = 0;
   for (int k = 0; k < cells; ++k) {
@@ -170,7 +199,7 @@ void LeafWalk::PlaceInLeaf(const double* m, size_t n, double* u, double* v,
   t_.resize(n);
   for (size_t i = 0; i < n; ++i) t_[i] = std::clamp((m[i] - begin_mass_) / leaf_mass_, 0.0, 1.0);
   u_ = u, v_ = v, curve_position_ = curve_position;
-  const Square leaf{0, 1, 0, 0, 1, 0, 1, cell_.state, 0};
+  const Square leaf{0, 1, 0, 0, 1, 0, 1, 1, 0, 0, cell_.state, 0};
   reached_.clear();
   reached_of_.resize(n);
   PlaceInSquare(leaf, 0, static_cast<uint32_t>(n), 0);
@@ -202,7 +231,11 @@ void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end,
     last = TabulateExact(square, exact_levels_, bounds);
     if (last >= 0) levels = exact_levels_;
   }
-  if (last < 0 && levels > 0) last = Tabulate(square, levels, bounds);
+  // Cells of a model table follow the model's slope inside; an exact
+  // table's cells are uniform (its leaf carries under kRoughFloor samples).
+  const bool sloped = last < 0;
+  const GridFactors& factors = factors_[level];
+  if (last < 0 && levels > 0) last = Tabulate(square, levels, bounds, factors_[level]);
   if (last < 0) {
     Reached(square, begin, end);
     return;
@@ -230,9 +263,17 @@ void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end,
     cell.pos = square.pos + k * span, cell.span = span;
     cell.state = order[k].state;
     cell.depth = square.depth + levels;
+    cell.mass = 1, cell.gx = cell.gy = 0;
     if (level < kMaxModelLevels && (cell.t1 - cell.t0) * samples_ >= kTableSamples) {
       PlaceInSquare(cell, i, j, level + 1);
     } else {
+      const int x = order[k].dx, y = order[k].dy;
+      const double mass = sloped ? factors.Integral(x, y) : 0;
+      if (mass > kLeastSlopedMass) {
+        cell.mass = mass;
+        if (factors.halves[0]) cell.gx = SlopeOf(mass, factors.LowerX(x, y));
+        if (factors.halves[1]) cell.gy = SlopeOf(mass, factors.LowerY(x, y));
+      }
       Reached(cell, i, j);
     }
     i = j;
@@ -260,15 +301,17 @@ void LeafWalk::Continue(size_t n) {
                      cy_.data());
   for (size_t i = 0; i < n; ++i) {
     const Square& at = reached_[reached_of_[i]];
-    // For Hilbert the division is by 2^26: a multiplication, with the same bits.
-    const double cell =
-        cells_power_of_two_ ? at.side * inverse_cells_ : at.side / continuation_cells_;
-    const double x = static_cast<double>(static_cast<int64_t>(cx_[i]));
-    const double y = static_cast<double>(static_cast<int64_t>(cy_[i]));
-    double px = at.x0 + (x + 0.5) * cell, py = at.y0 + (y + 0.5) * cell;
+    // The centre of the continuation's cell as fractions of the square; for
+    // Hilbert the division is by 2^26: a multiplication, with the same bits.
+    const double x = static_cast<double>(static_cast<int64_t>(cx_[i])) + 0.5;
+    const double y = static_cast<double>(static_cast<int64_t>(cy_[i])) + 0.5;
+    double fx = cells_power_of_two_ ? x * inverse_cells_ : x / continuation_cells_;
+    double fy = cells_power_of_two_ ? y * inverse_cells_ : y / continuation_cells_;
+    fx = FollowSlope(fx, at.mass, at.gx), fy = FollowSlope(fy, at.mass, at.gy);
+    double px = at.x0 + fx * at.side, py = at.y0 + fy * at.side;
     if (warped_) {
-      px = PlaceOnAxis(model_->warp[0], at.x0, at.side, px);
-      py = PlaceOnAxis(model_->warp[1], at.y0, at.side, py);
+      px = PlaceOnAxis(model_->warp[0], at.x0, at.side, fx);
+      py = PlaceOnAxis(model_->warp[1], at.y0, at.side, fy);
     }
     u_[i] = cell_.u0 + px * cell_.size;
     v_[i] = cell_.v0 + py * cell_.size;

@@ -6,19 +6,26 @@
 // resolution: the leaf's square is cut into the n x n cells some levels of
 // its own curve reach (a table), the model's exact integral over each cell is
 // summed in curve order, and t falls into the cell whose share of the sum
-// holds it. The table is as fine as the leaf's samples need, a quarter of a
-// sample a cell or less (counted at the tree's grade, so every sequence on one tree
+// holds it. The table is as fine as the leaf's samples need, kCellSamples
+// a cell or less (counted at the tree's grade, so every sequence on one tree
 // places a given t alike, and limited to 32 x 32 cells); a cell that still
 // carries many samples, where the mass is uneven or the leaf is large, gets
 // a table of its own. The rest of t is followed as pure curve bits for
-// continuation_levels() more levels, and the sample sits at the centre of
-// the cell reached. In a leaf whose model is warped toward a singular line
-// (LeafModel::warp) where the area element blows up, the tables run in the
-// warped coordinates, where the model is smooth, and the point reached is
-// mapped back through the warp: the paper's reparameterisation (Sect. 5.3)
-// inside one leaf, whose cells are then thin strips along the line. Where it
-// vanishes, the tables stay in leaf coordinates and the continuation inside
-// the last cell is uniform in warped ones (DescendsWarped).
+// continuation_levels() more levels, to the centre of the cell reached, and
+// that point is moved inside its table cell to follow the mass's slope
+// there: along each axis, the inverse CDF of the linear density with the
+// model's masses over the cell's two halves (FollowSlope), a monotone
+// bijection of the cell onto itself, so the curve's stratification is kept
+// and the gradient's bias of order the cell's area is gone (docs/QUALITY.md,
+// "Placement that follows the slope"). In a leaf whose model is warped
+// toward a singular line (LeafModel::warp) where the area element blows up,
+// the tables run in the warped coordinates, where the model is smooth, and
+// the point reached is mapped back through the warp: the paper's
+// reparameterisation (Sect. 5.3) inside one leaf, whose cells are then thin
+// strips along the line; the slope is followed there in warped coordinates.
+// Where it vanishes, the tables stay in leaf coordinates and the continuation
+// inside the last cell is uniform in warped ones (DescendsWarped), with no
+// slope along that axis.
 //
 // A leaf whose parent was rough (CurveTree::leaf_rough_parent) and whose
 // quadratic is not warped may be cut by a step or crease that its quadratic
@@ -56,13 +63,13 @@ class LeafWalk {
   // Below this many samples' worth a leaf's placement is pure curve bits.
   static constexpr double kNegligibleSamples = 1.0 / 8;
   // A table's cells carry at most this many samples on average. Inside a
-  // cell the sample follows the curve uniformly, which ignores the mass's
-  // gradient there: a bias of the order of a cell's area, seen beside
-  // singular lines (the Monte Carlo check of docs/QUALITY.md: a quarter
-  // sample keeps it below what 8 seeds resolve, a whole sample does not).
-  static constexpr double kCellSamples = 0.25;
+  // cell the sample follows the curve and the mass's slope (FollowSlope);
+  // what it misses is of second order in the cell's side: the Monte Carlo
+  // check beside singular lines gives the same figures at 1/4, 1, 2 and 4
+  // samples a cell (docs/QUALITY.md, "Placement that follows the slope").
+  static constexpr double kCellSamples = 2;
   // A table cell carrying at least this many samples gets a table of its own.
-  static constexpr double kTableSamples = 1;
+  static constexpr double kTableSamples = 4 * kCellSamples;
   // Tables stop this many curve levels below the leaf in any case.
   static constexpr int kMaxModelLevels = 40;
 
@@ -88,15 +95,18 @@ class LeafWalk {
   // the coordinates the walk descends in), its orientation, its start and
   // share along the leaf's curve (fractions of the leaf's span), and how many
   // curve levels below the leaf it is.
+  // mass, gx, gy: FollowSlope's p and q along x and y, the density across
+  // the square along x being 1 + (gx / mass)(2s - 1) at fraction s (gx = gy
+  // = 0: uniform, where no model table reached the square).
   struct Square {
-    double t0, t1, x0, y0, side, pos, span;
+    double t0, t1, x0, y0, side, pos, span, mass, gx, gy;
     int state;
     int depth;
   };
 
-  // Leaf coordinate along one axis of the point at x in the cell
-  // [x0, x0 + side] the walk reached (DescendsWarped: x is warped).
-  static double PlaceOnAxis(const AxisWarp& w, double x0, double side, double x);
+  // Leaf coordinate along one axis of the point at fraction f of the cell
+  // [x0, x0 + side] the walk reached (DescendsWarped: that cell is warped).
+  static double PlaceOnAxis(const AxisWarp& w, double x0, double side, double f);
   // The leaf holding m: a forward step from the current one, else a search.
   size_t LeafFor(double m) const;
   // Makes l the current leaf.
@@ -108,7 +118,8 @@ class LeafWalk {
   // cells in curve order (non-decreasing, the last with mass and all after
   // it ending at t1); returns the index of the last cell with mass, or -1
   // where the model vanishes.
-  int Tabulate(const Square& square, int levels, std::vector<double>& bounds);
+  // `factors` keeps the table's GridFactors, for the cells' slopes.
+  int Tabulate(const Square& square, int levels, std::vector<double>& bounds, GridFactors& factors);
   // The same for the whole leaf from the true mass density at the cells'
   // centres; -1 where it is not finite or vanishes (the model's table then).
   int TabulateExact(const Square& leaf, int levels, std::vector<double>& bounds);
@@ -155,7 +166,7 @@ class LeafWalk {
   // Scratch of PlaceInLeaf, kept to reuse its memory.
   std::vector<double> t_;                           // each sample's fraction of the leaf's mass
   std::vector<std::vector<double>> tables_;         // cell bounds, one table per recursion level
-  GridFactors factors_;                             // a table's cell integrals, as factors
+  std::vector<GridFactors> factors_;                // their cell integrals, as factors
   std::vector<double> cell_us_, cell_vs_, cell_m_;  // an exact table's centres and densities
   std::vector<Square> reached_;                     // the squares samples end in
   std::vector<uint32_t> reached_of_;                // each sample's square in reached_

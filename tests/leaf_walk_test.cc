@@ -103,5 +103,26 @@ TEST(LeafWalk, PlacementIsAPureFunctionOfTheMassCoordinate) {
   }
 }
 
+// Inside a table cell a sample follows the mass's slope (LeafWalk,
+// FollowSlope). Under a linear density every leaf's quadratic is exact, and
+// so is each cell's linear density, so finely spaced mass coordinates give
+// the density's mean of u to far below the bias of a uniform placement
+// inside the cells (about h^2 / 12 of the relative slope 3 / (1 + 3u), ~7e-6
+// at the cells of side 1/128 that leaves of one sample at grade 2^12 get).
+TEST(LeafWalk, InsideACellSamplesFollowTheMassSlope) {
+  const auto setup = MakeSetup("plane", "expr:1+3*u", 4096);
+  LeafWalk walk(*setup.tree, *setup.surface, *setup.density);
+  const size_t n = size_t{1} << 20;
+  std::vector<double> m(n), u(n), v(n);
+  for (size_t i = 0; i < n; ++i) m[i] = (i + 0.5) / n * setup.tree->total_mass();
+  walk.Place(m.data(), n, u.data(), v.data(), nullptr);
+  double mean_u = 0, mean_v = 0;
+  for (size_t i = 0; i < n; ++i) mean_u += u[i], mean_v += v[i];
+  mean_u /= n, mean_v /= n;
+  // int u (1 + 3u) / int (1 + 3u) = (1/2 + 1) / (1 + 3/2).
+  EXPECT_NEAR(mean_u, 0.6, 1e-6);
+  EXPECT_NEAR(mean_v, 0.5, 1e-6);
+}
+
 }  // namespace
 }  // namespace sfc
