@@ -65,14 +65,20 @@ TEST(BlueSequence, PlaneKeepsExactCountAndSpacing) {
 }
 
 TEST(BlueSequence, SphereChordSpacing) {
+  // The figures, means of seeds 1-3: 0.72 and 0.79.
   Engine e;
-  const SampleBatch b = DrawAll(e.engine, Blue("sphere", 4096, 3));
-  ASSERT_EQ(b.size(), 4096u);
-  std::vector<Vec3> p;
-  for (size_t i = 0; i < b.size(); ++i) p.push_back({b.x[i], b.y[i], b.z[i]});
-  const NearestNeighbour blue = SphereNearestNeighbour(p);
-  EXPECT_GE(blue.min, 0.72);
-  EXPECT_GE(blue.mean, 0.79);
+  double min = 0, mean = 0;
+  for (uint64_t seed : {1, 2, 3}) {
+    const SampleBatch b = DrawAll(e.engine, Blue("sphere", 4096, seed));
+    ASSERT_EQ(b.size(), 4096u);
+    std::vector<Vec3> p;
+    for (size_t i = 0; i < b.size(); ++i) p.push_back({b.x[i], b.y[i], b.z[i]});
+    const NearestNeighbour blue = SphereNearestNeighbour(p);
+    EXPECT_GE(blue.min, 0.70) << "seed " << seed;
+    min += blue.min / 3, mean += blue.mean / 3;
+  }
+  EXPECT_GE(min, 0.72);
+  EXPECT_GE(mean, 0.79);
 }
 
 TEST(BlueSequence, EverySampleStaysInItsStratum) {
