@@ -59,4 +59,6 @@ for name,f,ex in [('torus',torus_f,ex_t),('sphere',sphere_f,ex_s)]:
         p=qmc.Sobol(2,scramble=True,seed=seed).random(N)
         el.append(abs(f(p[:,0],p[:,1]).mean()-ex))
     eo=np.array(eo);el=np.array(el)
-    print(name,'owen mean|err| %.2e +- %.1e   scipy LMS+shift %.2e +- %.1e  (20 seeds)'%(eo.mean(),eo.std()/np.sqrt(20),el.mean(),el.std()/np.sqrt(20)))
+    se = np.sqrt(20)
+    print(name, 'owen mean|err| %.2e +- %.1e   scipy LMS+shift %.2e +- %.1e  (20 seeds)'
+          % (eo.mean(), eo.std() / se, el.mean(), el.std() / se))
