@@ -32,6 +32,22 @@ uint64_t Drain(SampleCursor& cursor, SampleBatch& batch) {
   }
 }
 
+// The timed loop of generation alone: n jittered samples (seed 1) from a tree
+// built once for `surface` (uniform density), drained on `threads` threads.
+void SampleFromBuiltTree(benchmark::State& state, std::shared_ptr<const Surface> surface,
+                         const CurveTreeOptions& options, uint64_t n, int threads = 1) {
+  auto density = Uniform();
+  auto tree = *CurveTree::Build(*surface, *density, options, CurveTree::GradeFor(n));
+  auto sampler = std::make_shared<const Sampler>(tree, surface, density,
+                                                 Sequence(SequenceKind::kJittered, n, 1));
+  SampleBatch batch;
+  for (auto _ : state) {
+    auto cursor = *SampleCursor::Create(sampler, 0, n, {}, {}, threads);
+    benchmark::DoNotOptimize(Drain(*cursor, batch));
+  }
+  state.SetItemsProcessed(state.iterations() * n);
+}
+
 void BM_BuildTreeAndSampleSphere(benchmark::State& state) {
   const uint64_t n = state.range(0);
   CurveTreeOptions options;
@@ -73,18 +89,9 @@ void BM_SampleFromBuiltTree(benchmark::State& state) {
   const uint64_t n = kMillion;
   const auto curve = static_cast<CurveType>(state.range(0));
   auto surface = state.range(1) ? std::shared_ptr<const Surface>(MakePlane()) : Sphere();
-  auto density = Uniform();
   CurveTreeOptions options;
   options.curve = curve;
-  auto tree = *CurveTree::Build(*surface, *density, options, CurveTree::GradeFor(n));
-  auto sampler = std::make_shared<const Sampler>(tree, surface, density,
-                                                 Sequence(SequenceKind::kJittered, n, 1));
-  SampleBatch batch;
-  for (auto _ : state) {
-    auto cursor = *SampleCursor::Create(sampler, 0, n, {}, {});
-    benchmark::DoNotOptimize(Drain(*cursor, batch));
-  }
-  state.SetItemsProcessed(state.iterations() * n);
+  SampleFromBuiltTree(state, surface, options, n);
   state.SetLabel(std::string(CurveName(curve)) + (state.range(1) ? " plane" : " sphere"));
 }
 BENCHMARK(BM_SampleFromBuiltTree)
@@ -102,17 +109,7 @@ constexpr const char* kSpecSurfaces[] = {"sphere", "torus", "superellipsoid",
 void BM_SampleSurface(benchmark::State& state) {
   const char* spec = kSpecSurfaces[state.range(0)];
   const uint64_t n = static_cast<uint64_t>(state.range(1));
-  auto surface = MakeSurface(spec)->surface;
-  auto density = Uniform();
-  auto tree = *CurveTree::Build(*surface, *density, {}, CurveTree::GradeFor(n));
-  auto sampler = std::make_shared<const Sampler>(tree, surface, density,
-                                                 Sequence(SequenceKind::kJittered, n, 1));
-  SampleBatch batch;
-  for (auto _ : state) {
-    auto cursor = *SampleCursor::Create(sampler, 0, n, {}, {});
-    benchmark::DoNotOptimize(Drain(*cursor, batch));
-  }
-  state.SetItemsProcessed(state.iterations() * n);
+  SampleFromBuiltTree(state, MakeSurface(spec)->surface, {}, n);
   state.SetLabel(spec);
 }
 BENCHMARK(BM_SampleSurface)
@@ -124,17 +121,7 @@ BENCHMARK(BM_SampleSurface)
 void BM_SampleFromBuiltTreeThreads(benchmark::State& state) {
   const uint64_t n = kMillion;
   const int threads = static_cast<int>(state.range(0));
-  auto surface = Sphere();
-  auto density = Uniform();
-  auto tree = *CurveTree::Build(*surface, *density, {}, CurveTree::GradeFor(n));
-  auto sampler = std::make_shared<const Sampler>(tree, surface, density,
-                                                 Sequence(SequenceKind::kJittered, n, 1));
-  SampleBatch batch;
-  for (auto _ : state) {
-    auto cursor = *SampleCursor::Create(sampler, 0, n, {}, {}, threads);
-    benchmark::DoNotOptimize(Drain(*cursor, batch));
-  }
-  state.SetItemsProcessed(state.iterations() * n);
+  SampleFromBuiltTree(state, Sphere(), {}, n, threads);
   state.SetLabel("hilbert sphere, " + std::to_string(threads) + " threads");
 }
 BENCHMARK(BM_SampleFromBuiltTreeThreads)

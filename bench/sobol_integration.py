@@ -39,6 +39,8 @@ import time
 
 import numpy as np
 
+from compare_samplers import icosphere
+
 
 def f_smooth(x, y, z):
     return x * x + 0.3 * y * z + np.exp(z)
@@ -106,30 +108,12 @@ def superellipsoid_mean(func, e=1 / 3, nodes=256):
 
 
 def icosphere_obj(path, subdivisions=4):
-    phi = (1 + 5 ** 0.5) / 2
-    verts = [(-1, phi, 0), (1, phi, 0), (-1, -phi, 0), (1, -phi, 0), (0, -1, phi), (0, 1, phi),
-             (0, -1, -phi), (0, 1, -phi), (phi, 0, -1), (phi, 0, 1), (-phi, 0, -1), (-phi, 0, 1)]
-    verts = [tuple(c / math.sqrt(sum(v * v for v in p)) for c in p) for p in verts]
-    faces = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4),
-             (11, 10, 2), (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8),
-             (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
-    for _ in range(subdivisions):
-        cache, out = {}, []
-        def mid(i, j):
-            key = (min(i, j), max(i, j))
-            if key not in cache:
-                p = [(verts[i][k] + verts[j][k]) / 2 for k in range(3)]
-                n = math.sqrt(sum(c * c for c in p))
-                verts.append(tuple(c / n for c in p))
-                cache[key] = len(verts) - 1
-            return cache[key]
-        for a, b, c in faces:
-            ab, bc, ca = mid(a, b), mid(b, c), mid(c, a)
-            out += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
-        faces = out
+    """Writes compare_samplers' icosphere as OBJ; returns f's exact mean over its flat
+    triangles (the midpoint rule is exact for a quadratic)."""
+    verts, faces = icosphere(subdivisions)
     with open(path, "w") as fh:
         for p in verts:
-            fh.write("v %.17g %.17g %.17g\n" % p)
+            fh.write("v %.17g %.17g %.17g\n" % tuple(p))
         for a, b, c in faces:
             fh.write("f %d %d %d\n" % (a + 1, b + 1, c + 1))
     V, F = np.array(verts), np.array(faces)

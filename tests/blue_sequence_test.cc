@@ -12,6 +12,7 @@
 #include "gtest/gtest.h"
 #include "kinds/registered_kinds.h"
 #include "tests/engine_helpers.h"
+#include "tests/test_util.h"
 
 namespace sfc {
 namespace {
@@ -36,16 +37,6 @@ SampleRequest Blue(const std::string& surface, uint64_t count, uint64_t seed,
   r.seed = seed;
   r.sequence = SequenceKind::kBlue;
   return r;
-}
-
-void ExpectSameBytes(const SampleBatch& a, const SampleBatch& b) {
-  ASSERT_EQ(a.size(), b.size());
-  EXPECT_EQ(a.index, b.index);
-  EXPECT_EQ(a.u, b.u);
-  EXPECT_EQ(a.v, b.v);
-  EXPECT_EQ(a.x, b.x);
-  EXPECT_EQ(a.y, b.y);
-  EXPECT_EQ(a.z, b.z);
 }
 
 TEST(BlueSequence, PlaneKeepsExactCountAndSpacing) {
@@ -126,7 +117,7 @@ TEST(BlueSequence, DensityKeepsItsMassSplit) {
 TEST(BlueSequence, SameBytesForAnyThreadCount) {
   Engine one(1), three(3);
   const SampleRequest r = Blue("torus:R=1;r=0.4", 20000, 6, "gaussian:floor=0.1");
-  ExpectSameBytes(DrawAll(one.engine, r), DrawAll(three.engine, r));
+  testing::ExpectSameSamples(DrawAll(one.engine, r), DrawAll(three.engine, r));
 }
 
 TEST(BlueSequence, ShardsRangesAndRegionsAreTheWholeRun) {
@@ -140,13 +131,13 @@ TEST(BlueSequence, ShardsRangesAndRegionsAreTheWholeRun) {
     r.shard_index = s, r.shard_count = 8;
     shards.Append(DrawAll(e.engine, r));
   }
-  ExpectSameBytes(whole, shards);
+  testing::ExpectSameSamples(whole, shards);
 
   SampleRequest range = whole_request;
   range.begin = 1501, range.end = 3777;
   SampleBatch expected;
   expected.AppendFrom(whole, 1501, 3777);
-  ExpectSameBytes(DrawAll(e.engine, range), expected);
+  testing::ExpectSameSamples(DrawAll(e.engine, range), expected);
 
   SampleRequest box = whole_request;
   box.region.kind = Region::Kind::kBox;
@@ -156,7 +147,7 @@ TEST(BlueSequence, ShardsRangesAndRegionsAreTheWholeRun) {
     if (whole.x[i] >= 0 && whole.x[i] <= 2 && whole.y[i] >= 0 && whole.y[i] <= 2)
       inside.AppendFrom(whole, i, i + 1);
   }
-  ExpectSameBytes(DrawAll(e.engine, box), inside);
+  testing::ExpectSameSamples(DrawAll(e.engine, box), inside);
 }
 
 TEST(BlueSequence, TooLargeACountIsInvalidArgument) {

@@ -11,22 +11,7 @@ dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 fail() { echo "FAIL: $*"; cat "$dir/err.txt" 2>/dev/null; exit 1; }
 "$make_fixtures" "$dir" > /dev/null
-cat > "$dir/mesh.obj" <<'OBJ'
-v 1 0 0
-v -1 0 0
-v 0 1 0
-v 0 -1 0
-v 0 0 1.5
-v 0 0 -1
-f 1 3 5
-f 3 2 5
-f 2 4 5
-f 4 1 5
-f 3 1 6
-f 2 3 6
-f 4 2 6
-f 1 4 6
-OBJ
+cp "$(dirname "$0")/octahedron.obj" "$dir/mesh.obj"  # the pinned bytes' mesh
 for model in "step:$dir/box_with_hole.step" "obj:$dir/mesh.obj"; do
   args=(--surface "$model" --count 5000 --seed 3 --sequence sobol)
   "$cli" sample -q "${args[@]}" -o "$dir/whole.csv"

@@ -20,22 +20,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 "$make_fixtures" "$tmp" > /dev/null
 # A small closed mesh (an octahedron with one vertex pulled out), as OBJ.
-cat > "$tmp/mesh.obj" <<'OBJ'
-v 1 0 0
-v -1 0 0
-v 0 1 0
-v 0 -1 0
-v 0 0 1.5
-v 0 0 -1
-f 1 3 5
-f 3 2 5
-f 2 4 5
-f 4 1 5
-f 3 1 6
-f 2 3 6
-f 4 2 6
-f 1 4 6
-OBJ
+cp "$(dirname "$0")/octahedron.obj" "$tmp/mesh.obj"
 hash_of() {  # ARGS...: the SHA-256 of the NPY the CLI writes
   "$cli" sample -q --format npy "$@" -o "$tmp/out.npy" 2> "$tmp/stderr" ||
     { cat "$tmp/stderr" >&2; echo "FAIL: sample $*" >&2; exit 1; }
