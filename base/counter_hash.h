@@ -16,10 +16,28 @@ inline uint64_t Mix64(uint64_t z) {
   return z ^ (z >> 31);
 }
 
+// The streams of the sampler's random numbers, one per use, so no two uses
+// share bits (core/sequence.cc, core/blue_relaxation.cc). A new use takes a
+// new number: changing one changes the bytes of its sequence.
+namespace hash_stream {
+inline constexpr uint64_t kJitter = 1;
+inline constexpr uint64_t kRandom = 2;
+inline constexpr uint64_t kOwen = 3;
+inline constexpr uint64_t kOwenTail = 4;
+inline constexpr uint64_t kSobol[2] = {5, 6};           // the sobol coordinates' scrambles
+inline constexpr uint64_t kSobolTail[2] = {7, 8};       // and their bits below 2^-32
+inline constexpr uint64_t kBlueCandidate = 0x626c7565;  // "blue" in ASCII
+inline constexpr uint64_t kBluePriority = 0x626c7566;
+}  // namespace hash_stream
+
+// The key of the stream `stream` of `seed`.
+inline uint64_t CounterKey(uint64_t seed, uint64_t stream) {
+  return Mix64(seed + 0x9e3779b97f4a7c15ULL * (stream + 1));
+}
+
 // 64 well-mixed bits for `counter` in the stream `stream` of `seed`.
 inline uint64_t CounterHash(uint64_t seed, uint64_t stream, uint64_t counter) {
-  const uint64_t key = Mix64(seed + 0x9e3779b97f4a7c15ULL * (stream + 1));
-  return Mix64(key ^ Mix64(counter + 0x632be59bd9b4e019ULL));
+  return Mix64(CounterKey(seed, stream) ^ Mix64(counter + 0x632be59bd9b4e019ULL));
 }
 
 // A double uniform in [0,1) with 53 random bits.

@@ -1,7 +1,6 @@
 #include "core/area_estimator.h"
 
 #include <cmath>
-#include <vector>
 
 #include "absl/strings/str_format.h"
 #include "base/status_macros.h"
@@ -68,8 +67,8 @@ SurfacePoint PointFromJet(const SurfaceJet& jet, double u, double v, bool curvat
 void MassDensityGrid(const Surface& surface, const Density& density, const double* us, int nu,
                      const double* vs, int nv, double* out) {
   const bool curvature = density.NeedsCurvature();
-  std::vector<SurfaceJet> jets(static_cast<size_t>(nu) * nv);
-  surface.JetGrid(us, nu, vs, nv, curvature ? 2 : 1, jets.data());
+  SurfaceJet jets[kMassDensityGridPoints];
+  surface.JetGrid(us, nu, vs, nv, curvature ? 2 : 1, jets);
   for (int i = 0; i < nu; ++i) {
     for (int j = 0; j < nv; ++j) {
       const SurfaceJet& jet = jets[static_cast<size_t>(i) * nv + j];

@@ -33,7 +33,8 @@ absl::Status CheckDensityValue(double delta, double u, double v);
 // i < nu, j < nv: out[i * nv + j], through Surface::JetGrid (jets of the
 // order the density needs). +infinity where the point, its area element or
 // delta is not finite (a pole or singular line); delta is not checked for
-// sign (CheckDensityValue).
+// sign (CheckDensityValue). REQUIRES: nu * nv <= kMassDensityGridPoints.
+inline constexpr int kMassDensityGridPoints = 81;
 void MassDensityGrid(const Surface& surface, const Density& density, const double* us, int nu,
                      const double* vs, int nv, double* out);
 

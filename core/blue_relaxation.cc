@@ -9,15 +9,12 @@
 #include "base/counter_hash.h"
 #include "base/status_macros.h"
 #include "base/worker_pool.h"
+#include "core/hilbert3d.h"
 #include "core/sequence.h"
 
 namespace sfc {
 namespace {
 
-// The counter-hash stream of the candidates (core/sequence.cc's streams are
-// small integers; this one is "blue" in ASCII, apart from them).
-constexpr uint64_t kCandidateStream = 0x626c7565;
-constexpr uint64_t kPriorityStream = 0x626c7566;
 // A sample's spacing is at most this many times the median spacing (where the
 // density vanishes at a point the spacing would be infinite).
 constexpr double kMaxSpacingRatio = 8;
@@ -37,17 +34,6 @@ constexpr double kDensityJump = 1.25;
 // moves; the moved points are listed in a second grid.
 class HashGrid {
  public:
-  // The low 21 bits of x, two zero bits between each.
-  static uint64_t Spread(int64_t x) {
-    uint64_t v = static_cast<uint64_t>(x) & 0x1fffff;
-    v = (v | v << 32) & 0x1f00000000ffffULL;
-    v = (v | v << 16) & 0x1f0000ff0000ffULL;
-    v = (v | v << 8) & 0x100f00f00f00f00fULL;
-    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
-    v = (v | v << 2) & 0x1249249249249249ULL;
-    return v;
-  }
-
   static constexpr uint32_t kDead = ~uint32_t{0};
   struct Entry {
     Vec3 p;
@@ -86,7 +72,10 @@ class HashGrid {
   // The cell's Morton code, cut to the table: neighbouring cells share
   // cache lines, and so do the cells of queries made in curve order.
   uint32_t Bucket(int64_t cx, int64_t cy, int64_t cz) const {
-    return static_cast<uint32_t>((Spread(cx) | Spread(cy) << 1 | Spread(cz) << 2) & mask_);
+    return static_cast<uint32_t>((Spread3(static_cast<uint32_t>(cx)) |
+                                  Spread3(static_cast<uint32_t>(cy)) << 1 |
+                                  Spread3(static_cast<uint32_t>(cz)) << 2) &
+                                 mask_);
   }
   // Calls f(entry) for every live entry in the bucket of cell (cx, cy, cz)
   // (and of the cells sharing it); stops and returns true when f does.
@@ -133,7 +122,8 @@ class Relaxation {
   double Crowding(uint32_t i, const Vec3& x, double floor) const;
   // Who of two samples of a colour that are too close moves in `sweep`.
   uint64_t Priority(int sweep, uint32_t k) const {
-    return CounterHash(seed_, kPriorityStream, static_cast<uint64_t>(k) * options_.sweeps + sweep);
+    return CounterHash(seed_, hash_stream::kBluePriority,
+                       static_cast<uint64_t>(k) * options_.sweeps + sweep);
   }
   bool Conflicts(uint32_t i, const Vec3& x) const {
     return AnyNear(i, x, [](uint32_t, double) { return true; });
@@ -261,7 +251,7 @@ absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
         const uint64_t k = todo[s.t];
         for (int j = 0; j < m; ++j) {
           const uint64_t counter = (k * options_.sweeps + sweep) * candidates + j0 + j;
-          h[j] = {CounterUniform(seed_, kCandidateStream, counter), j};
+          h[j] = {CounterUniform(seed_, hash_stream::kBlueCandidate, counter), j};
         }
         std::sort(h.begin(), h.begin() + m);
         for (int j = 0; j < m; ++j) {

@@ -15,9 +15,8 @@
 
 namespace sfc {
 
-namespace hilbert3d_internal {
-
-// Spreads the low 21 bits of v to every third bit (bit i to bit 3 i).
+// Spreads the low 21 bits of v to every third bit (bit i to bit 3 i): one
+// axis of a Morton (Z-order) code, also core/blue_relaxation.cc's grid key.
 inline uint64_t Spread3(uint32_t v) {
   uint64_t x = v & 0x1fffffu;
   x = (x | x << 32) & 0x1f00000000ffffull;
@@ -27,6 +26,8 @@ inline uint64_t Spread3(uint32_t v) {
   x = (x | x << 2) & 0x1249249249249249ull;
   return x;
 }
+
+namespace hilbert3d_internal {
 
 // One level q of the inverse undo, branch-free: for each axis i, if its bit
 // q is set, invert a0's lower bits, else exchange the lower bits of a0 and a_i

@@ -308,10 +308,12 @@ void LeafWalk::Continue(size_t n) {
     double fx = cells_power_of_two_ ? x * inverse_cells_ : x / continuation_cells_;
     double fy = cells_power_of_two_ ? y * inverse_cells_ : y / continuation_cells_;
     fx = FollowSlope(fx, at.mass, at.gx), fy = FollowSlope(fy, at.mass, at.gy);
-    double px = at.x0 + fx * at.side, py = at.y0 + fy * at.side;
+    double px, py;
     if (warped_) {
       px = PlaceOnAxis(model_->warp[0], at.x0, at.side, fx);
       py = PlaceOnAxis(model_->warp[1], at.y0, at.side, fy);
+    } else {
+      px = at.x0 + fx * at.side, py = at.y0 + fy * at.side;
     }
     u_[i] = cell_.u0 + px * cell_.size;
     v_[i] = cell_.v0 + py * cell_.size;

@@ -11,15 +11,6 @@
 namespace sfc {
 namespace {
 
-// Streams of the counter hash, one per use, so no two uses share bits.
-constexpr uint64_t kJitterStream = 1;
-constexpr uint64_t kRandomStream = 2;
-constexpr uint64_t kOwenStream = 3;
-constexpr uint64_t kOwenTailStream = 4;
-// The sobol sequence's two coordinates: their scrambles and their tails.
-constexpr uint64_t kSobolStream[2] = {5, 6};
-constexpr uint64_t kSobolTailStream[2] = {7, 8};
-
 uint32_t ReverseBits32(uint32_t x) {
   x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
   x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
@@ -38,10 +29,10 @@ double OwenScrambledRadicalInverse(uint64_t k, uint64_t seed) {
   uint32_t out = 0;
   for (int i = 0; i < 32; ++i) {
     const uint32_t prefix = i == 0 ? 0 : r >> (32 - i);
-    const uint32_t flip = CounterHash(seed, kOwenStream, (uint64_t{prefix} << 6) | i) & 1;
+    const uint32_t flip = CounterHash(seed, hash_stream::kOwen, (uint64_t{prefix} << 6) | i) & 1;
     out |= (((r >> (31 - i)) & 1) ^ flip) << (31 - i);
   }
-  const double tail = CounterUniform(seed, kOwenTailStream, k);
+  const double tail = CounterUniform(seed, hash_stream::kOwenTail, k);
   return (out + tail) * 0x1.0p-32;
 }
 
@@ -62,9 +53,7 @@ uint32_t SobolSecond(uint32_t k) {
 // bits above it are `prefix`: a random bit of (seed, dimension, i, prefix).
 // One SplitMix64 finaliser (Steele, Lea and Flood 2014), keyed by the seed and
 // the dimension.
-uint64_t SobolKey(uint64_t seed, int dim) {
-  return Mix64(seed + 0x9e3779b97f4a7c15ULL * (kSobolStream[dim] + 1));
-}
+uint64_t SobolKey(uint64_t seed, int dim) { return CounterKey(seed, hash_stream::kSobol[dim]); }
 uint64_t BlockHash(uint64_t key, uint64_t prefix, int i) {
   return Mix64(key + 0x9e3779b97f4a7c15ULL * ((prefix << 6) | i));
 }
@@ -129,7 +118,7 @@ double NestedScramble(uint32_t r, uint64_t k, uint64_t seed, int dim, const Owen
                << (31 - i);
     }
   }
-  const double tail = CounterUniform(seed, kSobolTailStream[dim], k);
+  const double tail = CounterUniform(seed, hash_stream::kSobolTail[dim], k);
   return ((r ^ flips) + tail) * 0x1.0p-32;
 }
 
@@ -138,12 +127,12 @@ double NestedScramble(uint32_t r, uint64_t k, uint64_t seed, int dim, const Owen
 double Sequence::Raw(uint64_t k) const {
   switch (kind_) {
     case SequenceKind::kJittered:
-      return (static_cast<double>(k) + CounterUniform(seed_, kJitterStream, k)) /
+      return (static_cast<double>(k) + CounterUniform(seed_, hash_stream::kJitter, k)) /
              static_cast<double>(count_);
     case SequenceKind::kEqual:
       return (static_cast<double>(k) + 0.5) / static_cast<double>(count_);
     case SequenceKind::kRandom:
-      return CounterUniform(seed_, kRandomStream, k);
+      return CounterUniform(seed_, hash_stream::kRandom, k);
     case SequenceKind::kVanDerCorput:
       return ReverseBits32(static_cast<uint32_t>(k)) * 0x1.0p-32;
     case SequenceKind::kProgressive:
@@ -167,7 +156,7 @@ void Sequence::AtMany(uint64_t k0, size_t n, double* out) const {
     case SequenceKind::kJittered:
       for (size_t i = 0; i < n; ++i) {
         const uint64_t k = k0 + i;
-        out[i] = (static_cast<double>(k) + CounterUniform(seed_, kJitterStream, k)) / count;
+        out[i] = (static_cast<double>(k) + CounterUniform(seed_, hash_stream::kJitter, k)) / count;
       }
       break;
     case SequenceKind::kEqual:
@@ -185,6 +174,5 @@ void Sequence::AtMany(uint64_t k0, size_t n, double* out) const {
     for (size_t i = 0; i < n; ++i) out[i] = (out[i] - lo_) / (hi_ - lo_);
   }
 }
-
 
 }  // namespace sfc

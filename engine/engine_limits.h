@@ -10,17 +10,17 @@
 namespace sfc {
 
 struct EngineLimits {
-  uint64_t max_count = 100'000'000;              // largest N
+  uint64_t max_count = 100'000'000;  // largest N
   uint64_t max_tree_leaves = uint64_t{1}
                              << 22;  // per tree: 73 B a leaf (CurveTree::kBytesPerLeaf), 292 MiB
-  size_t max_spec_length = 4096;                 // surface/density spec, in characters
-  int generation_threads = 1;                    // threads filling one stream's large batches
+  size_t max_spec_length = 4096;     // surface/density spec, in characters
+  int generation_threads = 1;        // threads filling one stream's large batches
   // Sequences that are not monotone in k are sorted into curve order per
   // request (16 bytes a sample): at most this many samples per request.
   uint64_t max_sorted_range = uint64_t{1} << 24;
-  // The blue sequence relaxes the whole set in memory (up to 128 bytes a
-  // sample, core/blue_relaxation.h) for every request: at most this many
-  // samples.
+  // The blue sequence relaxes the whole set in memory (up to
+  // kBlueNoiseBytesPerSample a sample, core/blue_relaxation.h) for every
+  // request: at most this many samples.
   uint64_t max_blue_count = uint64_t{1} << 24;
   // Model files (CAD, meshes) are parsed on threads of their own
   // (engine/loaded_models.h): parsed models kept, bytes (LRU past it);

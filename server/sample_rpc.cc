@@ -1,5 +1,3 @@
-#include "server/sampler_service.h"
-
 #include <chrono>
 
 #include "absl/strings/str_format.h"
@@ -12,6 +10,7 @@
 #include "request/tree_count.h"
 #include "server/message_pipeline.h"
 #include "server/request_control.h"
+#include "server/sampler_service.h"
 #include "spdlog/spdlog.h"
 
 namespace sfc {
@@ -70,11 +69,11 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
     // Claim a stream slot; give it back on every path out.
     if (active_streams_.fetch_add(1) >= options_.max_concurrent_streams) {
       active_streams_.fetch_sub(1);
-      status = grpc::Status(
-          grpc::StatusCode::RESOURCE_EXHAUSTED,
-          absl::StrFormat("%d sample streams are already running, the server's limit "
-                          "(max_concurrent_streams); retry later",
-                          options_.max_concurrent_streams));
+      status =
+          grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                       absl::StrFormat("%d sample streams are already running, the server's limit "
+                                       "(max_concurrent_streams); retry later",
+                                       options_.max_concurrent_streams));
     } else {
       metrics_->StreamStarted();
       status = call.ok() ? RunSample(context, *request, *call, writer, &sent)
@@ -113,8 +112,8 @@ grpc::Status SamplerService::PrepareModelOutsideSlot(grpc::ServerContext* contex
   return grpc::Status::OK;
 }
 
-grpc::Status SamplerService::RunSample(grpc::ServerContext* context,
-                                       const v1::SampleRequest& wire, const SampleCall& call,
+grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::SampleRequest& wire,
+                                       const SampleCall& call,
                                        grpc::ServerWriter<v1::SampleResponse>* writer,
                                        uint64_t* sent) {
   const auto start = Clock::now();
@@ -131,9 +130,9 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context,
   }
   const BuildControl control = RequestControl(context, deadline, options_.request_deadline_seconds);
   // The stream's working memory, reserved before its cursor sorts anything.
-  auto memory = stream_memory_.Reserve(
-      StreamWorkingBytes(request, stream, options_.stream_pipeline_depth), "this stream",
-      control.check);
+  auto memory =
+      stream_memory_.Reserve(StreamWorkingBytes(request, stream, options_.stream_pipeline_depth),
+                             "this stream", control.check);
   if (!memory.ok()) return ToGrpcStatus(memory.status());
   auto job = engine_.Start(request, control);
   if (!job.ok()) return ToGrpcStatus(job.status());
@@ -145,13 +144,12 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context,
   *header.mutable_request() = wire;  // echoed as it came
   header.set_begin(job->begin);
   header.set_end(job->end);
-  header.set_expected_samples(request.region.kind == Region::Kind::kAll
-                                   ? static_cast<int64_t>(job->end - job->begin)
-                                   : -1);
+  header.set_expected_samples(
+      request.region.kind == Region::Kind::kAll ? static_cast<int64_t>(job->end - job->begin) : -1);
 
   // Every message, the first with its header too, fits max_message_bytes.
   const bool indices_listed =
-      request.region.kind != Region::Kind::kAll || !Sequence(request.sequence, 1, 0).monotone();
+      request.region.kind != Region::Kind::kAll || !SequenceIsMonotone(request.sequence);
   const uint32_t fits = MaxSamplesPerMessage(request.fields, stream.precision, indices_listed,
                                              header.ByteSizeLong(), options_.max_message_bytes);
   if (fits == 0) {
@@ -204,14 +202,14 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context,
   SampleBatch batch;  // the producer's
   BatchCursor* const cursor = job->cursor.get();
   const SampleFields fields = request.fields;
-  MessagePipeline pipeline(options_.stream_pipeline_depth,
-                           [&batch, cursor, fields, stream,
-                            batch_size](v1::SampleBatch* out) -> absl::StatusOr<size_t> {
-                             batch.Clear();
-                             ASSIGN_OR_RETURN(const size_t n, cursor->Next(batch_size, &batch));
-                             ToProto(batch, fields, stream, out);
-                             return n;
-                           });
+  MessagePipeline pipeline(
+      options_.stream_pipeline_depth,
+      [&batch, cursor, fields, stream, batch_size](v1::SampleBatch* out) -> absl::StatusOr<size_t> {
+        batch.Clear();
+        ASSIGN_OR_RETURN(const size_t n, cursor->Next(batch_size, &batch));
+        ToProto(batch, fields, stream, out);
+        return n;
+      });
   bool first = true;
   while (true) {
     if (context->IsCancelled()) return cut_status("the client cancelled the stream");

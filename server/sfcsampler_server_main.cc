@@ -4,7 +4,6 @@
 // cancels them.
 #include <malloc.h>
 #include <signal.h>
-
 #include <unistd.h>
 
 #include <filesystem>
@@ -15,6 +14,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/strip.h"
 #include "base/subprocess.h"
+#include "core/blue_relaxation.h"
 #include "core/curve_tree.h"
 #include "kinds/registered_kinds.h"
 #include "request/model_spec.h"
@@ -83,8 +83,9 @@ int main(int argc, char** argv) {
                  "whole)")
       ->capture_default_str();
   app.add_option("--max-blue-count", o.limits.max_blue_count,
-                 "largest N of the blue sequence (each request relaxes the whole set in memory, "
-                 "up to 128 bytes a sample)")
+                 absl::StrFormat("largest N of the blue sequence (each request relaxes the whole "
+                                 "set in memory, up to %d bytes a sample)",
+                                 sfc::kBlueNoiseBytesPerSample))
       ->capture_default_str();
   app.add_option("--cache-bytes", o.cache_bytes, "tree cache budget in bytes (LRU eviction)")
       ->capture_default_str();

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Checks .clang-format's column limit on every C++, proto and Python file of
-# the tree (python/, bench/, examples/): prints each longer line as file:line
+# the tree: prints each longer line as file:line
 # and exits 1 if there is any. (Fix a C++ one with clang-format --lines=N:N -i
 # FILE.) Needs no build.
 #   tools/check_format.sh [SOURCE_DIR]

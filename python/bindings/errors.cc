@@ -11,9 +11,8 @@ void RegisterErrors(py::module_& m) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const StatusException& e) {
-      // The exception classes live in pure Python (sfcsampler/errors.py) so
-      // that the gRPC client, which never touches this module's C++ side,
-      // raises the same ones.
+      // The exception classes live in pure Python (sfcsampler/errors.py), one
+      // set for both extensions (_core in process, _client over the wire).
       py::object errors = py::module_::import("sfcsampler.errors");
       py::object error = errors.attr("from_status")(static_cast<int>(e.status().code()),
                                                     std::string(e.status().message()));

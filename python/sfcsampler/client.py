@@ -13,15 +13,10 @@ A Client may be used from several threads at once; each batches() iterator
 belongs to one thread.
 """
 
-import numpy as np
-
 from sfcsampler import _client, meshes
 from sfcsampler._request import make_request
-from sfcsampler.samples import Samples, concatenate, kept_columns, select, warn_depth_cap
-
-
-def _dtype(precision):
-    return np.float32 if precision == "float32" else np.float64
+from sfcsampler.samples import (Samples, column_dtype, concatenate, kept_columns, select,
+                                warn_depth_cap)
 
 
 class Client:
@@ -135,7 +130,7 @@ class Client:
     @staticmethod
     def _samples(columns, header, precision, kept):
         return Samples(columns, header["tree"], header["begin"], header["end"], header["seed"],
-                       header["algorithm_version"], _dtype(precision), kept)
+                       header["algorithm_version"], column_dtype(precision), kept)
 
     def sample(self, *, precision=None, batch_size=None, columns=None, **request):
         """All the requested samples as one Samples: the same values as sfcsampler.sample()."""
@@ -145,7 +140,7 @@ class Client:
         last = parts[-1]  # a stream gives at least its header
         filled = [p.columns() for p in parts if len(p)]
         return concatenate(filled, last.tree, last.begin, last.end, last.seed,
-                           last.algorithm_version, _dtype(precision), kept)
+                           last.algorithm_version, column_dtype(precision), kept)
 
     def prepare(self, **request):
         """Builds (or finds in the server's cache) the request's tree; returns its summary."""

@@ -2,17 +2,11 @@
 
 import contextlib
 
-import numpy as np
-
 from sfcsampler import _core, meshes
 from sfcsampler._request import make_request
-from sfcsampler.samples import Samples, kept_columns, select, warn_depth_cap
+from sfcsampler.samples import Samples, column_dtype, kept_columns, select, warn_depth_cap
 
 _ALL = 1 << 62  # "every remaining sample"
-
-
-def _dtype(precision):
-    return np.float32 if precision == "float32" else np.float64
 
 
 class Sampler:
@@ -64,7 +58,7 @@ class Sampler:
         job = self._start(precision, request)
         filled = select(job.next(_ALL) or {}, kept)
         return Samples(filled, job.tree, job.begin, job.end, job.seed, _core.ALGORITHM_VERSION,
-                       _dtype(precision), kept)
+                       column_dtype(precision), kept)
 
     def sample_bytes(self, fmt, data, name="", *, precision="float64", columns=None, **request):
         """sample() of a model given as its file's bytes (fmt: step, iges, nurbs, obj, ply):
@@ -93,7 +87,7 @@ class Sampler:
             if filled is None:
                 return
             yield Samples(select(filled, kept), job.tree, job.begin, job.end, job.seed,
-                          _core.ALGORITHM_VERSION, _dtype(precision), kept)
+                          _core.ALGORITHM_VERSION, column_dtype(precision), kept)
 
     def prepare(self, **request):
         """Builds (or finds) the request's tree, sized for tree_count or count; returns its

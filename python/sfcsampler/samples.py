@@ -26,6 +26,11 @@ def column_names(columns):
     return names
 
 
+def column_dtype(precision):
+    """The NumPy type of the value columns at `precision` ("float32" or "float64")."""
+    return np.float32 if precision == "float32" else np.float64
+
+
 def kept_columns(columns, request):
     """The set of column names a `columns=` argument keeps (None: every column the request
     makes). InvalidArgumentError for an unknown name, or one the request does not make
