@@ -11,7 +11,7 @@ dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 fail() { echo "FAIL: $*"; cat "$dir/err.txt" 2>/dev/null; exit 1; }
 "$make_fixtures" "$dir" > /dev/null
-cp "$(dirname "$0")/octahedron.obj" "$dir/mesh.obj"  # the pinned bytes' mesh
+cp "$(dirname "$0")/pulled_octahedron.obj" "$dir/mesh.obj"  # the pinned bytes' mesh
 for model in "step:$dir/box_with_hole.step" "obj:$dir/mesh.obj"; do
   args=(--surface "$model" --count 5000 --seed 3 --sequence sobol)
   "$cli" sample -q "${args[@]}" -o "$dir/whole.csv"

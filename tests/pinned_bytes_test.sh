@@ -20,7 +20,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 "$make_fixtures" "$tmp" > /dev/null
 # A small closed mesh (an octahedron with one vertex pulled out), as OBJ.
-cp "$(dirname "$0")/octahedron.obj" "$tmp/mesh.obj"
+cp "$(dirname "$0")/pulled_octahedron.obj" "$tmp/mesh.obj"
 hash_of() {  # ARGS...: the SHA-256 of the NPY the CLI writes
   "$cli" sample -q --format npy "$@" -o "$tmp/out.npy" 2> "$tmp/stderr" ||
     { cat "$tmp/stderr" >&2; echo "FAIL: sample $*" >&2; exit 1; }

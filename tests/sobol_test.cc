@@ -159,8 +159,8 @@ TEST(SobolSampler, SphereMeansMeetTheClosedFormAtQuasiMonteCarloRates) {
   };
   const double e10 = mean_error(1 << 10), e13 = mean_error(1 << 13), e16 = mean_error(1 << 16);
   EXPECT_LT(e13, 1.5e-5);
-  // 64 times the points: the error falls by more than 64^1.25 (N^-1.25; a
-  // jittered set's falls as N^-0.96 here, docs/QUALITY.md).
+  // 64 times the points: the error falls by more than 64^1.25 (N^-1.25),
+  // which one sample per curve stratum cannot reach (about N^-1, He and Owen 2016).
   EXPECT_LT(e16, e10 / std::pow(64.0, 1.25)) << e10 << " " << e13 << " " << e16;
 }
 
