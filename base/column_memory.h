@@ -21,14 +21,21 @@ inline constexpr size_t kHugePageColumnBytes = size_t{4} << 20;
 // the kernel or the platform lacks them.
 void AdviseHugePages(void* data, size_t bytes);
 
-// column->resize(rows), first reserving a large column's memory with the
-// huge-page advice, before any of it is touched.
+// column->reserve(rows), with the huge-page advice for a large column's new
+// memory, before any of it is touched.
 template <class T>
-void ResizeColumn(std::vector<T>* column, size_t rows) {
-  if (rows > column->capacity() && rows * sizeof(T) >= kHugePageColumnBytes) {
-    column->reserve(rows);
+void ReserveColumn(std::vector<T>* column, size_t rows) {
+  if (rows <= column->capacity()) return;
+  column->reserve(rows);
+  if (rows * sizeof(T) >= kHugePageColumnBytes) {
     AdviseHugePages(column->data(), column->capacity() * sizeof(T));
   }
+}
+
+// column->resize(rows), reserving as ReserveColumn does.
+template <class T>
+void ResizeColumn(std::vector<T>* column, size_t rows) {
+  ReserveColumn(column, rows);
   column->resize(rows);
 }
 

@@ -19,7 +19,10 @@ noisy machine's load hits both sides alike):
     sphere (bench/model_benchmark).
  7. Mesh, 10^6 cold on the 81 920-triangle icosphere, against Open3D's
     sample_points_uniformly (bench/mesh_vs_open3d.py).
---quick runs rows 1-3 only. The CPU's vector path (SSE2/AVX/AVX-512) is
+ 8. Warm in-process calls whose results are dropped: the kernel's share of
+    the CPU time, with and without the Sampler's output pool.
+ 9. A new interpreter's import plus its first 1 000 in-process samples.
+--quick runs rows 1-3, 8 and 9 only. The CPU's vector path (SSE2/AVX/AVX-512) is
 printed first; the bytes never depend on it.
 """
 
@@ -90,6 +93,49 @@ def row_python(n=4_000_000):
     except ImportError:
         pass
     return rows
+
+
+def kernel_share(fn, rounds=ROUNDS):
+    """Kernel (system) time as a share of fn's CPU time over `rounds` calls."""
+    import resource
+    r0 = resource.getrusage(resource.RUSAGE_SELF)
+    for _ in range(rounds):
+        fn()
+    r1 = resource.getrusage(resource.RUSAGE_SELF)
+    user, system = r1.ru_utime - r0.ru_utime, r1.ru_stime - r0.ru_stime
+    return system / (user + system)
+
+
+def row_warm_kernel(n=4_000_000):
+    """Warm calls whose results are dropped at once: with the output pool their
+    arrays refill the last call's memory; without, the kernel faults in and zeroes
+    fresh pages each time."""
+    import sfcsampler
+    request = dict(surface="sphere", count=n, seed=1)
+    pooled = sfcsampler.Sampler(max_trees=1, threads=1)
+    unpooled = sfcsampler.Sampler(max_trees=1, threads=1, output_pool_bytes=0)
+    shares = {"pooled": [], "unpooled": []}
+    for sampler in (pooled, unpooled):
+        sampler.sample(**request)
+    for _ in range(3):  # alternating
+        for name, sampler in (("pooled", pooled), ("unpooled", unpooled)):
+            shares[name].append(kernel_share(lambda: sampler.sample(**request), rounds=3))
+    p, u = shares["pooled"], shares["unpooled"]
+    return [(f"8. warm in-process calls, {n / 1e6:.0f} M sphere samples each, results dropped: "
+             "kernel share of CPU time",
+             f"{statistics.median(p):.1%} ({min(p):.1%}-{max(p):.1%})",
+             f"without the output pool {statistics.median(u):.1%}", "target under 5%")]
+
+
+def row_first_sample():
+    """A new interpreter: import sfcsampler and take 1 000 sphere samples."""
+    code = ("import time; t = time.perf_counter(); import sfcsampler; "
+            "sfcsampler.sample(count=1000); print(time.perf_counter() - t)")
+    env = dict(os.environ, PYTHONPATH=os.path.join(BUILD, "python"))
+    times = [float(run([sys.executable, "-c", code], env=env)) for _ in range(ROUNDS)]
+    return [("9. new interpreter: import sfcsampler + first 1 000 in-process samples",
+             f"median {statistics.median(times) * 1e3:.0f} ms "
+             f"({min(times) * 1e3:.0f}-{max(times) * 1e3:.0f})", "", "target 150 ms")]
 
 
 def row_core():
@@ -169,7 +215,7 @@ def main():
     print(f"# Throughput, algorithm {sfcsampler.ALGORITHM_VERSION}"
           + (f", vector path {path}" if path else "") + f", {os.cpu_count()} CPUs\n")
     print("| measure | ours | peer | ratio / target |\n|---|---|---|---|")
-    for rows in (row_python(), row_core(), row_cold_cli()):
+    for rows in (row_python(), row_core(), row_cold_cli(), row_warm_kernel(), row_first_sample()):
         for r in rows:
             print("| " + " | ".join(r) + " |")
     sys.stdout.flush()

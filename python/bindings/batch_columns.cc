@@ -14,29 +14,50 @@ constexpr const char* kValueNames[] = {"u",  "v",  "x",  "y",       "z",
 
 }  // namespace
 
-void Narrow(BatchColumns* c) {
+void TakeColumns(const SampleFields& fields, size_t n, BufferPool& pool, SampleBatch* batch) {
+  batch->index = pool.Take<uint64_t>(n);
+  for (auto* column : {&batch->u, &batch->v, &batch->x, &batch->y, &batch->z}) {
+    *column = pool.Take<double>(n);
+  }
+  if (fields.normal) {
+    for (auto* column : {&batch->nx, &batch->ny, &batch->nz}) *column = pool.Take<double>(n);
+  }
+  if (fields.density) batch->density = pool.Take<double>(n);
+  if (fields.curve_position) batch->curve_position = pool.Take<double>(n);
+  if (fields.face) batch->face = pool.Take<uint32_t>(n);
+  if (fields.triangle) batch->triangle = pool.Take<uint32_t>(n);
+}
+
+void Narrow(BatchColumns* c, BufferPool* pool) {
   const auto& columns = SampleBatch::ValueColumns();
   for (size_t i = 0; i < columns.size(); ++i) {
     std::vector<double>& column = c->batch.*columns[i];
+    if (pool != nullptr) c->narrowed[i] = pool->Take<float>(column.size());
     c->narrowed[i].resize(column.size());
     std::transform(column.begin(), column.end(), c->narrowed[i].begin(),
                    [](double d) { return static_cast<float>(d); });
-    std::vector<double>().swap(column);
+    if (pool != nullptr) {
+      pool->Give(std::move(column));
+      column = {};
+    } else {
+      std::vector<double>().swap(column);
+    }
   }
   c->float32 = true;
 }
 
-py::dict ColumnsDict(BatchColumns&& c, const SampleFields& fields) {
+py::dict ColumnsDict(BatchColumns&& c, const SampleFields& fields,
+                     const std::shared_ptr<BufferPool>& pool) {
   py::dict out;
-  out["index"] = ToNumpy(std::move(c.batch.index));
-  if (fields.face) out["face"] = ToNumpy(std::move(c.batch.face));
-  if (fields.triangle) out["triangle"] = ToNumpy(std::move(c.batch.triangle));
+  out["index"] = ToNumpy(std::move(c.batch.index), pool);
+  if (fields.face) out["face"] = ToNumpy(std::move(c.batch.face), pool);
+  if (fields.triangle) out["triangle"] = ToNumpy(std::move(c.batch.triangle), pool);
   const auto& columns = SampleBatch::ValueColumns();
   for (size_t i = 0; i < columns.size(); ++i) {
     if (c.float32) {
-      if (!c.narrowed[i].empty()) out[kValueNames[i]] = ToNumpy(std::move(c.narrowed[i]));
+      if (!c.narrowed[i].empty()) out[kValueNames[i]] = ToNumpy(std::move(c.narrowed[i]), pool);
     } else if (!(c.batch.*columns[i]).empty()) {
-      out[kValueNames[i]] = ToNumpy(std::move(c.batch.*columns[i]));
+      out[kValueNames[i]] = ToNumpy(std::move(c.batch.*columns[i]), pool);
     }
   }
   return out;

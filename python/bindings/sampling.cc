@@ -8,6 +8,7 @@
 // Thread-safety: an Engine may be used from several Python threads at once
 // (its tree source is locked); a Job serialises calls to next().
 #include <algorithm>
+#include <memory>
 #include <mutex>
 #include <thread>
 
@@ -16,6 +17,7 @@
 #include "engine/sampling_engine.h"
 #include "kinds/registered_kinds.h"
 #include "python/bindings/batch_columns.h"
+#include "python/bindings/buffer_pool.h"
 #include "python/bindings/errors.h"
 #include "python/bindings/memory_models.h"
 #include "python/bindings/recent_tree_source.h"
@@ -33,8 +35,10 @@ namespace {
 
 class PyJob {
  public:
-  PyJob(SamplingJob job, const SampleRequest& request, bool float32)
+  PyJob(SamplingJob job, const SampleRequest& request, bool float32,
+        std::shared_ptr<BufferPool> pool)
       : job_(std::move(job)),
+        pool_(std::move(pool)),
         fields_(request.fields),
         float32_(float32),
         seed_(request.seed),
@@ -55,10 +59,7 @@ class PyJob {
       const uint64_t left = job_.end - job_.begin - std::min(job_.end - job_.begin, produced_);
       const size_t reserve =
           static_cast<size_t>(std::min(max_samples, region_ ? uint64_t{1} << 16 : left));
-      batch.index.reserve(reserve);
-      for (SampleBatch::ValueColumn column : SampleBatch::ValueColumns()) {
-        (batch.*column).reserve(reserve);
-      }
+      TakeColumns(fields_, reserve, *pool_, &batch);
       uint64_t got = 0;
       while (got < max_samples) {
         // A region may drop samples, so ask for what is still wanted.
@@ -68,10 +69,10 @@ class PyJob {
         got += *n;
       }
       produced_ += got;
-      if (float32_) Narrow(&filled);
+      if (float32_) Narrow(&filled, pool_.get());
     }
     if (batch.size() == 0) return py::none();
-    return ColumnsDict(std::move(filled), fields_);
+    return ColumnsDict(std::move(filled), fields_, pool_);
   }
 
   py::dict Tree() const { return TreeSummaryDict(SummarizeTree(job_.tree)); }
@@ -86,6 +87,7 @@ class PyJob {
  private:
   std::mutex mu_;
   SamplingJob job_;
+  const std::shared_ptr<BufferPool> pool_;
   const SampleFields fields_;
   const bool float32_;
   const uint64_t seed_;
@@ -96,8 +98,10 @@ class PyJob {
 class PyEngine {
  public:
   PyEngine(size_t max_trees, int threads, const std::string& model_check_program,
-           double model_parse_seconds, uint64_t parsed_model_bytes, int parse_threads)
+           double model_parse_seconds, uint64_t parsed_model_bytes, int parse_threads,
+           uint64_t output_pool_bytes)
       : source_(max_trees),
+        pool_(std::make_shared<BufferPool>(output_pool_bytes)),
         engine_(RegisteredSurfaceKinds(),
                 Limits(threads, model_check_program, model_parse_seconds, parsed_model_bytes,
                        parse_threads),
@@ -125,8 +129,8 @@ class PyEngine {
       job = engine_.Start(r.request);
     }
     ThrowIfError(job.status());
-    return std::make_unique<PyJob>(*std::move(job), r.request,
-                                   *parsed == ColumnPrecision::kFloat32);
+    return std::make_unique<PyJob>(*std::move(job), r.request, *parsed == ColumnPrecision::kFloat32,
+                                   pool_);
   }
 
   py::dict Prepare(const PyRequest& r) {
@@ -168,7 +172,8 @@ class PyEngine {
   }
 
   RecentTreeSource source_;
-  MemoryModelSource models_;  // local files, and meshes handed over as arrays
+  const std::shared_ptr<BufferPool> pool_;  // the arrays' buffers, for the next calls
+  MemoryModelSource models_;                // local files, and meshes handed over as arrays
   SamplingEngine engine_;
 };
 
@@ -208,12 +213,15 @@ parsed_model_bytes: parsed models (meshes, CAD shapes) kept for later calls, in
   bytes, least recently used out first (0 = none: each call parses its model,
   as a run over many models seen once wants).
 parse_threads: 0 = each call parses its model on its own thread (no hand-over
-  to another thread); 1 to 64 = models parsed at once on the engine's threads.)doc")
-      .def(py::init<size_t, int, const std::string&, double, uint64_t, int>(), py::kw_only(),
-           py::arg("max_trees") = 0, py::arg("threads") = 0, py::arg("model_check_program") = "",
-           py::arg("model_parse_seconds") = 0.0,
+  to another thread); 1 to 64 = models parsed at once on the engine's threads.
+output_pool_bytes: buffers of freed result arrays (1 MiB or more each) kept, in
+  bytes, to hold later results: a warm loop refills memory it owns instead of
+  the kernel faulting in fresh pages (0 = none).)doc")
+      .def(py::init<size_t, int, const std::string&, double, uint64_t, int, uint64_t>(),
+           py::kw_only(), py::arg("max_trees") = 0, py::arg("threads") = 0,
+           py::arg("model_check_program") = "", py::arg("model_parse_seconds") = 0.0,
            py::arg("parsed_model_bytes") = EngineLimits().parsed_model_bytes,
-           py::arg("parse_threads") = 0)
+           py::arg("parse_threads") = 0, py::arg("output_pool_bytes") = 0)
       .def("start", &PyEngine::Start, py::arg("request"), py::kw_only(),
            py::arg("precision") = "float64",
            "Validates the request, builds (or reuses) its tree and opens its job. Raises "

@@ -22,18 +22,21 @@ class Sampler:
     parsed_model_bytes: parsed models (meshes, CAD shapes) kept for later calls
     (default 256 MiB; 0 = none, for models each sampled once); parse_threads: 0 =
     each call parses its model on its own thread (calls on several threads parse
-    at once), N = on N threads of the engine's own.
+    at once), N = on N threads of the engine's own. output_pool_bytes: the buffers
+    of freed result arrays kept to hold later results (default 256 MiB; 0 = none), so a
+    warm loop reuses its memory instead of faulting in fresh pages.
 
     The request keywords are `sfcsampler sample`'s flags (see sample()).
     """
 
     def __init__(self, max_trees=4, threads=0, *, model_check_program="", model_parse_seconds=0,
-                 parsed_model_bytes=256 << 20, parse_threads=0):
+                 parsed_model_bytes=256 << 20, parse_threads=0, output_pool_bytes=256 << 20):
         self._engine = _core.Engine(max_trees=max_trees, threads=threads,
                                     model_check_program=model_check_program,
                                     model_parse_seconds=model_parse_seconds,
                                     parsed_model_bytes=parsed_model_bytes,
-                                    parse_threads=parse_threads)
+                                    parse_threads=parse_threads,
+                                    output_pool_bytes=output_pool_bytes)
 
     def _held(self, request, call):
         """call(parsed request) with a mesh=... argument held in memory as its PLY bytes."""
@@ -138,15 +141,20 @@ def sample(*, precision="float64", threads=0, **request):
     while the tree is built and the arrays are filled. Builds the tree every
     call; use a Sampler to keep it.
     """
-    return Sampler(max_trees=0, threads=threads).sample(precision=precision, **request)
+    return _one_call(threads).sample(precision=precision, **request)
 
 
 def batches(*, batch_size=65536, precision="float64", threads=0, **request):
     """Like sample(), but yields Samples of at most batch_size samples each."""
-    return Sampler(max_trees=0, threads=threads).batches(batch_size=batch_size, precision=precision,
-                                                          **request)
+    return _one_call(threads).batches(batch_size=batch_size, precision=precision, **request)
 
 
 def prepare(**request):
     """The summary (dict) of the curve tree a request would use, after building it."""
-    return Sampler(max_trees=0).prepare(**request)
+    return _one_call(0).prepare(**request)
+
+
+def _one_call(threads):
+    """A Sampler for one call: no trees kept, and no pool (its buffers would outlive the
+    call's arrays for nothing)."""
+    return Sampler(max_trees=0, threads=threads, output_pool_bytes=0)

@@ -122,6 +122,30 @@ def test_sampler_reuses_its_tree():
     assert np.array_equal(second.x, sfcsampler.sample(surface="torus", count=10000, seed=2).x)
 
 
+def test_a_sampler_refills_freed_buffers_and_never_one_still_held():
+    n = 200000  # 1.6 MB columns: pooled
+    sampler = sfcsampler.Sampler(max_trees=1)
+    held = sampler.sample(surface="torus", count=n)
+    held_copy = {c: getattr(held, c).copy() for c in ("index", "u", "v", "x", "y", "z")}
+    freed = sampler.sample(surface="torus", count=n, seed=2)
+    freed_buffers = {getattr(freed, c).ctypes.data for c in ("index", "u", "v", "x", "y", "z")}
+    del freed
+    third = sampler.sample(surface="torus", count=n, seed=3, precision="float32")  # fills doubles
+    again = sampler.sample(surface="torus", count=n, seed=2)
+    # Buffers come back: the freed float64 set's memory holds the next float64 set.
+    assert {getattr(again, c).ctypes.data for c in ("x", "y", "z")} <= freed_buffers
+    # Never one a live array still owns, and the values are a fresh call's.
+    for c, values in held_copy.items():
+        assert np.array_equal(getattr(held, c), values)
+        assert not np.shares_memory(getattr(held, c), getattr(again, c))
+        assert not np.shares_memory(getattr(third, c), getattr(again, c))
+    fresh = sfcsampler.sample(surface="torus", count=n, seed=2)
+    for c in held_copy:
+        assert np.array_equal(getattr(again, c), getattr(fresh, c))
+    assert np.array_equal(third.x, sfcsampler.sample(surface="torus", count=n, seed=3,
+                                                     precision="float32").x)
+
+
 def test_gil_is_released_while_sampling():
     # Another Python thread keeps running while a large request fills.
     ticks = []
