@@ -237,8 +237,8 @@ absl::StatusOr<StreamSummary> SamplerClient::Sample(const SampleRequest& asked,
     // Behind a proxy, a resume after the model's replica died reaches the
     // next replica on the ring, which lacks the model: upload it there
     // again (when the request named a local file) and resume.
-    const bool model_moved = status.error_code() == grpc::StatusCode::NOT_FOUND &&
-                             summary.resumes > 0 && from_file;
+    const bool model_moved =
+        status.error_code() == grpc::StatusCode::NOT_FOUND && summary.resumes > 0 && from_file;
     const bool resumable =
         status.error_code() == grpc::StatusCode::UNAVAILABLE || transport_reset || model_moved;
     if (!resumable || attempt >= options_.max_resumes) {
@@ -388,7 +388,8 @@ absl::StatusOr<bool> SamplerClient::CheckHealth(const std::string& service,
   auto stub = grpc::health::v1::Health::NewStub(channel_);
   grpc::ClientContext context;
   if (deadline_seconds <= 0) {
-    deadline_seconds = options_.deadline_seconds > 0 ? options_.deadline_seconds : 5;
+    deadline_seconds =
+        options_.deadline_seconds > 0 ? options_.deadline_seconds : kHealthCheckSeconds;
   }
   context.set_deadline(std::chrono::system_clock::now() +
                        std::chrono::milliseconds(static_cast<int64_t>(deadline_seconds * 1000)));

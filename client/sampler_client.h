@@ -41,16 +41,16 @@
 namespace sfc {
 
 struct ClientOptions {
-  std::string target = "127.0.0.1:50051";  // host:port
-  std::string token;                       // bearer token; "" = none
-  bool tls = false;                        // use TLS ...
-  std::string tls_root_certs_file;         // ... trusting these roots ("" = system roots)
-  std::string tls_cert_file, tls_key_file; // client certificate and key for mutual TLS ("" = none)
-  int max_resumes = 5;                     // resumes per Sample() call
+  std::string target = "127.0.0.1:50051";   // host:port
+  std::string token;                        // bearer token; "" = none
+  bool tls = false;                         // use TLS ...
+  std::string tls_root_certs_file;          // ... trusting these roots ("" = system roots)
+  std::string tls_cert_file, tls_key_file;  // client certificate and key for mutual TLS ("" = none)
+  int max_resumes = 5;                      // resumes per Sample() call
   // First wait before a resume; doubles each time. After each wait the
   // client waits up to as long again for the connection to come back.
   double resume_backoff_seconds = 0.2;
-  double deadline_seconds = 0;             // per RPC; 0 = none
+  double deadline_seconds = 0;  // per RPC; 0 = none
   // How Sample()'s samples travel unless a call says otherwise. Raw columns
   // (one memcpy a column at each end) rather than the wire's default, packed
   // repeated fields: servers that predate raw columns send packed ones
@@ -110,14 +110,14 @@ class SamplerClient {
                                                           const std::string& bytes);
   // grpc.health.v1 Check of `service` ("" = the whole server): true when
   // SERVING. It sends no token. `deadline_seconds` 0: the options' deadline,
-  // or 5 s without one.
+  // or kHealthCheckSeconds without one.
+  static constexpr double kHealthCheckSeconds = 5;
   absl::StatusOr<bool> CheckHealth(const std::string& service = "", double deadline_seconds = 0);
 
   // Range and shard helpers: the same request restricted to [begin, end) or
   // to shard i of k.
   static SampleRequest Range(SampleRequest request, uint64_t begin, uint64_t end);
   static SampleRequest Shard(SampleRequest request, uint64_t i, uint64_t k);
-
 
  private:
   explicit SamplerClient(const ClientOptions& options, std::shared_ptr<grpc::Channel> channel);

@@ -39,6 +39,15 @@ std::optional<ModelFormat> ModelFormatFromName(std::string_view name) {
   return std::nullopt;
 }
 
+std::string ModelFormatList() {
+  std::string out;
+  for (size_t i = 0; i < kFormats.size(); ++i) {
+    if (i > 0) out += i + 1 == kFormats.size() ? " or " : ", ";
+    out += kFormats[i].second;
+  }
+  return out;
+}
+
 std::string Sha256Hex(std::string_view bytes) {
   unsigned char digest[SHA256_DIGEST_LENGTH];
   SHA256(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), digest);
@@ -69,8 +78,8 @@ absl::StatusOr<std::optional<ModelSpec>> ParseModelSpec(std::string_view text) {
   }
   if (absl::StartsWith(out.reference, "sha256=")) {
     const std::string hash = absl::AsciiStrToLower(out.reference.substr(7));
-    const bool hex = hash.size() == 64 &&
-                     hash.find_first_not_of("0123456789abcdef") == std::string::npos;
+    const bool hex =
+        hash.size() == 64 && hash.find_first_not_of("0123456789abcdef") == std::string::npos;
     if (!hex) {
       return absl::InvalidArgumentError(absl::StrFormat(
           "\"%s\" is not a SHA-256: it needs 64 hex digits after sha256=", Echo(out.reference)));

@@ -20,6 +20,8 @@ enum class ModelFormat { kStep, kIges, kNurbs, kObj, kPly };
 
 std::string_view ModelFormatName(ModelFormat format);  // "step", "iges", "nurbs", "obj", "ply"
 std::optional<ModelFormat> ModelFormatFromName(std::string_view name);
+// Every format's name, for messages: "step, iges, nurbs, obj or ply".
+std::string ModelFormatList();
 
 // SHA-256 of `bytes` as 64 lowercase hex digits.
 std::string Sha256Hex(std::string_view bytes);

@@ -1,5 +1,3 @@
-#include "server/sampler_service.h"
-
 #include <algorithm>
 #include <chrono>
 
@@ -8,6 +6,7 @@
 #include "proto/convert.h"
 #include "proto/service/service_convert.h"
 #include "server/request_control.h"
+#include "server/sampler_service.h"
 #include "spdlog/spdlog.h"
 
 namespace sfc {
@@ -34,11 +33,9 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
         name = Echo(chunk.name(), kMaxNameEcho);
         format = ModelFormatFromName(chunk.format());
         if (!format) {
-          status =
-              grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                           absl::StrFormat("unknown model format \"%s\"; use step, iges, nurbs, "
-                                           "obj or ply",
-                                           Echo(chunk.format())));
+          status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                                absl::StrFormat("unknown model format \"%s\"; use %s",
+                                                Echo(chunk.format()), ModelFormatList()));
         }
         first = false;
         if (status.ok() && chunk.total_bytes() > 0) {

@@ -27,10 +27,9 @@ int RunUpload(const UploadFlags& flags) {
     auto parsed = ParseModelSpec(spec);
     if (!parsed.ok()) return Fail(parsed.status());
     if (!parsed->has_value()) {
-      return Fail(absl::InvalidArgumentError(absl::StrFormat(
-          "\"%s\" names no model file; write FORMAT:FILE with FORMAT step, iges, nurbs, obj or "
-          "ply",
-          spec)));
+      return Fail(absl::InvalidArgumentError(
+          absl::StrFormat("\"%s\" names no model file; write FORMAT:FILE with FORMAT %s", spec,
+                          ModelFormatList())));
     }
     auto wire = (*client)->EnsureModel(spec);
     if (!wire.ok()) return Fail(wire.status());

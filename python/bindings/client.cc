@@ -284,8 +284,8 @@ class PyClient {
                           const std::string& name) {
     const std::optional<ModelFormat> parsed = ModelFormatFromName(format);
     if (!parsed) {
-      throw StatusException(absl::InvalidArgumentError(
-          "model format must be one of step, iges, nurbs, obj, ply, not \"" + format + "\""));
+      throw StatusException(absl::InvalidArgumentError("model format must be " + ModelFormatList() +
+                                                       ", not \"" + format + "\""));
     }
     std::string bytes = data;
     const std::shared_ptr<SamplerClient> client = Connected();
@@ -369,7 +369,7 @@ PYBIND11_MODULE(_client, m) {
       .def("upload", &PyClient::Upload, py::arg("spec"))
       .def("upload_bytes", &PyClient::UploadBytes, py::arg("format"), py::arg("data"),
            py::arg("name") = "")
-      .def("health", &PyClient::Health, py::arg("service") = "", py::arg("timeout") = 5.0)
+      .def("health", &PyClient::Health, py::arg("service") = "", py::arg("timeout") = 0.0)
       .def("cache_stats", &PyClient::CacheStats)
       .def("catalog", &PyClient::Catalog);
 }

@@ -110,8 +110,8 @@ class PyEngine {
   std::string HoldModel(const std::string& format, const py::bytes& data, const std::string& name) {
     const auto parsed = ModelFormatFromName(format);
     if (!parsed) {
-      throw StatusException(absl::InvalidArgumentError(
-          "model format must be one of step, iges, nurbs, obj, ply, not \"" + format + "\""));
+      throw StatusException(absl::InvalidArgumentError("model format must be " + ModelFormatList() +
+                                                       ", not \"" + format + "\""));
     }
     std::string bytes = data;  // one copy, owned by the held model
     py::gil_scoped_release release;

@@ -148,8 +148,10 @@ class Client:
         warn_depth_cap(tree, stacklevel=3)
         return tree
 
-    def health(self, service="", timeout=5.0):
-        """True when the server reports SERVING (grpc.health.v1 Check; needs no token)."""
+    def health(self, service="", timeout=0):
+        """True when the server reports SERVING (grpc.health.v1 Check; needs no token).
+        timeout: seconds (0 = the client's deadline, or the client library's default without
+        one)."""
         return self._client.health(service, timeout)
 
     def cache_stats(self):
