@@ -22,7 +22,10 @@ noisy machine's load hits both sides alike):
  8. Warm in-process calls whose results are dropped: the kernel's share of
     the CPU time, with and without the Sampler's output pool.
  9. A new interpreter's import plus its first 1 000 in-process samples.
---quick runs rows 1-3, 8 and 9 only. The CPU's vector path (SSE2/AVX/AVX-512) is
+10. Samples a second from a built tree, one core, per surface of
+    core_benchmark's BM_SampleSurface, and the cost at N = 2^23 + 1 against 10^6.
+11. Two threads against one (core_benchmark's BM_SampleFromBuiltTreeThreads).
+--quick runs rows 1-3 and 8-11 only. The CPU's vector path (SSE2/AVX/AVX-512) is
 printed first; the bytes never depend on it.
 """
 
@@ -138,6 +141,55 @@ def row_first_sample():
              f"({min(times) * 1e3:.0f}-{max(times) * 1e3:.0f})", "", "target 150 ms")]
 
 
+def core_benchmarks(pattern):
+    """{(name, label): items per second} of core_benchmark's runs matching `pattern`, on
+    core 0 (a threads benchmark gets both cores)."""
+    import json
+    threads = "Threads" in pattern
+    cmd = ([] if threads else ["taskset", "-c", "0"]) + [
+        f"{BUILD}/bench/core_benchmark", f"--benchmark_filter={pattern}",
+        "--benchmark_format=json", "--benchmark_repetitions=3",
+        "--benchmark_report_aggregates_only=true"]
+    out = {}
+    for b in json.loads(run(cmd))["benchmarks"]:
+        if b.get("aggregate_name") == "median":
+            out[(b["run_name"], b.get("label", ""))] = b["items_per_second"]
+    return out
+
+
+def row_surfaces():
+    """Samples a second from a built tree, one core, per surface; and each surface's rate
+    at N = 2^23 + 1 against its rate at 10^6."""
+    rates = core_benchmarks("BM_SampleSurface")
+    by_label = {}
+    for (name, label), rate in rates.items():
+        by_label.setdefault(label, {})[int(name.rsplit("/", 1)[1])] = rate
+    sphere = by_label.get("sphere", {}).get(1_000_000)
+    rows = []
+    for label, at in by_label.items():
+        small, large = at.get(1_000_000), at.get((1 << 23) + 1)
+        if small is None or large is None:
+            continue
+        rows.append((f"10. per-sample cost from a built tree, one core: {label}",
+                     f"{small / 1e6:.1f} M/s at 10^6",
+                     f"sphere/this {sphere / small:.2f}x" if sphere else "",
+                     f"2^23+1 costs {small / large:.2f}x of 10^6 a sample (target: sphere "
+                     "50 M/s, every surface within 2x of it, 2^23+1 within 1.2x)"))
+    return rows
+
+
+def row_threads():
+    """Two threads against one, the same samples (wall time)."""
+    rates = core_benchmarks("BM_SampleFromBuiltTreeThreads")
+    by_threads = {int(name.rsplit("/", 2)[1]): rate for (name, _), rate in rates.items()}
+    one, two = by_threads.get(1), by_threads.get(2)
+    if not one or not two:
+        return []
+    return [("11. two threads against one from a built tree (C++, wall)",
+             f"{two / 1e6:.1f} M/s on 2", f"{one / 1e6:.1f} M/s on 1",
+             f"{two / one:.2f}x (target 1.8x)")]
+
+
 def row_core():
     out = run(["taskset", "-c", "0", f"{BUILD}/bench/core_benchmark",
                "--benchmark_filter="
@@ -215,7 +267,8 @@ def main():
     print(f"# Throughput, algorithm {sfcsampler.ALGORITHM_VERSION}"
           + (f", vector path {path}" if path else "") + f", {os.cpu_count()} CPUs\n")
     print("| measure | ours | peer | ratio / target |\n|---|---|---|---|")
-    for rows in (row_python(), row_core(), row_cold_cli(), row_warm_kernel(), row_first_sample()):
+    for rows in (row_python(), row_core(), row_cold_cli(), row_warm_kernel(), row_first_sample(),
+                 row_surfaces(), row_threads()):
         for r in rows:
             print("| " + " | ".join(r) + " |")
     sys.stdout.flush()
