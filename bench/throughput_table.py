@@ -25,6 +25,8 @@ noisy machine's load hits both sides alike):
 10. Samples a second from a built tree, one core, per surface of
     core_benchmark's BM_SampleSurface, and the cost at N = 2^23 + 1 against 10^6.
 11. Two threads against one (core_benchmark's BM_SampleFromBuiltTreeThreads).
+12. sample_many of 1 000 small meshes against a loop over Open3D
+    (bench/many_meshes.py).
 --quick runs rows 1-3 and 8-11 only. The CPU's vector path (SSE2/AVX/AVX-512) is
 printed first; the bytes never depend on it.
 """
@@ -280,6 +282,9 @@ def main():
                    "## 6. Models against the built-in sphere (bench/model_benchmark)"))
     print(table_of(["/usr/bin/python3", os.path.join(HERE, "mesh_vs_open3d.py"), BUILD, "1000000"],
                    "## 7. Mesh against Open3D (bench/mesh_vs_open3d.py)"))
+    print(table_of(["/usr/bin/python3", os.path.join(HERE, "many_meshes.py"), "--no-dask"],
+                   "## 12. sample_many of 1 000 small meshes against Open3D's loop "
+                   "(bench/many_meshes.py; target 3x)"))
 
 
 if __name__ == "__main__":
