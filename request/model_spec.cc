@@ -39,6 +39,12 @@ std::optional<ModelFormat> ModelFormatFromName(std::string_view name) {
   return std::nullopt;
 }
 
+std::vector<ModelFormat> AllModelFormats() {
+  std::vector<ModelFormat> out;
+  for (const auto& [format, name] : kFormats) out.push_back(format);
+  return out;
+}
+
 std::string ModelFormatList() {
   std::string out;
   for (size_t i = 0; i < kFormats.size(); ++i) {

@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "absl/status/statusor.h"
 
@@ -20,6 +21,8 @@ enum class ModelFormat { kStep, kIges, kNurbs, kObj, kPly };
 
 std::string_view ModelFormatName(ModelFormat format);  // "step", "iges", "nurbs", "obj", "ply"
 std::optional<ModelFormat> ModelFormatFromName(std::string_view name);
+// Every format, in the order of ModelFormatList.
+std::vector<ModelFormat> AllModelFormats();
 // Every format's name, for messages: "step, iges, nurbs, obj or ply".
 std::string ModelFormatList();
 

@@ -17,10 +17,18 @@ TEST(ModelFiles, EveryExtensionNamesItsFormat) {
     formats.insert(e.format);
   }
   // Every model format has a file extension.
-  for (const ModelFormat f : {ModelFormat::kStep, ModelFormat::kIges, ModelFormat::kNurbs,
-                              ModelFormat::kObj, ModelFormat::kPly}) {
+  for (const ModelFormat f : AllModelFormats()) {
     EXPECT_EQ(formats.count(f), 1u) << ModelFormatName(f);
   }
+}
+
+TEST(ModelFiles, EveryFormatIsNamedOnceAndListedForMessages) {
+  const std::string list = ModelFormatList();
+  for (const ModelFormat f : AllModelFormats()) {
+    EXPECT_EQ(ModelFormatFromName(ModelFormatName(f)), f);
+    EXPECT_NE(list.find(ModelFormatName(f)), std::string::npos) << list;
+  }
+  EXPECT_EQ(ModelFormatFromName("stl"), std::nullopt);
 }
 
 TEST(ModelFiles, ExtensionsIgnoreCaseAndOnlyTheLastCounts) {
