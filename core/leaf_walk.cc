@@ -5,21 +5,12 @@
 #include <limits>
 
 #include "core/area_estimator.h"
+#include "core/slope_batch.h"
 #include "core/vector_math.h"
 
 namespace sfc {
 
 namespace {
-
-// The point at fraction f of [0, 1] under the linear density 1 + g (2s - 1)
-// with g = q / p (mean 1, slope 2g; p > 0 and |q| <= p keep it >= 0): the
-// root in [0, 1] of g s^2 + (1 - g) s = f, in the form without cancellation,
-// times p / p so that no division by p is needed per cell. Monotone in f, 0
-// at 0 and 1 at 1, and f itself for q = 0 (2fp / 2p, exact).
-double FollowSlope(double f, double p, double q) {
-  const double a = p - q;
-  return std::min(2 * f * p / (a + std::sqrt(a * a + 4 * q * f * p)), 1.0);
-}
 
 // Below this mass a cell is placed uniformly: FollowSlope squares p.
 constexpr double kLeastSlopedMass = 1e-150;
@@ -279,7 +270,6 @@ void LeafWalk::Continue(size_t n) {
   // curve decoding, then the coordinates.
   const uint64_t scale = continuation_scale_;
   fraction_.resize(n), digits_.resize(n), states_.resize(n), cx_.resize(n), cy_.resize(n);
-  if (warped_) fx_.resize(n), fy_.resize(n);
   for (size_t i = 0; i < n; ++i) {
     const Square& at = reached_[reached_of_[i]];
     const double t = t_[i];
@@ -293,19 +283,25 @@ void LeafWalk::Continue(size_t n) {
   }
   curve_.DescendMany(digits_.data(), continuation_levels_, n, states_.data(), cx_.data(),
                      cy_.data());
+  // The centre of the continuation's cell in cells, and its square's slope
+  // (FollowSlope's p and q), then the fractions of the square for all n in
+  // one vectorised pass (slope_batch.h).
+  fx_.resize(n), fy_.resize(n), mass_.resize(n), gx_.resize(n), gy_.resize(n);
   for (size_t i = 0; i < n; ++i) {
     const Square& at = reached_[reached_of_[i]];
-    // The centre of the continuation's cell as fractions of the square; for
-    // Hilbert the division is by 2^26: a multiplication, with the same bits.
-    const double x = static_cast<double>(static_cast<int64_t>(cx_[i])) + 0.5;
-    const double y = static_cast<double>(static_cast<int64_t>(cy_[i])) + 0.5;
-    double fx = cells_power_of_two_ ? x * inverse_cells_ : x / continuation_cells_;
-    double fy = cells_power_of_two_ ? y * inverse_cells_ : y / continuation_cells_;
-    fx = FollowSlope(fx, at.mass, at.gx), fy = FollowSlope(fy, at.mass, at.gy);
-    if (warped_) {
-      fx_[i] = fx, fy_[i] = fy;  // placed below, a batch of powers at a time
-    } else {
-      const double px = at.x0 + fx * at.side, py = at.y0 + fy * at.side;
+    fx_[i] = static_cast<double>(static_cast<int64_t>(cx_[i])) + 0.5;
+    fy_[i] = static_cast<double>(static_cast<int64_t>(cy_[i])) + 0.5;
+    mass_[i] = at.mass, gx_[i] = at.gx, gy_[i] = at.gy;
+  }
+  // For Hilbert the division is by 2^26: a multiplication, with the same bits.
+  slope_batch::FollowSlopes(fx_.data(), mass_.data(), gx_.data(), n, cells_power_of_two_,
+                            continuation_cells_, inverse_cells_);
+  slope_batch::FollowSlopes(fy_.data(), mass_.data(), gy_.data(), n, cells_power_of_two_,
+                            continuation_cells_, inverse_cells_);
+  for (size_t i = 0; i < n; ++i) {
+    const Square& at = reached_[reached_of_[i]];
+    if (!warped_) {
+      const double px = at.x0 + fx_[i] * at.side, py = at.y0 + fy_[i] * at.side;
       u_[i] = cell_.u0 + px * cell_.size;
       v_[i] = cell_.v0 + py * cell_.size;
     }

@@ -177,7 +177,8 @@ class LeafWalk {
   std::vector<double> fraction_;                    // each sample's fraction of its square's t
   std::vector<uint64_t> digits_, cx_, cy_;          // its curve digits and the cell they reach
   std::vector<uint64_t> states_;                    // its square's orientation, then the cell's
-  std::vector<double> fx_, fy_;                     // in a warped leaf: fractions of the cell
+  std::vector<double> fx_, fy_;                     // its fractions of its square
+  std::vector<double> mass_, gx_, gy_;              // its square's FollowSlope p and q
   std::vector<double> base_, power_, place_;        // PlaceWarped's powers and places
   // The run being placed: output columns (curve_position_ may be null).
   double *u_ = nullptr, *v_ = nullptr, *curve_position_ = nullptr;

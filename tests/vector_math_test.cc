@@ -7,10 +7,12 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include <sleef.h>
 
+#include "core/slope_batch.h"
 #include "gtest/gtest.h"
 
 namespace sfc::math {
@@ -144,6 +146,41 @@ TEST(VectorMath, ValuesAreSineAndCosineOfPiX) {
   EXPECT_NEAR(a.cos, std::cos(0.3), 1e-16);
   EXPECT_NEAR(Pow(2.5, 1.0 / 3), std::cbrt(2.5), 1e-15);
   EXPECT_EQ(Pow(0, 0.5), 0);
+}
+
+// The placement's vectorised slope pass (core/slope_batch.h) gives the
+// scalar code's bits on every path this CPU runs, for both ways of scaling
+// the cell centres, at every tail length.
+TEST(SlopeBatch, EveryPathGivesTheScalarBits) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> unit(0, 1);
+  const size_t n = 1001;
+  std::vector<double> c(n), p(n), q(n);
+  for (size_t i = 0; i < n; ++i) {
+    c[i] = std::floor(unit(rng) * 67108864) + 0.5;
+    p[i] = i % 7 == 0 ? 1 : std::ldexp(unit(rng), -static_cast<int>(rng() % 40));
+    q[i] = i % 5 == 0 ? 0 : i % 11 == 0 ? -p[i] : (2 * unit(rng) - 1) * p[i];
+  }
+  using Kernel = void (*)(double*, const double*, const double*, size_t, bool, double, double);
+  const std::pair<VectorPath, Kernel> paths[] = {
+      {VectorPath::kAvx, slope_batch::FollowSlopesAvx},
+      {VectorPath::kAvx512, slope_batch::FollowSlopesAvx512},
+      {BestVectorPath(), slope_batch::FollowSlopes}};
+  for (const bool exact : {true, false}) {
+    const double cells = exact ? 67108864 : 59049, inverse = 1 / cells;
+    std::vector<double> want = c;
+    slope_batch::FollowSlopesOf(want.data(), p.data(), q.data(), n, exact, cells, inverse);
+    for (const auto& [path, kernel] : paths) {
+      if (!Runs(path)) continue;
+      for (size_t m : {n, size_t{1}, size_t{3}, size_t{9}, size_t{17}}) {
+        std::vector<double> got(c.begin(), c.begin() + m);
+        kernel(got.data(), p.data(), q.data(), m, exact, cells, inverse);
+        for (size_t i = 0; i < m; ++i) {
+          ASSERT_TRUE(SameBits(got[i], want[i])) << VectorPathName(path) << " i = " << i;
+        }
+      }
+    }
+  }
 }
 
 }  // namespace
