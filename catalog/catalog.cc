@@ -1,5 +1,6 @@
 #include "catalog/catalog.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <type_traits>
@@ -119,6 +120,21 @@ class ExpressionSurface final : public Surface {
     const double uv[2] = {u0_ + u * du_, v0_ + v * dv_};
     TrigCache trig;
     return {x_->Evaluate(uv, &trig), y_->Evaluate(uv, &trig), z_->Evaluate(uv, &trig)};
+  }
+
+  // Point's values by the expressions' batch evaluation, chunk by chunk.
+  void Points(const double* u, const double* v, size_t n, double* x, double* y,
+              double* z) const override {
+    constexpr size_t kChunk = 256;
+    double nu[kChunk], nv[kChunk];
+    const double* const columns[2] = {nu, nv};
+    for (size_t at = 0; at < n; at += kChunk) {
+      const size_t m = std::min(kChunk, n - at);
+      for (size_t i = 0; i < m; ++i) nu[i] = u0_ + u[at + i] * du_, nv[i] = v0_ + v[at + i] * dv_;
+      x_->EvaluateMany(columns, 2, m, x + at);
+      y_->EvaluateMany(columns, 2, m, y + at);
+      z_->EvaluateMany(columns, 2, m, z + at);
+    }
   }
 
   SurfaceJet Jet(double u, double v, int order) const override {

@@ -10,6 +10,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/strip.h"
+#include "core/vector_math.h"
 #include "muParser.h"
 
 namespace sfc {
@@ -454,6 +455,132 @@ T Run(const std::vector<Instruction>& code, const T* vars, TrigCache* cache = nu
   return st[0];
 }
 
+// Points evaluated at once by ExecuteMany.
+constexpr size_t kBatch = 64;
+
+// Runs a program without conditionals over m <= kBatch points at once: stack
+// entry k is the column st[k][0..m), and each instruction runs over its
+// columns with Execute<double>'s operations in the same order (the same
+// bits), sin and cos in one vector batch (math::SinCosOf, SinCosOf's bits).
+void ExecuteMany(const std::vector<Instruction>& code, const double* const* vars, size_t m,
+                 double (*st)[kBatch]) {
+  int sp = -1;
+  double s[kBatch], c[kBatch], args[kMaxStack];
+  for (const Instruction& in : code) {
+    double* top = st[sp + 1];  // a pushed column
+    double* a = sp >= 1 ? st[sp - 1] : nullptr;  // a binary operator's columns
+    const double* b = sp >= 0 ? st[sp] : nullptr;
+    switch (in.op) {
+      case Op::kConst:
+        std::fill(top, top + m, in.a), ++sp;
+        break;
+      case Op::kVar:
+        std::copy(vars[in.arg], vars[in.arg] + m, top), ++sp;
+        break;
+      case Op::kVarMulAdd:
+        for (size_t i = 0; i < m; ++i) top[i] = VarMulAdd(vars[in.arg][i], in.a, in.b);
+        ++sp;
+        break;
+      case Op::kVarSquare:
+        for (size_t i = 0; i < m; ++i) top[i] = VarSquare(vars[in.arg][i]);
+        ++sp;
+        break;
+      case Op::kVarCube:
+        for (size_t i = 0; i < m; ++i) top[i] = VarCube(vars[in.arg][i]);
+        ++sp;
+        break;
+      case Op::kVarFourth:
+        for (size_t i = 0; i < m; ++i) top[i] = VarFourth(vars[in.arg][i]);
+        ++sp;
+        break;
+      case Op::kAdd:
+        for (size_t i = 0; i < m; ++i) a[i] = a[i] + b[i];
+        --sp;
+        break;
+      case Op::kSub:
+        for (size_t i = 0; i < m; ++i) a[i] = a[i] - b[i];
+        --sp;
+        break;
+      case Op::kMul:
+        for (size_t i = 0; i < m; ++i) a[i] = a[i] * b[i];
+        --sp;
+        break;
+      case Op::kDiv:
+        for (size_t i = 0; i < m; ++i) a[i] = a[i] / b[i];
+        --sp;
+        break;
+      case Op::kPow:
+        for (size_t i = 0; i < m; ++i) a[i] = Pow(a[i], b[i]);
+        --sp;
+        break;
+      case Op::kLess:
+        for (size_t i = 0; i < m; ++i) a[i] = Lt(a[i], b[i]);
+        --sp;
+        break;
+      case Op::kGreater:
+        for (size_t i = 0; i < m; ++i) a[i] = Lt(b[i], a[i]);
+        --sp;
+        break;
+      case Op::kLessEqual:
+        for (size_t i = 0; i < m; ++i) a[i] = Le(a[i], b[i]);
+        --sp;
+        break;
+      case Op::kGreaterEqual:
+        for (size_t i = 0; i < m; ++i) a[i] = Le(b[i], a[i]);
+        --sp;
+        break;
+      case Op::kEqual:
+        for (size_t i = 0; i < m; ++i) a[i] = Eq(a[i], b[i]);
+        --sp;
+        break;
+      case Op::kNotEqual:
+        for (size_t i = 0; i < m; ++i) a[i] = Ne(a[i], b[i]);
+        --sp;
+        break;
+      case Op::kAnd:
+        for (size_t i = 0; i < m; ++i) a[i] = And(a[i], b[i]);
+        --sp;
+        break;
+      case Op::kOr:
+        for (size_t i = 0; i < m; ++i) a[i] = Or(a[i], b[i]);
+        --sp;
+        break;
+      case Op::kFunc:
+        if (in.fn == Fn::kSin || in.fn == Fn::kCos) {
+          math::SinCosOf(st[sp], m, s, c);
+          std::copy_n(in.fn == Fn::kSin ? s : c, m, st[sp]);
+        } else {
+          for (size_t i = 0; i < m; ++i) st[sp][i] = Apply(in.fn, st[sp][i]);
+        }
+        break;
+      case Op::kAtan2:
+        for (size_t i = 0; i < m; ++i) a[i] = Atan2(a[i], b[i]);
+        --sp;
+        break;
+      case Op::kSum:
+      case Op::kAvg:
+      case Op::kMin:
+      case Op::kMax:
+        sp -= in.arg - 1;
+        for (size_t i = 0; i < m; ++i) {
+          for (int k = 0; k < in.arg; ++k) args[k] = st[sp + k][i];
+          st[sp][i] = ApplyMulti(in.op, args, in.arg);
+        }
+        break;
+      case Op::kIf:
+      case Op::kElse:
+      case Op::kEndIf:
+        break;  // not reached: programs with conditionals run point by point
+    }
+  }
+}
+
+bool HasConditionals(const std::vector<Instruction>& code) {
+  return std::any_of(code.begin(), code.end(), [](const Instruction& in) {
+    return in.op == Op::kIf || in.op == Op::kElse || in.op == Op::kEndIf;
+  });
+}
+
 // ---- muparser callbacks: used by muparser only to parse and to fold
 // constants, so they compute exactly what Run<double> computes.
 
@@ -626,7 +753,7 @@ absl::StatusOr<std::vector<Instruction>> Translate(const mu::ParserByteCode& byt
 }  // namespace
 
 Expression::Expression(std::string text, std::vector<Instruction> code)
-    : text_(std::move(text)), code_(std::move(code)) {}
+    : text_(std::move(text)), code_(std::move(code)), straight_(!HasConditionals(code_)) {}
 
 Expression::~Expression() = default;
 
@@ -717,6 +844,26 @@ Dual1 Expression::Evaluate(const Dual1* values, TrigCache* cache) const {
 }
 Dual2 Expression::Evaluate(const Dual2* values, TrigCache* cache) const {
   return Run(code_, values, cache);
+}
+
+void Expression::EvaluateMany(const double* const* columns, size_t variables, size_t n,
+                              double* out) const {
+  if (!straight_) {
+    std::vector<double> values(variables);
+    for (size_t k = 0; k < n; ++k) {
+      for (size_t i = 0; i < variables; ++i) values[i] = columns[i][k];
+      out[k] = Run(code_, values.data());
+    }
+    return;
+  }
+  double st[kMaxStack][kBatch];
+  std::vector<const double*> vars(columns, columns + variables);
+  for (size_t at = 0; at < n; at += kBatch) {
+    const size_t m = std::min(kBatch, n - at);
+    ExecuteMany(code_, vars.data(), m, st);
+    std::copy_n(st[0], m, out + at);
+    for (const double*& column : vars) column += m;
+  }
 }
 
 void TrigCache::SinCos(double x, double* s, double* c) {

@@ -30,6 +30,7 @@
 #ifndef SFCSAMPLER_CATALOG_EXPRESSION_H_
 #define SFCSAMPLER_CATALOG_EXPRESSION_H_
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -87,6 +88,12 @@ class Expression {
   Dual1 Evaluate(const Dual1* values, TrigCache* cache) const;
   Dual2 Evaluate(const Dual2* values, TrigCache* cache) const;
 
+  // Evaluate at n points, out[k] bit for bit Evaluate's value with
+  // variables[i] = columns[i][k] (i < variables). Programs without
+  // conditionals run an instruction at a time over chunks of points, sin and
+  // cos as vector batches; the others point by point.
+  void EvaluateMany(const double* const* columns, size_t variables, size_t n, double* out) const;
+
   const std::string& text() const { return text_; }
   // Number of instructions of the compiled program (for tests and tracing).
   size_t program_size() const;
@@ -98,6 +105,7 @@ class Expression {
 
   const std::string text_;
   const std::vector<Instruction> code_;
+  const bool straight_;  // no conditionals: EvaluateMany runs it over chunks
 };
 
 // Evaluates a constant expression such as "2*_pi" or "1/3" with the same

@@ -64,10 +64,12 @@ SurfacePoint PointFromJet(const SurfaceJet& jet, double u, double v, bool curvat
   return point;
 }
 
-void MassDensityGrid(const Surface& surface, const Density& density, const double* us, int nu,
-                     const double* vs, int nv, double* out) {
+namespace {
+
+// MassDensityGrid with room for the grid's jets in `jets`.
+void MassDensityGridIn(const Surface& surface, const Density& density, const double* us, int nu,
+                       const double* vs, int nv, double* out, SurfaceJet* jets) {
   const bool curvature = density.NeedsCurvature();
-  SurfaceJet jets[kMassDensityGridPoints];
   surface.JetGrid(us, nu, vs, nv, curvature ? 2 : 1, jets);
   for (int i = 0; i < nu; ++i) {
     for (int j = 0; j < nv; ++j) {
@@ -82,6 +84,20 @@ void MassDensityGrid(const Surface& surface, const Density& density, const doubl
       if (std::isfinite(delta)) m = delta * area;
     }
   }
+}
+
+}  // namespace
+
+void MassDensityGrid(const Surface& surface, const Density& density, const double* us, int nu,
+                     const double* vs, int nv, double* out) {
+  // Jets start zeroed, which costs about as much as computing them: as few
+  // as the grid needs (the tree's 3 x 3 nodes mostly).
+  if (nu * nv <= 9) {
+    SurfaceJet jets[9];
+    return MassDensityGridIn(surface, density, us, nu, vs, nv, out, jets);
+  }
+  SurfaceJet jets[kMassDensityGridPoints];
+  MassDensityGridIn(surface, density, us, nu, vs, nv, out, jets);
 }
 
 absl::Status CheckDensityValue(double delta, double u, double v) {

@@ -330,26 +330,59 @@ double SignedPow(double c, double e) { return std::copysign(math::Pow(std::fabs(
 struct PowTrig {
   double g = 0, d1 = 0, d2 = 0;
 };
-// c = cos x or sin x, dc its derivative (-sin x or cos x); c'' = -c.
-PowTrig SignedPowOf(double c, double dc, double e, int order) {
+// c = cos x or sin x, dc its derivative (-sin x or cos x); c'' = -c; with
+// the powers of a = |c| given: pe = a^e, pe1 = a^(e-1) (read when e != 1)
+// and pe2 = a^(e-2) (when e != 1 and order >= 2), each math::Pow's value.
+PowTrig SignedPowFrom(double c, double dc, double e, int order, double pe, double pe1,
+                      double pe2) {
   PowTrig r;
-  const double a = std::fabs(c);
-  r.g = std::copysign(math::Pow(a, e), c);
+  r.g = std::copysign(pe, c);
   // d/dx sign(c)|c|^e = e |c|^(e-1) c'
-  r.d1 = e == 1 ? dc : e * math::Pow(a, e - 1) * dc;
+  r.d1 = e == 1 ? dc : e * pe1 * dc;
   if (order >= 2) {
     // d2 = e (e-1) |c|^(e-2) sign(c) c'^2 + e |c|^(e-1) c''
-    const double curv = e == 1 ? 0 : e * (e - 1) * std::copysign(math::Pow(a, e - 2), c) * dc * dc;
-    r.d2 = curv + (e == 1 ? -c : -e * math::Pow(a, e - 1) * c);
+    const double curv = e == 1 ? 0 : e * (e - 1) * std::copysign(pe2, c) * dc * dc;
+    r.d2 = curv + (e == 1 ? -c : -e * pe1 * c);
   }
   return r;
+}
+PowTrig SignedPowOf(double c, double dc, double e, int order) {
+  const double a = std::fabs(c);
+  const bool more = e != 1;
+  return SignedPowFrom(c, dc, e, order, math::Pow(a, e), more ? math::Pow(a, e - 1) : 0,
+                       more && order >= 2 ? math::Pow(a, e - 2) : 0);
 }
 
 class Superellipsoid final : public Surface {
  public:
+  // Point's operations in chunks: the angles' sin and cos, then the four
+  // powers of each point, in batch calls of the vector path (the same bits).
   void Points(const double* u, const double* v, size_t n, double* x, double* y,
               double* z) const override {
-    PointsOf(*this, u, v, n, x, y, z);
+    constexpr size_t kChunk = 256;
+    int quarter[2 * kChunk];
+    double offset[2 * kChunk], s[2 * kChunk], c[2 * kChunk], base[4 * kChunk], g[4 * kChunk];
+    for (size_t at = 0; at < n; at += kChunk) {
+      const size_t m = std::min(kChunk, n - at);
+      for (size_t i = 0; i < m; ++i) {
+        const AngleJet a = Angle(u[at + i], -1, 2), b = Angle(v[at + i], -2, 4);
+        quarter[i] = a.quarter, offset[i] = a.offset;
+        quarter[m + i] = b.quarter, offset[m + i] = b.offset;
+      }
+      math::SinCosOf(offset, 2 * m, s, c);
+      // base: |cos a|, |sin a| of the u angles, then of the v angles.
+      for (size_t i = 0; i < 2 * m; ++i) {
+        Turn(quarter[i], c[i], s[i], &c[i], &s[i]);
+        base[2 * i] = std::fabs(c[i]), base[2 * i + 1] = std::fabs(s[i]);
+      }
+      math::Pow(base, e_, 4 * m, g);
+      for (size_t i = 0; i < m; ++i) {
+        const double ca = std::copysign(g[2 * i], c[i]), sa = std::copysign(g[2 * i + 1], s[i]);
+        const double cb = std::copysign(g[2 * (m + i)], c[m + i]);
+        const double sb = std::copysign(g[2 * (m + i) + 1], s[m + i]);
+        x[at + i] = ca * cb, y[at + i] = ca * sb, z[at + i] = sa;
+      }
+    }
   }
   Superellipsoid(double e, bool reparam) : e_(e), reparam_(reparam) {}
   Vec3 Point(double u, double v) const override {
@@ -374,12 +407,38 @@ class Superellipsoid final : public Surface {
   }
   void JetGrid(const double* us, int nu, const double* vs, int nv, int order,
                SurfaceJet* out) const override {
-    if (nu > 16 || nv > 16) return Surface::JetGrid(us, nu, vs, nv, order, out);
-    Factors fv[16];
-    for (int j = 0; j < nv; ++j) fv[j] = FactorsV(vs[j], order);
+    constexpr int kMax = 16;
+    if (nu > kMax || nv > kMax) return Surface::JetGrid(us, nu, vs, nv, order, out);
+    // The rows' and columns' angles (u's, then v's), their sin and cos, and
+    // the powers of |cos| and |sin| in batch calls (the same bits as FactorsU
+    // and FactorsV one by one).
+    const int n = nu + nv;
+    AngleJet angle[2 * kMax];
+    double offset[2 * kMax], c[2 * kMax], s[2 * kMax], base[4 * kMax];
+    double pe[4 * kMax], pe1[4 * kMax] = {}, pe2[4 * kMax] = {};
+    for (int i = 0; i < n; ++i) {
+      angle[i] = i < nu ? Angle(us[i], -1, 2) : Angle(vs[i - nu], -2, 4);
+      offset[i] = angle[i].offset;
+    }
+    math::SinCosOf(offset, n, s, c);
+    for (int i = 0; i < n; ++i) {
+      Turn(angle[i].quarter, c[i], s[i], &c[i], &s[i]);
+      base[2 * i] = std::fabs(c[i]), base[2 * i + 1] = std::fabs(s[i]);
+    }
+    math::Pow(base, e_, 2 * n, pe);
+    if (e_ != 1) {
+      math::Pow(base, e_ - 1, 2 * n, pe1);
+      if (order >= 2) math::Pow(base, e_ - 2, 2 * n, pe2);
+    }
+    Factors f[2 * kMax];
+    for (int i = 0; i < n; ++i) {
+      const int k = 2 * i, l = 2 * i + 1;
+      f[i].c = SignedPowFrom(c[i], -s[i], e_, order, pe[k], pe1[k], pe2[k]);
+      f[i].s = SignedPowFrom(s[i], c[i], e_, order, pe[l], pe1[l], pe2[l]);
+      Chain(angle[i], &f[i]);
+    }
     for (int i = 0; i < nu; ++i) {
-      const Factors fu = FactorsU(us[i], order);
-      for (int j = 0; j < nv; ++j) Combine(fu, fv[j], order, &out[i * nv + j]);
+      for (int j = 0; j < nv; ++j) Combine(f[i], f[nu + j], order, &out[i * nv + j]);
     }
   }
 
@@ -393,23 +452,18 @@ class Superellipsoid final : public Surface {
     double offset, d1, d2;
     void CosSin(double* c, double* s) const {
       const math::SinCos r = math::SinCosOf(offset);
-      const double co = r.cos, so = r.sin;
-      switch (((quarter % 4) + 4) % 4) {
-        case 0:
-          *c = co, *s = so;
-          break;
-        case 1:
-          *c = -so, *s = co;
-          break;
-        case 2:
-          *c = -co, *s = -so;
-          break;
-        default:
-          *c = so, *s = -co;
-          break;
-      }
+      Turn(quarter, r.cos, r.sin, c, s);
     }
   };
+  // cos and sin of quarter * pi/2 + offset from co, so: those of the offset.
+  static void Turn(int quarter, double co, double so, double* c, double* s) {
+    switch (((quarter % 4) + 4) % 4) {
+      case 0: *c = co, *s = so; break;
+      case 1: *c = -so, *s = co; break;
+      case 2: *c = -co, *s = -so; break;
+      default: *c = so, *s = -co; break;
+    }
+  }
   // cos- and sin-type factors of one parameter, differentiated by it.
   struct Factors {
     PowTrig c, s;
@@ -443,12 +497,15 @@ class Superellipsoid final : public Surface {
     Factors f;
     f.c = SignedPowOf(c, -s, e_, order);
     f.s = SignedPowOf(s, c, e_, order);
-    // Chain rule: d/dx g(a(x)) = g' a', d2 = g'' a'^2 + g' a''.
-    for (PowTrig* p : {&f.c, &f.s}) {
+    Chain(a, &f);
+    return f;
+  }
+  // Chain rule: d/dx g(a(x)) = g' a', d2 = g'' a'^2 + g' a''.
+  static void Chain(const AngleJet& a, Factors* f) {
+    for (PowTrig* p : {&f->c, &f->s}) {
       p->d2 = p->d2 * a.d1 * a.d1 + (a.d2 != 0 ? p->d1 * a.d2 : 0);
       p->d1 *= a.d1;
     }
-    return f;
   }
   Factors FactorsU(double u, int order) const { return FactorsOf(Angle(u, -1, 2), order); }
   Factors FactorsV(double v, int order) const { return FactorsOf(Angle(v, -2, 4), order); }

@@ -54,8 +54,8 @@ bool FailsAt(int g, double error, double mass, double base, double rho) {
 // The smallest grade g at which the leaf carries scale * N^(1/2) samples
 // (N = 2^g, so the condition only tightens as g grows).
 int SamplesGrade(double mass, double base, double scale) {
-  for (int g = 0; g <= 62; ++g) {
-    const double n = std::ldexp(1.0, g);
+  double n = 1;  // 2^g, exactly
+  for (int g = 0; g <= 62; ++g, n *= 2) {
     if (mass / base * n >= std::max(CurveTree::kMinSamples, scale * RootN(n))) return g;
   }
   return kNeverFails;
@@ -66,8 +66,9 @@ int SamplesGrade(double mass, double base, double scale) {
 // or a singular line cuts it), it is examined down to this floor, which does
 // not grow with N, so the error along the feature falls like N^(-1/2).
 int RoughGrade(double mass, double base) {
-  for (int g = 0; g <= 62; ++g) {
-    if (mass / base * std::ldexp(1.0, g) >= CurveTree::kRoughFloor) return g;
+  double n = 1;  // 2^g, exactly
+  for (int g = 0; g <= 62; ++g, n *= 2) {
+    if (mass / base * n >= CurveTree::kRoughFloor) return g;
   }
   return kNeverFails;
 }

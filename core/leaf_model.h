@@ -59,12 +59,29 @@ inline double WarpSplit(const AxisWarp& w) {
   const double a = math::Pow(static_cast<double>(w.centre), r);
   return a / (a + math::Pow(1 - static_cast<double>(w.centre), r));
 }
+// W and W^-1 in two steps, for batches: with sc = WarpSplit(w), W(s) is
+// WarpFrom(w, sc, s, Pow(WarpBase(w, sc, s), k)) with k = w.power, and
+// W^-1(x) is UnwarpFrom(w, sc, x, Pow(UnwarpBase(w, x), 1 / k)).
+inline double WarpBase(const AxisWarp& w, double sc, double s) {
+  return s <= sc && sc > 0 ? 1 - s / sc : (s - sc) / (1 - sc);
+}
+inline double WarpFrom(const AxisWarp& w, double sc, double s, double power) {
+  const double c = w.centre;
+  return s <= sc && sc > 0 ? c - c * power : c + (1 - c) * power;
+}
+inline double UnwarpBase(const AxisWarp& w, double x) {
+  const double c = w.centre;
+  return x <= c && c > 0 ? (c - x) / c : (x - c) / (1 - c);
+}
+inline double UnwarpFrom(const AxisWarp& w, double sc, double x, double power) {
+  const double c = w.centre;
+  return x <= c && c > 0 ? sc * (1 - power) : sc + (1 - sc) * power;
+}
 // x = W(s), W'(s) and s = W^-1(x): each maps [0,1] onto itself, increasing.
 inline double Warp(const AxisWarp& w, double s) {
   if (w.power == 1) return s;
-  const double k = w.power, c = w.centre, sc = WarpSplit(w);
-  if (s <= sc && sc > 0) return c - c * math::Pow(1 - s / sc, k);
-  return c + (1 - c) * math::Pow((s - sc) / (1 - sc), k);
+  const double sc = WarpSplit(w);
+  return WarpFrom(w, sc, s, math::Pow(WarpBase(w, sc, s), w.power));
 }
 inline double WarpSlope(const AxisWarp& w, double s) {
   if (w.power == 1) return 1;
@@ -74,9 +91,8 @@ inline double WarpSlope(const AxisWarp& w, double s) {
 }
 inline double Unwarp(const AxisWarp& w, double x) {
   if (w.power == 1) return x;
-  const double r = 1 / static_cast<double>(w.power), c = w.centre, sc = WarpSplit(w);
-  if (x <= c && c > 0) return sc * (1 - math::Pow((c - x) / c, r));
-  return sc + (1 - sc) * math::Pow((x - c) / (1 - c), r);
+  const double sc = WarpSplit(w);
+  return UnwarpFrom(w, sc, x, math::Pow(UnwarpBase(w, x), 1 / static_cast<double>(w.power)));
 }
 
 // Whether the walk descends a leaf's curve in the warped coordinate of this

@@ -5,20 +5,12 @@
 #include <limits>
 
 #include "core/area_estimator.h"
+#include "core/slope_batch.h"
+#include "core/vector_math.h"
 
 namespace sfc {
 
 namespace {
-
-// The point at fraction f of [0, 1] under the linear density 1 + g (2s - 1)
-// with g = q / p (mean 1, slope 2g; p > 0 and |q| <= p keep it >= 0): the
-// root in [0, 1] of g s^2 + (1 - g) s = f, in the form without cancellation,
-// times p / p so that no division by p is needed per cell. Monotone in f, 0
-// at 0 and 1 at 1, and f itself for q = 0 (2fp / 2p, exact).
-double FollowSlope(double f, double p, double q) {
-  const double a = p - q;
-  return std::min(2 * f * p / (a + std::sqrt(a * a + 4 * q * f * p)), 1.0);
-}
 
 // Below this mass a cell is placed uniformly: FollowSlope squares p.
 constexpr double kLeastSlopedMass = 1e-150;
@@ -105,17 +97,9 @@ void LeafWalk::Enter(size_t l) {
   samples_ = leaf_mass_ / total_mass_ * grade_samples_;
   // Below the rough floor a leaf under a rough parent was never examined:
   // a step may cut it. Above it, it passed the rough test and its model holds.
+  if (warped_) split_[0] = WarpSplit(model_->warp[0]), split_[1] = WarpSplit(model_->warp[1]);
   exact_ = tree_.leaf_rough_parent(l) && samples_ < CurveTree::kRoughFloor &&
            kind_ == LeafModel::Kind::kQuadratic && !warped_;
-}
-
-double LeafWalk::PlaceOnAxis(const AxisWarp& w, double x0, double side, double f) {
-  const double x = x0 + f * side;
-  if (w.power == 1) return x;
-  if (DescendsWarped(w)) return Warp(w, x);  // the curve ran in warped coordinates
-  // Uniform in warped coordinates inside the sub-cell [x0, x0 + side].
-  const double s0 = Unwarp(w, x0), s1 = Unwarp(w, x0 + side);
-  return std::clamp(Warp(w, s0 + f * (s1 - s0)), x0, x0 + side);
 }
 
 int LeafWalk::TableLevels(double carried, int depth) const {
@@ -299,29 +283,82 @@ void LeafWalk::Continue(size_t n) {
   }
   curve_.DescendMany(digits_.data(), continuation_levels_, n, states_.data(), cx_.data(),
                      cy_.data());
+  // The centre of the continuation's cell in cells, and its square's slope
+  // (FollowSlope's p and q), then the fractions of the square for all n in
+  // one vectorised pass (slope_batch.h).
+  fx_.resize(n), fy_.resize(n), mass_.resize(n), gx_.resize(n), gy_.resize(n);
   for (size_t i = 0; i < n; ++i) {
     const Square& at = reached_[reached_of_[i]];
-    // The centre of the continuation's cell as fractions of the square; for
-    // Hilbert the division is by 2^26: a multiplication, with the same bits.
-    const double x = static_cast<double>(static_cast<int64_t>(cx_[i])) + 0.5;
-    const double y = static_cast<double>(static_cast<int64_t>(cy_[i])) + 0.5;
-    double fx = cells_power_of_two_ ? x * inverse_cells_ : x / continuation_cells_;
-    double fy = cells_power_of_two_ ? y * inverse_cells_ : y / continuation_cells_;
-    fx = FollowSlope(fx, at.mass, at.gx), fy = FollowSlope(fy, at.mass, at.gy);
-    double px, py;
-    if (warped_) {
-      px = PlaceOnAxis(model_->warp[0], at.x0, at.side, fx);
-      py = PlaceOnAxis(model_->warp[1], at.y0, at.side, fy);
-    } else {
-      px = at.x0 + fx * at.side, py = at.y0 + fy * at.side;
+    fx_[i] = static_cast<double>(static_cast<int64_t>(cx_[i])) + 0.5;
+    fy_[i] = static_cast<double>(static_cast<int64_t>(cy_[i])) + 0.5;
+    mass_[i] = at.mass, gx_[i] = at.gx, gy_[i] = at.gy;
+  }
+  // For Hilbert the division is by 2^26: a multiplication, with the same bits.
+  slope_batch::FollowSlopes(fx_.data(), mass_.data(), gx_.data(), n, cells_power_of_two_,
+                            continuation_cells_, inverse_cells_);
+  slope_batch::FollowSlopes(fy_.data(), mass_.data(), gy_.data(), n, cells_power_of_two_,
+                            continuation_cells_, inverse_cells_);
+  for (size_t i = 0; i < n; ++i) {
+    const Square& at = reached_[reached_of_[i]];
+    if (!warped_) {
+      const double px = at.x0 + fx_[i] * at.side, py = at.y0 + fy_[i] * at.side;
+      u_[i] = cell_.u0 + px * cell_.size;
+      v_[i] = cell_.v0 + py * cell_.size;
     }
-    u_[i] = cell_.u0 + px * cell_.size;
-    v_[i] = cell_.v0 + py * cell_.size;
     if (curve_position_ != nullptr) {
       const double pos = at.pos + fraction_[i] * at.span;
       curve_position_[i] = (leaf_start_ + pos * leaf_span_) / static_cast<double>(curve_.Span(0));
     }
   }
+  if (!warped_) return;
+  PlaceWarped(0, n, fx_.data(), u_);
+  PlaceWarped(1, n, fy_.data(), v_);
+}
+
+void LeafWalk::PlaceWarped(int axis, size_t n, const double* f, double* out) {
+  // Warp's and Unwarp's operations in order, their powers taken in batch
+  // calls (the same bits as the one-value functions).
+  const AxisWarp& w = model_->warp[axis];
+  const double sc = split_[axis], k = w.power;
+  const double origin = axis == 0 ? cell_.u0 : cell_.v0;
+  auto square = [&](size_t i) -> const Square& { return reached_[reached_of_[i]]; };
+  auto lower = [&](size_t i) { return axis == 0 ? square(i).x0 : square(i).y0; };
+  base_.resize(2 * n), power_.resize(2 * n), place_.resize(n);
+  double* base = base_.data();
+  double* power = power_.data();
+  double* s = place_.data();
+  if (w.power == 1) {
+    for (size_t i = 0; i < n; ++i) s[i] = lower(i) + f[i] * square(i).side;
+  } else if (DescendsWarped(w)) {
+    // The curve ran in warped coordinates: W of the point reached.
+    for (size_t i = 0; i < n; ++i) {
+      s[i] = lower(i) + f[i] * square(i).side;
+      base[i] = WarpBase(w, sc, s[i]);
+    }
+    math::Pow(base, k, n, power);
+    for (size_t i = 0; i < n; ++i) s[i] = WarpFrom(w, sc, s[i], power[i]);
+  } else {
+    // Uniform in warped coordinates inside the cell [x0, x0 + side]: its
+    // ends through W^-1, the point between them through W.
+    for (size_t i = 0; i < n; ++i) {
+      const double x0 = lower(i);
+      base[2 * i] = UnwarpBase(w, x0), base[2 * i + 1] = UnwarpBase(w, x0 + square(i).side);
+    }
+    math::Pow(base, 1 / k, 2 * n, power);
+    for (size_t i = 0; i < n; ++i) {
+      const double x0 = lower(i), x1 = x0 + square(i).side;
+      const double s0 = UnwarpFrom(w, sc, x0, power[2 * i]);
+      const double s1 = UnwarpFrom(w, sc, x1, power[2 * i + 1]);
+      s[i] = s0 + f[i] * (s1 - s0);
+      base[i] = WarpBase(w, sc, s[i]);
+    }
+    math::Pow(base, k, n, power);
+    for (size_t i = 0; i < n; ++i) {
+      const double x0 = lower(i);
+      s[i] = std::clamp(WarpFrom(w, sc, s[i], power[i]), x0, x0 + square(i).side);
+    }
+  }
+  for (size_t i = 0; i < n; ++i) out[i] = origin + s[i] * cell_.size;
 }
 
 }  // namespace sfc

@@ -104,9 +104,12 @@ class LeafWalk {
     int depth;
   };
 
-  // Leaf coordinate along one axis of the point at fraction f of the cell
-  // [x0, x0 + side] the walk reached (DescendsWarped: that cell is warped).
-  static double PlaceOnAxis(const AxisWarp& w, double x0, double side, double f);
+  // The current run's n samples in a leaf with a warped model along `axis`
+  // (0: u, 1: v): out[i] gets the parameter of the point at fraction f[i]
+  // of the cell [x0, x0 + side] sample i reached along that axis: W of it
+  // where the curve descended in warped coordinates (DescendsWarped), else
+  // uniform in warped coordinates inside the cell.
+  void PlaceWarped(int axis, size_t n, const double* f, double* out);
   // The leaf holding m: a forward step from the current one, else a search.
   size_t LeafFor(double m) const;
   // Makes l the current leaf.
@@ -162,6 +165,7 @@ class LeafWalk {
   const LeafModel* model_ = nullptr;
   LeafModel::Kind kind_ = LeafModel::Kind::kQuadratic;
   bool warped_ = false;  // the model has a power law (LeafModel::warp)
+  double split_[2] = {};  // WarpSplit of each axis's warp, when warped_
   bool exact_ = false;   // the first table follows the true mass density (kExactCells)
   // Scratch of PlaceInLeaf, kept to reuse its memory.
   std::vector<double> t_;                           // each sample's fraction of the leaf's mass
@@ -173,6 +177,9 @@ class LeafWalk {
   std::vector<double> fraction_;                    // each sample's fraction of its square's t
   std::vector<uint64_t> digits_, cx_, cy_;          // its curve digits and the cell they reach
   std::vector<uint64_t> states_;                    // its square's orientation, then the cell's
+  std::vector<double> fx_, fy_;                     // its fractions of its square
+  std::vector<double> mass_, gx_, gy_;              // its square's FollowSlope p and q
+  std::vector<double> base_, power_, place_;        // PlaceWarped's powers and places
   // The run being placed: output columns (curve_position_ may be null).
   double *u_ = nullptr, *v_ = nullptr, *curve_position_ = nullptr;
 };

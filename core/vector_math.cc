@@ -28,22 +28,22 @@ VectorPath Detect() {
   return widest;
 }
 
-// Whole vectors of `width` by `body`; a tail of two or more values as one
-// more vector, padded with zeros (each lane's value is its own, so the same
-// bits), a single value through the scalar reference.
-template <typename Body>
-void Batched(const double* x, size_t n, double* s, double* c, size_t width, Body body) {
+// Whole vectors of `width` by `body`(x, n, s, c); a tail of two or more
+// values as one more vector, padded with zeros (each lane's value is its own,
+// so the same bits), a single value by `one`(x, &s, &c), the scalar
+// reference. A function of one result passes c = nullptr.
+template <typename Body, typename One>
+void Batched(const double* x, size_t n, double* s, double* c, size_t width, Body body, One one) {
   const size_t whole = n / width * width, tail = n - whole;
   body(x, whole, s, c);
   if (tail >= 2) {
     double xp[8] = {}, sp[8], cp[8];
     std::copy(x + whole, x + n, xp);
-    body(xp, width, sp, cp);
+    body(xp, width, sp, c == nullptr ? nullptr : cp);
     std::copy(sp, sp + tail, s + whole);
-    std::copy(cp, cp + tail, c + whole);
+    if (c != nullptr) std::copy(cp, cp + tail, c + whole);
   } else if (tail == 1) {
-    const SinCos r = SinCosPi(x[whole]);
-    s[whole] = r.sin, c[whole] = r.cos;
+    one(x[whole], s + whole, c == nullptr ? nullptr : c + whole);
   }
 }
 
@@ -53,6 +53,20 @@ void SinCosPiSse2(const double* x, size_t n, double* s, double* c) {
     _mm_storeu_pd(s + i, r.x);
     _mm_storeu_pd(c + i, r.y);
   }
+}
+
+void SinCosOfSse2(const double* x, size_t n, double* s, double* c) {
+  for (size_t i = 0; i < n; i += 2) {
+    const Sleef___m128d_2 r = Sleef_cinz_sincosd2_u10sse2(_mm_loadu_pd(x + i));
+    _mm_storeu_pd(s + i, r.x);
+    _mm_storeu_pd(c + i, r.y);
+  }
+}
+
+void PowSse2(const double* x, double y, size_t n, double* out) {
+  const __m128d e = _mm_set1_pd(y);
+  for (size_t i = 0; i < n; i += 2)
+    _mm_storeu_pd(out + i, Sleef_cinz_powd2_u10sse2(_mm_loadu_pd(x + i), e));
 }
 
 }  // namespace
@@ -109,6 +123,10 @@ bool Runs(VectorPath path) {
 }
 
 void SinCosPiOn(VectorPath path, const double* x, size_t n, double* s, double* c) {
+  auto one = [](double x, double* s, double* c) {
+    const SinCos r = SinCosPi(x);
+    *s = r.sin, *c = r.cos;
+  };
   switch (path) {
     case VectorPath::kScalar:  // SLEEF's portable C: the reference
       for (size_t i = 0; i < n; ++i) {
@@ -116,14 +134,59 @@ void SinCosPiOn(VectorPath path, const double* x, size_t n, double* s, double* c
         s[i] = r.x, c[i] = r.y;
       }
       return;
-    case VectorPath::kSse2: return Batched(x, n, s, c, 2, SinCosPiSse2);
-    case VectorPath::kAvx: return Batched(x, n, s, c, 4, vector_math_internal::SinCosPiAvx);
-    case VectorPath::kAvx512: return Batched(x, n, s, c, 8, vector_math_internal::SinCosPiAvx512);
+    case VectorPath::kSse2: return Batched(x, n, s, c, 2, SinCosPiSse2, one);
+    case VectorPath::kAvx: return Batched(x, n, s, c, 4, vector_math_internal::SinCosPiAvx, one);
+    case VectorPath::kAvx512:
+      return Batched(x, n, s, c, 8, vector_math_internal::SinCosPiAvx512, one);
   }
 }
 
 void SinCosPi(const double* x, size_t n, double* s, double* c) {
   SinCosPiOn(BestVectorPath(), x, n, s, c);
+}
+
+void SinCosOfOn(VectorPath path, const double* x, size_t n, double* s, double* c) {
+  auto one = [](double x, double* s, double* c) {
+    const SinCos r = SinCosOf(x);
+    *s = r.sin, *c = r.cos;
+  };
+  switch (path) {
+    case VectorPath::kScalar:
+      for (size_t i = 0; i < n; ++i) {
+        const Sleef_double_2 r = Sleef_cinz_sincosd1_u10purec(x[i]);
+        s[i] = r.x, c[i] = r.y;
+      }
+      return;
+    case VectorPath::kSse2: return Batched(x, n, s, c, 2, SinCosOfSse2, one);
+    case VectorPath::kAvx: return Batched(x, n, s, c, 4, vector_math_internal::SinCosOfAvx, one);
+    case VectorPath::kAvx512:
+      return Batched(x, n, s, c, 8, vector_math_internal::SinCosOfAvx512, one);
+  }
+}
+
+void SinCosOf(const double* x, size_t n, double* s, double* c) {
+  SinCosOfOn(BestVectorPath(), x, n, s, c);
+}
+
+void PowOn(VectorPath path, const double* x, double y, size_t n, double* out) {
+  auto one = [y](double x, double* r, double*) { *r = Pow(x, y); };
+  auto with = [y](void (*body)(const double*, double, size_t, double*)) {
+    return [y, body](const double* x, size_t n, double* r, double*) { body(x, y, n, r); };
+  };
+  switch (path) {
+    case VectorPath::kScalar:
+      for (size_t i = 0; i < n; ++i) out[i] = Sleef_cinz_powd1_u10purec(x[i], y);
+      return;
+    case VectorPath::kSse2: return Batched(x, n, out, nullptr, 2, with(PowSse2), one);
+    case VectorPath::kAvx:
+      return Batched(x, n, out, nullptr, 4, with(vector_math_internal::PowAvx), one);
+    case VectorPath::kAvx512:
+      return Batched(x, n, out, nullptr, 8, with(vector_math_internal::PowAvx512), one);
+  }
+}
+
+void Pow(const double* x, double y, size_t n, double* out) {
+  PowOn(BestVectorPath(), x, y, n, out);
 }
 
 }  // namespace sfc::math

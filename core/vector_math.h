@@ -29,9 +29,13 @@ void SinCosPi(const double* x, size_t n, double* s, double* c);
 
 // sin x and cos x within 1 ulp.
 SinCos SinCosOf(double x);
+// The same for x[0..n): s[i], c[i] equal SinCosOf(x[i]) bit for bit.
+void SinCosOf(const double* x, size_t n, double* s, double* c);
 // The C library's functions of the same names, within 1 ulp, with C's
 // values at special arguments.
 double Pow(double x, double y);
+// Pow(x[i], y) for x[0..n) into out[i], bit for bit.
+void Pow(const double* x, double y, size_t n, double* out);
 double Exp(double x);
 double Log(double x);
 double Log2(double x);
@@ -59,6 +63,9 @@ std::string_view VectorPathName(VectorPath path);
 bool Runs(VectorPath path);
 // SinCosPi over a batch on one given path. REQUIRES: Runs(path).
 void SinCosPiOn(VectorPath path, const double* x, size_t n, double* s, double* c);
+// SinCosOf and Pow over a batch on one given path. REQUIRES: Runs(path).
+void SinCosOfOn(VectorPath path, const double* x, size_t n, double* s, double* c);
+void PowOn(VectorPath path, const double* x, double y, size_t n, double* out);
 
 namespace vector_math_internal {
 // The AVX and AVX-512F loops, each in a file built for its instruction set
@@ -66,6 +73,10 @@ namespace vector_math_internal {
 // multiple of 4 resp. 8.
 void SinCosPiAvx(const double* x, size_t n, double* s, double* c);
 void SinCosPiAvx512(const double* x, size_t n, double* s, double* c);
+void SinCosOfAvx(const double* x, size_t n, double* s, double* c);
+void SinCosOfAvx512(const double* x, size_t n, double* s, double* c);
+void PowAvx(const double* x, double y, size_t n, double* out);
+void PowAvx512(const double* x, double y, size_t n, double* out);
 }  // namespace vector_math_internal
 
 }  // namespace sfc::math

@@ -195,26 +195,28 @@ TEST(Dual, EachFunctionMatchesFiniteDifferences) {
   }
 }
 
+// Everything a muparser user writes: every function, operator and branch.
+const char* const kMuparserTexts[] = {
+    "u", "-u", "+u", "2*u + 1", "1 - 3*u", "u*2/4", "u^2", "u^3", "u^4", "u^0", "u^1",
+    "u^2.5", "u*u", "u+u", "(u+v)^2", "u/v", "u^v", "-u^2", "2^-u", "sin(u)", "cos(v)",
+    "tan(u)", "asin(u)", "acos(v)", "atan(u)", "atan2(u, v)", "sinh(u)", "cosh(u)",
+    "tanh(u)", "asinh(u)", "acosh(1+u)", "atanh(u/2)", "log2(u)", "log10(u)", "log(u)",
+    "ln(v)", "exp(u)", "sqrt(v)", "sign(u-0.5)", "rint(3*u)", "abs(u-v)", "min(u, v, 0.3)",
+    "max(u, v)", "sum(u, v, 1)", "avg(u, v)", "u < v", "u > v", "u <= v", "u >= v", "u == v",
+    "u != v", "u < 0.5 && v > 0.5", "u < 0.5 || v > 0.5", "u < v ? u : v",
+    "u < 0.3 ? 1 : u < 0.6 ? 2 : 3", "(u < v ? sin(u) : cos(v)) * 2", "_e^u", "2*_pi*u",
+    "sin(_pi/4)", "1e-3*u", "min(u, v) * max(2, 3)", "-(-u)", "3 - -u", "u - -v*2",
+};
+
 // Everything a muparser user writes today still compiles and gives
 // muparser's value (to rounding: our _pi is the full double pi, muparser's
 // GCC build truncates it to 3.141592653589, and asinh/log2 are library calls).
 TEST(Expression, AgreesWithMuparsersDefaultParser) {
-  const char* kTexts[] = {
-      "u", "-u", "+u", "2*u + 1", "1 - 3*u", "u*2/4", "u^2", "u^3", "u^4", "u^0", "u^1",
-      "u^2.5", "u*u", "u+u", "(u+v)^2", "u/v", "u^v", "-u^2", "2^-u", "sin(u)", "cos(v)",
-      "tan(u)", "asin(u)", "acos(v)", "atan(u)", "atan2(u, v)", "sinh(u)", "cosh(u)",
-      "tanh(u)", "asinh(u)", "acosh(1+u)", "atanh(u/2)", "log2(u)", "log10(u)", "log(u)",
-      "ln(v)", "exp(u)", "sqrt(v)", "sign(u-0.5)", "rint(3*u)", "abs(u-v)", "min(u, v, 0.3)",
-      "max(u, v)", "sum(u, v, 1)", "avg(u, v)", "u < v", "u > v", "u <= v", "u >= v", "u == v",
-      "u != v", "u < 0.5 && v > 0.5", "u < 0.5 || v > 0.5", "u < v ? u : v",
-      "u < 0.3 ? 1 : u < 0.6 ? 2 : 3", "(u < v ? sin(u) : cos(v)) * 2", "_e^u", "2*_pi*u",
-      "sin(_pi/4)", "1e-3*u", "min(u, v) * max(2, 3)", "-(-u)", "3 - -u", "u - -v*2",
-  };
   mu::Parser reference;
   double vars[2];
   reference.DefineVar("u", &vars[0]);
   reference.DefineVar("v", &vars[1]);
-  for (const char* text : kTexts) {
+  for (const char* text : kMuparserTexts) {
     auto e = CompileUV(text);
     ASSERT_NE(e, nullptr) << text;
     reference.SetExpr(text);
@@ -226,6 +228,47 @@ TEST(Expression, AgreesWithMuparsersDefaultParser) {
         EXPECT_NEAR(got, want, 1e-11 * std::max(1.0, std::fabs(want))) << text << " at " << u
                                                                          << "," << v;
       }
+    }
+  }
+}
+
+// The batch evaluation gives Evaluate's bits for every text (straight-line
+// programs by chunks, those with conditionals point by point), at batch
+// lengths that leave every tail; and an expression surface's Points is its
+// Point, bit for bit.
+TEST(Expression, EvaluateManyIsEvaluateBitForBit) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> unit(-0.2, 1.2);
+  std::vector<double> u(1000), v(1000);
+  for (size_t k = 0; k < u.size(); ++k) u[k] = unit(rng), v[k] = unit(rng);
+  u[0] = 0, v[0] = 0, u[1] = -0.0, v[1] = 0.5;
+  const double* const columns[2] = {u.data(), v.data()};
+  for (const char* text : kMuparserTexts) {
+    auto e = CompileUV(text);
+    ASSERT_NE(e, nullptr) << text;
+    for (size_t n : {size_t{1}, size_t{7}, size_t{64}, size_t{65}, u.size()}) {
+      std::vector<double> out(n);
+      e->EvaluateMany(columns, 2, n, out.data());
+      for (size_t k = 0; k < n; ++k) {
+        const double p[2] = {u[k], v[k]};
+        const double want = e->Evaluate(p);
+        ASSERT_EQ(std::memcmp(&want, &out[k], sizeof want), 0) << text << " at " << u[k] << ","
+                                                               << v[k];
+      }
+    }
+  }
+  for (const Pair& pair : kPairs) {
+    auto surface = MakeSurface(pair.expr);
+    ASSERT_TRUE(surface.ok());
+    std::vector<double> su(u.size()), sv(u.size());
+    for (size_t k = 0; k < u.size(); ++k)
+      su[k] = std::fabs(u[k] - 0.2), sv[k] = std::fabs(v[k]) / 1.2;
+    std::vector<double> x(u.size()), y(u.size()), z(u.size());
+    surface->surface->Points(su.data(), sv.data(), su.size(), x.data(), y.data(), z.data());
+    for (size_t k = 0; k < su.size(); ++k) {
+      const Vec3 one = surface->surface->Point(su[k], sv[k]);
+      const Vec3 got{x[k], y[k], z[k]};
+      ASSERT_EQ(std::memcmp(&one, &got, sizeof one), 0) << pair.expr;
     }
   }
 }

@@ -83,6 +83,7 @@ std::vector<std::unique_ptr<Surface>> EveryBuiltin() {
   surfaces.push_back(MakeWhitneyUmbrella());
   surfaces.push_back(MakeSuperellipsoid(1.0 / 3, false));
   surfaces.push_back(MakeSuperellipsoid(0.5, true));
+  surfaces.push_back(MakeSuperellipsoid(1, false));  // e = 1: the jets' other branch
   return surfaces;
 }
 

@@ -7,10 +7,12 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include <sleef.h>
 
+#include "core/slope_batch.h"
 #include "gtest/gtest.h"
 
 namespace sfc::math {
@@ -29,6 +31,9 @@ std::vector<double> Arguments() {
 }
 
 bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+// The same bits, or both NaN (sin of infinity: SLEEF's portable C and its
+// vector code set different sign bits; a sample there is rejected anyway).
+bool SameValue(double a, double b) { return SameBits(a, b) || (std::isnan(a) && std::isnan(b)); }
 
 TEST(VectorMath, EveryPathGivesTheScalarBits) {
   const std::vector<double> x = Arguments();
@@ -89,6 +94,41 @@ TEST(VectorMath, OneValueFunctionsGiveThePortableBits) {
   }
 }
 
+// The batch SinCosOf and Pow (the superellipsoid's and expressions' points)
+// give the one-value functions' bits on every path, every start and length.
+TEST(VectorMath, SinCosOfAndPowBatchesGiveTheScalarBits) {
+  std::vector<double> x = Arguments();
+  for (double& a : x) a = std::fabs(a);  // pow's bases: the superellipsoid's |cos|, |sin|
+  x.push_back(0);
+  x.push_back(INFINITY);
+  for (double y : {1.0 / 3, 0.1, 2.5, -2.0 / 3}) {
+    for (VectorPath path :
+         {VectorPath::kScalar, VectorPath::kSse2, VectorPath::kAvx, VectorPath::kAvx512}) {
+      if (!Runs(path)) continue;
+      for (size_t start : {0, 1, 3}) {
+        for (size_t n : {x.size() - start, size_t{1}, size_t{2}, size_t{7}, size_t{13}}) {
+          std::vector<double> s(n), c(n), p(n);
+          SinCosOfOn(path, x.data() + start, n, s.data(), c.data());
+          PowOn(path, x.data() + start, y, n, p.data());
+          for (size_t i = 0; i < n; ++i) {
+            const double a = x[start + i];
+            const SinCos one = SinCosOf(a);
+            ASSERT_TRUE(SameValue(s[i], one.sin) && SameValue(c[i], one.cos))
+                << VectorPathName(path) << " x = " << a;
+            ASSERT_TRUE(SameBits(p[i], Pow(a, y))) << VectorPathName(path) << " x = " << a;
+          }
+        }
+      }
+    }
+  }
+  std::vector<double> s(x.size()), c(x.size()), p(x.size());
+  SinCosOf(x.data(), x.size(), s.data(), c.data());
+  Pow(x.data(), 0.25, x.size(), p.data());
+  for (size_t i = 0; i < x.size(); ++i) {
+    ASSERT_TRUE(SameValue(s[i], SinCosOf(x[i]).sin) && SameBits(p[i], Pow(x[i], 0.25)));
+  }
+}
+
 TEST(VectorMath, ValuesAreSineAndCosineOfPiX) {
   for (double x : Arguments()) {
     if (std::fabs(x) > 4) continue;
@@ -106,6 +146,41 @@ TEST(VectorMath, ValuesAreSineAndCosineOfPiX) {
   EXPECT_NEAR(a.cos, std::cos(0.3), 1e-16);
   EXPECT_NEAR(Pow(2.5, 1.0 / 3), std::cbrt(2.5), 1e-15);
   EXPECT_EQ(Pow(0, 0.5), 0);
+}
+
+// The placement's vectorised slope pass (core/slope_batch.h) gives the
+// scalar code's bits on every path this CPU runs, for both ways of scaling
+// the cell centres, at every tail length.
+TEST(SlopeBatch, EveryPathGivesTheScalarBits) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> unit(0, 1);
+  const size_t n = 1001;
+  std::vector<double> c(n), p(n), q(n);
+  for (size_t i = 0; i < n; ++i) {
+    c[i] = std::floor(unit(rng) * 67108864) + 0.5;
+    p[i] = i % 7 == 0 ? 1 : std::ldexp(unit(rng), -static_cast<int>(rng() % 40));
+    q[i] = i % 5 == 0 ? 0 : i % 11 == 0 ? -p[i] : (2 * unit(rng) - 1) * p[i];
+  }
+  using Kernel = void (*)(double*, const double*, const double*, size_t, bool, double, double);
+  const std::pair<VectorPath, Kernel> paths[] = {
+      {VectorPath::kAvx, slope_batch::FollowSlopesAvx},
+      {VectorPath::kAvx512, slope_batch::FollowSlopesAvx512},
+      {BestVectorPath(), slope_batch::FollowSlopes}};
+  for (const bool exact : {true, false}) {
+    const double cells = exact ? 67108864 : 59049, inverse = 1 / cells;
+    std::vector<double> want = c;
+    slope_batch::FollowSlopesOf(want.data(), p.data(), q.data(), n, exact, cells, inverse);
+    for (const auto& [path, kernel] : paths) {
+      if (!Runs(path)) continue;
+      for (size_t m : {n, size_t{1}, size_t{3}, size_t{9}, size_t{17}}) {
+        std::vector<double> got(c.begin(), c.begin() + m);
+        kernel(got.data(), p.data(), q.data(), m, exact, cells, inverse);
+        for (size_t i = 0; i < m; ++i) {
+          ASSERT_TRUE(SameBits(got[i], want[i])) << VectorPathName(path) << " i = " << i;
+        }
+      }
+    }
+  }
 }
 
 }  // namespace
