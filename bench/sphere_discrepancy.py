@@ -19,14 +19,20 @@ Measure (plane, --surface plane, the unit square): the exact anchored star discr
 discrepancy (random boxes + local search, as for the sphere).
 
 Report: least-squares slope of log D against log N over the N series, per sample seed and
-mean +- standard error over seeds; and D at the largest N.
+mean +- standard error over seeds; and D at the largest N. --profile adds D N^(3/4) at each N
+(mean over seeds) and the slope fitted over N >= --fit-from only: every point set's spherical
+cap discrepancy is at least of order N^(-3/4) (Beck 1984), and a jittered set's sup carries a
+further sqrt(log N), so this shows where a slope is made.
 
 Examples:
   /usr/bin/python3 bench/sphere_discrepancy.py                       # default, Hammersley, iid
   /usr/bin/python3 bench/sphere_discrepancy.py --variant hilbert2="--curve hilbert2" \
       --variant triangle="--estimator triangle"
   /usr/bin/python3 bench/sphere_discrepancy.py --quick
+  /usr/bin/python3 bench/sphere_discrepancy.py --seeds 1,2,3,4,5,6 --profile --fit-from 384 \
+      --variant sobol="--sequence sobol"
   /usr/bin/python3 bench/sphere_discrepancy.py --self-test
+  /usr/bin/python3 bench/sphere_discrepancy.py --pole-caps 100     # counts beside the poles
   /usr/bin/python3 bench/sphere_discrepancy.py --surface plane --variant peano="--curve peano"
 """
 import argparse
@@ -41,7 +47,7 @@ import time
 
 import numpy as np
 
-DEFAULT_CLI = "/tmp/v4c/sfcsampler"
+DEFAULT_CLI = "build/client/sfcsampler"  # run from the repository root
 FOUR_PI = 4.0 * math.pi
 
 
@@ -422,6 +428,23 @@ def report(args, ns, seeds, results):
                 diff = "%+.3f +- %.3f" % (dm, dse)
             print("%-14s %-22s %+.3f +- %.3f   %.5f      %s" % (
                 name, " ".join("%+.3f" % x for x in sl), mu, se, dl, diff))
+        if args.profile:
+            profile(args, ns, results, m)
+
+
+def profile(args, ns, results, m):
+    """D N^(3/4) at each N (mean over seeds) and the slope over N >= args.fit_from."""
+    tail = [i for i, n in enumerate(ns) if n >= args.fit_from]
+    if len(tail) < 2:
+        raise SystemExit("--fit-from %d leaves fewer than 2 N" % args.fit_from)
+    print("\nD N^(3/4), mean over seeds, at N = %s" % ",".join(map(str, ns)))
+    for name, mv in results.items():
+        d = np.array(list(mv[m].values()))
+        scaled = (d * np.array(ns, dtype=float) ** 0.75).mean(0)
+        tail_sl = [slope([ns[i] for i in tail], row[tail]) for row in d]
+        mu, se = mean_se(tail_sl)
+        print("%-14s %s   slope N >= %d: %+.3f +- %.3f" % (
+            name, " ".join("%.2f" % x for x in scaled), args.fit_from, mu, se))
 
 
 def self_test(args):
@@ -464,6 +487,24 @@ def self_test(args):
     return 0 if ok else 1
 
 
+def pole_caps(args):
+    """Samples in the caps z > 1 - 2 e / N and z < -1 + 2 e / N (e samples expected in each),
+    mean of the two poles minus e, over seeds 1..args.pole_caps, at N = args.n_max."""
+    n = args.n_max
+    expect = [0.5, 1, 2, 4, 8, 16, 32, 64, 256]
+    with tempfile.TemporaryDirectory() as tmpdir:
+        fn = CliSampler(args.cli, "sphere", [], tmpdir)
+        dev = np.array([[(np.sum(p[:, 2] > 1 - 2 * e / n) + np.sum(p[:, 2] < -1 + 2 * e / n)) / 2
+                         - e for e in expect] for p in (fn(n, s)
+                                                        for s in range(1, args.pole_caps + 1))])
+    print("N = %d, seeds 1-%d: samples in a cap about a pole (mean of both) minus expected" %
+          (n, args.pole_caps))
+    for e, col in zip(expect, dev.T):
+        mu, se = mean_se(col)
+        print("expected %6.1f: %+.3f +- %.3f (rms %.3f)" % (e, mu, se, math.sqrt(np.mean(col**2))))
+    return 0
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -484,13 +525,20 @@ def main():
     ap.add_argument("--no-reference", action="store_true", help="omit Hammersley / iid")
     ap.add_argument("--quick", action="store_true", help="fewer N, triangles and rounds (~1 min)")
     ap.add_argument("--self-test", action="store_true")
+    ap.add_argument("--pole-caps", type=int, default=0, metavar="SEEDS",
+                    help="only count the samples beside the poles at N = --n-max, seeds 1..SEEDS")
     ap.add_argument("--json", help="also write the raw discrepancies here")
+    ap.add_argument("--profile", action="store_true",
+                    help="also print D N^(3/4) at each N and the slope over N >= --fit-from")
+    ap.add_argument("--fit-from", type=int, default=384, help="smallest N of --profile's slope")
     ap.add_argument("-v", "--verbose", action="store_true")
     args = ap.parse_args()
     if args.quick:
         args.random, args.local, args.keep, args.props, args.rounds = 1000, 1000, 16, 16, 40
     if args.self_test:
         return self_test(args)
+    if args.pole_caps:
+        return pole_caps(args)
     if (args.surface == "sphere" and not os.path.exists(args.cli)
             and (not args.no_default or args.variant)):
         raise SystemExit("no CLI at %s (use --cli)" % args.cli)
