@@ -52,6 +52,7 @@ Face::Face(int index, FaceType type, double area, ParameterBox box, bool reverse
       trim_(std::move(trim)) {}
 
 bool Face::Contains(double s, double t) const { return trim_->Contains(s, t); }
+double Face::TrimGridCell() { return 1.0 / FaceTrim::kGridSide; }
 
 double Face::Clearance(double s, double t) const { return trim_->Clearance(s, t); }
 

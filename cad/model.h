@@ -104,6 +104,8 @@ class Face {
   // only the points within ~1/2048 of the boundary.
   // REQUIRES: (s, t) in [0,1]^2.
   bool Contains(double s, double t) const;
+  // The side of that grid's cells in the unit square (1/128).
+  static double TrimGridCell();
 
   // State of the cell [s0,s1]x[t0,t1] of the unit square. Conservative: only
   // kInside or kOutside when no trim curve can enter the cell (the curves are

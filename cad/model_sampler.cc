@@ -22,6 +22,13 @@ class TrimmedDensity final : public Density {
     if (face_->trimmed() && !face_->Contains(point.u, point.v)) return 0;
     return inner_->Value(point);
   }
+  // The trim is a step of this density that leaves need not follow below the
+  // trim grid's cells (Face::Contains): a sample outside the trim moves to
+  // the nearest inside point (KeepInTrim), and following the trim down to
+  // issue 33's rough floor asked the CAD kernel about every point within
+  // ~1/2048 of it (the STEP box with a hole: 197 588 leaves and 60 s for
+  // 10^6 samples, against 0.23 s before).
+  double StepResolution() const override { return face_->trimmed() ? Face::TrimGridCell() : 0; }
 
  private:
   const Face* face_;  // owned by the model, which the tree keeps alive

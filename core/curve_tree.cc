@@ -552,7 +552,9 @@ class CurveTree::Builder {
     // Below the error floor only the children of a rough leaf are examined:
     // a feature the parent's test did not see is too small to matter there.
     int fail = SamplesGrade(eval.mass, base_, kErrorFloor);
-    if (rough_parent) fail = std::min(fail, RoughGrade(eval.mass, base_));
+    // Steps are followed only in cells larger than the density asks.
+    const bool follow_steps = h > density_.StepResolution();
+    if (rough_parent && follow_steps) fail = std::min(fail, RoughGrade(eval.mass, base_));
     double error = 0;
     bool rough = false;
     CellEval children[9];
@@ -564,7 +566,7 @@ class CurveTree::Builder {
       }
       error += EdgeError(eval, x * h, y * h, h);
       fail = FailGrade(error, eval.mass, base_, options_.rho);
-      rough = IsRough(eval, error);
+      rough = IsRough(eval, error) && follow_steps;
       if (rough) fail = std::min(fail, RoughGrade(eval.mass, base_));
       // The paper's flatness test, for leaves that carry a whole sample.
       int flat = SamplesGrade(eval.mass, base_, kFlatnessFloor);

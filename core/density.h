@@ -13,8 +13,8 @@ namespace sfc {
 
 // What a density may depend on at one surface point.
 struct SurfacePoint {
-  double u = 0, v = 0;  // unit-square parameters
-  Vec3 p;               // f(u, v)
+  double u = 0, v = 0;            // unit-square parameters
+  Vec3 p;                         // f(u, v)
   Vec3 normal;                    // valid only if the density NeedsCurvature()
   double gaussian_curvature = 0;  // likewise
   double mean_curvature = 0;      // likewise
@@ -28,6 +28,12 @@ class Density {
   virtual bool NeedsCurvature() const { return false; }
   // delta at the point. Callers reject negative or non-finite values.
   virtual double Value(const SurfacePoint& point) const = 0;
+  // The unit-square side of the cells below which the tree need not follow
+  // this density's steps with leaves of their own (issue 33's rough
+  // refinement, core/curve_tree.cc), because the sampler keeps its samples
+  // on the right side of them by other means. 0 (every density of the
+  // catalogue): steps are followed down to CurveTree::kRoughFloor samples.
+  virtual double StepResolution() const { return 0; }
 };
 
 // delta = 1.

@@ -12,6 +12,8 @@
 
 #include "cad/fixtures.h"
 #include "cad/load.h"
+#include "cad/model_sampler.h"
+#include "core/density.h"
 #include "engine/sampling_engine.h"
 #include "evaluation/blue_noise.h"
 #include "evaluation/discrepancy.h"
@@ -122,6 +124,21 @@ TEST(EngineCad, FacesGetSamplesInProportionToTheirExactAreas) {
   }
 }
 
+// A trim is a step of its face's density that the cursor keeps samples
+// inside by itself (KeepInTrim): the tree follows it no finer than the trim
+// grid. Followed down to issue 33's rough floor, the box's tree for 10^6
+// samples had 197 588 leaves and took a minute of CAD-kernel classification.
+TEST(EngineCad, TrimsAreFollowedNoFinerThanTheTrimGrid) {
+  auto bytes = fx::SolidBytes(fx::Solid::kBoxWithHole, ModelFormat::kStep);
+  ASSERT_TRUE(bytes.ok());
+  auto model = cad::Load(ModelFormat::kStep, *bytes, "box_with_hole.step");
+  ASSERT_TRUE(model.ok()) << model.status();
+  auto tree = cad::ModelTree::Build(*model, std::shared_ptr<const Density>(MakeUniformDensity()),
+                                    {}, 1'000'000);
+  ASSERT_TRUE(tree.ok()) << tree.status();
+  EXPECT_LT((*tree)->leaf_count(), 100'000u);
+}
+
 TEST(EngineCad, AStepSphereSamplesAsWellAsTheBuiltInSphere) {
   Engine e;
   const std::string step = "step:" + Fixture(fx::Solid::kSphere);
@@ -225,9 +242,9 @@ TEST(EngineCad, MalformedModelsAreRefusedByName) {
   std::string nurbs = fx::NurbsPatchText();
   const size_t knots = nurbs.find("knots_u");
   ASSERT_NE(knots, std::string::npos) << nurbs;
-  const std::string bad_knots = WriteTemp(
-      "engine_cad_bad_knots.nurbs", nurbs.substr(0, knots) + "knots_u 1 0 0 0 1 1\n" +
-                                        nurbs.substr(nurbs.find('\n', knots) + 1));
+  const std::string bad_knots =
+      WriteTemp("engine_cad_bad_knots.nurbs", nurbs.substr(0, knots) + "knots_u 1 0 0 0 1 1\n" +
+                                                  nurbs.substr(nurbs.find('\n', knots) + 1));
   status = e.engine.Start(ModelRequest("nurbs:" + bad_knots, 100)).status();
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << status;
   EXPECT_NE(status.message().find("engine_cad_bad_knots.nurbs"), std::string::npos) << status;
@@ -256,7 +273,6 @@ TEST(EngineCad, EverySampleLiesOnItsFace) {
     auto worst = fx::MaxDistanceToFaces(*bytes, ModelFormat::kStep, points);
     ASSERT_TRUE(worst.ok()) << worst.status();
     EXPECT_LT(*worst, 1e-6) << fx::SolidName(solid);
-
   }
 }
 
