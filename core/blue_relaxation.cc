@@ -27,6 +27,10 @@ constexpr int kRound = 16;
 // A candidate whose density differs from the density at its sample's
 // jittered place by more than this factor is not taken.
 constexpr double kDensityJump = 1.25;
+// Two samples closer than this many times the larger of their spacings whose
+// densities differ by more than kDensityJump both keep their jittered places
+// (Relaxation::FreezeBesideJumps).
+constexpr double kJumpReach = 2;
 
 // Points in a grid of cubic cells of side `cell`, hashed by Morton code: a
 // bucket array of cell lists in CSR form, each entry a copy of its point and radius (so a
@@ -125,6 +129,14 @@ class Relaxation {
     return CounterHash(seed_, hash_stream::kBluePriority,
                        static_cast<uint64_t>(k) * options_.sweeps + sweep);
   }
+  // Marks frozen_ the samples beside a density jump. Relaxed samples gather
+  // against a step on its sparse side, as hard disks layer against a wall
+  // (the dense side's small spacing leaves them more room there), and layer
+  // on the dense side too: +43 % and +38 % in the strips of 5e-4 on either
+  // side of u = 0.3 for density 1 | 10 at N = 2^18. A frozen sample stays
+  // uniform in its stratum, so a strip beside a step holds its share as in
+  // the jittered set; its neighbours relax around it.
+  absl::Status FreezeBesideJumps();
   bool Conflicts(uint32_t i, const Vec3& x) const {
     return AnyNear(i, x, [](uint32_t, double) { return true; });
   }
@@ -148,6 +160,7 @@ class Relaxation {
   std::vector<uint8_t> suspect_;  // may be too close to a neighbour
   std::vector<uint8_t> in_todo_;  // in the half-sweep's list (constant during it)
   std::vector<double> delta_;     // the density at each sample's jittered place
+  std::vector<uint8_t> frozen_;   // keeps its jittered place (FreezeBesideJumps)
   bool uniform_density_ = true;   // all of delta_ alike: candidates need none
   HashGrid main_, moved_grid_;
 };
@@ -186,6 +199,43 @@ bool Relaxation::AnyNear(uint32_t i, const Vec3& x, const F& f) const {
     }
   }
   return false;
+}
+
+absl::Status Relaxation::FreezeBesideJumps() {
+  frozen_.assign(n_, 0);
+  if (uniform_density_) return absl::OkStatus();
+  // Sample i looks kJumpReach d_i around its point (d_i as clamped in r_);
+  // a pair is found from its sparse end in any case.
+  std::vector<std::vector<uint32_t>> found(threads_);
+  RETURN_IF_ERROR(ForParts(n_, [&](int part, size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const double reach = kJumpReach * r_[i] / options_.rho;
+      const Vec3 x = p_[i];
+      bool jump = false;
+      const auto visit = [&](const HashGrid::Entry& e) {
+        const Vec3 v = e.p - x;
+        if (Dot(v, v) < reach * reach &&
+            (delta_[e.id] * kDensityJump < delta_[i] || delta_[e.id] > kDensityJump * delta_[i])) {
+          found[part].push_back(e.id);
+          jump = true;
+        }
+        return false;
+      };
+      const int64_t x1 = main_.Cell(x.x + reach), y1 = main_.Cell(x.y + reach);
+      const int64_t z1 = main_.Cell(x.z + reach);
+      for (int64_t a = main_.Cell(x.x - reach); a <= x1; ++a) {
+        for (int64_t b = main_.Cell(x.y - reach); b <= y1; ++b) {
+          for (int64_t c = main_.Cell(x.z - reach); c <= z1; ++c) main_.AnyIn(a, b, c, visit);
+        }
+      }
+      if (jump) found[part].push_back(static_cast<uint32_t>(i));
+    }
+    return absl::OkStatus();
+  }));
+  for (const std::vector<uint32_t>& part : found) {
+    for (uint32_t k : part) frozen_[k] = 1;
+  }
+  return absl::OkStatus();
 }
 
 double Relaxation::Crowding(uint32_t i, const Vec3& x, double floor) const {
@@ -370,6 +420,7 @@ absl::StatusOr<BlueNoiseSet> Relaxation::Run(double total_mass) {
   main_ = HashGrid(cell);
   moved_grid_ = HashGrid(cell);
   main_.Build(p_, r_, all, &slot);
+  RETURN_IF_ERROR(FreezeBesideJumps());
   for (int sweep = 0; sweep < options_.sweeps; ++sweep) {
     if (moved_since_build.size() > n_ / 8) {
       main_.Build(p_, r_, all, &slot);
@@ -380,7 +431,7 @@ absl::StatusOr<BlueNoiseSet> Relaxation::Run(double total_mass) {
     for (uint32_t c = 0; c < 2; ++c) {
       colour.clear();
       for (uint32_t i = c; i < n_; i += 2) {
-        if (suspect_[i]) colour.push_back(i);
+        if (suspect_[i] && !frozen_[i]) colour.push_back(i);
       }
       if (colour.empty()) continue;
       moved.clear();
