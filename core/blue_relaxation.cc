@@ -75,18 +75,22 @@ class HashGrid {
   int64_t Cell(double x) const { return static_cast<int64_t>(std::floor(x * inv_cell_)); }
   // The cell's Morton code, cut to the table: neighbouring cells share
   // cache lines, and so do the cells of queries made in curve order.
+  // Morton(cx, cy, cz) = Spread(cx) | Spread(cy) << 1 | Spread(cz) << 2.
+  static uint64_t Spread(int64_t c) { return Spread3(static_cast<uint32_t>(c)); }
   uint32_t Bucket(int64_t cx, int64_t cy, int64_t cz) const {
-    return static_cast<uint32_t>((Spread3(static_cast<uint32_t>(cx)) |
-                                  Spread3(static_cast<uint32_t>(cy)) << 1 |
-                                  Spread3(static_cast<uint32_t>(cz)) << 2) &
-                                 mask_);
+    return static_cast<uint32_t>((Spread(cx) | Spread(cy) << 1 | Spread(cz) << 2) & mask_);
   }
   // Calls f(entry) for every live entry in the bucket of cell (cx, cy, cz)
   // (and of the cells sharing it); stops and returns true when f does.
   template <typename F>
   bool AnyIn(int64_t cx, int64_t cy, int64_t cz, const F& f) const {
+    return AnyInMorton(Spread(cx) | Spread(cy) << 1 | Spread(cz) << 2, f);
+  }
+  // The same for the cell of Morton code `morton`.
+  template <typename F>
+  bool AnyInMorton(uint64_t morton, const F& f) const {
     if (entries_.empty()) return false;
-    const uint32_t b = Bucket(cx, cy, cz);
+    const uint32_t b = static_cast<uint32_t>(morton & mask_);
     for (uint32_t t = start_[b]; t < start_[b + 1]; ++t) {
       if (entries_[t].id != kDead && f(entries_[t])) return true;
     }
@@ -191,10 +195,19 @@ bool Relaxation::AnyNear(uint32_t i, const Vec3& x, const F& f) const {
     const double d2 = Dot(d, d);
     return d2 < r * r && f(e.id, d2 / (r * r));
   };
+  // The cells' Morton codes from each coordinate's spread bits, spread once
+  // (a query meets 2 x 2 x 2 cells of both grids: 6 spreads, not 48).
+  constexpr int64_t kKept = 4;
+  uint64_t sz[kKept];
+  for (int64_t c = z0; c <= std::min(z1, z0 + kKept - 1); ++c)
+    sz[c - z0] = HashGrid::Spread(c) << 2;
   for (int64_t a = x0; a <= x1; ++a) {
+    const uint64_t sa = HashGrid::Spread(a);
     for (int64_t b = y0; b <= y1; ++b) {
+      const uint64_t sab = sa | HashGrid::Spread(b) << 1;
       for (int64_t c = z0; c <= z1; ++c) {
-        if (main_.AnyIn(a, b, c, visit) || moved_grid_.AnyIn(a, b, c, visit)) return true;
+        const uint64_t morton = sab | (c - z0 < kKept ? sz[c - z0] : HashGrid::Spread(c) << 2);
+        if (main_.AnyInMorton(morton, visit) || moved_grid_.AnyInMorton(morton, visit)) return true;
       }
     }
   }
