@@ -133,13 +133,12 @@ class Relaxation {
     return CounterHash(seed_, hash_stream::kBluePriority,
                        static_cast<uint64_t>(k) * options_.sweeps + sweep);
   }
-  // Marks frozen_ the samples beside a density jump. Relaxed samples gather
-  // against a step on its sparse side, as hard disks layer against a wall
-  // (the dense side's small spacing leaves them more room there), and layer
-  // on the dense side too: +43 % and +38 % in the strips of 5e-4 on either
-  // side of u = 0.3 for density 1 | 10 at N = 2^18. A frozen sample stays
-  // uniform in its stratum, so a strip beside a step holds its share as in
-  // the jittered set; its neighbours relax around it.
+  // Marks frozen_ the samples beside a density jump. Relaxed samples layer
+  // against a step on both sides, as hard disks against a wall (the dense
+  // side's small spacing leaves a sparse-side sample more room there;
+  // docs/QUALITY.md, "Strip checks"). A frozen sample stays uniform in its
+  // stratum, so a strip beside a step holds its share as in the jittered
+  // set; its neighbours relax around it.
   absl::Status FreezeBesideJumps();
   bool Conflicts(uint32_t i, const Vec3& x) const {
     return AnyNear(i, x, [](uint32_t, double) { return true; });
