@@ -125,9 +125,17 @@ class Relaxation {
   // whether it did.
   template <typename F>
   bool AnyNear(uint32_t i, const Vec3& x, const F& f) const;
-  // min(1, min_j (|x - p_j| / t_ij)^2): 1 when x clears every neighbour. May
-  // stop early with any value <= floor once one is found.
-  double Crowding(uint32_t i, const Vec3& x, double floor) const;
+  // min(1, min_j (|x - p_j| / t_ij)^2) over the points p_j of `near`, which
+  // holds (at least) every point of the grids within r_i of x other than
+  // sample i's: 1 when x clears every neighbour. May stop early with any
+  // value <= floor once one is found (so the value is the same whatever the
+  // order of `near` when it is above floor).
+  double Crowding(uint32_t i, const Vec3& x, double floor,
+                  const std::vector<HashGrid::Entry>& near) const;
+  // Fills *near with the live points of the grids, other than sample i's,
+  // in the cells that meet the box [lo, hi] widened by r_i on every side
+  // (entries outside that box are left out).
+  void Gather(uint32_t i, const Vec3& lo, const Vec3& hi, std::vector<HashGrid::Entry>* near) const;
   // Who of two samples of a colour that are too close moves in `sweep`.
   uint64_t Priority(int sweep, uint32_t k) const {
     return CounterHash(seed_, hash_stream::kBluePriority,
@@ -250,12 +258,45 @@ absl::Status Relaxation::FreezeBesideJumps() {
   return absl::OkStatus();
 }
 
-double Relaxation::Crowding(uint32_t i, const Vec3& x, double floor) const {
+void Relaxation::Gather(uint32_t i, const Vec3& lo, const Vec3& hi,
+                        std::vector<HashGrid::Entry>* near) const {
+  near->clear();
+  const double ri = r_[i];
+  const Vec3 a = {lo.x - ri, lo.y - ri, lo.z - ri}, b = {hi.x + ri, hi.y + ri, hi.z + ri};
+  const auto keep = [&](const HashGrid::Entry& e) {
+    if (e.id != i && e.p.x >= a.x && e.p.x <= b.x && e.p.y >= a.y && e.p.y <= b.y && e.p.z >= a.z &&
+        e.p.z <= b.z) {
+      near->push_back(e);
+    }
+    return false;
+  };
+  const int64_t x1 = main_.Cell(b.x), y1 = main_.Cell(b.y), z1 = main_.Cell(b.z);
+  for (int64_t cx = main_.Cell(a.x); cx <= x1; ++cx) {
+    const uint64_t sx = HashGrid::Spread(cx);
+    for (int64_t cy = main_.Cell(a.y); cy <= y1; ++cy) {
+      const uint64_t sxy = sx | HashGrid::Spread(cy) << 1;
+      for (int64_t cz = main_.Cell(a.z); cz <= z1; ++cz) {
+        const uint64_t morton = sxy | HashGrid::Spread(cz) << 2;
+        main_.AnyInMorton(morton, keep);
+        moved_grid_.AnyInMorton(morton, keep);
+      }
+    }
+  }
+}
+
+double Relaxation::Crowding(uint32_t i, const Vec3& x, double floor,
+                            const std::vector<HashGrid::Entry>& near) const {
+  const double ri = r_[i];
   double worst = 1;
-  AnyNear(i, x, [&](uint32_t, double ratio2) {
-    worst = std::min(worst, ratio2);
-    return worst <= floor;
-  });
+  for (const HashGrid::Entry& e : near) {
+    const double r = std::min(ri, e.r);
+    const Vec3 d = e.p - x;
+    const double d2 = Dot(d, d);
+    if (d2 < r * r) {
+      worst = std::min(worst, d2 / (r * r));
+      if (worst <= floor) return worst;
+    }
+  }
   return worst;
 }
 
@@ -304,6 +345,7 @@ absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
     std::vector<Vec3> cp;
     std::vector<double> cd;
     std::vector<Search> still;
+    std::vector<HashGrid::Entry> near;
     for (uint64_t j0 = 0; j0 < tries && !searching.empty(); j0 += kRound) {
       const int m = static_cast<int>(std::min<uint64_t>(kRound, tries - j0));
       // Candidates j0 .. j0 + m - 1 of every searching sample, sorted inside
@@ -331,10 +373,19 @@ absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
       for (size_t s = 0; s < searching.size(); ++s) {
         Search& search = searching[s];
         const uint32_t k = todo[search.t];
+        // The neighbours of all m candidates, gathered once from the grids:
+        // a sample's candidates lie in its stratum, so one box holds them.
+        Vec3 lo = cp[s * m], hi = cp[s * m];
+        for (int j = 0; j < m; ++j) {
+          const Vec3& x = cp[s * m + j];
+          if (!IsFinite(x)) return absl::InvalidArgumentError("a candidate is not finite");
+          lo = {std::min(lo.x, x.x), std::min(lo.y, x.y), std::min(lo.z, x.z)};
+          hi = {std::max(hi.x, x.x), std::max(hi.y, x.y), std::max(hi.z, x.z)};
+        }
+        Gather(k, lo, hi, &near);
         int first = -1;
         for (int j = 0; j < m; ++j) {
           const size_t c = s * m + j;
-          if (!IsFinite(cp[c])) return absl::InvalidArgumentError("a candidate is not finite");
           if (first >= 0 && cj[c] > cj[s * m + first]) continue;
           // Across a density step a stratum's sample would drift to the
           // sparse side, where it is less crowded: it stays where the
@@ -343,7 +394,7 @@ absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
               !(cd[c] * kDensityJump >= delta_[k] && cd[c] <= kDensityJump * delta_[k])) {
             continue;
           }
-          const double crowding = Crowding(k, cp[c], search.best);
+          const double crowding = Crowding(k, cp[c], search.best, near);
           if (crowding >= 1) {
             first = j;
           } else if (first < 0 && crowding > search.best) {
