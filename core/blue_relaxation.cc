@@ -27,6 +27,10 @@ constexpr int kRound = 16;
 // A candidate whose density differs from the density at its sample's
 // jittered place by more than this factor is not taken.
 constexpr double kDensityJump = 1.25;
+// Two samples closer than this many times the larger of their spacings whose
+// densities differ by more than kDensityJump both keep their jittered places
+// (Relaxation::FreezeBesideJumps).
+constexpr double kJumpReach = 2;
 
 // Points in a grid of cubic cells of side `cell`, hashed by Morton code: a
 // bucket array of cell lists in CSR form, each entry a copy of its point and radius (so a
@@ -71,18 +75,22 @@ class HashGrid {
   int64_t Cell(double x) const { return static_cast<int64_t>(std::floor(x * inv_cell_)); }
   // The cell's Morton code, cut to the table: neighbouring cells share
   // cache lines, and so do the cells of queries made in curve order.
+  // Morton(cx, cy, cz) = Spread(cx) | Spread(cy) << 1 | Spread(cz) << 2.
+  static uint64_t Spread(int64_t c) { return Spread3(static_cast<uint32_t>(c)); }
   uint32_t Bucket(int64_t cx, int64_t cy, int64_t cz) const {
-    return static_cast<uint32_t>((Spread3(static_cast<uint32_t>(cx)) |
-                                  Spread3(static_cast<uint32_t>(cy)) << 1 |
-                                  Spread3(static_cast<uint32_t>(cz)) << 2) &
-                                 mask_);
+    return static_cast<uint32_t>((Spread(cx) | Spread(cy) << 1 | Spread(cz) << 2) & mask_);
   }
   // Calls f(entry) for every live entry in the bucket of cell (cx, cy, cz)
   // (and of the cells sharing it); stops and returns true when f does.
   template <typename F>
   bool AnyIn(int64_t cx, int64_t cy, int64_t cz, const F& f) const {
+    return AnyInMorton(Spread(cx) | Spread(cy) << 1 | Spread(cz) << 2, f);
+  }
+  // The same for the cell of Morton code `morton`.
+  template <typename F>
+  bool AnyInMorton(uint64_t morton, const F& f) const {
     if (entries_.empty()) return false;
-    const uint32_t b = Bucket(cx, cy, cz);
+    const uint32_t b = static_cast<uint32_t>(morton & mask_);
     for (uint32_t t = start_[b]; t < start_[b + 1]; ++t) {
       if (entries_[t].id != kDead && f(entries_[t])) return true;
     }
@@ -117,14 +125,29 @@ class Relaxation {
   // whether it did.
   template <typename F>
   bool AnyNear(uint32_t i, const Vec3& x, const F& f) const;
-  // min(1, min_j (|x - p_j| / t_ij)^2): 1 when x clears every neighbour. May
-  // stop early with any value <= floor once one is found.
-  double Crowding(uint32_t i, const Vec3& x, double floor) const;
+  // min(1, min_j (|x - p_j| / t_ij)^2) over the points p_j of `near`, which
+  // holds (at least) every point of the grids within r_i of x other than
+  // sample i's: 1 when x clears every neighbour. May stop early with any
+  // value <= floor once one is found (so the value is the same whatever the
+  // order of `near` when it is above floor).
+  double Crowding(uint32_t i, const Vec3& x, double floor,
+                  const std::vector<HashGrid::Entry>& near) const;
+  // Fills *near with the live points of the grids, other than sample i's,
+  // in the cells that meet the box [lo, hi] widened by r_i on every side
+  // (entries outside that box are left out).
+  void Gather(uint32_t i, const Vec3& lo, const Vec3& hi, std::vector<HashGrid::Entry>* near) const;
   // Who of two samples of a colour that are too close moves in `sweep`.
   uint64_t Priority(int sweep, uint32_t k) const {
     return CounterHash(seed_, hash_stream::kBluePriority,
                        static_cast<uint64_t>(k) * options_.sweeps + sweep);
   }
+  // Marks frozen_ the samples beside a density jump. Relaxed samples layer
+  // against a step on both sides, as hard disks against a wall (the dense
+  // side's small spacing leaves a sparse-side sample more room there;
+  // docs/QUALITY.md, "Strip checks"). A frozen sample stays uniform in its
+  // stratum, so a strip beside a step holds its share as in the jittered
+  // set; its neighbours relax around it.
+  absl::Status FreezeBesideJumps();
   bool Conflicts(uint32_t i, const Vec3& x) const {
     return AnyNear(i, x, [](uint32_t, double) { return true; });
   }
@@ -148,6 +171,7 @@ class Relaxation {
   std::vector<uint8_t> suspect_;  // may be too close to a neighbour
   std::vector<uint8_t> in_todo_;  // in the half-sweep's list (constant during it)
   std::vector<double> delta_;     // the density at each sample's jittered place
+  std::vector<uint8_t> frozen_;   // keeps its jittered place (FreezeBesideJumps)
   bool uniform_density_ = true;   // all of delta_ alike: candidates need none
   HashGrid main_, moved_grid_;
 };
@@ -178,22 +202,101 @@ bool Relaxation::AnyNear(uint32_t i, const Vec3& x, const F& f) const {
     const double d2 = Dot(d, d);
     return d2 < r * r && f(e.id, d2 / (r * r));
   };
+  // The cells' Morton codes from each coordinate's spread bits, spread once
+  // (a query meets 2 x 2 x 2 cells of both grids: 6 spreads, not 48).
+  constexpr int64_t kKept = 4;
+  uint64_t sz[kKept];
+  for (int64_t c = z0; c <= std::min(z1, z0 + kKept - 1); ++c)
+    sz[c - z0] = HashGrid::Spread(c) << 2;
   for (int64_t a = x0; a <= x1; ++a) {
+    const uint64_t sa = HashGrid::Spread(a);
     for (int64_t b = y0; b <= y1; ++b) {
+      const uint64_t sab = sa | HashGrid::Spread(b) << 1;
       for (int64_t c = z0; c <= z1; ++c) {
-        if (main_.AnyIn(a, b, c, visit) || moved_grid_.AnyIn(a, b, c, visit)) return true;
+        const uint64_t morton = sab | (c - z0 < kKept ? sz[c - z0] : HashGrid::Spread(c) << 2);
+        if (main_.AnyInMorton(morton, visit) || moved_grid_.AnyInMorton(morton, visit)) return true;
       }
     }
   }
   return false;
 }
 
-double Relaxation::Crowding(uint32_t i, const Vec3& x, double floor) const {
+absl::Status Relaxation::FreezeBesideJumps() {
+  frozen_.assign(n_, 0);
+  if (uniform_density_) return absl::OkStatus();
+  // Sample i looks kJumpReach d_i around its point (d_i as clamped in r_);
+  // a pair is found from its sparse end in any case.
+  std::vector<std::vector<uint32_t>> found(threads_);
+  RETURN_IF_ERROR(ForParts(n_, [&](int part, size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const double reach = kJumpReach * r_[i] / options_.rho;
+      const Vec3 x = p_[i];
+      bool jump = false;
+      const auto visit = [&](const HashGrid::Entry& e) {
+        const Vec3 v = e.p - x;
+        if (Dot(v, v) < reach * reach &&
+            (delta_[e.id] * kDensityJump < delta_[i] || delta_[e.id] > kDensityJump * delta_[i])) {
+          found[part].push_back(e.id);
+          jump = true;
+        }
+        return false;
+      };
+      const int64_t x1 = main_.Cell(x.x + reach), y1 = main_.Cell(x.y + reach);
+      const int64_t z1 = main_.Cell(x.z + reach);
+      for (int64_t a = main_.Cell(x.x - reach); a <= x1; ++a) {
+        for (int64_t b = main_.Cell(x.y - reach); b <= y1; ++b) {
+          for (int64_t c = main_.Cell(x.z - reach); c <= z1; ++c) main_.AnyIn(a, b, c, visit);
+        }
+      }
+      if (jump) found[part].push_back(static_cast<uint32_t>(i));
+    }
+    return absl::OkStatus();
+  }));
+  for (const std::vector<uint32_t>& part : found) {
+    for (uint32_t k : part) frozen_[k] = 1;
+  }
+  return absl::OkStatus();
+}
+
+void Relaxation::Gather(uint32_t i, const Vec3& lo, const Vec3& hi,
+                        std::vector<HashGrid::Entry>* near) const {
+  near->clear();
+  const double ri = r_[i];
+  const Vec3 a = {lo.x - ri, lo.y - ri, lo.z - ri}, b = {hi.x + ri, hi.y + ri, hi.z + ri};
+  const auto keep = [&](const HashGrid::Entry& e) {
+    if (e.id != i && e.p.x >= a.x && e.p.x <= b.x && e.p.y >= a.y && e.p.y <= b.y && e.p.z >= a.z &&
+        e.p.z <= b.z) {
+      near->push_back(e);
+    }
+    return false;
+  };
+  const int64_t x1 = main_.Cell(b.x), y1 = main_.Cell(b.y), z1 = main_.Cell(b.z);
+  for (int64_t cx = main_.Cell(a.x); cx <= x1; ++cx) {
+    const uint64_t sx = HashGrid::Spread(cx);
+    for (int64_t cy = main_.Cell(a.y); cy <= y1; ++cy) {
+      const uint64_t sxy = sx | HashGrid::Spread(cy) << 1;
+      for (int64_t cz = main_.Cell(a.z); cz <= z1; ++cz) {
+        const uint64_t morton = sxy | HashGrid::Spread(cz) << 2;
+        main_.AnyInMorton(morton, keep);
+        moved_grid_.AnyInMorton(morton, keep);
+      }
+    }
+  }
+}
+
+double Relaxation::Crowding(uint32_t i, const Vec3& x, double floor,
+                            const std::vector<HashGrid::Entry>& near) const {
+  const double ri = r_[i];
   double worst = 1;
-  AnyNear(i, x, [&](uint32_t, double ratio2) {
-    worst = std::min(worst, ratio2);
-    return worst <= floor;
-  });
+  for (const HashGrid::Entry& e : near) {
+    const double r = std::min(ri, e.r);
+    const Vec3 d = e.p - x;
+    const double d2 = Dot(d, d);
+    if (d2 < r * r) {
+      worst = std::min(worst, d2 / (r * r));
+      if (worst <= floor) return worst;
+    }
+  }
   return worst;
 }
 
@@ -242,6 +345,7 @@ absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
     std::vector<Vec3> cp;
     std::vector<double> cd;
     std::vector<Search> still;
+    std::vector<HashGrid::Entry> near;
     for (uint64_t j0 = 0; j0 < tries && !searching.empty(); j0 += kRound) {
       const int m = static_cast<int>(std::min<uint64_t>(kRound, tries - j0));
       // Candidates j0 .. j0 + m - 1 of every searching sample, sorted inside
@@ -269,10 +373,19 @@ absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
       for (size_t s = 0; s < searching.size(); ++s) {
         Search& search = searching[s];
         const uint32_t k = todo[search.t];
+        // The neighbours of all m candidates, gathered once from the grids:
+        // a sample's candidates lie in its stratum, so one box holds them.
+        Vec3 lo = cp[s * m], hi = cp[s * m];
+        for (int j = 0; j < m; ++j) {
+          const Vec3& x = cp[s * m + j];
+          if (!IsFinite(x)) return absl::InvalidArgumentError("a candidate is not finite");
+          lo = {std::min(lo.x, x.x), std::min(lo.y, x.y), std::min(lo.z, x.z)};
+          hi = {std::max(hi.x, x.x), std::max(hi.y, x.y), std::max(hi.z, x.z)};
+        }
+        Gather(k, lo, hi, &near);
         int first = -1;
         for (int j = 0; j < m; ++j) {
           const size_t c = s * m + j;
-          if (!IsFinite(cp[c])) return absl::InvalidArgumentError("a candidate is not finite");
           if (first >= 0 && cj[c] > cj[s * m + first]) continue;
           // Across a density step a stratum's sample would drift to the
           // sparse side, where it is less crowded: it stays where the
@@ -281,7 +394,7 @@ absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
               !(cd[c] * kDensityJump >= delta_[k] && cd[c] <= kDensityJump * delta_[k])) {
             continue;
           }
-          const double crowding = Crowding(k, cp[c], search.best);
+          const double crowding = Crowding(k, cp[c], search.best, near);
           if (crowding >= 1) {
             first = j;
           } else if (first < 0 && crowding > search.best) {
@@ -370,6 +483,7 @@ absl::StatusOr<BlueNoiseSet> Relaxation::Run(double total_mass) {
   main_ = HashGrid(cell);
   moved_grid_ = HashGrid(cell);
   main_.Build(p_, r_, all, &slot);
+  RETURN_IF_ERROR(FreezeBesideJumps());
   for (int sweep = 0; sweep < options_.sweeps; ++sweep) {
     if (moved_since_build.size() > n_ / 8) {
       main_.Build(p_, r_, all, &slot);
@@ -380,7 +494,7 @@ absl::StatusOr<BlueNoiseSet> Relaxation::Run(double total_mass) {
     for (uint32_t c = 0; c < 2; ++c) {
       colour.clear();
       for (uint32_t i = c; i < n_; i += 2) {
-        if (suspect_[i]) colour.push_back(i);
+        if (suspect_[i] && !frozen_[i]) colour.push_back(i);
       }
       if (colour.empty()) continue;
       moved.clear();

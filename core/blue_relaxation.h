@@ -13,12 +13,16 @@
 // does, the least crowded one, when it is less crowded than its place
 // (candidates where the density differs from the density at the sample's
 // jittered place by more than 1.25x are not taken: across a density step a
-// sample would drift to the sparse side, where it is less crowded). All
-// samples of a colour decide on the points as they were when the colour's
-// half-sweep began, so the result depends neither on the order they are
-// visited in nor on threads; of two samples of one colour that are too close
-// to each other only the one of higher priority (a hash of seed, sweep and
-// index) moves, so the two do not jump into each other again.
+// sample would drift to the sparse side, where it is less crowded). Two
+// samples closer than twice the larger of their spacings whose densities
+// differ by more than that both keep their jittered places (relaxed samples
+// gather against a density step, as hard disks against a wall, and the
+// strips beside it would no longer hold their share). All samples of a
+// colour decide on the points as they were when the colour's half-sweep
+// began, so the result depends neither on the order they are visited in nor
+// on threads; of two samples of one colour that are too close to each other
+// only the one of higher priority (a hash of seed, sweep and index) moves,
+// so the two do not jump into each other again.
 // Too close: |p_k - p_l| < rho min(d_k, d_l), with d_k = sqrt(2 a_k / sqrt 3)
 // the nearest-neighbour distance of a hexagonal packing with a_k = S_M /
 // (N delta(p_k)) of area per sample (delta the density at the jittered
