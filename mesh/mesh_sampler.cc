@@ -155,11 +155,7 @@ MeshSampler::MeshSampler(std::shared_ptr<const MeshCurveTree> tree, Sequence seq
   if (sequence.two_dimensional()) warp_ = std::make_unique<const MeshWarp>(*tree_);
 }
 
-CurveAddress MeshSampler::AddressOf(uint64_t k) const {
-  CurveAddress at = warp_->Locate(sequence().At(k), sequence().Second(k));
-  at.index = static_cast<uint32_t>(k);
-  return at;
-}
+CurveAddress MeshSampler::Warped(double a, double b) const { return warp_->Locate(a, b); }
 
 size_t MeshSampler::LeafForMass(double m) const {
   const auto& ends = tree_->mass_ends();

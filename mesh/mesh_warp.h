@@ -13,11 +13,13 @@
 // as a jittered set; docs/QUALITY.md, "Integration"). The halving stops at
 // the first node inside one leaf; one still across leaves 12 levels
 // below the leaf level is split by mass. Inside the leaf the node's share of
-// the leaf's mass is a fan sector from the cell's apex over its base (entry
-// to exit): the next coordinate to be halved picks the sector's ray by mass
-// and the other the point along the ray (exactly, by the cell's linear
-// density model; uniform density: the base point's share itself, and the
-// square root of the coordinate along the ray).
+// the leaf cell's mass goes to one of the cell's halves (E, A, M), (A, X, M)
+// by their masses and grows there from the outer corner (E, resp. X) in
+// similar triangles: the next coordinate to be halved gives the share, the
+// other the place along the scaled triangle's far side (exactly by the
+// cell's linear density model). Both halves place that side, A M, alike, so
+// the map is continuous, and a share near either end of the leaf is a small
+// triangle at E or X.
 //
 // The point is recorded by its address: its leaf and the bisection choices
 // below the leaf that hold it (MeshCurveTree::PathOf), which sort a set into
