@@ -52,7 +52,7 @@ struct QualityOptions {
   std::vector<uint64_t> seeds = {1, 2, 3};             // slopes and Monte Carlo
   std::vector<uint64_t> strip_seeds = {5, 6, 7};       // strips (the seed 5 first)
   std::vector<std::string> sections;  // empty: all of boxes strips bands mc plane sphere models
-                                      // blue features integration
+                                      // blue features (integration only when named)
   std::string step_sphere;  // model spec of a sphere (step:/tmp/fx/sphere.step); empty: skipped
   std::string mesh_sphere;  // model spec of a sphere mesh (ply:/tmp/ico.ply); empty: skipped
   std::string out_dir = ".";  // where a section writes its files (integration's icosphere OBJ)

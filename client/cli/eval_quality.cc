@@ -20,7 +20,7 @@ void AddEvalQualityFlags(CLI::App* eval, EvalQualityFlags* f) {
       ->capture_default_str();
   eval->add_option("--quality-sections", f->quality_sections,
                    "subset of: boxes strips bands mc plane sphere models blue features "
-                   "integration (default all)")
+                   "integration (default all but integration, which times its runs)")
       ->delimiter(',');
   eval->add_option("--quality-seeds", f->seeds,
                    "seeds of the quality report's slopes and Monte Carlo (>= 3)")
