@@ -27,6 +27,10 @@ scaled to the unit sphere, against the sphere's closed form (N = 8192 and 2^16, 
 The plane's rectangle discrepancy is bench/sphere_discrepancy.py's:
   /usr/bin/python3 bench/sphere_discrepancy.py --surface plane --variant sobol="--sequence sobol"
 
+`sfcsampler eval --sections quality --quality-sections integration` prints the same surfaces'
+table for every mode (jittered, sobol, progressive) from exact means of its own
+(evaluation/integration.h), with slopes and the points and time to reach 1e-4 and 1e-5.
+
 Usage: /usr/bin/python3 bench/sobol_integration.py [--cli build/client/sfcsampler] [--quick]
 """
 import argparse

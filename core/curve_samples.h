@@ -45,7 +45,7 @@ struct IndexSegment {
 struct CurveAddress {
   uint64_t digits;
   uint32_t leaf;
-  uint32_t index;  // the sample's k (a two-dimensional sequence has k < 2^32)
+  uint32_t index;  // the sample's k (< MaxSequenceCount(kSobol) = 2^32)
   // By leaf, then digits (below 2^52), then index: one 128-bit comparison.
   unsigned __int128 Key() const {
     return static_cast<unsigned __int128>(uint64_t{leaf} << 20 | digits >> 32) << 64 |
@@ -94,10 +94,13 @@ class CurveSamples {
   virtual absl::Status PlanRegion(const Region& region, uint64_t begin, uint64_t end,
                                   std::vector<IndexSegment>* segments) const = 0;
   // Two-dimensional sequences (Sequence::two_dimensional): sample k's
-  // address, by which the cursor sorts the whole set and the filler places
-  // it. Kinds without a warp are refused by AcceptsSequence before.
-  virtual CurveAddress AddressOf(uint64_t k) const {
-    return {0, 0, static_cast<uint32_t>(k)};
+  // address, its point of the unit square (Sequence::At, Second) through the
+  // kind's warp (Warped), by which the cursor sorts the whole set and the
+  // filler places it.
+  CurveAddress AddressOf(uint64_t k) const {
+    CurveAddress at = Warped(sequence_.At(k), sequence_.Second(k));
+    at.index = static_cast<uint32_t>(k);
+    return at;
   }
   // OK when the kind can place `sequence`'s samples; INVALID_ARGUMENT with
   // the reason otherwise (a kind without a warp for two-dimensional ones).
@@ -115,6 +118,9 @@ class CurveSamples {
   // to `segments`, joined to the last one when they meet it.
   void AddMassRange(double m0, double m1, bool through_end, uint64_t begin, uint64_t end,
                     std::vector<IndexSegment>* segments) const;
+  // The address (index 0) of the point (a, b) of the unit square through the
+  // kind's warp. Kinds without a warp are refused by AcceptsSequence before.
+  virtual CurveAddress Warped(double a, double b) const { return {}; }
 
  private:
   Sequence sequence_;

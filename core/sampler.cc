@@ -100,11 +100,7 @@ Sampler::Sampler(std::shared_ptr<const CurveTree> tree, std::shared_ptr<const Su
   if (sequence.two_dimensional()) warp_ = std::make_unique<const TreeWarp>(*tree_);
 }
 
-CurveAddress Sampler::AddressOf(uint64_t k) const {
-  CurveAddress at = warp_->Locate(sequence().At(k), sequence().Second(k));
-  at.index = static_cast<uint32_t>(k);
-  return at;
-}
+CurveAddress Sampler::Warped(double a, double b) const { return warp_->Locate(a, b); }
 
 std::unique_ptr<SampleFiller> Sampler::NewFiller(const Region&, const SampleFields& fields) const {
   return std::make_unique<SurfaceFiller>(*this, fields);

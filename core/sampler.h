@@ -41,9 +41,9 @@ class Sampler final : public CurveSamples {
   // Every sequence: a two-dimensional one (sobol) through a TreeWarp of the
   // tree, made with the sampler (O(leaves)).
   absl::Status AcceptsSequence(const Sequence&) const override { return absl::OkStatus(); }
-  // Sample k's point of the unit square (At(k), Second(k)), warped onto the
-  // surface. REQUIRES: a two-dimensional sequence.
-  CurveAddress AddressOf(uint64_t k) const override;
+  // The point (a, b) of the unit square through the TreeWarp. REQUIRES: a
+  // two-dimensional sequence.
+  CurveAddress Warped(double a, double b) const override;
   // The warp of a two-dimensional sequence; null for the others.
   const TreeWarp* warp() const { return warp_.get(); }
 

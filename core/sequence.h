@@ -26,8 +26,8 @@ struct OwenFlips;
 
 class Sequence {
  public:
-  // REQUIRES: count >= 1; count <= 2^32 for the radical-inverse kinds and
-  // sobol; not kBlue (its values come from a relaxation: FromTable).
+  // REQUIRES: 1 <= count <= MaxSequenceCount(kind); not kBlue (its values
+  // come from a relaxation: FromTable).
   Sequence(SequenceKind kind, uint64_t count, uint64_t seed)
       : kind_(kind), count_(count), seed_(seed) {
     if (kind == SequenceKind::kSobol) flips_ = MakeOwenFlips(seed);

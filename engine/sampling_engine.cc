@@ -150,10 +150,7 @@ absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint6
 absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
                                                   const BuildControl& caller) const {
   RETURN_IF_ERROR(CheckCount(request.count));  // before anything is built for it
-  const bool radical_inverse = request.sequence == SequenceKind::kVanDerCorput ||
-                               request.sequence == SequenceKind::kProgressive ||
-                               request.sequence == SequenceKind::kSobol;
-  if (radical_inverse && request.count > (uint64_t{1} << 32)) {
+  if (request.count > MaxSequenceCount(request.sequence)) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "the %s sequence supports at most 2^32 samples", SequenceName(request.sequence)));
   }

@@ -17,7 +17,8 @@
 //  - issue 33's generic features: density steps on the plane, a cube-root
 //    blow-up line and the double cone's kink at irrational positions (off the
 //    grid of every curve), strip counts and means against closed forms, and
-//    an N sweep of a step's share error with its slope.
+//    an N sweep of a step's share error with its slope;
+//  - issue 36's integration table (evaluation/integration.h).
 // Nothing here reads the curve tree: point sets come from `QualitySource`.
 //
 // Thread-safety: RunQuality is reentrant.
@@ -50,10 +51,11 @@ struct QualityOptions {
   bool full = false;
   std::vector<uint64_t> seeds = {1, 2, 3};             // slopes and Monte Carlo
   std::vector<uint64_t> strip_seeds = {5, 6, 7};       // strips (the issue's seed 5 first)
-  std::vector<std::string>
-      sections;             // empty: all of boxes strips bands mc plane sphere models blue features
+  std::vector<std::string> sections;  // empty: all of boxes strips bands mc plane sphere models
+                                      // blue features (integration only when named)
   std::string step_sphere;  // model spec of a sphere (step:/tmp/fx/sphere.step); empty: skipped
   std::string mesh_sphere;  // model spec of a sphere mesh (ply:/tmp/ico.ply); empty: skipped
+  std::string out_dir = ".";  // where a section writes its files (integration's icosphere OBJ)
   std::function<void(const std::string&)> progress;  // one line per finished item
 };
 

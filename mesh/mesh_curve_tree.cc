@@ -363,7 +363,7 @@ const std::array<PackedAffine, 256>& PackedByteMaps() {
   return maps;
 }
 
-constexpr int kLevels = 52;  // all the bits of a sample's fraction t
+constexpr int kLevels = MeshCurveTree::kLevels;
 
 // The child choices of a uniform cell: the first 52 binary digits of t.
 uint64_t UniformBits(double t) { return static_cast<uint64_t>(t * 4503599627370496.0); }  // 2^52
@@ -377,39 +377,78 @@ void FinishUniform(const MeshCurveTree::Cell& cell, uint64_t bits, double ca, do
   for (int i = 0; i < 3; ++i) (*bary)[i] = e[i] + ca * (x[i] - e[i]) + cb * (a[i] - e[i]);
 }
 
+// The centroids of the sub-cells `bits` (kLevels choices each) of n cells,
+// in their frames: InnerPoint(bits[j], kLevels, ...) for each, a step of
+// every sample at a time (their chains of dependent steps overlap), both
+// coordinates in one packed step.
+void InnerPoints(size_t n, const uint64_t* bits, Lanes* xy) {
+  for (size_t j = 0; j < n; ++j) xy[j] = Lanes{1.0 / 3, 1.0 / 3};
+  const auto& maps = PackedByteMaps();
+  for (int byte = 0; byte < kLevels / 8; ++byte) {
+    for (size_t j = 0; j < n; ++j) xy[j] = maps[(bits[j] >> (8 * byte)) & 255].Apply(xy[j]);
+  }
+  static const PackedAffine child[2] = {Pack(kChild[0]), Pack(kChild[1])};
+  for (int level = kLevels / 8 * 8; level < kLevels; ++level) {
+    for (size_t j = 0; j < n; ++j) xy[j] = child[(bits[j] >> level) & 1].Apply(xy[j]);
+  }
+}
+
 }  // namespace
 
 void MeshCurveTree::DescendMany(size_t n, const Cell* const* cells, const double* t,
                                 std::array<double, 3>* bary, double* area_position) {
   constexpr size_t kMax = 64;
   size_t uniform[kMax];
-  uint64_t bits[kMax];
+  uint64_t bits[kMax] = {};
   Lanes xy[kMax];
   size_t u = 0;
   for (size_t i = 0; i < n; ++i) {
     if (cells[i]->uniform && u < kMax) {
       uniform[u] = i;
       bits[u] = UniformBits(t[i]);
-      xy[u] = Lanes{1.0 / 3, 1.0 / 3};
       ++u;
     } else {
       Descend(*cells[i], t[i], &bary[i], &area_position[i]);
     }
   }
-  // The steps of InnerPoint(bits, 52, ...), sample after sample at each step,
-  // both coordinates in one packed step.
-  const auto& maps = PackedByteMaps();
-  for (int byte = 0; byte < kLevels / 8; ++byte) {
-    for (size_t j = 0; j < u; ++j) xy[j] = maps[(bits[j] >> (8 * byte)) & 255].Apply(xy[j]);
-  }
-  static const PackedAffine child[2] = {Pack(kChild[0]), Pack(kChild[1])};
-  for (int level = kLevels / 8 * 8; level < kLevels; ++level) {
-    for (size_t j = 0; j < u; ++j) xy[j] = child[(bits[j] >> level) & 1].Apply(xy[j]);
-  }
+  InnerPoints(u, bits, xy);
   for (size_t j = 0; j < u; ++j) {
     const size_t i = uniform[j];
     FinishUniform(*cells[i], bits[j], xy[j][0], xy[j][1], &bary[i], &area_position[i]);
   }
+}
+
+void MeshCurveTree::DescendPaths(size_t n, const Cell* const* cells, const uint64_t* paths,
+                                 std::array<double, 3>* bary, double* area_position) {
+  constexpr size_t kMax = 64;
+  Lanes xy[kMax];
+  for (size_t i0 = 0; i0 < n; i0 += kMax) {
+    const size_t m = std::min(kMax, n - i0);
+    InnerPoints(m, paths + i0, xy);
+    for (size_t j = 0; j < m; ++j) {
+      FinishUniform(*cells[i0 + j], paths[i0 + j], xy[j][0], xy[j][1], &bary[i0 + j],
+                    &area_position[i0 + j]);
+    }
+  }
+}
+
+uint64_t MeshCurveTree::PathOf(double pa, double pb) {
+  // Each level maps the point into the frame of the child holding it, by the
+  // inverse of that child's map T0 or T1.
+  uint64_t path = 0;
+  for (int level = 0; level < kLevels; ++level) {
+    if (2 * pa + pb < 1) {  // child (E, A, M): frame (a, b) -> (b, 2a)
+      const double na = pb, nb = 2 * pa;
+      pa = na, pb = nb;
+      path <<= 1;
+    } else {  // child (A, X, M): (a, b) -> (2a + b - 1, 2 (1 - a - b))
+      const double na = 2 * pa + pb - 1, nb = 2 * (1 - pa - pb);
+      pa = na, pb = nb;
+      path = path << 1 | 1;
+    }
+    pa = std::clamp(pa, 0.0, 1.0), pb = std::clamp(pb, 0.0, 1.0 - pa);
+  }
+  return path;
 }
 
 void MeshCurveTree::Descend(const Cell& cell, double t, std::array<double, 3>* bary,

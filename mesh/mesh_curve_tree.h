@@ -140,6 +140,20 @@ class MeshCurveTree {
   static void DescendMany(size_t n, const Cell* const* cells, const double* t,
                           std::array<double, 3>* bary, double* area_position);
 
+  // The bisection levels below a leaf that a sample's place holds: all the
+  // bits of its fraction (Descend), 2^-26 of the leaf's size.
+  static constexpr int kLevels = 52;
+  // The kLevels child choices (first level highest) of the sub-cell holding
+  // the point (a, b) of a cell's frame, entry (0, 0), exit (1, 0), apex
+  // (0, 1): where the geometry alone puts it, whatever the cell's density.
+  static uint64_t PathOf(double a, double b);
+  // The centroid of the sub-cell `path` (PathOf's choices) of `cell`, by the
+  // geometry alone: barycentrics in its triangle and the area position along
+  // the triangle's curve; bit for bit Descend's for a uniform cell at the
+  // fraction path 2^-kLevels. n at once, interleaved as DescendMany.
+  static void DescendPaths(size_t n, const Cell* const* cells, const uint64_t* paths,
+                           std::array<double, 3>* bary, double* area_position);
+
  private:
   struct Box {
     Vec3 lo, hi;

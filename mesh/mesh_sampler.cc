@@ -28,21 +28,30 @@ class MeshFiller final : public SampleFiller {
     return absl::OkStatus();
   }
 
-  // Places each sample at its address through the sampler's MeshWarp.
+  // Places each sample at its address (MeshWarp::Locate's): its leaf's cell
+  // (decoded once for a run of samples in one leaf, as addresses come sorted)
+  // and the sub-cell the address's digits choose, a chunk at a time.
   absl::Status FillAddressed(size_t n, const CurveAddress* at, const SampleRows& out) override {
-    const MeshWarp& warp = *sampler_.warp();
+    const MeshCurveTree& tree = sampler_.tree();
     for (size_t i0 = 0; i0 < n; i0 += kChunk) {
       const size_t m = std::min(kChunk, n - i0);
       const MeshCurveTree::Cell* cells[kChunk];
+      uint64_t paths[kChunk];
       std::array<double, 3> barys[kChunk];
       double area_positions[kChunk];
       chunk_cells_.clear();
+      if (cached_leaf_ != SIZE_MAX) chunk_cells_.push_back(cached_cell_);
       for (size_t i = 0; i < m; ++i) {
-        MeshCurveTree::Cell cell;
-        warp.Place(at[i0 + i], &cell, &barys[i], &area_positions[i]);
-        chunk_cells_.push_back(cell);
+        const CurveAddress& a = at[i0 + i];
+        if (a.leaf != cached_leaf_) {
+          cached_leaf_ = a.leaf;
+          cached_cell_ = tree.LeafCell(a.leaf);
+          chunk_cells_.push_back(cached_cell_);
+        }
+        cells[i] = &chunk_cells_.back();
+        paths[i] = a.digits;
       }
-      for (size_t i = 0; i < m; ++i) cells[i] = &chunk_cells_[i];
+      MeshCurveTree::DescendPaths(m, cells, paths, barys, area_positions);
       RETURN_IF_ERROR(WriteColumns(m, cells, barys, area_positions, out.From(i0)));
     }
     return absl::OkStatus();
@@ -146,11 +155,7 @@ MeshSampler::MeshSampler(std::shared_ptr<const MeshCurveTree> tree, Sequence seq
   if (sequence.two_dimensional()) warp_ = std::make_unique<const MeshWarp>(*tree_);
 }
 
-CurveAddress MeshSampler::AddressOf(uint64_t k) const {
-  CurveAddress at = warp_->Locate(sequence().At(k), sequence().Second(k));
-  at.index = static_cast<uint32_t>(k);
-  return at;
-}
+CurveAddress MeshSampler::Warped(double a, double b) const { return warp_->Locate(a, b); }
 
 size_t MeshSampler::LeafForMass(double m) const {
   const auto& ends = tree_->mass_ends();

@@ -79,9 +79,11 @@ class MeshSampler final : public CurveSamples {
   MeshSample AtMass(uint64_t k, double m, size_t l, const MeshCurveTree::Cell& cell) const;
 
   // Every sequence: a two-dimensional one (sobol) through a MeshWarp made
-  // with the sampler (O(leaves log leaves)).
+  // with the sampler (O(1)).
   absl::Status AcceptsSequence(const Sequence&) const override { return absl::OkStatus(); }
-  CurveAddress AddressOf(uint64_t k) const override;
+  // The point (a, b) of the unit square through the MeshWarp. REQUIRES: a
+  // two-dimensional sequence.
+  CurveAddress Warped(double a, double b) const override;
   const MeshWarp* warp() const { return warp_.get(); }
 
   // INVALID_ARGUMENT for a parameter rectangle: a mesh has no parameter

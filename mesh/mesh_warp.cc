@@ -6,121 +6,155 @@
 namespace sfc {
 namespace {
 
-// Bisection levels below a leaf that an address holds (MeshCurveTree's
-// kLevels: all the bits of a sample's fraction).
-constexpr int kLevels = 52;
 constexpr double kBelowOne = 1.0 - 0x1.0p-53;
+// Halvings past the depth at which nodes hold one leaf's mass on average
+// before a node that still straddles leaves is split by mass: the straddling
+// nodes' share of the error falls as 2^-kExtraDepth of the leaf level's.
+constexpr int kExtraDepth = 12;
+// At most 26 halvings of each coordinate, far below the net's 2^-32.
+constexpr int kMaxDepth = 52;
 
-// Picks the half of a split that *c falls in and rescales *c to it.
-int Pick(double split, const double inverse[2], double* c) {
-  const int side = *c < split ? 0 : 1;
-  *c = std::clamp((side == 0 ? *c : *c - split) * inverse[side], 0.0, kBelowOne);
+// Halves *c at 1/2: the side it falls on, *c rescaled to it (exact).
+int Halve(double* c) {
+  const int side = *c < 0.5 ? 0 : 1;
+  *c = 2 * *c - side;
   return side;
+}
+
+// The u in [0, 1] where the mass of a density linear on [0, 1], from d0 at 0
+// to d1 at 1 (both >= 0), reaches `share` of its whole: the root of
+// (d1 - d0) u^2 / 2 + d0 u = share (d0 + d1) / 2 in the form that does not
+// cancel.
+double InvertLinear(double d0, double d1, double share) {
+  const double k = (d1 - d0) / 2, c = share * (d0 + d1) / 2;
+  const double denominator = d0 + std::sqrt(std::max(0.0, d0 * d0 + 4 * k * c));
+  return denominator > 0 ? std::clamp(2 * c / denominator, 0.0, 1.0) : share;
+}
+
+// The s in [0, 1] where F(s) = s^2 (q1 + q2 s), not decreasing on [0, 1],
+// reaches `share` of F(1): Newton's method in a shrinking bracket, from the
+// root of the quadratic part.
+double InvertScaled(double q1, double q2, double share) {
+  const double target = share * (q1 + q2);
+  if (!(q1 + q2 > 0) || q2 == 0) return std::sqrt(share);
+  double lo = 0, hi = 1, s = std::sqrt(share);
+  for (int iter = 0; iter < 100; ++iter) {
+    const double f = s * s * (q1 + q2 * s) - target;
+    if (f == 0) return s;
+    if (f > 0) {
+      hi = s;
+    } else {
+      lo = s;
+    }
+    const double d = s * (2 * q1 + 3 * q2 * s);
+    double next = d > 0 ? s - f / d : (lo + hi) / 2;
+    if (!(next > lo && next < hi)) next = (lo + hi) / 2;
+    if (std::fabs(next - s) <= 0x1.0p-50 || hi - lo <= 0x1.0p-52) return next;
+    s = next;
+  }
+  return s;
+}
+
+// The point of a leaf cell, in its frame (entry E (0, 0), exit X (1, 0),
+// apex A (0, 1)), at the share f in [0, 1) of the cell's mass and g in
+// [0, 1). The cell's halves (E, A, M) and (A, X, M), M = (E + X) / 2, take
+// f below and above their mass split; each grows from its outer corner (E,
+// resp. X) in similar triangles, scaled by s where the mass reaches the
+// share, and g is the share along the scaled triangle's far side, from M's
+// side to A's. Both halves place g alike on the side A M they share, so the
+// map is continuous; a share near 0 or 1 is a small triangle at E or X.
+// With the cell's linear density model (values fe, fx, fa at E, X, A) the
+// shares are exact.
+void PlaceInCell(const MeshCurveTree::Cell& cell, double f, double g, double* pa, double* pb) {
+  const double fe = cell.density[0], fx = cell.density[1], fa = cell.density[2];
+  const double fm = (fe + fx) / 2;
+  const bool uniform = cell.uniform;
+  // The halves' masses, exact for the linear model.
+  const double m0 = fe + fa + fm, m1 = fa + fx + fm;
+  const double split = uniform ? 0.5 : m0 / (m0 + m1);
+  const bool first = f < split;
+  const double share = first ? f / split : (1 - f) / (1 - split);
+  const double fo = first ? fe : fx;  // at the outer corner
+  double s, b;
+  if (uniform) {
+    s = std::sqrt(share), b = g;
+  } else {
+    // The mass of the half scaled by s about its outer corner O: s^2 times
+    // the mean of the model on it, fo + s (fm + fa - 2 fo) / 3.
+    s = InvertScaled(fo, (fm + fa - 2 * fo) / 3, share);
+    b = InvertLinear(fo + s * (fm - fo), fo + s * (fa - fo), g);
+  }
+  // O + s ((1 - b) (M - O) + b (A - O)), M = (1/2, 0), A = (0, 1).
+  const double ox = first ? 0.0 : 1.0;
+  *pa = ox + s * ((1 - b) * (0.5 - ox) + b * (0.0 - ox));
+  *pb = s * b;
 }
 
 }  // namespace
 
 MeshWarp::MeshWarp(const MeshCurveTree& tree) : tree_(tree) {
-  nodes_.reserve(tree.leaf_count());
-  root_ = Build(0, tree.leaf_count());
-}
-
-int32_t MeshWarp::Build(size_t lo, size_t hi) {
-  if (hi - lo == 1) return -static_cast<int32_t>(lo) - 1;
-  const auto& ends = tree_.mass_ends();
-  const double begin = tree_.mass_begin(lo), end = ends[hi - 1];
-  // The first leaf whose end reaches half the node's mass closes the first
-  // half; each half keeps at least one leaf.
-  const size_t j =
-      std::lower_bound(ends.begin() + lo, ends.begin() + (hi - 1), begin + (end - begin) / 2) -
-      ends.begin();
-  const size_t mid = std::clamp(j + 1, lo + 1, hi - 1);
-  const int32_t index = static_cast<int32_t>(nodes_.size());
-  nodes_.push_back({});
-  const int32_t left = Build(lo, mid);
-  const int32_t right = Build(mid, hi);
-  Node& node = nodes_[index];
-  node.child[0] = left, node.child[1] = right;
-  const double first = tree_.mass_begin(mid) - begin, second = end - tree_.mass_begin(mid);
-  const double total = first + second;
-  node.split = !(first > 0) ? 0.0 : !(second > 0) ? 1.0 : first / total;
-  node.inverse[0] = first > 0 ? total / first : 0;
-  node.inverse[1] = second > 0 ? total / second : 0;
-  return index;
+  int depth = 0;
+  while (depth < 40 && (size_t{1} << depth) < tree.leaf_count()) ++depth;
+  max_depth_ = std::min(depth + kExtraDepth, kMaxDepth);
 }
 
 CurveAddress MeshWarp::Locate(double a, double b) const {
   double c[2] = {std::clamp(a, 0.0, kBelowOne), std::clamp(b, 0.0, kBelowOne)};
-  int axis = 0;  // the coordinate the next split takes
-  int32_t ref = root_;
-  while (ref >= 0) {
-    const Node& node = nodes_[ref];
-    ref = node.child[Pick(node.split, node.inverse, &c[axis])];
+  const auto& ends = tree_.mass_ends();
+  const double total = tree_.total_mass();
+  // The node is the mass interval [t0, t0 + w) x total; the leaves that meet
+  // it are lo..hi (the leaves holding its first and last mass).
+  double t0 = 0, w = 1;
+  auto leaf_at = [&](double t, size_t from, size_t to) {
+    // The first leaf in [from, to] whose end passes t x total.
+    return static_cast<size_t>(std::upper_bound(ends.begin() + from, ends.begin() + to, t * total) -
+                               ends.begin());
+  };
+  const size_t last = ends.size() - 1;
+  size_t lo = leaf_at(0, 0, last), hi = last;
+  while (hi > 0 && !(ends[hi] > tree_.mass_begin(hi))) --hi;  // the last leaf with mass
+  int axis = 0, depth = 0;
+  for (; lo < hi && depth < max_depth_; ++depth) {
+    // Dyadic halves of the square hold equal masses: their line is a line of
+    // the net's elementary intervals, which every scrambled (0, m, 2)-net
+    // fills exactly, whatever the integrand does across it.
+    w *= 0.5;
+    const double m = (t0 + w) * total;
+    if (Halve(&c[axis]) == 0) {  // the last leaf holding mass below m
+      hi = static_cast<size_t>(std::lower_bound(ends.begin() + lo, ends.begin() + hi, m) -
+                               ends.begin());
+    } else {  // the first leaf holding mass above m
+      t0 += w, lo = leaf_at(t0, lo, hi);
+    }
     axis ^= 1;
   }
-  const size_t l = static_cast<size_t>(-ref - 1);
+  if (lo < hi) {
+    // Still across leaves at the depth cap: the coordinate picks the mass.
+    const double t = t0 + c[axis] * w;
+    const size_t l = leaf_at(t, lo, hi);
+    const double begin = std::max(t0 * total, tree_.mass_begin(l));
+    const double end = std::min((t0 + w) * total, ends[l]);
+    c[axis] = end > begin ? std::clamp((t * total - begin) / (end - begin), 0.0, kBelowOne) : 0.0;
+    t0 = begin / total, w = (end - begin) / total;
+    lo = hi = l;
+  }
+  const size_t l = lo;
   const MeshCurveTree::Cell cell = tree_.LeafCell(l);
-  // Down the cell's bisection while its linear model varies (the test of
-  // MeshCurveTree::Descend), by the model's values at the current cell's
-  // entry, exit and apex.
-  double fe = cell.density[0], fx = cell.density[1], fa = cell.density[2];
-  uint64_t path = 0;
-  int level = 0;
-  if (!cell.uniform) {
-    for (; level < kLevels; ++level) {
-      const double lo = std::min({fe, fx, fa}), hi = std::max({fe, fx, fa});
-      if (hi - lo <= std::ldexp(hi, level / 2 - 26)) break;
-      const double fm = (fe + fx) * 0.5;
-      // Exact integrals of the linear model over the two equal-area children.
-      const double m0 = fe + fa + fm, m1 = fa + fx + fm;
-      const double total = m0 + m1;
-      const double split = !(m0 > 0) ? 0.0 : !(m1 > 0) ? 1.0 : m0 / total;
-      const double inverse[2] = {m0 > 0 ? total / m0 : 0, m1 > 0 ? total / m1 : 0};
-      const int side = Pick(split, inverse, &c[axis]);
-      axis ^= 1;
-      path = path << 1 | side;
-      if (side == 0) {  // (E, A, M)
-        fx = fa;
-      } else {  // (A, X, M)
-        fe = fa;
-      }
-      fa = fm;
-    }
-  }
-  // The area-preserving map of the square onto the current cell, in its own
-  // frame (entry (0, 0), exit (1, 0), apex (0, 1)); then the point's
-  // remaining bisection choices, each child's frame mapped back by the
-  // inverse of MeshCurveTree's T0, T1.
-  const double s = std::sqrt(c[0]);
-  double pa = s * (1 - c[1]), pb = s * c[1];
-  for (; level < kLevels; ++level) {
-    if (2 * pa + pb < 1) {  // child (E, A, M): frame (a, b) -> (b, 2a)
-      const double na = pb, nb = 2 * pa;
-      pa = na, pb = nb;
-      path <<= 1;
-    } else {  // child (A, X, M): (a, b) -> (2a + b - 1, 2 (1 - a - b))
-      const double na = 2 * pa + pb - 1, nb = 2 * (1 - pa - pb);
-      pa = na, pb = nb;
-      path = path << 1 | 1;
-    }
-    pa = std::clamp(pa, 0.0, 1.0), pb = std::clamp(pb, 0.0, 1.0 - pa);
-  }
+  // The node's share of the leaf, as fractions of the leaf's mass.
+  const double leaf_begin = tree_.mass_begin(l), leaf_mass = ends[l] - leaf_begin;
+  const double f0 =
+      leaf_mass > 0 ? std::clamp((t0 * total - leaf_begin) / leaf_mass, 0.0, 1.0) : 0.0;
+  const double f1 =
+      leaf_mass > 0 ? std::clamp(((t0 + w) * total - leaf_begin) / leaf_mass, 0.0, 1.0) : 1.0;
+  // The node's share of the leaf: the next coordinate to be halved takes the
+  // mass along it, the other the way across.
+  double pa, pb;
+  PlaceInCell(cell, f0 + c[axis] * (f1 - f0), c[axis ^ 1], &pa, &pb);
   CurveAddress address;
-  address.digits = path;
+  address.digits = MeshCurveTree::PathOf(pa, pb);
   address.leaf = static_cast<uint32_t>(l);
   address.index = 0;
   return address;
-}
-
-void MeshWarp::Place(const CurveAddress& at, MeshCurveTree::Cell* cell, std::array<double, 3>* bary,
-                     double* area_position) const {
-  *cell = tree_.LeafCell(at.leaf);
-  // The digits are the sub-cell's bisection choices: decoded as in a
-  // uniform cell, whose choices are the digits of its fraction.
-  MeshCurveTree::Cell geometric = *cell;
-  geometric.uniform = true;
-  MeshCurveTree::Descend(geometric, std::ldexp(static_cast<double>(at.digits), -kLevels), bary,
-                         area_position);
 }
 
 }  // namespace sfc

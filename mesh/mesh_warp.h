@@ -3,20 +3,27 @@
 // map from the unit square onto the mesh with the tree's mass as its measure
 // (McCool and Harwood 1997; Clarberg et al. 2005, Sect. 4).
 //
-// A balanced binary tree over the leaves in curve order (each node split
-// where its mass halves, as nearly as leaves allow) splits the point's first
-// coordinate at even depths and its second at odd ones, by the two halves'
-// masses, rescaling the coordinate each time. Inside a leaf cell the split
-// goes on down the cell's own bisection (mesh/mesh_curve_tree.h) by the exact
-// integrals of its linear density model while that model still varies
-// across the cell, alternating as before; then the area-preserving map of
-// the square onto the cell's triangle, (1 - sqrt a) E + sqrt a (1 - b) X +
-// sqrt a b A (Turk 1990), places the point.
+// The square is halved at 1/2, the first coordinate at even depths and the
+// second at odd ones, and the mass along the curve with it: a node is the
+// mass interval [k, k + 1) 2^-depth of the whole. Each line is a line of the
+// net's elementary intervals, so every aligned block of 2^m points fills
+// both sides exactly, whatever the integrand does across the line (mass-
+// proportional lines between whole leaves, which the mesh's irregular
+// triangle areas make, let a point cross each one at random and cost as much
+// as a jittered set; docs/QUALITY.md, "Integration"). The halving stops at
+// the first node inside one leaf; one still across leaves 12 levels
+// below the leaf level is split by mass. Inside the leaf the node's share of
+// the leaf cell's mass goes to one of the cell's halves (E, A, M), (A, X, M)
+// by their masses and grows there from the outer corner (E, resp. X) in
+// similar triangles: the next coordinate to be halved gives the share, the
+// other the place along the scaled triangle's far side (exactly by the
+// cell's linear density model). Both halves place that side, A M, alike, so
+// the map is continuous, and a share near either end of the leaf is a small
+// triangle at E or X.
 //
-// The point is recorded by its address: its leaf and the 52 bisection
-// choices below the leaf that hold it, the same digits by which
-// MeshCurveTree::Descend places a uniform cell's samples, so addresses sort a
-// set into curve order and place it.
+// The point is recorded by its address: its leaf and the bisection choices
+// below the leaf that hold it (MeshCurveTree::PathOf), which sort a set into
+// curve order and place it (MeshCurveTree::DescendPaths).
 //
 // Thread-safety: immutable after construction; thread-safe.
 #ifndef SFCSAMPLER_MESH_MESH_WARP_H_
@@ -24,7 +31,6 @@
 
 #include <array>
 #include <cstdint>
-#include <vector>
 
 #include "core/curve_samples.h"
 #include "mesh/mesh_curve_tree.h"
@@ -33,29 +39,15 @@ namespace sfc {
 
 class MeshWarp {
  public:
-  // O(leaves log leaves). REQUIRES: `tree` outlives the warp.
+  // O(1). REQUIRES: `tree` outlives the warp.
   explicit MeshWarp(const MeshCurveTree& tree);
 
   // The address of the image of (a, b) in [0, 1]^2 (clamped); index 0.
   CurveAddress Locate(double a, double b) const;
 
-  // The sample at `at`: barycentric coordinates in the leaf's triangle (the
-  // centre of the addressed sub-cell) and its area position along the
-  // triangle's curve, as MeshCurveTree::Descend gives them.
-  void Place(const CurveAddress& at, MeshCurveTree::Cell* cell, std::array<double, 3>* bary,
-             double* area_position) const;
-
  private:
-  struct Node {
-    int32_t child[2];   // node index, or -(leaf + 1)
-    double split;       // the first half's share of the node's mass
-    double inverse[2];  // each half's share, inverted (0 for none)
-  };
-  int32_t Build(size_t lo, size_t hi);
-
   const MeshCurveTree& tree_;
-  std::vector<Node> nodes_;
-  int32_t root_ = 0;
+  int max_depth_ = 0;  // halvings before a node across leaves is split by mass
 };
 
 }  // namespace sfc

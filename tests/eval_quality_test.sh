@@ -27,6 +27,17 @@ for row in "^| step u<0.3 | 262144 | share below C | 0.0410958904 |" "^| step u<
   grep -q "$row" "$tmp/out.md" || fail "missing features row: $row"
 done
 grep -q "^| N sweep, step u<0.3, N = 16384..262144: slope" "$tmp/out.md" || fail "features sweep check"
+# Issue 36's integration table, only when named (it prints run times): every surface with the
+# exact mean computed by the evaluation (the sphere's closed form; the others as
+# bench/sobol_integration.py computes them), every mode.
+! grep -q "Integration: sample means" "$tmp/out.md" || fail "integration ran unasked"
+"$cli" eval --sections quality --quality-sections integration --out-dir "$tmp/i" > "$tmp/int.md" 2> "$tmp/err.txt" ||
+  { cat "$tmp/err.txt"; fail "eval integration"; }
+for row in "^### sphere, f (exact mean 1.5085345269771" "^### torus R = 2, r = 1, f (exact mean 4.016065877752" \
+           "^### superellipsoid e = 1/3, f (exact mean 1.755002216004" \
+           "^### icosphere mesh (5120 triangles), g (exact mean 0.3328530394366" "^| sobol | " "^| progressive | "; do
+  grep -q "$row" "$tmp/int.md" || fail "missing integration row: $row"
+done
 # Every summary row has a verdict.
 rows=$(sed -n '/## Summary/,$p' "$tmp/out.md" | grep -c '^| [a-zA-Z]' || true)
 verdicts=$(sed -n '/## Summary/,$p' "$tmp/out.md" | grep -cE '\| (PASS|\*\*FAIL\*\*|INFO) \|$' || true)

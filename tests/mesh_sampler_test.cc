@@ -376,8 +376,8 @@ TEST(MeshCurveTree, BadDensitiesAreErrors) {
 // index once, curve order, shards that concatenate to the whole set, and
 // means of a quadratic that meet its exact integral over the flat triangles
 // (edge-midpoint rule) well inside i.i.d. points' error (about 5e-3 here). On
-// a mesh of many triangles the warp's error is about the jittered set's or
-// worse (docs/QUALITY.md, "Integration"), not the fifth the issue asks.
+// a mesh of many triangles the warp's error is about the jittered set's
+// (docs/QUALITY.md, "Integration"), not the fifth the issue asks.
 TEST(MeshSampler, SobolSetsAreExactOrderedAndIntegrateQuadratics) {
   const auto surface = Icosphere(3);
   const TriangleMesh& mesh = surface->mesh();
@@ -419,6 +419,43 @@ TEST(MeshSampler, SobolSetsAreExactOrderedAndIntegrateQuadratics) {
   std::printf("mesh mean error at %llu: sobol %.3g, jittered %.3g\n",
               static_cast<unsigned long long>(n), sobol_error, jittered_error);
   EXPECT_LT(sobol_error, 1e-3);
+}
+
+// The warp halves the square at 1/2 and the mass along the curve with it
+// (mesh/mesh_warp.h): every point of the dyadic box k of depth 6 (the first
+// coordinate halved at even depths, the second at odd ones) lands in a leaf
+// that meets the mass interval [k, k + 1) / 64 of the whole, on a mesh whose
+// triangles' areas are not dyadic, and with a density.
+TEST(MeshSampler, SobolWarpSendsDyadicBoxesToEqualMassIntervals) {
+  TriangleMesh mesh = MakeIcosphere(2);
+  for (const Vec3& p : mesh.positions) mesh.weights.push_back(1.5 + p.x);
+  const auto surface = MeshSurface::Create(std::move(mesh), false);
+  for (bool weighted : {false, true}) {
+    const auto sampler =
+        MakeSampler(surface, weighted ? VertexWeightMeshDensity() : UniformMeshDensity(), 4096, 1,
+                    SequenceKind::kSobol);
+    const MeshCurveTree& tree = sampler->tree();
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> unit(0, 1);
+    constexpr int kDepth = 6;
+    for (int i = 0; i < 4096; ++i) {
+      const double a = unit(rng), b = unit(rng);
+      uint64_t k = 0;
+      double c[2] = {a, b};
+      for (int level = 0; level < kDepth; ++level) {
+        double& x = c[level % 2];
+        const int bit = x < 0.5 ? 0 : 1;
+        x = 2 * x - bit;
+        k = 2 * k + bit;
+      }
+      const CurveAddress at = sampler->warp()->Locate(a, b);
+      const double lo = std::ldexp(static_cast<double>(k), -kDepth) * tree.total_mass();
+      const double hi = std::ldexp(static_cast<double>(k + 1), -kDepth) * tree.total_mass();
+      const double slack = 1e-12 * tree.total_mass();
+      ASSERT_LT(tree.mass_begin(at.leaf), hi + slack) << a << " " << b << " box " << k;
+      ASSERT_GT(tree.mass_ends()[at.leaf], lo - slack) << a << " " << b << " box " << k;
+    }
+  }
 }
 
 // Weights 1.5 + x at the vertices: the density 1.5 + x on the flat triangles.

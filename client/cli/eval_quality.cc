@@ -15,12 +15,12 @@ void AddEvalQualityFlags(CLI::App* eval, EvalQualityFlags* f) {
                    "protocol (the paper's Tables 1-2) and/or quality (issue 19: sample-anchored "
                    "boxes, strips, "
                    "Monte Carlo, plane, sphere, models, blue noise; issue 33: generic "
-                   "features)")
+                   "features; issue 36: integration)")
       ->delimiter(',')
       ->capture_default_str();
   eval->add_option("--quality-sections", f->quality_sections,
                    "subset of: boxes strips bands mc plane sphere models blue features "
-                   "(default all)")
+                   "integration (default all but integration, which times its runs)")
       ->delimiter(',');
   eval->add_option("--quality-seeds", f->seeds,
                    "seeds of the quality report's slopes and Monte Carlo (>= 3)")
@@ -48,6 +48,7 @@ int RunEvalQuality(const EvalQualityFlags& flags, bool full, const std::string& 
   options.sections = flags.quality_sections;
   options.step_sphere = flags.step_sphere;
   options.mesh_sphere = flags.mesh_sphere;
+  options.out_dir = out_dir;
   const auto start = std::chrono::steady_clock::now();
   options.progress = [&](const std::string& line) {
     std::fprintf(stderr, "quality: %s (%.0f s)\n", line.c_str(),

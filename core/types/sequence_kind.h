@@ -3,6 +3,7 @@
 #ifndef SFCSAMPLER_CORE_TYPES_SEQUENCE_KIND_H_
 #define SFCSAMPLER_CORE_TYPES_SEQUENCE_KIND_H_
 
+#include <cstdint>
 #include <optional>
 #include <string_view>
 
@@ -38,6 +39,16 @@ inline bool SequenceIsMonotone(SequenceKind kind) {
 // whole into curve order, and index ranges and shards select positions in
 // that order (docs/SERVICE.md, "Sobol sets").
 inline bool SequenceIsTwoDimensional(SequenceKind kind) { return kind == SequenceKind::kSobol; }
+
+// The largest count the kind serves: 2^32 for the radical-inverse kinds (van
+// der Corput, progressive, sobol), whose 32 digits of k index a sample (and a
+// sobol address holds k in 32 bits, core/curve_samples.h); no bound for the
+// others.
+inline uint64_t MaxSequenceCount(SequenceKind kind) {
+  const bool radical_inverse = kind == SequenceKind::kVanDerCorput ||
+                               kind == SequenceKind::kProgressive || kind == SequenceKind::kSobol;
+  return radical_inverse ? uint64_t{1} << 32 : UINT64_MAX;
+}
 
 }  // namespace sfc
 
