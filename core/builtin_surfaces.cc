@@ -321,6 +321,15 @@ class WhitneyUmbrella final : public Surface {
 };
 
 // Signed power sign(c)|c|^e.
+// std::round's value without its library call (x86-64's baseline has no
+// rounding instruction): the integer part by conversion, exact below 2^52,
+// then halves away from zero; the sign of a zero kept.
+double RoundHalfAway(double y) {
+  if (!(std::fabs(y) < 0x1p52)) return std::round(y);  // an integer already, or NaN
+  const double t = std::copysign(static_cast<double>(static_cast<int64_t>(y)), y);
+  return std::fabs(y - t) >= 0.5 ? t + std::copysign(1.0, y) : t;
+}
+
 double SignedPow(double c, double e) { return std::copysign(math::Pow(std::fabs(c), e), c); }
 
 // g(x) = sign(c(x)) |c(x)|^e for c = cos or sin, with its first two
@@ -476,7 +485,7 @@ class Superellipsoid final : public Surface {
     const double quarter = kPi / 2;
     const double y = x * pieces;  // exact: pieces is a power of two
     if (!reparam_) {
-      const double k = std::round(y);
+      const double k = RoundHalfAway(y);
       return {start + static_cast<int>(k), (y - k) * quarter, pieces * quarter, 0};
     }
     const int piece = std::min(static_cast<int>(y), pieces - 1);
