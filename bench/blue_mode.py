@@ -41,6 +41,8 @@ import time
 import numpy as np
 from scipy.spatial import cKDTree
 
+from seed_stats import mean_se
+
 
 def hex_spacing(n, area):
     return np.sqrt(2 * area / (np.sqrt(3) * n))
@@ -50,12 +52,6 @@ def nn(points, area):
     d, _ = cKDTree(points).query(points, k=2)
     s = hex_spacing(len(points), area)
     return d[:, 1].min() / s, d[:, 1].mean() / s
-
-
-def mean_se(values):
-    a = np.asarray(values, dtype=float)
-    se = a.std(ddof=1) / np.sqrt(len(a)) if len(a) > 1 else 0.0
-    return a.mean(), se
 
 
 def fmt(values, digits=3):

@@ -51,6 +51,8 @@ import zlib
 
 import numpy as np
 
+from seed_stats import mean_se
+
 STEP_WIDTH = 1e-3
 CONST_RE = re.compile(r"^[0-9.+\-*/() ]*(sqrt\([0-9.+\-*/ ]+\)[0-9.+\-*/() ]*)*$")
 
@@ -404,13 +406,6 @@ def file_digest(path):
             return hashlib.sha256(f.read()).hexdigest()
     except OSError:
         return None
-
-
-def mean_se(x):
-    x = np.asarray(x, dtype=float)
-    if x.size < 2:
-        return float(x.mean()), float("nan")
-    return float(x.mean()), float(x.std(ddof=1) / math.sqrt(x.size))
 
 
 def evaluate(case, n, seeds, source, target_n, log):

@@ -47,6 +47,8 @@ import time
 
 import numpy as np
 
+from seed_stats import mean_se, slope
+
 DEFAULT_CLI = "build/client/sfcsampler"  # run from the repository root
 FOUR_PI = 4.0 * math.pi
 
@@ -332,17 +334,6 @@ def n_series(n_min, n_max):
             out.append(m)
         n *= 2
     return sorted(set(out))
-
-
-def slope(ns, ds):
-    return float(np.polyfit(np.log(ns), np.log(ds), 1)[0])
-
-
-def mean_se(v):
-    v = np.asarray(v, dtype=float)
-    if len(v) < 2:
-        return float(v.mean()), float("nan")
-    return float(v.mean()), float(v.std(ddof=1) / math.sqrt(len(v)))
 
 
 def build_samplers(args, tmpdir):
