@@ -55,18 +55,25 @@ absl::Status SampleCursor::Plan(uint64_t begin, uint64_t end) {
     // Addresses are pure functions of k, computed in parts over the threads.
     const Sequence& sequence = samples.sequence();
     const uint64_t count = sequence.count();
-    // Samples outside a window get the largest address and sort last.
-    constexpr CurveAddress kOutside = {UINT64_MAX, UINT32_MAX, UINT32_MAX};
-    addresses_.resize(count);
-    const int parts = count >= 8192 ? threads_ : 1;
+    // A window's samples (a CAD face's) are found first, so only they are
+    // warped and sorted: one face's cursor costs its own share of the set,
+    // not the whole set's warp and sort.
+    std::vector<uint64_t> in_window;
+    if (sequence.windowed()) {
+      for (uint64_t k = 0; k < count; ++k) {
+        if (sequence.InWindow(k)) in_window.push_back(k);
+      }
+    }
+    const uint64_t m = sequence.windowed() ? in_window.size() : count;
+    addresses_.resize(m);
+    const int parts = m >= 8192 ? threads_ : 1;
     WorkerPool::Shared().ParallelFor(parts, [&](int i) {
-      for (uint64_t k = count * i / parts; k < count * (i + 1) / parts; ++k) {
-        addresses_[k] = sequence.InWindow(k) ? samples.AddressOf(k) : kOutside;
+      for (uint64_t j = m * i / parts; j < m * (i + 1) / parts; ++j) {
+        addresses_[j] = samples.AddressOf(sequence.windowed() ? in_window[j] : j);
       }
     });
     std::sort(addresses_.begin(), addresses_.end());
-    uint64_t kept = addresses_.size();
-    while (kept > 0 && addresses_[kept - 1].leaf == UINT32_MAX) --kept;
+    const uint64_t kept = addresses_.size();
     addresses_.erase(addresses_.begin() + std::min(end, kept), addresses_.end());
     addresses_.erase(addresses_.begin(), addresses_.begin() + std::min(begin, kept));
     addresses_.shrink_to_fit();
