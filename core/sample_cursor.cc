@@ -144,32 +144,25 @@ absl::StatusOr<size_t> SampleCursor::NextRuns(size_t max, SampleBatch* batch) {
 
 SampleRows SampleCursor::Grow(SampleBatch* batch, size_t n) const {
   const size_t s0 = batch->size(), rows = s0 + n;
-  auto grow = [&](auto* column, bool wanted) -> decltype(column->data()) {
-    if (!wanted) return nullptr;
-    ResizeColumn(column, rows);
-    return column->data() + s0;
+  batch->ForEachColumn(fields_, [&](auto* column) { ResizeColumn(column, rows); });
+  // The columns `fields_` hold grew to `rows` (n >= 1); the others stayed at
+  // s0 (a batch keeps one set of columns) and get no rows.
+  auto rows_of = [&](auto& column) -> decltype(column.data()) {
+    return n > 0 && column.size() == rows ? column.data() + s0 : nullptr;
   };
   SampleRows out;
-  out.index = grow(&batch->index, true);
-  out.u = grow(&batch->u, true), out.v = grow(&batch->v, true);
-  out.x = grow(&batch->x, true), out.y = grow(&batch->y, true), out.z = grow(&batch->z, true);
-  out.nx = grow(&batch->nx, fields_.normal), out.ny = grow(&batch->ny, fields_.normal);
-  out.nz = grow(&batch->nz, fields_.normal);
-  out.density = grow(&batch->density, fields_.density);
-  out.curve_position = grow(&batch->curve_position, fields_.curve_position);
-  out.triangle = grow(&batch->triangle, fields_.triangle);
+  out.index = rows_of(batch->index);
+  out.u = rows_of(batch->u), out.v = rows_of(batch->v);
+  out.x = rows_of(batch->x), out.y = rows_of(batch->y), out.z = rows_of(batch->z);
+  out.nx = rows_of(batch->nx), out.ny = rows_of(batch->ny), out.nz = rows_of(batch->nz);
+  out.density = rows_of(batch->density);
+  out.curve_position = rows_of(batch->curve_position);
+  out.triangle = rows_of(batch->triangle);
   return out;
 }
 
 void SampleCursor::Truncate(SampleBatch* batch, size_t rows) const {
-  batch->index.resize(rows);
-  for (auto* column : {&batch->u, &batch->v, &batch->x, &batch->y, &batch->z}) column->resize(rows);
-  if (fields_.normal) {
-    for (auto* column : {&batch->nx, &batch->ny, &batch->nz}) column->resize(rows);
-  }
-  if (fields_.density) batch->density.resize(rows);
-  if (fields_.curve_position) batch->curve_position.resize(rows);
-  if (fields_.triangle) batch->triangle.resize(rows);
+  batch->ForEachColumn(fields_, [&](auto* column) { column->resize(rows); });
 }
 
 absl::Status SampleCursor::Fill(uint64_t k0, const uint64_t* order, size_t n,

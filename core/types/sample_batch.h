@@ -66,6 +66,22 @@ struct SampleBatch {
     }
   }
   void Append(const SampleBatch& other) { AppendFrom(other, 0, other.size()); }
+  // f(&column) for every column a batch with `fields` holds: index, u, v, x,
+  // y and z always, then nx ny nz, density, curve_position, face and
+  // triangle as `fields` ask. The one list of them: the cursor grows and
+  // truncates by it, and Python's embedded path takes its buffers by it.
+  template <class F>
+  void ForEachColumn(const SampleFields& fields, F&& f) {
+    f(&index);
+    for (auto* column : {&u, &v, &x, &y, &z}) f(column);
+    if (fields.normal) {
+      for (auto* column : {&nx, &ny, &nz}) f(column);
+    }
+    if (fields.density) f(&density);
+    if (fields.curve_position) f(&curve_position);
+    if (fields.face) f(&face);
+    if (fields.triangle) f(&triangle);
+  }
   void Clear() {
     for (ValueColumn column : ValueColumns()) (this->*column).clear();
     index.clear(), face.clear(), triangle.clear();

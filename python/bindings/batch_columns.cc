@@ -1,6 +1,7 @@
 #include "python/bindings/batch_columns.h"
 
 #include <algorithm>
+#include <type_traits>
 
 #include "python/bindings/arrays.h"
 
@@ -15,17 +16,9 @@ constexpr const char* kValueNames[] = {"u",  "v",  "x",  "y",       "z",
 }  // namespace
 
 void TakeColumns(const SampleFields& fields, size_t n, BufferPool& pool, SampleBatch* batch) {
-  batch->index = pool.Take<uint64_t>(n);
-  for (auto* column : {&batch->u, &batch->v, &batch->x, &batch->y, &batch->z}) {
-    *column = pool.Take<double>(n);
-  }
-  if (fields.normal) {
-    for (auto* column : {&batch->nx, &batch->ny, &batch->nz}) *column = pool.Take<double>(n);
-  }
-  if (fields.density) batch->density = pool.Take<double>(n);
-  if (fields.curve_position) batch->curve_position = pool.Take<double>(n);
-  if (fields.face) batch->face = pool.Take<uint32_t>(n);
-  if (fields.triangle) batch->triangle = pool.Take<uint32_t>(n);
+  batch->ForEachColumn(fields, [&](auto* column) {
+    *column = pool.Take<typename std::remove_pointer_t<decltype(column)>::value_type>(n);
+  });
 }
 
 void Narrow(BatchColumns* c, BufferPool* pool) {
