@@ -330,7 +330,16 @@ double RoundHalfAway(double y) {
   return std::fabs(y - t) >= 0.5 ? t + std::copysign(1.0, y) : t;
 }
 
-double SignedPow(double c, double e) { return std::copysign(math::Pow(std::fabs(c), e), c); }
+// a^e for a >= 0, the superellipsoid's powers of |cos| and |sin| (points,
+// bounds and the value of its jets alike): the cube root where e is the
+// double nearest 1/3, the default exponent, three times as fast as Pow.
+double Power(double a, double e) { return e == 1.0 / 3 ? math::Cbrt(a) : math::Pow(a, e); }
+// Power(a[i], e) for a[0..n) into out[i], bit for bit.
+void Powers(const double* a, double e, size_t n, double* out) {
+  e == 1.0 / 3 ? math::Cbrt(a, n, out) : math::Pow(a, e, n, out);
+}
+
+double SignedPow(double c, double e) { return std::copysign(Power(std::fabs(c), e), c); }
 
 // g(x) = sign(c(x)) |c(x)|^e for c = cos or sin, with its first two
 // derivatives. With e < 1 the derivatives are infinite where c = 0 (the
@@ -340,8 +349,8 @@ struct PowTrig {
   double g = 0, d1 = 0, d2 = 0;
 };
 // c = cos x or sin x, dc its derivative (-sin x or cos x); c'' = -c; with
-// the powers of a = |c| given: pe = a^e, pe1 = a^(e-1) (read when e != 1)
-// and pe2 = a^(e-2) (when e != 1 and order >= 2), each math::Pow's value.
+// the powers of a = |c| given: pe = Power(a, e), pe1 = a^(e-1) (read when
+// e != 1) and pe2 = a^(e-2) (when e != 1 and order >= 2), math::Pow's values.
 PowTrig SignedPowFrom(double c, double dc, double e, int order, double pe, double pe1,
                       double pe2) {
   PowTrig r;
@@ -358,7 +367,7 @@ PowTrig SignedPowFrom(double c, double dc, double e, int order, double pe, doubl
 PowTrig SignedPowOf(double c, double dc, double e, int order) {
   const double a = std::fabs(c);
   const bool more = e != 1;
-  return SignedPowFrom(c, dc, e, order, math::Pow(a, e), more ? math::Pow(a, e - 1) : 0,
+  return SignedPowFrom(c, dc, e, order, Power(a, e), more ? math::Pow(a, e - 1) : 0,
                        more && order >= 2 ? math::Pow(a, e - 2) : 0);
 }
 
@@ -384,7 +393,7 @@ class Superellipsoid final : public Surface {
         Turn(quarter[i], c[i], s[i], &c[i], &s[i]);
         base[2 * i] = std::fabs(c[i]), base[2 * i + 1] = std::fabs(s[i]);
       }
-      math::Pow(base, e_, 4 * m, g);
+      Powers(base, e_, 4 * m, g);
       for (size_t i = 0; i < m; ++i) {
         const double ca = std::copysign(g[2 * i], c[i]), sa = std::copysign(g[2 * i + 1], s[i]);
         const double cb = std::copysign(g[2 * (m + i)], c[m + i]);
@@ -434,7 +443,7 @@ class Superellipsoid final : public Surface {
       Turn(angle[i].quarter, c[i], s[i], &c[i], &s[i]);
       base[2 * i] = std::fabs(c[i]), base[2 * i + 1] = std::fabs(s[i]);
     }
-    math::Pow(base, e_, 2 * n, pe);
+    Powers(base, e_, 2 * n, pe);
     if (e_ != 1) {
       math::Pow(base, e_ - 1, 2 * n, pe1);
       if (order >= 2) math::Pow(base, e_ - 2, 2 * n, pe2);

@@ -67,7 +67,7 @@ class LeafWalk {
   // what it misses is of second order in the cell's side: the Monte Carlo
   // check beside singular lines gives the same figures at 1/4, 1, 2 and 4
   // samples a cell (docs/QUALITY.md, "Placement that follows the slope").
-  static constexpr double kCellSamples = 2;
+  static constexpr double kCellSamples = 4;
   // A table cell carrying at least this many samples gets a table of its own.
   static constexpr double kTableSamples = 4 * kCellSamples;
   // Tables stop this many curve levels below the leaf in any case.

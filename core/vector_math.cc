@@ -49,7 +49,7 @@ void Batched(const double* x, size_t n, double* s, double* c, size_t width, Body
 
 void SinCosPiSse2(const double* x, size_t n, double* s, double* c) {
   for (size_t i = 0; i < n; i += 2) {
-    const Sleef___m128d_2 r = Sleef_cinz_sincospid2_u05sse2(_mm_loadu_pd(x + i));
+    const Sleef___m128d_2 r = Sleef_cinz_sincospid2_u35sse2(_mm_loadu_pd(x + i));
     _mm_storeu_pd(s + i, r.x);
     _mm_storeu_pd(c + i, r.y);
   }
@@ -69,12 +69,17 @@ void PowSse2(const double* x, double y, size_t n, double* out) {
     _mm_storeu_pd(out + i, Sleef_cinz_powd2_u10sse2(_mm_loadu_pd(x + i), e));
 }
 
+void CbrtSse2(const double* x, size_t n, double* out) {
+  for (size_t i = 0; i < n; i += 2)
+    _mm_storeu_pd(out + i, Sleef_cinz_cbrtd2_u35sse2(_mm_loadu_pd(x + i)));
+}
+
 }  // namespace
 
 // One value through lane 0 of the SSE2 functions: ~20% faster than SLEEF's
 // portable scalar code (purec), with its bits (tests/vector_math_test.cc).
 SinCos SinCosPi(double x) {
-  const Sleef___m128d_2 r = Sleef_cinz_sincospid2_u05sse2(_mm_set_sd(x));
+  const Sleef___m128d_2 r = Sleef_cinz_sincospid2_u35sse2(_mm_set_sd(x));
   return {_mm_cvtsd_f64(r.x), _mm_cvtsd_f64(r.y)};
 }
 
@@ -86,6 +91,7 @@ SinCos SinCosOf(double x) {
 double Pow(double x, double y) {
   return _mm_cvtsd_f64(Sleef_cinz_powd2_u10sse2(_mm_set_sd(x), _mm_set_sd(y)));
 }
+double Cbrt(double x) { return _mm_cvtsd_f64(Sleef_cinz_cbrtd2_u35sse2(_mm_set_sd(x))); }
 double Exp(double x) { return Sleef_cinz_expd1_u10purec(x); }
 double Log(double x) { return Sleef_cinz_logd1_u10purec(x); }
 double Log2(double x) { return Sleef_cinz_log2d1_u10purec(x); }
@@ -130,7 +136,7 @@ void SinCosPiOn(VectorPath path, const double* x, size_t n, double* s, double* c
   switch (path) {
     case VectorPath::kScalar:  // SLEEF's portable C: the reference
       for (size_t i = 0; i < n; ++i) {
-        const Sleef_double_2 r = Sleef_cinz_sincospid1_u05purec(x[i]);
+        const Sleef_double_2 r = Sleef_cinz_sincospid1_u35purec(x[i]);
         s[i] = r.x, c[i] = r.y;
       }
       return;
@@ -188,5 +194,24 @@ void PowOn(VectorPath path, const double* x, double y, size_t n, double* out) {
 void Pow(const double* x, double y, size_t n, double* out) {
   PowOn(BestVectorPath(), x, y, n, out);
 }
+
+void CbrtOn(VectorPath path, const double* x, size_t n, double* out) {
+  auto one = [](double x, double* r, double*) { *r = Cbrt(x); };
+  auto with = [](void (*body)(const double*, size_t, double*)) {
+    return [body](const double* x, size_t n, double* r, double*) { body(x, n, r); };
+  };
+  switch (path) {
+    case VectorPath::kScalar:
+      for (size_t i = 0; i < n; ++i) out[i] = Sleef_cinz_cbrtd1_u35purec(x[i]);
+      return;
+    case VectorPath::kSse2: return Batched(x, n, out, nullptr, 2, with(CbrtSse2), one);
+    case VectorPath::kAvx:
+      return Batched(x, n, out, nullptr, 4, with(vector_math_internal::CbrtAvx), one);
+    case VectorPath::kAvx512:
+      return Batched(x, n, out, nullptr, 8, with(vector_math_internal::CbrtAvx512), one);
+  }
+}
+
+void Cbrt(const double* x, size_t n, double* out) { CbrtOn(BestVectorPath(), x, n, out); }
 
 }  // namespace sfc::math
