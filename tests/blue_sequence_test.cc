@@ -17,17 +17,6 @@
 namespace sfc {
 namespace {
 
-struct Engine {
-  DirectTreeSource source;
-  SamplingEngine engine;
-  explicit Engine(int threads = 1) : engine(RegisteredSurfaceKinds(), Limits(threads), &source) {}
-  static EngineLimits Limits(int threads) {
-    EngineLimits limits;
-    limits.generation_threads = threads;
-    return limits;
-  }
-};
-
 SampleRequest Blue(const std::string& surface, uint64_t count, uint64_t seed,
                    const std::string& density = "uniform") {
   SampleRequest r;
@@ -40,7 +29,7 @@ SampleRequest Blue(const std::string& surface, uint64_t count, uint64_t seed,
 }
 
 TEST(BlueSequence, PlaneKeepsExactCountAndSpacing) {
-  Engine e;
+  LocalEngine e;
   for (uint64_t seed : {1, 2}) {
     const SampleBatch b = DrawAll(e.engine, Blue("plane", 4096, seed));
     ASSERT_EQ(b.size(), 4096u);
@@ -57,7 +46,7 @@ TEST(BlueSequence, PlaneKeepsExactCountAndSpacing) {
 
 TEST(BlueSequence, SphereChordSpacing) {
   // The figures, means of seeds 1-3: 0.72 and 0.79.
-  Engine e;
+  LocalEngine e;
   double min = 0, mean = 0;
   for (uint64_t seed : {1, 2, 3}) {
     const SampleBatch b = DrawAll(e.engine, Blue("sphere", 4096, seed));
@@ -105,7 +94,7 @@ TEST(BlueSequence, EverySampleStaysInItsStratum) {
 TEST(BlueSequence, DensityKeepsItsMassSplit) {
   // delta = u + v on the unit square: u < 0.3 holds 0.195 of the mass (not
   // u < 1/2, a union of whole runs of the curve, exact for any strata).
-  Engine e;
+  LocalEngine e;
   const uint64_t n = 20000;
   const SampleBatch b = DrawAll(e.engine, Blue("plane", n, 4, "expr:u+v"));
   ASSERT_EQ(b.size(), n);
@@ -119,7 +108,7 @@ TEST(BlueSequence, SamplesBesideADensityStepKeepTheirJitteredPlaces) {
   // step (strips of 5e-4 beside it +43 % and +38 % at N = 2^18). Samples
   // within a spacing of the step keep their jittered places, so the strips
   // beside it hold what the jittered set's do.
-  Engine e;
+  LocalEngine e;
   const uint64_t n = 20000;  // sparse-side spacing ~0.02
   SampleRequest r = Blue("plane", n, 3, "expr:u<0.3 ? 1 : 10");
   const SampleBatch blue = DrawAll(e.engine, r);
@@ -142,13 +131,13 @@ TEST(BlueSequence, SamplesBesideADensityStepKeepTheirJitteredPlaces) {
 }
 
 TEST(BlueSequence, SameBytesForAnyThreadCount) {
-  Engine one(1), three(3);
+  LocalEngine one(1), three(3);
   const SampleRequest r = Blue("torus:R=1;r=0.4", 20000, 6, "gaussian:floor=0.1");
   testing::ExpectSameSamples(DrawAll(one.engine, r), DrawAll(three.engine, r));
 }
 
 TEST(BlueSequence, ShardsRangesAndRegionsAreTheWholeRun) {
-  Engine e(2);
+  LocalEngine e(2);
   const SampleRequest whole_request = Blue("torus:R=1;r=0.4", 6000, 9);
   const SampleBatch whole = DrawAll(e.engine, whole_request);
   ASSERT_EQ(whole.size(), 6000u);

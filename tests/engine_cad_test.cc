@@ -38,19 +38,6 @@ std::string Fixture(fx::Solid solid, ModelFormat format = ModelFormat::kStep) {
   return path;
 }
 
-struct Engine {
-  DirectTreeSource source;
-  FileModelSource files;
-  SamplingEngine engine;
-  explicit Engine(int threads = 1)
-      : engine(RegisteredSurfaceKinds(), Limits(threads), &source, &files) {}
-  static EngineLimits Limits(int threads) {
-    EngineLimits limits;
-    limits.generation_threads = threads;
-    return limits;
-  }
-};
-
 SampleRequest ModelRequest(const std::string& surface, uint64_t count, uint64_t seed = 3) {
   SampleRequest r;
   r.tree.surface = surface;
@@ -62,7 +49,7 @@ SampleRequest ModelRequest(const std::string& surface, uint64_t count, uint64_t 
 }
 
 TEST(EngineCad, BlueSpreadsTheStepSphereForAnyThreadCount) {
-  Engine one(1), three(3);
+  LocalEngine one(1), three(3);
   SampleRequest r = ModelRequest("step:" + Fixture(fx::Solid::kSphere), 4096, 5);
   r.sequence = SequenceKind::kBlue;
   const SampleBatch a = DrawAll(one.engine, r);
@@ -81,7 +68,7 @@ TEST(EngineCad, BlueSpreadsTheStepSphereForAnyThreadCount) {
 }
 
 TEST(EngineCad, NoSampleOfTheBoxWithAHoleLeavesItsFace) {
-  Engine e;
+  LocalEngine e;
   const SampleBatch b =
       DrawAll(e.engine, ModelRequest("step:" + Fixture(fx::Solid::kBoxWithHole), 30000));
   ASSERT_EQ(b.size(), 30000u);
@@ -109,7 +96,7 @@ TEST(EngineCad, FacesGetSamplesInProportionToTheirExactAreas) {
   ASSERT_TRUE(bytes.ok());
   auto model = cad::Load(ModelFormat::kStep, *bytes, "box_with_hole.step");
   ASSERT_TRUE(model.ok()) << model.status();
-  Engine e;
+  LocalEngine e;
   for (uint64_t n : {1000u, 20000u}) {
     const SampleBatch b =
         DrawAll(e.engine, ModelRequest("step:" + Fixture(fx::Solid::kBoxWithHole), n));
@@ -140,7 +127,7 @@ TEST(EngineCad, TrimsAreFollowedNoFinerThanTheTrimGrid) {
 }
 
 TEST(EngineCad, AStepSphereSamplesAsWellAsTheBuiltInSphere) {
-  Engine e;
+  LocalEngine e;
   const std::string step = "step:" + Fixture(fx::Solid::kSphere);
   std::vector<double> ns, model_d, builtin_d;
   for (int l = 6; l <= 14; ++l) {
@@ -176,7 +163,7 @@ TEST(EngineCad, AStepSphereSamplesAsWellAsTheBuiltInSphere) {
 
 TEST(EngineCad, TheSameBytesForAnyThreadCountAndRangesPartitionTheSet) {
   const std::string spec = "step:" + Fixture(fx::Solid::kBoxWithHole);
-  Engine one(1), two(2);
+  LocalEngine one(1), two(2);
   SampleRequest r = ModelRequest(spec, 20000);
   r.fields.density = r.fields.curve_position = true;
   r.tree.density = "mean:floor=0.05";
@@ -206,7 +193,7 @@ TEST(EngineCad, TheSameBytesForAnyThreadCountAndRangesPartitionTheSet) {
 
 TEST(EngineCad, ABoxRegionIsTheFilteredFullSet) {
   const std::string spec = "step:" + Fixture(fx::Solid::kBoxWithHole);
-  Engine e;
+  LocalEngine e;
   const SampleRequest full = ModelRequest(spec, 20000);
   const SampleBatch all = DrawAll(e.engine, full);
   const Region box = Region::Box({15, 5, -1}, {30, 20, 8});
@@ -224,7 +211,7 @@ TEST(EngineCad, ABoxRegionIsTheFilteredFullSet) {
 }
 
 TEST(EngineCad, MalformedModelsAreRefusedByName) {
-  Engine e;
+  LocalEngine e;
   auto bytes = fx::SolidBytes(fx::Solid::kBoxWithHole, ModelFormat::kStep);
   ASSERT_TRUE(bytes.ok());
   const std::string truncated =
@@ -260,7 +247,7 @@ TEST(EngineCad, MalformedModelsAreRefusedByName) {
 TEST(EngineCad, EverySampleLiesOnItsFace) {
   for (fx::Solid solid : {fx::Solid::kBoxWithHole, fx::Solid::kTiltedBoxWithHole,
                           fx::Solid::kTiltedConeAndTorus, fx::Solid::kSplineHolePlate}) {
-    Engine e;
+    LocalEngine e;
     const std::string path = Fixture(solid);
     const SampleBatch b = DrawAll(e.engine, ModelRequest("step:" + path, 600));
     ASSERT_EQ(b.size(), 600u);
@@ -281,7 +268,7 @@ TEST(EngineCad, EverySampleLiesOnItsFace) {
 // the samples are the same whether the file is read here or through the
 // model check's BRep (the server's path).
 TEST(EngineCad, FacesWithoutAreaTakeNoSamplesAndAModelOfThemIsRefused) {
-  Engine e;
+  LocalEngine e;
   const std::string only =
       WriteTemp("engine_cad_collinear.step", fx::CollinearFacesStep(10, false));
   auto status = e.engine.Start(ModelRequest("step:" + only, 1000)).status();
@@ -330,7 +317,7 @@ TEST(EngineCad, FacesWithoutAreaTakeNoSamplesAndAModelOfThemIsRefused) {
 
 TEST(EngineCad, ANurbsPatchSamplesItsArea) {
   const std::string path = WriteTemp("engine_cad_patch.nurbs", fx::NurbsPatchText());
-  Engine e;
+  LocalEngine e;
   const SampleBatch b = DrawAll(e.engine, ModelRequest("nurbs:" + path, 5000));
   ASSERT_EQ(b.size(), 5000u);
   for (size_t i = 0; i < b.size(); ++i) {
