@@ -39,19 +39,9 @@ import tempfile
 import time
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from seed_stats import mean_se
-
-
-def hex_spacing(n, area):
-    return np.sqrt(2 * area / (np.sqrt(3) * n))
-
-
-def nn(points, area):
-    d, _ = cKDTree(points).query(points, k=2)
-    s = hex_spacing(len(points), area)
-    return d[:, 1].min() / s, d[:, 1].mean() / s
+from spacing import hex_spacing, nn
 
 
 def fmt(values, digits=3):

@@ -23,20 +23,15 @@ import subprocess
 import sys
 
 import numpy as np
-from scipy.spatial import cKDTree
 from scipy.stats import qmc
+
+from spacing import hex_spacing, nn
 
 N = 4096
 
 
-def spacing(n, sphere):
-    return np.sqrt((8 * np.pi if sphere else 2) / (np.sqrt(3) * n))
-
-
-def nn(points, sphere, n_norm=None):
-    d, _ = cKDTree(points).query(points, k=2)
-    s = spacing(n_norm or len(points), sphere)
-    return d[:, 1].min() / s, d[:, 1].mean() / s
+# Areas of the unit square and the unit sphere, for spacing.nn.
+PLANE, SPHERE = 1.0, 4 * np.pi
 
 
 def ours(cli, surface, seed):
@@ -88,17 +83,17 @@ def main():
         rng = np.random.default_rng(seed)
         uv, _ = ours(cli, "plane", seed)
         _, xyz = ours(cli, "sphere", seed)
-        add("ours (hilbert-jittered)", nn(uv, False), nn(xyz, True))
+        add("ours (hilbert-jittered)", nn(uv, PLANE), nn(xyz, SPHERE))
         j = jittered(rng)
-        add("2D jittered", nn(j, False), nn(to_sphere(j), True))
+        add("2D jittered", nn(j, PLANE), nn(to_sphere(j), SPHERE))
         s = qmc.Sobol(d=2, scramble=True, seed=seed).random_base2(12)
-        add("scrambled Sobol (scipy)", nn(s, False), nn(to_sphere(s), True))
+        add("scrambled Sobol (scipy)", nn(s, PLANE), nn(to_sphere(s), SPHERE))
         for r in (0.80, 0.70):
-            p = qmc.PoissonDisk(d=2, radius=r * spacing(N, False), seed=seed).random(N)
-            ds = dart_sphere(r * spacing(N, True), rng)
+            p = qmc.PoissonDisk(d=2, radius=r * hex_spacing(N, PLANE), seed=seed).random(N)
+            ds = dart_sphere(r * hex_spacing(N, SPHERE), rng)
             counts.setdefault(r, []).append(f"{len(p)}/{len(ds)}")
-            add(f"PoissonDisk r = {r:.2f}, by N = 4096", nn(p, False, N), nn(ds, True, N))
-            add(f"PoissonDisk r = {r:.2f}, by its own count", nn(p, False), nn(ds, True))
+            add(f"PoissonDisk r = {r:.2f}, by N = 4096", nn(p, PLANE, N), nn(ds, SPHERE, N))
+            add(f"PoissonDisk r = {r:.2f}, by its own count", nn(p, PLANE), nn(ds, SPHERE))
         print(f"seed {seed} done", file=sys.stderr)
     print(f"Blue noise, N = {N}, nearest-neighbour distance / hexagonal spacing, mean +- SE over "
           f"seeds {','.join(map(str, seeds))}\n")
