@@ -308,6 +308,27 @@ absl::StatusOr<size_t> ModelSampleCursor::Next(size_t max, SampleBatch* batch) {
   const double pieces = static_cast<double>(tree_->pieces().size());
   while (got < max && piece_ < tree_->pieces().size()) {
     if (!cursor_) RETURN_IF_ERROR(OpenPiece());
+    const ModelTree::Piece& piece = tree_->pieces()[piece_];
+    if (region_.kind == Region::Kind::kAll) {
+      // Every sample is kept: the face's samples go straight into `batch`
+      // and are kept in the trim there (a copy of every column less).
+      const size_t at = batch->size();
+      ASSIGN_OR_RETURN(const size_t n, cursor_->Next(max - got, batch));
+      if (n == 0) {
+        cursor_.reset();
+        ++piece_;
+        continue;
+      }
+      for (size_t i = at; i < at + n; ++i) KeepInTrim(piece, i, batch);
+      if (fields_.curve_position) {
+        for (size_t i = at; i < at + n; ++i) {
+          batch->curve_position[i] = (piece_ + batch->curve_position[i]) / pieces;
+        }
+      }
+      if (fields_.face) batch->face.insert(batch->face.end(), n, static_cast<uint32_t>(piece.face));
+      got += n;
+      continue;
+    }
     scratch_.Clear();
     ASSIGN_OR_RETURN(const size_t n, cursor_->Next(max - got, &scratch_));
     if (n == 0) {
@@ -315,7 +336,6 @@ absl::StatusOr<size_t> ModelSampleCursor::Next(size_t max, SampleBatch* batch) {
       ++piece_;
       continue;
     }
-    const ModelTree::Piece& piece = tree_->pieces()[piece_];
     for (size_t i = 0; i < n; ++i) KeepInTrim(piece, i, &scratch_);
     if (fields_.curve_position) {
       for (double& c : scratch_.curve_position) c = (piece_ + c) / pieces;
