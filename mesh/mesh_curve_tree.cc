@@ -138,7 +138,7 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
     live.push_back(static_cast<uint32_t>(t));
     const auto& f = mesh.triangles[t];
     centroid[t] = (mesh.positions[f[0]] + mesh.positions[f[1]] + mesh.positions[f[2]]) * (1.0 / 3);
-    area[t] = 0.5 * Norm(mesh.FaceCross(t));
+    area[t] = surface->area(t);
   }
   const std::vector<uint32_t> order = CurveOrderOfTriangles(live, centroid, area);
   const size_t ranks = order.size();
@@ -209,7 +209,7 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
         }
         root_f[r][i] = vd;
       }
-      const double area = 0.5 * Norm(mesh.FaceCross(t));
+      const double area = surface->area(t);
       RETURN_IF_ERROR(probe.Masses(t, c, root_f[r], area, &root_q[r], &root_l[r]));
       total0 += root_q[r];
     }
@@ -226,8 +226,7 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
       tree->rank_first_leaf_[r] = static_cast<uint32_t>(tree->mass_ends_.size());
       leaves.clear();
       RETURN_IF_ERROR(builder.Build(t, RootCorners(tree->rank_roles_[r]), root_f[r],
-                                    0.5 * Norm(mesh.FaceCross(t)), root_q[r], root_l[r], 0, 0,
-                                    &leaves));
+                                    surface->area(t), root_q[r], root_l[r], 0, 0, &leaves));
       if (tree->mass_ends_.size() + leaves.size() > options.max_leaves ||
           tree->mass_ends_.size() + leaves.size() > UINT32_MAX) {
         return absl::ResourceExhaustedError(absl::StrFormat(
