@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "absl/strings/str_format.h"
 #include "base/status_macros.h"
@@ -377,19 +378,30 @@ void FinishUniform(const MeshCurveTree::Cell& cell, uint64_t bits, double ca, do
 }
 
 // The centroids of the sub-cells `bits` (kLevels choices each) of n cells,
-// in their frames: InnerPoint(bits[j], kLevels, ...) for each, a step of
-// every sample at a time (their chains of dependent steps overlap), both
-// coordinates in one packed step.
+// in their frames: InnerPoint(bits[j], kLevels, ...) for each, both
+// coordinates in one packed step. kGroup samples at a time walk all their
+// levels together in registers, so their chains of dependent steps overlap
+// (the same operations in the same order for each sample: the same bits).
 void InnerPoints(size_t n, const uint64_t* bits, Lanes* xy) {
-  for (size_t j = 0; j < n; ++j) xy[j] = Lanes{1.0 / 3, 1.0 / 3};
   const auto& maps = PackedByteMaps();
-  for (int byte = 0; byte < kLevels / 8; ++byte) {
-    for (size_t j = 0; j < n; ++j) xy[j] = maps[(bits[j] >> (8 * byte)) & 255].Apply(xy[j]);
-  }
   static const PackedAffine child[2] = {Pack(kChild[0]), Pack(kChild[1])};
-  for (int level = kLevels / 8 * 8; level < kLevels; ++level) {
-    for (size_t j = 0; j < n; ++j) xy[j] = child[(bits[j] >> level) & 1].Apply(xy[j]);
-  }
+  constexpr size_t kGroup = 8;
+  auto walk = [&](auto group, size_t j0) {
+    constexpr size_t g = decltype(group)::value;
+    Lanes p[g];
+    uint64_t b[g];
+    for (size_t k = 0; k < g; ++k) p[k] = Lanes{1.0 / 3, 1.0 / 3}, b[k] = bits[j0 + k];
+    for (int byte = 0; byte < kLevels / 8; ++byte) {
+      for (size_t k = 0; k < g; ++k) p[k] = maps[(b[k] >> (8 * byte)) & 255].Apply(p[k]);
+    }
+    for (int level = kLevels / 8 * 8; level < kLevels; ++level) {
+      for (size_t k = 0; k < g; ++k) p[k] = child[(b[k] >> level) & 1].Apply(p[k]);
+    }
+    for (size_t k = 0; k < g; ++k) xy[j0 + k] = p[k];
+  };
+  size_t j = 0;
+  for (; j + kGroup <= n; j += kGroup) walk(std::integral_constant<size_t, kGroup>{}, j);
+  for (; j < n; ++j) walk(std::integral_constant<size_t, 1>{}, j);
 }
 
 }  // namespace
