@@ -108,9 +108,10 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
     std::shared_ptr<const MeshSurface> surface, std::shared_ptr<const MeshDensity> density,
     const MeshTreeOptions& options) {
   if (options.count < 1 || !(options.tolerance > 0) || options.max_depth < 0 ||
-      options.max_depth > 56) {
+      options.max_depth > 56 || options.threads < 1) {
     return absl::InvalidArgumentError(
-        "mesh tree options: count must be >= 1, tolerance > 0, max_depth in [0, 56]");
+        "mesh tree options: count must be >= 1, tolerance > 0, max_depth in [0, 56], threads "
+        ">= 1");
   }
   const TriangleMesh& mesh = surface->mesh();
   if (density->needs_weights() && mesh.weights.empty()) {
@@ -141,7 +142,7 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
     centroid[t] = (mesh.positions[f[0]] + mesh.positions[f[1]] + mesh.positions[f[2]]) * (1.0 / 3);
     area[t] = surface->area(t);
   }
-  const std::vector<uint32_t> order = CurveOrderOfTriangles(live, centroid, area);
+  const std::vector<uint32_t> order = CurveOrderOfTriangles(live, centroid, area, options.threads);
   const size_t ranks = order.size();
   tree->rank_triangle_ = order;
   tree->rank_roles_.resize(ranks);

@@ -64,6 +64,9 @@ struct MeshTreeOptions {
   // Bisection levels below a mesh triangle, 0..56. Cells the cap stops are
   // counted in Stats::capped_leaves.
   int max_depth = 40;
+  // Threads for the triangles' order (mesh/triangle_order.h), >= 1: the same
+  // tree for any count.
+  int threads = 1;
   // RESOURCE_EXHAUSTED past this many leaves (32 bytes each for non-uniform
   // densities, 24 for uniform).
   uint64_t max_leaves = uint64_t{1} << 25;
