@@ -1,5 +1,6 @@
 // Mesh sampling figures, printed as tables (not a ctest; run by hand):
 //   ./build/bench/mesh_benchmark [count=1000000] [repeats=3] [threads=1] [speed]
+// (threads: the cursor's and the triangle order's; the same samples for any count)
 // ("speed" prints the uniform row of table 1 only.)
 // 1. Speed: `count` samples on the 81 920-triangle icosphere, read from a
 //    binary PLY file: cold (read + parse + tree + samples) and warm (samples
@@ -94,6 +95,7 @@ Timing Run(const std::string& path, bool curvature_density, uint64_t count) {
   auto density = curvature_density ? MeanCurvatureMeshDensity(0.1) : UniformMeshDensity();
   MeshTreeOptions options;
   options.count = count;
+  options.threads = g_threads;
   auto tree = MeshCurveTree::Build(surface, density, options);
   if (!tree.ok()) {
     std::fprintf(stderr, "%s\n", tree.status().ToString().c_str());

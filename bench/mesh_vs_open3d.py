@@ -11,7 +11,8 @@ uses) and writes it as binary PLY with Open3D, then times:
   - Open3D sample_points_poisson_disk(POISSON_COUNT) (slow: run with fewer
     points and reported per point);
   - build/bench/mesh_benchmark COUNT 3 THREADS: our cold (read + parse + tree +
-    samples) and warm times.
+    samples) and warm times (THREADS: the cursor's and the triangle order's; the
+    same samples for any count; Open3D's calls use one).
 and prints the ratios. Installs python3-open3d from Debian when missing
 (apt-get, as root or with sudo). Timings are wall-clock medians of 3 runs.
 """
@@ -122,7 +123,7 @@ def main():
                 "warm": (float(cells[6]), float(cells[8]))}
 
         print(f"# {count} samples on the icosphere ({len(faces)} triangles); medians of 3 runs; "
-              f"our cursor on {threads} thread(s)")
+              f"our cursor and triangle order on {threads} thread(s)")
         print("| method | wall s | cpu s | ours / it, wall | ours / it, cpu |")
         print("|---|---:|---:|---:|---:|")
         print(f"| sfcsampler cold (read + parse + tree + samples) | {ours['cold'][0]:.3f} | "

@@ -35,6 +35,32 @@ class TrimmedDensity final : public Density {
   std::shared_ptr<const Density> inner_;
 };
 
+// The paper's tolerance a for the whole model when the options leave it
+// automatic (0): 1% of the diagonal of the box of every face with area, each
+// measured as core measures one surface (a 17 x 17 grid of its unit square).
+// a is a length in model units, and the model is one surface made of faces:
+// 1% of each face's own diagonal split every face, however small or flat, to
+// stage 1's base depth (4096 leaves a face: 32 768 of the STEP box's 46 064).
+// 0 when no face gives a finite box; each face's build then resolves its own.
+double ModelTolerance(const Model& model) {
+  constexpr int kGrid = 16;
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  for (const Face& face : model.faces()) {
+    if (!(face.area() > 0)) continue;
+    for (int i = 0; i <= kGrid; ++i) {
+      for (int j = 0; j <= kGrid; ++j) {
+        const Vec3 p = face.surface().Point(static_cast<double>(i) / kGrid,
+                                            static_cast<double>(j) / kGrid);
+        if (!IsFinite(p)) continue;  // the face's own build reports it
+        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+      }
+    }
+  }
+  const double diagonal = Norm(hi - lo);
+  return std::isfinite(diagonal) && diagonal > 0 ? 0.01 * diagonal : 0.0;
+}
+
 // A face the core tree cannot sample because it has nothing to sample: no
 // area (a degenerate face), or no density mass inside its trim.
 bool HasNothingToSample(const absl::Status& status) {
@@ -48,7 +74,9 @@ bool HasNothingToSample(const absl::Status& status) {
 
 absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
     std::shared_ptr<const Model> model, std::shared_ptr<const Density> density,
-    const CurveTreeOptions& options, uint64_t count, const BuildControl& control) {
+    const CurveTreeOptions& given, uint64_t count, const BuildControl& control) {
+  CurveTreeOptions options = given;
+  if (options.tolerance == 0) options.tolerance = ModelTolerance(*model);
   auto tree = std::shared_ptr<ModelTree>(new ModelTree());
   tree->model_ = model;
   uint64_t leaves = 0, bytes = 0;  // of the faces' trees so far
@@ -72,13 +100,10 @@ absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
     return absl::Status(status.code(), absl::StrFormat("face %d of \"%s\": %s", f, model->name(),
                                                        status.message()));
   };
-  // Stage one: every face's coarse tree (grade 0), for its mass.
-  for (int f : model->curve_order()) {
+  // Builds face f's tree at `grade` into a new piece, or counts the face as
+  // skipped; false when the face has nothing to sample.
+  auto build_face = [&](int f, int grade) -> absl::StatusOr<bool> {
     const Face& face = model->faces()[f];
-    if (!(face.area() > 0)) {  // at rounding level (cad/model.h): no samples
-      ++tree->skipped_faces_;
-      continue;
-    }
     Piece piece;
     piece.face = f;
     piece.surface = face.shared_surface();
@@ -86,47 +111,79 @@ absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
     if (leaves >= options.max_leaves) return over_budget();
     CurveTreeOptions o = options;
     o.max_leaves = options.max_leaves - leaves;  // what the faces before left
-    auto coarse = CurveTree::Build(*piece.surface, *piece.density, o, 0, control_after(bytes));
-    if (!coarse.ok()) {
-      if (HasNothingToSample(coarse.status())) {
+    auto built = CurveTree::Build(*piece.surface, *piece.density, o, grade, control_after(bytes));
+    if (!built.ok()) {
+      if (HasNothingToSample(built.status())) {
         ++tree->skipped_faces_;
-        continue;
+        return false;
       }
-      return on_face(f, coarse.status());
+      return on_face(f, built.status());
     }
-    piece.tree = *std::move(coarse);
+    piece.tree = *std::move(built);
     leaves += piece.tree->leaf_count();
     bytes += piece.tree->bytes();
     tree->pieces_.push_back(std::move(piece));
-  }
+    return true;
+  };
+  // The grade for the samples a face's share of the mass brings.
+  auto grade_for = [count](double share) {
+    const uint64_t samples = static_cast<uint64_t>(std::ceil(static_cast<double>(count) * share));
+    return CurveTree::GradeFor(std::max<uint64_t>(1, samples));
+  };
   auto total_mass = [&] {
     double total = 0;
     for (const Piece& piece : tree->pieces_) total += piece.tree->total_mass();
     return total;
   };
-  const double coarse_total = total_mass();
-  if (tree->pieces_.empty() || !(coarse_total > 0)) {
+  auto nothing_to_sample = [&] {
     return absl::InvalidArgumentError(absl::StrFormat(
         "the model \"%s\" has no face to sample: its %d faces have no area or no density mass",
         model->name(), model->faces().size()));
-  }
-  // Stage two: each face's tree refined for the samples its coarse share
-  // brings. Each refinement is bounded by the budget its coarse build was
-  // given; the sum is checked as they go.
-  leaves = 0, bytes = 0;
-  for (Piece& piece : tree->pieces_) {
-    const double share = piece.tree->total_mass() / coarse_total;
-    const uint64_t samples = static_cast<uint64_t>(std::ceil(static_cast<double>(count) * share));
-    const int grade = CurveTree::GradeFor(std::max<uint64_t>(1, samples));
-    if (grade > 0) {
-      auto refined =
-          piece.tree->Refined(*piece.surface, *piece.density, grade, control_after(bytes));
-      if (!refined.ok()) return on_face(piece.face, refined.status());
-      piece.tree = *std::move(refined);
+  };
+  if (density->IsUniform()) {
+    // A face's mass is its trimmed area (Face::area, the kernel's surface
+    // integral), so its share is known before any tree: each face's tree is
+    // built once, at its grade (a tree built at grade g is, bit for bit, the
+    // grade-0 tree refined to g: core/curve_tree.h).
+    double area = 0;  // of the faces with area
+    for (const Face& face : model->faces()) area += face.area() > 0 ? face.area() : 0;
+    for (int f : model->curve_order()) {
+      const Face& face = model->faces()[f];
+      if (!(face.area() > 0)) {  // at rounding level (cad/model.h): no samples
+        ++tree->skipped_faces_;
+        continue;
+      }
+      RETURN_IF_ERROR(build_face(f, grade_for(face.area() / area)).status());
+      if (leaves > options.max_leaves) return over_budget();
     }
-    leaves += piece.tree->leaf_count();
-    bytes += piece.tree->bytes();
-    if (leaves > options.max_leaves) return over_budget();
+    if (tree->pieces_.empty() || !(total_mass() > 0)) return nothing_to_sample();
+  } else {
+    // Stage one: every face's coarse tree (grade 0), for its mass.
+    for (int f : model->curve_order()) {
+      if (!(model->faces()[f].area() > 0)) {
+        ++tree->skipped_faces_;
+        continue;
+      }
+      RETURN_IF_ERROR(build_face(f, 0).status());
+    }
+    const double coarse_total = total_mass();
+    if (tree->pieces_.empty() || !(coarse_total > 0)) return nothing_to_sample();
+    // Stage two: each face's tree refined for the samples its coarse share
+    // brings. Each refinement is bounded by the budget its coarse build was
+    // given; the sum is checked as they go.
+    leaves = 0, bytes = 0;
+    for (Piece& piece : tree->pieces_) {
+      const int grade = grade_for(piece.tree->total_mass() / coarse_total);
+      if (grade > 0) {
+        auto refined =
+            piece.tree->Refined(*piece.surface, *piece.density, grade, control_after(bytes));
+        if (!refined.ok()) return on_face(piece.face, refined.status());
+        piece.tree = *std::move(refined);
+      }
+      leaves += piece.tree->leaf_count();
+      bytes += piece.tree->bytes();
+      if (leaves > options.max_leaves) return over_budget();
+    }
   }
   // The windows, from the refined masses; one double per boundary, so
   // neighbouring windows split the samples exactly.
@@ -251,6 +308,27 @@ absl::StatusOr<size_t> ModelSampleCursor::Next(size_t max, SampleBatch* batch) {
   const double pieces = static_cast<double>(tree_->pieces().size());
   while (got < max && piece_ < tree_->pieces().size()) {
     if (!cursor_) RETURN_IF_ERROR(OpenPiece());
+    const ModelTree::Piece& piece = tree_->pieces()[piece_];
+    if (region_.kind == Region::Kind::kAll) {
+      // Every sample is kept: the face's samples go straight into `batch`
+      // and are kept in the trim there (a copy of every column less).
+      const size_t at = batch->size();
+      ASSIGN_OR_RETURN(const size_t n, cursor_->Next(max - got, batch));
+      if (n == 0) {
+        cursor_.reset();
+        ++piece_;
+        continue;
+      }
+      for (size_t i = at; i < at + n; ++i) KeepInTrim(piece, i, batch);
+      if (fields_.curve_position) {
+        for (size_t i = at; i < at + n; ++i) {
+          batch->curve_position[i] = (piece_ + batch->curve_position[i]) / pieces;
+        }
+      }
+      if (fields_.face) batch->face.insert(batch->face.end(), n, static_cast<uint32_t>(piece.face));
+      got += n;
+      continue;
+    }
     scratch_.Clear();
     ASSIGN_OR_RETURN(const size_t n, cursor_->Next(max - got, &scratch_));
     if (n == 0) {
@@ -258,7 +336,6 @@ absl::StatusOr<size_t> ModelSampleCursor::Next(size_t max, SampleBatch* batch) {
       ++piece_;
       continue;
     }
-    const ModelTree::Piece& piece = tree_->pieces()[piece_];
     for (size_t i = 0; i < n; ++i) KeepInTrim(piece, i, &scratch_);
     if (fields_.curve_position) {
       for (double& c : scratch_.curve_position) c = (piece_ + c) / pieces;

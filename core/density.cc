@@ -9,6 +9,7 @@ namespace {
 class Uniform final : public Density {
  public:
   double Value(const SurfacePoint&) const override { return 1.0; }
+  bool IsUniform() const override { return true; }
 };
 
 class GaussianCurvature final : public Density {

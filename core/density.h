@@ -34,6 +34,10 @@ class Density {
   // on the right side of them by other means. 0 (every density of the
   // catalogue): steps are followed down to CurveTree::kRoughFloor samples.
   virtual double StepResolution() const { return 0; }
+  // True when delta is the same everywhere (MakeUniformDensity), so a part's
+  // mass is its area: CAD models then share samples among their faces by
+  // their exact trimmed areas, with no coarse tree to estimate them.
+  virtual bool IsUniform() const { return false; }
 };
 
 // delta = 1.

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
+#include <type_traits>
 
 #include "absl/strings/str_format.h"
 #include "base/status_macros.h"
@@ -94,6 +96,13 @@ class TriangleBuilder {
   uint64_t evaluations_ = 0;
 };
 
+// The bounding box hierarchy's leaves hold this many consecutive ranks: 1/8
+// of the memory and build time of one leaf per triangle, for a per-triangle
+// test inside the leaves a query does not settle.
+constexpr size_t kRanksPerBox = 8;
+// Meshes with fewer triangles place their ranks on one thread.
+constexpr size_t kParallelRanks = 16384;
+
 std::array<Bary, 3> RootCorners(uint8_t roles) {
   const int entry = roles / 3, exit = roles % 3, apex = 3 - entry - exit;
   std::array<Bary, 3> c{};
@@ -107,9 +116,10 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
     std::shared_ptr<const MeshSurface> surface, std::shared_ptr<const MeshDensity> density,
     const MeshTreeOptions& options) {
   if (options.count < 1 || !(options.tolerance > 0) || options.max_depth < 0 ||
-      options.max_depth > 56) {
+      options.max_depth > 56 || options.threads < 1) {
     return absl::InvalidArgumentError(
-        "mesh tree options: count must be >= 1, tolerance > 0, max_depth in [0, 56]");
+        "mesh tree options: count must be >= 1, tolerance > 0, max_depth in [0, 56], threads "
+        ">= 1");
   }
   const TriangleMesh& mesh = surface->mesh();
   if (density->needs_weights() && mesh.weights.empty()) {
@@ -138,41 +148,28 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
     live.push_back(static_cast<uint32_t>(t));
     const auto& f = mesh.triangles[t];
     centroid[t] = (mesh.positions[f[0]] + mesh.positions[f[1]] + mesh.positions[f[2]]) * (1.0 / 3);
-    area[t] = 0.5 * Norm(mesh.FaceCross(t));
+    area[t] = surface->area(t);
   }
-  const std::vector<uint32_t> order = CurveOrderOfTriangles(live, centroid, area);
+  const std::vector<uint32_t> order = CurveOrderOfTriangles(live, centroid, area, options.threads);
   const size_t ranks = order.size();
   tree->rank_triangle_ = order;
   tree->rank_roles_.resize(ranks);
-  // Entry and exit: the ends of the longest edge; the exit is the end nearer
-  // the next triangle's centroid (the last triangle: the entry is the end
-  // nearer the previous one's).
-  for (size_t r = 0; r < ranks; ++r) {
-    const auto& f = mesh.triangles[tree->rank_triangle_[r]];
-    int p = 0;
-    double longest = -1;
-    for (int e = 0; e < 3; ++e) {
-      const Vec3 d = mesh.positions[f[(e + 1) % 3]] - mesh.positions[f[e]];
-      if (Dot(d, d) > longest) longest = Dot(d, d), p = e;
-    }
-    const int q = (p + 1) % 3;
-    auto dist = [&](int corner, const Vec3& to) {
-      const Vec3 d = mesh.positions[f[corner]] - to;
-      return Dot(d, d);
-    };
-    bool p_is_entry;
-    if (r + 1 < ranks) {
-      const Vec3& next = centroid[tree->rank_triangle_[r + 1]];
-      p_is_entry = !(dist(p, next) < dist(q, next));
-    } else if (r > 0) {
-      const Vec3& prev = centroid[tree->rank_triangle_[r - 1]];
-      p_is_entry = !(dist(q, prev) < dist(p, prev));
-    } else {
-      p_is_entry = true;
-    }
-    const int entry = p_is_entry ? p : q, exit = p_is_entry ? q : p;
-    tree->rank_roles_[r] = static_cast<uint8_t>(entry * 3 + exit);
+  tree->box_leaves_ = 1;
+  while (tree->box_leaves_ * kRanksPerBox < ranks) tree->box_leaves_ *= 2;
+  const Box empty{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
+  tree->boxes_.assign(2 * tree->box_leaves_, empty);
+  // Each rank's roles and box, in runs of whole box leaves, on threads.
+  const size_t parts =
+      ranks >= kParallelRanks ? static_cast<size_t>(std::min(options.threads, 8)) : 1;
+  const size_t leaves_per_part = (ranks + kRanksPerBox - 1) / kRanksPerBox / parts + 1;
+  std::vector<std::thread> workers;
+  for (size_t part = 1; part < parts; ++part) {
+    const size_t a = std::min(ranks, part * leaves_per_part * kRanksPerBox);
+    const size_t b = std::min(ranks, (part + 1) * leaves_per_part * kRanksPerBox);
+    workers.emplace_back([&tree, &centroid, a, b] { tree->PlaceRanks(a, b, centroid); });
   }
+  tree->PlaceRanks(0, std::min(ranks, leaves_per_part * kRanksPerBox), centroid);
+  for (std::thread& worker : workers) worker.join();
 
   // Masses.
   tree->rank_first_leaf_.resize(ranks + 1);
@@ -209,7 +206,7 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
         }
         root_f[r][i] = vd;
       }
-      const double area = 0.5 * Norm(mesh.FaceCross(t));
+      const double area = surface->area(t);
       RETURN_IF_ERROR(probe.Masses(t, c, root_f[r], area, &root_q[r], &root_l[r]));
       total0 += root_q[r];
     }
@@ -226,8 +223,7 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
       tree->rank_first_leaf_[r] = static_cast<uint32_t>(tree->mass_ends_.size());
       leaves.clear();
       RETURN_IF_ERROR(builder.Build(t, RootCorners(tree->rank_roles_[r]), root_f[r],
-                                    0.5 * Norm(mesh.FaceCross(t)), root_q[r], root_l[r], 0, 0,
-                                    &leaves));
+                                    surface->area(t), root_q[r], root_l[r], 0, 0, &leaves));
       if (tree->mass_ends_.size() + leaves.size() > options.max_leaves ||
           tree->mass_ends_.size() + leaves.size() > UINT32_MAX) {
         return absl::ResourceExhaustedError(absl::StrFormat(
@@ -255,7 +251,7 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
     }
   }
   stats.leaves = tree->mass_ends_.size();
-  tree->BuildBoxes();
+  tree->FinishBoxes();
   stats.bytes = tree->rank_triangle_.size() * 4 + tree->rank_roles_.size() +
                 tree->rank_first_leaf_.size() * 4 + tree->leaf_rank_.size() * 4 +
                 tree->leaf_path_.size() * 8 + tree->leaf_depth_.size() +
@@ -378,19 +374,30 @@ void FinishUniform(const MeshCurveTree::Cell& cell, uint64_t bits, double ca, do
 }
 
 // The centroids of the sub-cells `bits` (kLevels choices each) of n cells,
-// in their frames: InnerPoint(bits[j], kLevels, ...) for each, a step of
-// every sample at a time (their chains of dependent steps overlap), both
-// coordinates in one packed step.
+// in their frames: InnerPoint(bits[j], kLevels, ...) for each, both
+// coordinates in one packed step. kGroup samples at a time walk all their
+// levels together in registers, so their chains of dependent steps overlap
+// (the same operations in the same order for each sample: the same bits).
 void InnerPoints(size_t n, const uint64_t* bits, Lanes* xy) {
-  for (size_t j = 0; j < n; ++j) xy[j] = Lanes{1.0 / 3, 1.0 / 3};
   const auto& maps = PackedByteMaps();
-  for (int byte = 0; byte < kLevels / 8; ++byte) {
-    for (size_t j = 0; j < n; ++j) xy[j] = maps[(bits[j] >> (8 * byte)) & 255].Apply(xy[j]);
-  }
   static const PackedAffine child[2] = {Pack(kChild[0]), Pack(kChild[1])};
-  for (int level = kLevels / 8 * 8; level < kLevels; ++level) {
-    for (size_t j = 0; j < n; ++j) xy[j] = child[(bits[j] >> level) & 1].Apply(xy[j]);
-  }
+  constexpr size_t kGroup = 8;
+  auto walk = [&](auto group, size_t j0) {
+    constexpr size_t g = decltype(group)::value;
+    Lanes p[g];
+    uint64_t b[g];
+    for (size_t k = 0; k < g; ++k) p[k] = Lanes{1.0 / 3, 1.0 / 3}, b[k] = bits[j0 + k];
+    for (int byte = 0; byte < kLevels / 8; ++byte) {
+      for (size_t k = 0; k < g; ++k) p[k] = maps[(b[k] >> (8 * byte)) & 255].Apply(p[k]);
+    }
+    for (int level = kLevels / 8 * 8; level < kLevels; ++level) {
+      for (size_t k = 0; k < g; ++k) p[k] = child[(b[k] >> level) & 1].Apply(p[k]);
+    }
+    for (size_t k = 0; k < g; ++k) xy[j0 + k] = p[k];
+  };
+  size_t j = 0;
+  for (; j + kGroup <= n; j += kGroup) walk(std::integral_constant<size_t, kGroup>{}, j);
+  for (; j < n; ++j) walk(std::integral_constant<size_t, 1>{}, j);
 }
 
 }  // namespace
@@ -506,10 +513,6 @@ void MeshCurveTree::Descend(const Cell& cell, double t, std::array<double, 3>* b
 
 namespace {
 
-// The bounding box hierarchy's leaves hold this many consecutive ranks: 1/8
-// of the memory and build time of one leaf per triangle, for a per-triangle
-// test inside the leaves a query does not settle.
-constexpr size_t kRanksPerBox = 8;
 
 void AppendRun(size_t a, size_t e, std::vector<std::pair<size_t, size_t>>* runs) {
   if (!runs->empty() && runs->back().second == a) {
@@ -532,18 +535,45 @@ MeshCurveTree::Box MeshCurveTree::TriangleBox(size_t r) const {
   return b;
 }
 
-void MeshCurveTree::BuildBoxes() {
+void MeshCurveTree::PlaceRanks(size_t begin, size_t end, const std::vector<Vec3>& centroid) {
+  const TriangleMesh& mesh = surface_->mesh();
   const size_t ranks = rank_triangle_.size();
-  box_leaves_ = 1;
-  while (box_leaves_ * kRanksPerBox < ranks) box_leaves_ *= 2;
-  const Box empty{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
-  boxes_.assign(2 * box_leaves_, empty);
-  for (size_t r = 0; r < ranks; ++r) {
+  // Entry and exit: the ends of the longest edge; the exit is the end nearer
+  // the next triangle's centroid (the last triangle: the entry is the end
+  // nearer the previous one's).
+  for (size_t r = begin; r < end; ++r) {
+    const auto& f = mesh.triangles[rank_triangle_[r]];
+    int p = 0;
+    double longest = -1;
+    for (int e = 0; e < 3; ++e) {
+      const Vec3 d = mesh.positions[f[(e + 1) % 3]] - mesh.positions[f[e]];
+      if (Dot(d, d) > longest) longest = Dot(d, d), p = e;
+    }
+    const int q = (p + 1) % 3;
+    auto dist = [&](int corner, const Vec3& to) {
+      const Vec3 d = mesh.positions[f[corner]] - to;
+      return Dot(d, d);
+    };
+    bool p_is_entry;
+    if (r + 1 < ranks) {
+      const Vec3& next = centroid[rank_triangle_[r + 1]];
+      p_is_entry = !(dist(p, next) < dist(q, next));
+    } else if (r > 0) {
+      const Vec3& prev = centroid[rank_triangle_[r - 1]];
+      p_is_entry = !(dist(q, prev) < dist(p, prev));
+    } else {
+      p_is_entry = true;
+    }
+    const int entry = p_is_entry ? p : q, exit = p_is_entry ? q : p;
+    rank_roles_[r] = static_cast<uint8_t>(entry * 3 + exit);
     Box& b = boxes_[box_leaves_ + r / kRanksPerBox];
     const Box t = TriangleBox(r);
     b.lo = {std::min(b.lo.x, t.lo.x), std::min(b.lo.y, t.lo.y), std::min(b.lo.z, t.lo.z)};
     b.hi = {std::max(b.hi.x, t.hi.x), std::max(b.hi.y, t.hi.y), std::max(b.hi.z, t.hi.z)};
   }
+}
+
+void MeshCurveTree::FinishBoxes() {
   for (size_t i = box_leaves_ - 1; i >= 1; --i) {
     const Box &a = boxes_[2 * i], &b = boxes_[2 * i + 1];
     boxes_[i] = {{std::min(a.lo.x, b.lo.x), std::min(a.lo.y, b.lo.y), std::min(a.lo.z, b.lo.z)},

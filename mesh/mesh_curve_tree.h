@@ -64,6 +64,9 @@ struct MeshTreeOptions {
   // Bisection levels below a mesh triangle, 0..56. Cells the cap stops are
   // counted in Stats::capped_leaves.
   int max_depth = 40;
+  // Threads for the triangles' order (mesh/triangle_order.h), >= 1: the same
+  // tree for any count.
+  int threads = 1;
   // RESOURCE_EXHAUSTED past this many leaves (32 bytes each for non-uniform
   // densities, 24 for uniform).
   uint64_t max_leaves = uint64_t{1} << 25;
@@ -160,7 +163,11 @@ class MeshCurveTree {
   };
   MeshCurveTree() = default;
   Box TriangleBox(size_t rank) const;  // of its vertices
-  void BuildBoxes();
+  // Ranks [begin, end): their entry and exit corners (rank_roles_) and their
+  // boxes' leaves (boxes_, allocated; end a multiple of kRanksPerBox or the
+  // last rank). Disjoint ranges may run at once.
+  void PlaceRanks(size_t begin, size_t end, const std::vector<Vec3>& centroid);
+  void FinishBoxes();  // boxes_'s inner nodes, from its leaves
   void CollectRuns(size_t node, size_t node_lo, size_t node_hi, const Vec3& lo, const Vec3& hi,
                    std::vector<std::pair<size_t, size_t>>* runs) const;
 

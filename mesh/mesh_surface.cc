@@ -6,10 +6,14 @@ std::shared_ptr<const MeshSurface> MeshSurface::Create(TriangleMesh mesh, bool w
   auto surface = std::shared_ptr<MeshSurface>(new MeshSurface(std::move(mesh)));
   const TriangleMesh& m = surface->mesh_;
   surface->face_normals_.resize(m.triangles.size());
+  surface->areas_.resize(m.triangles.size());
   for (size_t t = 0; t < m.triangles.size(); ++t) {
     const Vec3 c = m.FaceCross(t);
     const double len = Norm(c);
-    if (len > 0 && !IsDegenerateTriangle(m, t)) surface->face_normals_[t] = c * (1 / len);
+    if (len > 0 && !IsDegenerateTriangle(m, t, len)) {
+      surface->face_normals_[t] = c * (1 / len);
+      surface->areas_[t] = 0.5 * len;
+    }
   }
   if (with_curvature) surface->curvature_ = ComputeVertexCurvature(m);
   return surface;

@@ -39,6 +39,8 @@ class MeshSurface {
   // The density's inputs at a point (curvature only when computed).
   MeshPoint Attributes(size_t t, const std::array<double, 3>& b) const;
   const Vec3& FaceNormal(size_t t) const { return face_normals_[t]; }
+  // 0.5 |FaceCross(t)|, computed once; 0 for degenerate triangles.
+  double area(size_t t) const { return areas_[t]; }
   // IsDegenerateTriangle(mesh(), t), computed once.
   bool degenerate(size_t t) const { return face_normals_[t] == Vec3{}; }
 
@@ -47,6 +49,7 @@ class MeshSurface {
 
   TriangleMesh mesh_;
   std::vector<Vec3> face_normals_;  // unit; zero for degenerate triangles
+  std::vector<double> areas_;
   VertexCurvature curvature_;
 };
 

@@ -9,13 +9,17 @@
 namespace sfc {
 
 bool IsDegenerateTriangle(const TriangleMesh& mesh, size_t t) {
+  return IsDegenerateTriangle(mesh, t, Norm(mesh.FaceCross(t)));
+}
+
+bool IsDegenerateTriangle(const TriangleMesh& mesh, size_t t, double cross_norm) {
   const auto& f = mesh.triangles[t];
   if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2]) return true;
   const Vec3& a = mesh.positions[f[0]];
   const Vec3& b = mesh.positions[f[1]];
   const Vec3& c = mesh.positions[f[2]];
   const double longest2 = std::max({Dot(b - a, b - a), Dot(c - b, c - b), Dot(a - c, a - c)});
-  return !(Norm(Cross(b - a, c - a)) > 1e-12 * longest2);
+  return !(cross_norm > 1e-12 * longest2);
 }
 
 void ForEachEdge(const TriangleMesh& mesh,
@@ -106,11 +110,12 @@ absl::Status FinalizeMesh(TriangleMesh* mesh) {
             name, t, f[c], nv));
       }
     }
-    if (IsDegenerateTriangle(*mesh, t)) {
+    const double cross_norm = Norm(mesh->FaceCross(t));
+    if (IsDegenerateTriangle(*mesh, t, cross_norm)) {
       ++stats.degenerate_triangles;
       continue;
     }
-    stats.area += 0.5 * Norm(mesh->FaceCross(t));
+    stats.area += 0.5 * cross_norm;
   }
   if (stats.degenerate_triangles == mesh->triangles.size()) {
     return absl::InvalidArgumentError(absl::StrFormat(

@@ -45,6 +45,9 @@ struct TriangleMesh {
 // True when triangle t has (numerically) no area: a repeated corner, or
 // |e1 x e2| <= 1e-12 * (longest edge)^2. Such triangles are never sampled.
 bool IsDegenerateTriangle(const TriangleMesh& mesh, size_t t);
+// The same test, given cross_norm = Norm(mesh.FaceCross(t)) (computed once
+// by callers that also need the area or the normal).
+bool IsDegenerateTriangle(const TriangleMesh& mesh, size_t t, double cross_norm);
 
 // Calls f(a, b, n) once per distinct edge {a, b} (a < b) of the
 // non-degenerate triangles, n = how many of them have it, in order of a.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
 
 namespace sfc {
 namespace {
@@ -16,6 +17,9 @@ double Distance2(const Vec3& a, const Vec3& b) {
   const Vec3 d = a - b;
   return Dot(d, d);
 }
+
+// Meshes with fewer triangles are ordered on one thread.
+constexpr size_t kParallelItems = 16384;
 
 // The items stay where they are; the recursion arranges indices into them
 // (4 bytes to swap instead of 40).
@@ -129,6 +133,12 @@ Summary Summarize(const Item* items, const Index* begin, const Index* end) {
   return s;
 }
 
+// The centre a half of a split is compared by in Order and Walk: its
+// area-weighted centroid, or its first item's centroid when it has no area.
+Vec3 Centre(const Item* items, const Summary& half, const Index* first) {
+  return half.area > 0 ? half.weighted * (1 / half.area) : items[*first].c;
+}
+
 // Appends the items [begin, end) in curve order, starting near `entry`;
 // returns where the order ends (the last centroid). `run` is
 // Summarize(begin, end): the parent's pass over each half serves both the
@@ -146,20 +156,70 @@ Vec3 Order(const Item* items, Index* begin, Index* end, const Summary& run, Vec3
   Index* middle = begin + split;
   const Summary first = Summarize(items, begin, middle), second = Summarize(items, middle, end);
   // The half whose area-weighted centre is nearer the curve's end goes first.
-  auto centre = [items](const Summary& half, const Index* b) {
-    return half.area > 0 ? half.weighted * (1 / half.area) : items[*b].c;
-  };
-  if (Distance2(centre(first, begin), entry) <= Distance2(centre(second, middle), entry)) {
+  if (Distance2(Centre(items, first, begin), entry) <=
+      Distance2(Centre(items, second, middle), entry)) {
     return Order(items, middle, end, second, Order(items, begin, middle, first, entry, out), out);
   }
   return Order(items, begin, middle, first, Order(items, middle, end, second, entry, out), out);
+}
+
+// On threads, Order's work in two passes. Where a run splits does not depend
+// on where the curve enters it (only which half Order visits first does), so
+// the splits of disjoint runs are made at once (Split) into a bisection
+// tree, and one pass over it then chooses the order (Walk): the same order.
+// A run's node is numbered in preorder: its first half's is k + 1, its
+// second half's k + (the first half's items).
+struct Node {
+  uint32_t split;  // the first half's items
+  Vec3 centre[2];  // of the halves, as the split left them
+};
+
+// Splits the items [begin, end) (`run` = Summarize of them) into node k and
+// below, as Order does; the first halves `spawn` levels down on threads.
+void Split(const Item* items, Index* begin, Index* end, const Summary& run, size_t k, int spawn,
+           Node* nodes) {
+  const size_t n = static_cast<size_t>(end - begin);
+  if (n == 1) return;
+  const Vec3 extent = run.hi - run.lo;
+  const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
+  const size_t split = SplitByArea(items, begin, end, axis, run.area / 2);
+  Index* middle = begin + split;
+  const Summary first = Summarize(items, begin, middle), second = Summarize(items, middle, end);
+  nodes[k] = {static_cast<uint32_t>(split),
+              {Centre(items, first, begin), Centre(items, second, middle)}};
+  if (spawn > 0) {
+    std::thread worker([&] { Split(items, begin, middle, first, k + 1, spawn - 1, nodes); });
+    Split(items, middle, end, second, k + split, spawn - 1, nodes);
+    worker.join();
+    return;
+  }
+  Split(items, begin, middle, first, k + 1, 0, nodes);
+  Split(items, middle, end, second, k + split, 0, nodes);
+}
+
+// Order's choice of which half goes first, on Split's tree (node k holds
+// the items [begin, end)).
+Vec3 Walk(const Item* items, const Index* begin, const Index* end, size_t k, const Node* nodes,
+          Vec3 entry, std::vector<uint32_t>* out) {
+  if (end - begin == 1) {
+    out->push_back(items[*begin].t);
+    return items[*begin].c;
+  }
+  const Node& node = nodes[k];
+  const Index* middle = begin + node.split;
+  if (Distance2(node.centre[0], entry) <= Distance2(node.centre[1], entry)) {
+    return Walk(items, middle, end, k + node.split, nodes,
+                Walk(items, begin, middle, k + 1, nodes, entry, out), out);
+  }
+  return Walk(items, begin, middle, k + 1, nodes,
+              Walk(items, middle, end, k + node.split, nodes, entry, out), out);
 }
 
 }  // namespace
 
 std::vector<uint32_t> CurveOrderOfTriangles(const std::vector<uint32_t>& triangles,
                                             const std::vector<Vec3>& centroid,
-                                            const std::vector<double>& area) {
+                                            const std::vector<double>& area, int threads) {
   std::vector<uint32_t> out;
   if (triangles.empty()) return out;
   std::vector<Item> items(triangles.size());
@@ -173,8 +233,18 @@ std::vector<uint32_t> CurveOrderOfTriangles(const std::vector<uint32_t>& triangl
   Index* begin = arrangement.data();
   Index* end = begin + arrangement.size();
   const Summary all = Summarize(items.data(), begin, end);
+  // Threads split the top levels' halves, 2^spawn runs at once; none for a
+  // mesh too small to repay them.
+  int spawn = 0;
+  while ((1 << spawn) < threads && spawn < 6) ++spawn;
   // The curve starts at the low corner of the centroids' bounding box.
-  Order(items.data(), begin, end, all, all.lo, &out);
+  if (spawn == 0 || items.size() < kParallelItems) {
+    Order(items.data(), begin, end, all, all.lo, &out);
+    return out;
+  }
+  std::vector<Node> nodes(items.size() - 1);
+  Split(items.data(), begin, end, all, 0, spawn, nodes.data());
+  Walk(items.data(), begin, end, 0, nodes.data(), all.lo, &out);
   return out;
 }
 

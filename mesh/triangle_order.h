@@ -26,10 +26,11 @@ namespace sfc {
 // The triangles `triangles` in curve order. centroid[t] and area[t] are
 // triangle t's; REQUIRES: both cover every index in `triangles`, and the
 // areas are finite and >= 0. Ties are broken by triangle index, so the order
-// is a function of the geometry and the indices alone.
+// is a function of the geometry and the indices alone: the same for any
+// `threads` (>= 1), which split the top levels' halves at once.
 std::vector<uint32_t> CurveOrderOfTriangles(const std::vector<uint32_t>& triangles,
                                             const std::vector<Vec3>& centroid,
-                                            const std::vector<double>& area);
+                                            const std::vector<double>& area, int threads = 1);
 
 }  // namespace sfc
 

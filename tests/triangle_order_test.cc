@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <random>
 
 #include "gtest/gtest.h"
 #include "core/hilbert3d.h"
@@ -40,6 +41,23 @@ TEST(TriangleOrder, IsAPermutationOfTheTriangles) {
   std::sort(order.begin(), order.end());
   EXPECT_EQ(order, g.triangles);
   EXPECT_TRUE(CurveOrderOfTriangles({}, g.centroid, g.area).empty());
+}
+
+// Threads split the top levels' halves first and choose the order after:
+// the same order as one thread's single pass, on a mesh past the size that
+// takes threads, with equal areas and equal coordinates (ties) and with
+// triangles of no area.
+TEST(TriangleOrder, IsTheSameForAnyThreadCount) {
+  Geometry g = Of(MakeIcosphere(6));  // 81 920 triangles
+  std::mt19937_64 rng(3);
+  for (size_t t = 0; t < g.area.size(); t += 97) g.area[t] = 0;
+  for (size_t t = 5; t < g.centroid.size(); t += 101) g.centroid[t] = g.centroid[t - 5];
+  std::shuffle(g.triangles.begin(), g.triangles.end(), rng);
+  const std::vector<uint32_t> one = CurveOrderOfTriangles(g.triangles, g.centroid, g.area, 1);
+  for (int threads : {2, 3, 4, 8}) {
+    EXPECT_EQ(CurveOrderOfTriangles(g.triangles, g.centroid, g.area, threads), one)
+        << threads << " threads";
+  }
 }
 
 // The mean over runs of `run` consecutive triangles of the centroids' RMS

@@ -239,6 +239,10 @@ FaceTrim::FaceTrim(const TopoDS_Face& face, const UnitSquareMap& map, double tol
       queue.push_back({child + 1, mid, p.b, p.depth + 1});
     }
   }
+  if (lines_and_circles_ && !missing_pcurve_) {
+    exact_ = LineCircleTrim::Extract(
+        face, 1e-6 * std::max(map.box.u1 - map.box.u0, map.box.v1 - map.box.v0));
+  }
   // A face whose every trim curve lies on the square's border, and whose
   // centre is in it, is the whole square.
   bool interior_curve = missing_pcurve_;
@@ -365,7 +369,8 @@ void FaceTrim::BuildGrid() const {
             1.0 / kGridSide, kGridSide, &marked);
   }
   ClassifyPieces(marked, kGridSide, grid_.data(), [&](int k) {
-    return KernelState((k / kGridSide + 0.5) / kGridSide, (k % kGridSide + 0.5) / kGridSide);
+    return CheckedKernelState((k / kGridSide + 0.5) / kGridSide,
+                              (k % kGridSide + 0.5) / kGridSide);
   });
   int fine_cells = 0;
   for (int k = 0; k < kCells && fine_cells < kMaxFineCells; ++k) {
@@ -373,6 +378,19 @@ void FaceTrim::BuildGrid() const {
     BuildFineGrid(k / kGridSide, k % kGridSide);
     ++fine_cells;
   }
+  if (!exact_agrees_) exact_.reset();
+}
+
+CellState FaceTrim::CheckedKernelState(double s, double t) const {
+  const CellState state = KernelState(s, t);
+  if (exact_) {
+    const LineCircleTrim::Side side = exact_->Classify(map_.U(s), map_.V(t));
+    if (side != LineCircleTrim::Side::kUnsure &&
+        (side == LineCircleTrim::Side::kIn) != (state != CellState::kOutside)) {
+      exact_agrees_ = false;
+    }
+  }
+  return state;
 }
 
 void FaceTrim::BuildFineGrid(int i, int j) const {
@@ -403,7 +421,7 @@ void FaceTrim::BuildFineGrid(int i, int j) const {
   fine_at_[i * kGridSide + j] = at;
   fine_.resize(fine_.size() + kCells, static_cast<uint8_t>(CellState::kStraddles));
   ClassifyPieces(marked, kFineSide, fine_.data() + at, [&](int k) {
-    return KernelState(s0 + (k / kFineSide + 0.5) * w, t0 + (k % kFineSide + 0.5) * w);
+    return CheckedKernelState(s0 + (k / kFineSide + 0.5) * w, t0 + (k % kFineSide + 0.5) * w);
   });
 }
 
@@ -424,6 +442,10 @@ bool FaceTrim::Contains(double s, double t) const {
     case CellState::kInside: return true;
     case CellState::kOutside: return false;
     case CellState::kStraddles: break;
+  }
+  if (exact_) {
+    const LineCircleTrim::Side side = exact_->Classify(map_.U(s), map_.V(t));
+    if (side != LineCircleTrim::Side::kUnsure) return side == LineCircleTrim::Side::kIn;
   }
   auto classifier = classifiers_.Take();
   try {

@@ -25,6 +25,7 @@
 #include "absl/base/thread_annotations.h"
 #include "absl/synchronization/mutex.h"
 #include "cad/internal/closed_form.h"
+#include "cad/internal/line_circle_trim.h"
 #include "cad/model.h"
 #include "core/surface.h"
 
@@ -194,6 +195,9 @@ class FaceTrim {
   void BuildGrid() const;
   void BuildFineGrid(int i, int j) const;
   CellState KernelState(double s, double t) const;
+  // KernelState, compared with exact_'s answer (BuildGrid only): a
+  // disagreement clears exact_agrees_.
+  CellState CheckedKernelState(double s, double t) const;
   struct Node {
     Box2 box;
     int first_child = -1;  // children at first_child, first_child + 1; -1 for a leaf
@@ -218,6 +222,11 @@ class FaceTrim {
   bool lines_and_circles_ = true;  // every p-curve is a line or a circle (see kFineSide)
   bool trimmed_ = true;
   mutable LeasePool<BRepTopAdaptor_FClass2d> classifiers_;  // thread-safe
+  // Faces of lines and circles: Contains() asks it before the kernel. Checked
+  // against every kernel answer BuildGrid gets (hundreds, many within a few
+  // sub-cells of a curve), and dropped there if one differs.
+  mutable std::optional<LineCircleTrim> exact_;
+  mutable bool exact_agrees_ = true;  // written by BuildGrid only
   mutable std::once_flag grid_once_;
   mutable std::vector<CellState> grid_;  // row s, column t; filled by BuildGrid
   // For grid cell k that the boundary may cross, fine_[fine_at_[k] + a *
