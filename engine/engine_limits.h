@@ -14,7 +14,8 @@ struct EngineLimits {
   uint64_t max_tree_leaves = uint64_t{1}
                              << 22;  // per tree: 73 B a leaf (CurveTree::kBytesPerLeaf), 292 MiB
   size_t max_spec_length = 4096;     // surface/density spec, in characters
-  int generation_threads = 1;        // threads filling one stream's large batches
+  // Threads filling one stream's large batches, and ordering a mesh's triangles.
+  int generation_threads = 1;
   // Sequences that are not monotone in k are sorted into curve order per
   // request (16 bytes a sample): at most this many samples per request.
   uint64_t max_sorted_range = uint64_t{1} << 24;

@@ -1,5 +1,6 @@
 #include "kinds/mesh/mesh_kind.h"
 
+#include <algorithm>
 #include <utility>
 
 #include "absl/strings/ascii.h"
@@ -109,10 +110,11 @@ struct MeshTreeRecipe {
 
 // Parses `density` for a mesh, loads `model` (through `loaded`, on its parse
 // threads; `caller` is asked while the request waits) as that density needs
-// it, and returns how to build its tree. `tolerance` 0 takes the mesh tree's
+// it, and returns how to build its tree, its triangles ordered on `threads`
+// threads (the same tree for any count). `tolerance` 0 takes the mesh tree's
 // default.
 absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::string& density,
-                                           double tolerance, uint64_t max_leaves,
+                                           double tolerance, uint64_t max_leaves, int threads,
                                            LoadedModels* loaded,
                                            const std::function<absl::Status()>& caller) {
   ASSIGN_OR_RETURN(MeshDensityChoice choice, ParseMeshDensity(density));
@@ -148,11 +150,12 @@ absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::
           caller, working_bytes));
   MeshTreeRecipe recipe;
   recipe.canonical_density = choice.canonical;
-  recipe.factory.build = [surface, density = choice.density, tolerance, max_leaves](
+  recipe.factory.build = [surface, density = choice.density, tolerance, max_leaves, threads](
                              int grade, const BuildControl& control) -> TreeFactory::Result {
     RETURN_IF_ERROR(control.check ? control.check() : absl::OkStatus());
     MeshTreeOptions options;
     options.count = uint64_t{1} << grade;
+    options.threads = std::max(1, threads);
     if (tolerance > 0) options.tolerance = tolerance;
     options.max_leaves = max_leaves;
     ASSIGN_OR_RETURN(std::shared_ptr<const MeshCurveTree> tree,
@@ -194,7 +197,9 @@ class MeshKind final : public SurfaceKind {
     if (!model) return absl::InternalError("the mesh kind was given a spec that names no model");
     ASSIGN_OR_RETURN(MeshTreeRecipe recipe,
                      MeshTreeFor(*model, spec.density, spec.options.tolerance,
-                                 context.limits->max_tree_leaves, context.loaded, context.caller));
+                                 context.limits->max_tree_leaves,
+                                 context.limits->generation_threads, context.loaded,
+                                 context.caller));
     CurveTreeOptions options;  // a mesh's curve has no options but the tolerance
     options.tolerance = spec.options.tolerance;
     ResolvedSurface out;
