@@ -19,6 +19,39 @@ SampleFields ColumnsOf(const CurveSamples& samples, SampleFields fields) {
   return fields;
 }
 
+// Sorts addresses into curve order (by CurveAddress::Key): a counting sort
+// by leaf, stable, then each leaf's few addresses by key, the leaves split
+// over `parts` threads. The order is the same as one sort of the whole.
+// Many more leaves than addresses (a large mesh, a small set) take one sort.
+void SortAddresses(std::vector<CurveAddress>* addresses, int parts) {
+  std::vector<CurveAddress>& at = *addresses;
+  uint32_t leaves = 0;
+  for (const CurveAddress& a : at) leaves = std::max(leaves, a.leaf + 1);
+  if (leaves > 4 * at.size() + 1024) {
+    std::sort(at.begin(), at.end());
+    return;
+  }
+  std::vector<uint64_t> first(size_t{leaves} + 1, 0);  // each leaf's first position
+  for (const CurveAddress& a : at) ++first[a.leaf + 1];
+  for (uint32_t l = 0; l < leaves; ++l) first[l + 1] += first[l];
+  std::vector<CurveAddress> sorted(at.size());
+  {
+    std::vector<uint64_t> next(first.begin(), first.end() - 1);
+    for (const CurveAddress& a : at) sorted[next[a.leaf]++] = a;
+  }
+  // Parts of about equal counts, cut at leaf boundaries.
+  WorkerPool::Shared().ParallelFor(parts, [&](int i) {
+    const uint64_t from = at.size() * i / parts, to = at.size() * (i + 1) / parts;
+    uint32_t l = static_cast<uint32_t>(std::upper_bound(first.begin(), first.end(), from) -
+                                       first.begin() - 1);
+    if (first[l] < from) ++l;  // the leaf across `from` is the part before's
+    for (; l < leaves && first[l] < to; ++l) {
+      std::sort(sorted.begin() + first[l], sorted.begin() + first[l + 1]);
+    }
+  });
+  at.swap(sorted);
+}
+
 }  // namespace
 
 SampleCursor::SampleCursor(std::shared_ptr<const CurveSamples> samples, Region region,
@@ -68,11 +101,11 @@ absl::Status SampleCursor::Plan(uint64_t begin, uint64_t end) {
     addresses_.resize(m);
     const int parts = m >= 8192 ? threads_ : 1;
     WorkerPool::Shared().ParallelFor(parts, [&](int i) {
-      for (uint64_t j = m * i / parts; j < m * (i + 1) / parts; ++j) {
-        addresses_[j] = samples.AddressOf(sequence.windowed() ? in_window[j] : j);
-      }
+      const uint64_t j0 = m * i / parts, j1 = m * (i + 1) / parts;
+      samples.AddressesOf(sequence.windowed() ? in_window.data() + j0 : nullptr, j0, j1 - j0,
+                          addresses_.data() + j0);
     });
-    std::sort(addresses_.begin(), addresses_.end());
+    SortAddresses(&addresses_, parts);
     const uint64_t kept = addresses_.size();
     addresses_.erase(addresses_.begin() + std::min(end, kept), addresses_.end());
     addresses_.erase(addresses_.begin(), addresses_.begin() + std::min(begin, kept));

@@ -100,7 +100,9 @@ Sampler::Sampler(std::shared_ptr<const CurveTree> tree, std::shared_ptr<const Su
   if (sequence.two_dimensional()) warp_ = std::make_unique<const TreeWarp>(*tree_);
 }
 
-CurveAddress Sampler::Warped(double a, double b) const { return warp_->Locate(a, b); }
+void Sampler::WarpMany(size_t n, const double* a, const double* b, CurveAddress* out) const {
+  warp_->LocateMany(n, a, b, out);
+}
 
 std::unique_ptr<SampleFiller> Sampler::NewFiller(const Region&, const SampleFields& fields) const {
   return std::make_unique<SurfaceFiller>(*this, fields);

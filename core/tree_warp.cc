@@ -234,28 +234,46 @@ TreeWarp::TreeWarp(const CurveTree& tree)
   }
 }
 
-CurveAddress TreeWarp::Locate(double a, double b) const {
-  a = std::clamp(a, 0.0, kBelowOne), b = std::clamp(b, 0.0, kBelowOne);
-  int32_t ref = root_;
-  int state = Curve::kRootState;
+void TreeWarp::LocateMany(size_t n, const double* a_in, const double* b_in,
+                          CurveAddress* out) const {
+  constexpr size_t kBatch = 64;
+  double a[kBatch], b[kBatch];
+  int32_t ref[kBatch];
+  uint8_t state[kBatch];
   const int g = grid_;
-  while (ref >= 0) {
-    const double* split = &splits_[ref * stride_];
-    const int dx = Pick(split, split + g, g, &a);
-    const double* rows = split + 2 * g + 2 * g * dx;
-    const int dy = Pick(rows, rows + g, g, &b);
-    const int at = dy * g + dx;
-    ref = children_[ref * arity_ + at];
-    state = state_at_[state * arity_ + at];
+  for (size_t i0 = 0; i0 < n; i0 += kBatch) {
+    const size_t m = std::min(kBatch, n - i0);
+    for (size_t i = 0; i < m; ++i) {
+      a[i] = std::clamp(a_in[i0 + i], 0.0, kBelowOne);
+      b[i] = std::clamp(b_in[i0 + i], 0.0, kBelowOne);
+      ref[i] = root_;
+      state[i] = Curve::kRootState;
+    }
+    // One level of every point still above its leaf per round.
+    for (bool descending = true; descending;) {
+      descending = false;
+      for (size_t i = 0; i < m; ++i) {
+        if (ref[i] < 0) continue;
+        const double* split = &splits_[ref[i] * stride_];
+        const int dx = Pick(split, split + g, g, &a[i]);
+        const double* rows = split + 2 * g + 2 * g * dx;
+        const int dy = Pick(rows, rows + g, g, &b[i]);
+        const int at = dy * g + dx;
+        ref[i] = children_[ref[i] * arity_ + at];
+        state[i] = state_at_[state[i] * arity_ + at];
+        descending |= ref[i] >= 0;
+      }
+    }
+    for (size_t i = 0; i < m; ++i) {
+      const size_t l = static_cast<size_t>(-ref[i] - 1);
+      double x, y;
+      PlaceInLeaf(l, a[i], b[i], &x, &y);
+      CurveAddress& address = out[i0 + i];
+      address.leaf = static_cast<uint32_t>(l);
+      address.digits = DigitsInLeaf(x, y, state[i]);
+      address.index = 0;
+    }
   }
-  const size_t l = static_cast<size_t>(-ref - 1);
-  double x, y;
-  PlaceInLeaf(l, a, b, &x, &y);
-  CurveAddress address;
-  address.leaf = static_cast<uint32_t>(l);
-  address.digits = DigitsInLeaf(x, y, state);
-  address.index = 0;
-  return address;
 }
 
 TreeWarp::Point TreeWarp::Place(const CurveAddress& at) const {

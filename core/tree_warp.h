@@ -52,7 +52,15 @@ class TreeWarp {
 
   // The address of the image of (a, b) in [0, 1]^2 (values outside are
   // clamped); index is left 0.
-  CurveAddress Locate(double a, double b) const;
+  CurveAddress Locate(double a, double b) const {
+    CurveAddress at;
+    LocateMany(1, &a, &b, &at);
+    return at;
+  }
+  // out[i] = Locate(a[i], b[i]) for i < n, bit for bit: the points descend
+  // the tree a level at a time together, so their chains of dependent loads
+  // overlap instead of following one another.
+  void LocateMany(size_t n, const double* a, const double* b, CurveAddress* out) const;
 
   struct Point {
     double u, v;            // unit-square parameters
