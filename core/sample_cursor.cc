@@ -149,7 +149,13 @@ absl::StatusOr<size_t> SampleCursor::NextRuns(size_t max, SampleBatch* batch) {
     if (use_addresses_) {
       if (order_pos_ >= addresses_.size()) break;
       const size_t n = std::min<size_t>(max - produced, addresses_.size() - order_pos_);
-      ASSIGN_OR_RETURN(kept, Generate(0, nullptr, n, batch, addresses_.data() + order_pos_));
+      const CurveAddress* at = addresses_.data() + order_pos_;
+      if (threads_ > 1 && region_.kind == Region::Kind::kAll && n >= kMinParallel) {
+        RETURN_IF_ERROR(GenerateParallel(0, n, batch, at));
+        kept = n;
+      } else {
+        ASSIGN_OR_RETURN(kept, Generate(0, nullptr, n, batch, at));
+      }
       order_pos_ += n;
     } else if (use_order_) {
       if (order_pos_ >= order_.size()) break;
@@ -251,7 +257,8 @@ absl::StatusOr<size_t> SampleCursor::Generate(uint64_t k0, const uint64_t* order
   return kept;
 }
 
-absl::Status SampleCursor::GenerateParallel(uint64_t k0, size_t n, SampleBatch* batch) {
+absl::Status SampleCursor::GenerateParallel(uint64_t k0, size_t n, SampleBatch* batch,
+                                            const CurveAddress* at) {
   // threads_ contiguous parts of the run, on the shared pool, each filling its
   // own rows of the grown columns; part 0 with the cursor's filler, the others
   // with their own. A sample is a pure function of k, so the bytes are the
@@ -263,11 +270,12 @@ absl::Status SampleCursor::GenerateParallel(uint64_t k0, size_t n, SampleBatch* 
   auto bound = [&](int i) { return n * i / parts; };
   WorkerPool::Shared().ParallelFor(parts, [&](int i) {
     const size_t begin = bound(i), count = bound(i + 1) - begin;
+    const CurveAddress* part_at = at != nullptr ? at + begin : nullptr;
     if (i == 0) {
-      status[i] = Fill(k0, nullptr, count, *filler_, out);
+      status[i] = Fill(k0, nullptr, count, *filler_, out, part_at);
     } else {
       const std::unique_ptr<SampleFiller> filler = samples_->NewFiller(region_, fields_);
-      status[i] = Fill(k0 + begin, nullptr, count, *filler, out.From(begin));
+      status[i] = Fill(k0 + begin, nullptr, count, *filler, out.From(begin), part_at);
     }
   });
   for (const absl::Status& st : status) {

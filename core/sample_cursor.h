@@ -30,8 +30,9 @@ class SampleCursor {
   // n = end - begin). Errors: INVALID_ARGUMENT for begin > end, end > count,
   // a region the kind rejects, or an empty region; RESOURCE_EXHAUSTED is not
   // raised here (the caller bounds count). `threads` > 1 lets Next() fill
-  // large batches of plain index ranges with that many threads of the shared
-  // pool (base/worker_pool.h); the samples and their order do not change.
+  // large batches of plain index ranges (and a two-dimensional sequence's
+  // warp, sort and batches) with that many threads of the shared pool
+  // (base/worker_pool.h); the samples and their order do not change.
   static absl::StatusOr<std::unique_ptr<SampleCursor>> Create(
       std::shared_ptr<const CurveSamples> samples, uint64_t begin, uint64_t end,
       const Region& region, const SampleFields& fields, int threads = 1);
@@ -59,8 +60,10 @@ class SampleCursor {
   // in the region; returns how many.
   absl::StatusOr<size_t> Generate(uint64_t k0, const uint64_t* order, size_t n,
                                   SampleBatch* batch, const CurveAddress* at = nullptr);
-  // Appends [k0, k0 + n) (all kept: no region), split over threads_ threads.
-  absl::Status GenerateParallel(uint64_t k0, size_t n, SampleBatch* batch);
+  // Appends [k0, k0 + n) (or the samples at at[i], i < n), all kept (no
+  // region), split over threads_ threads.
+  absl::Status GenerateParallel(uint64_t k0, size_t n, SampleBatch* batch,
+                                const CurveAddress* at = nullptr);
 
   const std::shared_ptr<const CurveSamples> samples_;
   const Region region_;

@@ -41,12 +41,7 @@ absl::Status SurfaceFiller::Fill(size_t n, const SampleRows& out) {
 
 absl::Status SurfaceFiller::FillAddressed(size_t n, const CurveAddress* at,
                                           const SampleRows& out) {
-  const TreeWarp& warp = *sampler_.warp();
-  for (size_t i = 0; i < n; ++i) {
-    const TreeWarp::Point p = warp.Place(at[i]);
-    out.u[i] = p.u, out.v[i] = p.v;
-    if (out.curve_position != nullptr) out.curve_position[i] = p.curve_position;
-  }
+  sampler_.warp()->PlaceMany(n, at, out.u, out.v, out.curve_position);
   return Evaluate(n, out);
 }
 

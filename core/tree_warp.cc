@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 
 #include "core/leaf_model.h"
@@ -276,23 +277,39 @@ void TreeWarp::LocateMany(size_t n, const double* a_in, const double* b_in,
   }
 }
 
-TreeWarp::Point TreeWarp::Place(const CurveAddress& at) const {
-  const CurveTree::Cell cell = tree_.LeafCell(at.leaf);
+void TreeWarp::PlaceMany(size_t n, const CurveAddress* at, double* u, double* v,
+                         double* curve_position) const {
+  constexpr size_t kBatch = 64;
+  uint64_t digits[kBatch], states[kBatch], cx[kBatch], cy[kBatch];
   const int levels = curve_.continuation_levels();
-  uint64_t cx, cy;
-  int state = cell.state;
-  curve_.Descend(at.digits, levels, &cx, &cy, &state);
-  // The centre of the sub-cell, as LeafWalk::Continue computes it.
   const double cells = curve_.PowG(levels);
-  const double side = cell.size / cells;
-  Point p;
-  p.u = cell.u0 + (static_cast<double>(cx) + 0.5) * side;
-  p.v = cell.v0 + (static_cast<double>(cy) + 0.5) * side;
-  const double start = static_cast<double>(tree_.leaf_start(at.leaf));
-  const double span = static_cast<double>(tree_.leaf_end(at.leaf) - tree_.leaf_start(at.leaf));
-  const double fraction = static_cast<double>(at.digits) / static_cast<double>(curve_.PowW(levels));
-  p.curve_position = (start + fraction * span) / static_cast<double>(curve_.Span(0));
-  return p;
+  const double digit_span = static_cast<double>(curve_.PowW(levels));
+  const double curve_span = static_cast<double>(curve_.Span(0));
+  double u0[kBatch], v0[kBatch], side[kBatch];
+  size_t leaf = SIZE_MAX;  // the leaf whose cell is decoded
+  CurveTree::Cell cell{};
+  for (size_t i0 = 0; i0 < n; i0 += kBatch) {
+    const size_t m = std::min(kBatch, n - i0);
+    for (size_t i = 0; i < m; ++i) {
+      if (at[i0 + i].leaf != leaf) leaf = at[i0 + i].leaf, cell = tree_.LeafCell(leaf);
+      u0[i] = cell.u0, v0[i] = cell.v0;
+      side[i] = cell.size / cells;
+      digits[i] = at[i0 + i].digits;
+      states[i] = static_cast<uint64_t>(cell.state);
+    }
+    curve_.DescendMany(digits, levels, m, states, cx, cy);
+    for (size_t i = 0; i < m; ++i) {
+      // The centre of the sub-cell, as LeafWalk::Continue computes it.
+      u[i0 + i] = u0[i] + (static_cast<double>(cx[i]) + 0.5) * side[i];
+      v[i0 + i] = v0[i] + (static_cast<double>(cy[i]) + 0.5) * side[i];
+      if (curve_position == nullptr) continue;
+      const size_t l = at[i0 + i].leaf;
+      const double start = static_cast<double>(tree_.leaf_start(l));
+      const double span = static_cast<double>(tree_.leaf_end(l) - tree_.leaf_start(l));
+      const double fraction = static_cast<double>(digits[i]) / digit_span;
+      curve_position[i0 + i] = (start + fraction * span) / curve_span;
+    }
+  }
 }
 
 void TreeWarp::PlaceInLeaf(size_t l, double a, double b, double* x, double* y) const {

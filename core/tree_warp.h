@@ -67,7 +67,17 @@ class TreeWarp {
     double curve_position;  // in [0, 1), as LeafWalk's
   };
   // The sample at `at`. REQUIRES: an address Locate gave.
-  Point Place(const CurveAddress& at) const;
+  Point Place(const CurveAddress& at) const {
+    Point p;
+    PlaceMany(1, &at, &p.u, &p.v, &p.curve_position);
+    return p;
+  }
+  // Place(at[i]) into u[i], v[i] and curve_position[i] (when not null), i <
+  // n, bit for bit: a run of addresses in one leaf (a sorted set's) decodes
+  // the leaf's cell once, and the digits are decoded as a batch
+  // (Curve::DescendMany).
+  void PlaceMany(size_t n, const CurveAddress* at, double* u, double* v,
+                 double* curve_position) const;
   // Place(Locate(a, b)).
   Point Map(double a, double b) const { return Place(Locate(a, b)); }
 
