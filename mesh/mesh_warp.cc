@@ -1,8 +1,10 @@
 #include "mesh/mesh_warp.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstring>
+#include <vector>
 
 namespace sfc {
 namespace {
@@ -14,12 +16,44 @@ constexpr double kBelowOne = 1.0 - 0x1.0p-53;
 constexpr int kExtraDepth = 12;
 // At most 26 halvings of each coordinate, far below the net's 2^-32.
 constexpr int kMaxDepth = 52;
+// The buckets that start the search for a leaf: 2^(depth + 1) nodes of the
+// depth at which nodes hold one leaf on average, at most 2^20 (8 MB).
+constexpr int kMaxBucketBits = 20;
 
-// Halves *c at 1/2: the side it falls on, *c rescaled to it (exact).
-int Halve(double* c) {
-  const int side = *c < 0.5 ? 0 : 1;
-  *c = 2 * *c - side;
-  return side;
+// 2^k, for |k| <= 62, exactly.
+double Pow2(int k) {
+  return k >= 0 ? static_cast<double>(uint64_t{1} << k)
+                : 1.0 / static_cast<double>(uint64_t{1} << -k);
+}
+
+// Bit i of x at bit 2i, for x < 2^32.
+uint64_t Spread(uint64_t x) {
+  x = (x | x << 16) & 0x0000ffff0000ffffULL;
+  x = (x | x << 8) & 0x00ff00ff00ff00ffULL;
+  x = (x | x << 4) & 0x0f0f0f0f0f0f0f0fULL;
+  x = (x | x << 2) & 0x3333333333333333ULL;
+  return (x | x << 1) & 0x5555555555555555ULL;
+}
+
+// The first i < n with e[i] > x (FirstAbove) or e[i] >= x (FirstAtOrAbove),
+// n if none, in a sorted e: std::upper_bound's and std::lower_bound's answer
+// by a search whose steps are selects, not branches.
+template <typename Before>
+size_t FirstNotBefore(const double* e, size_t n, double x, const Before& before) {
+  if (n == 0) return 0;
+  const double* base = e;
+  for (size_t len = n; len > 1;) {
+    const size_t half = len / 2;
+    base = before(base[half - 1], x) ? base + half : base;
+    len -= half;
+  }
+  return static_cast<size_t>(base - e) + (before(*base, x) ? 1 : 0);
+}
+size_t FirstAbove(const double* e, size_t n, double x) {
+  return FirstNotBefore(e, n, x, [](double v, double y) { return v <= y; });
+}
+size_t FirstAtOrAbove(const double* e, size_t n, double x) {
+  return FirstNotBefore(e, n, x, [](double v, double y) { return v < y; });
 }
 
 // The u in [0, 1] where the mass of a density linear on [0, 1], from d0 at 0
@@ -97,42 +131,86 @@ MeshWarp::MeshWarp(const MeshCurveTree& tree) : tree_(tree) {
   int depth = 0;
   while (depth < 40 && (size_t{1} << depth) < tree.leaf_count()) ++depth;
   max_depth_ = std::min(depth + kExtraDepth, kMaxDepth);
+  // Leaves are numbered by 32 bits (CurveAddress::leaf): nodes are never
+  // narrower than 2^-44, which LocateInLeaf's search needs.
+  assert(max_depth_ <= 44);
+  // The buckets: node j of depth bucket_bits_ meets leaves FirstAbove(its
+  // begin) .. FirstAtOrAbove(its end), and every node inside it a sub-range.
+  // Two pointers walk the leaves once.
+  bucket_bits_ = std::min(max_depth_, std::min(depth + 1, kMaxBucketBits));
+  const size_t buckets = size_t{1} << bucket_bits_;
+  const auto& ends = tree.mass_ends();
+  const double total = tree.total_mass();
+  bucket_leaves_.resize(2 * buckets);
+  size_t first = 0, last = 0;
+  for (size_t j = 0; j < buckets; ++j) {
+    const double begin = std::ldexp(static_cast<double>(j), -bucket_bits_) * total;
+    const double end = std::ldexp(static_cast<double>(j + 1), -bucket_bits_) * total;
+    while (first < ends.size() && ends[first] <= begin) ++first;
+    while (last < ends.size() && ends[last] < end) ++last;
+    bucket_leaves_[2 * j] = static_cast<uint32_t>(first);
+    bucket_leaves_[2 * j + 1] = static_cast<uint32_t>(last);
+  }
 }
 
 void MeshWarp::LocateInLeaf(double a, double b, size_t* leaf, double* pa, double* pb) const {
   double c[2] = {std::clamp(a, 0.0, kBelowOne), std::clamp(b, 0.0, kBelowOne)};
   const auto& ends = tree_.mass_ends();
   const double total = tree_.total_mass();
-  // The node is the mass interval [t0, t0 + w) x total; the leaves that meet
-  // it are lo..hi (the leaves holding its first and last mass).
-  double t0 = 0, w = 1;
-  auto leaf_at = [&](double t, size_t from, size_t to) {
-    // The first leaf in [from, to] whose end passes t x total.
-    return static_cast<size_t>(std::upper_bound(ends.begin() + from, ends.begin() + to, t * total) -
-                               ends.begin());
+  // The node is the mass interval [t0, t0 + w) x total. Dyadic halves of the
+  // square hold equal masses: their line is a line of the net's elementary
+  // intervals, which every scrambled (0, m, 2)-net fills exactly, whatever
+  // the integrand does across it. The node at depth d holds the point whose
+  // top bits, the first coordinate's at even depths and the second's at odd
+  // ones, interleaved, are the top d bits of t0 (and c is what is left of
+  // each coordinate below them). The leaves that meet a node are lo..hi, the
+  // leaves holding its first and last mass: lo the first leaf ending above
+  // t0 x total, hi the first ending at or above (t0 + w) x total; both move
+  // inward as nodes nest (their ends differ by far more than their rounding:
+  // w >= 2^-44). The halving stops at the first node inside one leaf, or at
+  // the depth cap: the leaves of the node at the cap are found first, then
+  // the depth where the node's lo and hi first meet, by bisection.
+  const int bits_a = (max_depth_ + 1) / 2, bits_b = max_depth_ / 2;
+  const uint64_t top_a = Spread(static_cast<uint64_t>(c[0] * Pow2(bits_a)));
+  const uint64_t top_b = Spread(static_cast<uint64_t>(c[1] * Pow2(bits_b)));
+  const uint64_t cap_node = max_depth_ % 2 == 0 ? top_a << 1 | top_b : top_a | top_b << 1;
+  // The node of depth d: t0, and t0 + w (exact dyadic values).
+  auto begin_at = [&](int d) {
+    return static_cast<double>(cap_node >> (max_depth_ - d)) * Pow2(-d);
   };
-  const size_t last = ends.size() - 1;
-  size_t lo = leaf_at(0, 0, last), hi = last;
-  while (hi > 0 && !(ends[hi] > tree_.mass_begin(hi))) --hi;  // the last leaf with mass
-  int axis = 0, depth = 0;
-  for (; lo < hi && depth < max_depth_; ++depth) {
-    // Dyadic halves of the square hold equal masses: their line is a line of
-    // the net's elementary intervals, which every scrambled (0, m, 2)-net
-    // fills exactly, whatever the integrand does across it.
-    w *= 0.5;
-    const double m = (t0 + w) * total;
-    if (Halve(&c[axis]) == 0) {  // the last leaf holding mass below m
-      hi = static_cast<size_t>(std::lower_bound(ends.begin() + lo, ends.begin() + hi, m) -
-                               ends.begin());
-    } else {  // the first leaf holding mass above m
-      t0 += w, lo = leaf_at(t0, lo, hi);
+  auto end_at = [&](int d) {
+    return static_cast<double>((cap_node >> (max_depth_ - d)) + 1) * Pow2(-d);
+  };
+  // Both lie among the leaves that meet the cap node's bucket.
+  const size_t bucket = static_cast<size_t>(cap_node >> (max_depth_ - bucket_bits_));
+  const size_t from = bucket_leaves_[2 * bucket], to = bucket_leaves_[2 * bucket + 1] + size_t{1};
+  size_t lo = from + FirstAbove(ends.data() + from, to - from, begin_at(max_depth_) * total);
+  size_t hi = from + FirstAtOrAbove(ends.data() + from, to - from, end_at(max_depth_) * total);
+  int depth = max_depth_;
+  if (lo == hi) {
+    // The first depth whose node holds mass of leaf lo alone: t0 x total >=
+    // lo's begin and (t0 + w) x total <= lo's end, false and then true.
+    const double lo_begin = tree_.mass_begin(lo), lo_end = ends[lo];
+    int shallow = 0;
+    while (shallow < depth) {
+      const int mid = (shallow + depth) / 2;
+      if (begin_at(mid) * total >= lo_begin && end_at(mid) * total <= lo_end) {
+        depth = mid;
+      } else {
+        shallow = mid + 1;
+      }
     }
-    axis ^= 1;
   }
+  // What is left of each coordinate below the node's bits (exact).
+  const double scaled_a = c[0] * Pow2((depth + 1) / 2), scaled_b = c[1] * Pow2(depth / 2);
+  c[0] = scaled_a - std::floor(scaled_a), c[1] = scaled_b - std::floor(scaled_b);
+  const int axis = depth % 2;
+  double t0 = begin_at(depth), w = Pow2(-depth);
   if (lo < hi) {
     // Still across leaves at the depth cap: the coordinate picks the mass.
     const double t = t0 + c[axis] * w;
-    const size_t l = leaf_at(t, lo, hi);
+    const size_t l = static_cast<size_t>(
+        std::upper_bound(ends.begin() + lo, ends.begin() + hi, t * total) - ends.begin());
     const double begin = std::max(t0 * total, tree_.mass_begin(l));
     const double end = std::min((t0 + w) * total, ends[l]);
     c[axis] = end > begin ? std::clamp((t * total - begin) / (end - begin), 0.0, kBelowOne) : 0.0;

@@ -32,6 +32,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "core/curve_samples.h"
 #include "core/vector_math.h"
@@ -41,7 +42,8 @@ namespace sfc {
 
 class MeshWarp {
  public:
-  // O(1). REQUIRES: `tree` outlives the warp.
+  // O(leaves) time and at most 32 bytes a leaf (and 8 MB). REQUIRES: `tree`
+  // outlives the warp.
   explicit MeshWarp(const MeshCurveTree& tree);
 
   // The address of the image of (a, b) in [0, 1]^2 (clamped); index 0.
@@ -67,6 +69,10 @@ class MeshWarp {
 
   const MeshCurveTree& tree_;
   int max_depth_ = 0;  // halvings before a node across leaves is split by mass
+  // Node j of depth bucket_bits_ meets leaves bucket_leaves_[2j] ..
+  // bucket_leaves_[2j + 1]: where the search for a node's leaves starts.
+  int bucket_bits_ = 0;
+  std::vector<uint32_t> bucket_leaves_;
 };
 
 }  // namespace sfc
