@@ -71,22 +71,36 @@ constexpr int kBlockLevels = 4;
 
 }  // namespace
 
-// Bit (2^i - 1 + prefix) of flips[dim] is the flip of level i < kTableLevels.
+// top[dim][t] holds the flips of the levels i < kTableLevels (bit 31 - i for
+// level i, as NestedScramble xors them) of the coordinate whose top
+// kTableLevels bits are t: one look-up for the table's levels.
 struct OwenFlips {
   uint64_t key[2];
-  uint64_t flips[2][(1 << kTableLevels) / 64];
+  uint32_t top[2][1 << kTableLevels];
 };
 
 std::shared_ptr<const OwenFlips> Sequence::MakeOwenFlips(uint64_t seed) {
   auto t = std::make_shared<OwenFlips>();
   for (int dim = 0; dim < 2; ++dim) {
     t->key[dim] = SobolKey(seed, dim);
-    std::fill(std::begin(t->flips[dim]), std::end(t->flips[dim]), 0);
+    // Bit (2^i - 1 + prefix) of `flips` is the flip of level i, prefix its
+    // i bits above it.
+    uint64_t flips[(1 << kTableLevels) / 64] = {};
     for (int i = 0; i < kTableLevels; ++i) {
       for (uint64_t prefix = 0; prefix < (uint64_t{1} << i); ++prefix) {
         const uint64_t bit = (uint64_t{1} << i) - 1 + prefix;
-        t->flips[dim][bit / 64] |= uint64_t{SobolFlip(t->key[dim], prefix, i)} << (bit % 64);
+        flips[bit / 64] |= uint64_t{SobolFlip(t->key[dim], prefix, i)} << (bit % 64);
       }
+    }
+    for (uint32_t top = 0; top < (1u << kTableLevels); ++top) {
+      const uint32_t r = top << (32 - kTableLevels);
+      uint32_t mask = 0;
+      for (int i = 0; i < kTableLevels; ++i) {
+        const uint64_t prefix = i == 0 ? 0 : r >> (32 - i);
+        const uint64_t bit = (uint64_t{1} << i) - 1 + prefix;
+        mask |= static_cast<uint32_t>((flips[bit / 64] >> (bit % 64)) & 1) << (31 - i);
+      }
+      t->top[dim][top] = mask;
     }
   }
   return t;
@@ -103,12 +117,7 @@ namespace {
 // the all-zero tail would make them.
 double NestedScramble(uint32_t r, uint64_t k, uint64_t seed, int dim, const OwenFlips& table) {
   // The flips of all 32 levels as one mask, then one xor.
-  uint32_t flips = 0;
-  for (int i = 0; i < kTableLevels; ++i) {
-    const uint64_t prefix = i == 0 ? 0 : r >> (32 - i);
-    const uint64_t bit = (uint64_t{1} << i) - 1 + prefix;
-    flips |= static_cast<uint32_t>((table.flips[dim][bit / 64] >> (bit % 64)) & 1) << (31 - i);
-  }
+  uint32_t flips = table.top[dim][r >> (32 - kTableLevels)];
   for (int root = kTableLevels; root < 32; root += kBlockLevels) {
     const uint64_t block = BlockHash(table.key[dim], r >> (32 - root), root);
     for (int depth = 0; depth < kBlockLevels; ++depth) {

@@ -235,13 +235,32 @@ TreeWarp::TreeWarp(const CurveTree& tree)
   }
 }
 
+template <int G>
+void TreeWarp::Descend(size_t m, double* a, double* b, int32_t* ref, uint8_t* state) const {
+  // One level of every point still above its leaf per round.
+  constexpr int kArity = G * G, kStride = 2 * (G + G * G);
+  for (bool descending = true; descending;) {
+    descending = false;
+    for (size_t i = 0; i < m; ++i) {
+      if (ref[i] < 0) continue;
+      const double* split = &splits_[ref[i] * kStride];
+      const int dx = Pick(split, split + G, G, &a[i]);
+      const double* rows = split + 2 * G + 2 * G * dx;
+      const int dy = Pick(rows, rows + G, G, &b[i]);
+      const int at = dy * G + dx;
+      ref[i] = children_[ref[i] * kArity + at];
+      state[i] = state_at_[state[i] * kArity + at];
+      descending |= ref[i] >= 0;
+    }
+  }
+}
+
 void TreeWarp::LocateMany(size_t n, const double* a_in, const double* b_in,
                           CurveAddress* out) const {
   constexpr size_t kBatch = 64;
   double a[kBatch], b[kBatch];
   int32_t ref[kBatch];
   uint8_t state[kBatch];
-  const int g = grid_;
   for (size_t i0 = 0; i0 < n; i0 += kBatch) {
     const size_t m = std::min(kBatch, n - i0);
     for (size_t i = 0; i < m; ++i) {
@@ -250,20 +269,10 @@ void TreeWarp::LocateMany(size_t n, const double* a_in, const double* b_in,
       ref[i] = root_;
       state[i] = Curve::kRootState;
     }
-    // One level of every point still above its leaf per round.
-    for (bool descending = true; descending;) {
-      descending = false;
-      for (size_t i = 0; i < m; ++i) {
-        if (ref[i] < 0) continue;
-        const double* split = &splits_[ref[i] * stride_];
-        const int dx = Pick(split, split + g, g, &a[i]);
-        const double* rows = split + 2 * g + 2 * g * dx;
-        const int dy = Pick(rows, rows + g, g, &b[i]);
-        const int at = dy * g + dx;
-        ref[i] = children_[ref[i] * arity_ + at];
-        state[i] = state_at_[state[i] * arity_ + at];
-        descending |= ref[i] >= 0;
-      }
+    if (grid_ == 2) {
+      Descend<2>(m, a, b, ref, state);
+    } else {
+      Descend<3>(m, a, b, ref, state);
     }
     for (size_t i = 0; i < m; ++i) {
       const size_t l = static_cast<size_t>(-ref[i] - 1);

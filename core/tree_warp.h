@@ -82,6 +82,11 @@ class TreeWarp {
   Point Map(double a, double b) const { return Place(Locate(a, b)); }
 
  private:
+  // Moves each of m points from node ref[i] (orientation state[i]) down to
+  // its leaf, rescaling a[i] and b[i] at each level; ref[i] becomes -leaf -
+  // 1. G is the curve's grid.
+  template <int G>
+  void Descend(size_t m, double* a, double* b, int32_t* ref, uint8_t* state) const;
   // Places (a, b) inside leaf l, in the leaf's unit coordinates.
   void PlaceInLeaf(size_t l, double a, double b, double* x, double* y) const;
   // The digits of the leaf's curve, continuation_levels() deep, of the
