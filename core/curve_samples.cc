@@ -24,7 +24,7 @@ absl::Status CurveSamples::AcceptsSequence(const Sequence& sequence) const {
                       SequenceName(sequence.kind())));
 }
 
-void CurveSamples::AddressesOf(const uint64_t* ks, uint64_t k0, size_t n, CurveAddress* out) const {
+void CurveSamples::AddressesOf(const uint32_t* ks, uint64_t k0, size_t n, CurveAddress* out) const {
   // A batch's points first, then one call of the kind's warp for them.
   constexpr size_t kBatch = 256;
   double a[kBatch], b[kBatch];

@@ -98,7 +98,7 @@ class CurveSamples {
   // sample's point of the unit square (Sequence::At, Second) through the
   // kind's warp (WarpMany, a batch at a time), by which the cursor sorts the
   // whole set and the filler places it. A pure function of each k.
-  void AddressesOf(const uint64_t* ks, uint64_t k0, size_t n, CurveAddress* out) const;
+  void AddressesOf(const uint32_t* ks, uint64_t k0, size_t n, CurveAddress* out) const;
   // OK when the kind can place `sequence`'s samples; INVALID_ARGUMENT with
   // the reason otherwise (a kind without a warp for two-dimensional ones).
   virtual absl::Status AcceptsSequence(const Sequence& sequence) const;

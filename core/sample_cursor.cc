@@ -63,7 +63,8 @@ SampleCursor::SampleCursor(std::shared_ptr<const CurveSamples> samples, Region r
 
 absl::StatusOr<std::unique_ptr<SampleCursor>> SampleCursor::Create(
     std::shared_ptr<const CurveSamples> samples, uint64_t begin, uint64_t end,
-    const Region& region, const SampleFields& fields, int threads) {
+    const Region& region, const SampleFields& fields, int threads,
+    const std::vector<uint32_t>* in_window) {
   const uint64_t count = samples->sequence().count();
   if (begin > end || end > count) {
     return absl::InvalidArgumentError(absl::StrFormat(
@@ -76,11 +77,12 @@ absl::StatusOr<std::unique_ptr<SampleCursor>> SampleCursor::Create(
   RETURN_IF_ERROR(region.Validate());
   auto cursor = std::unique_ptr<SampleCursor>(new SampleCursor(std::move(samples), region, fields));
   cursor->threads_ = std::max(1, threads);
-  RETURN_IF_ERROR(cursor->Plan(begin, end));
+  RETURN_IF_ERROR(cursor->Plan(begin, end, in_window));
   return cursor;
 }
 
-absl::Status SampleCursor::Plan(uint64_t begin, uint64_t end) {
+absl::Status SampleCursor::Plan(uint64_t begin, uint64_t end,
+                                const std::vector<uint32_t>* in_window) {
   const CurveSamples& samples = *samples_;
   if (samples.sequence().two_dimensional()) {
     // Points warped onto the surface: the whole set in curve order, of which
@@ -91,19 +93,20 @@ absl::Status SampleCursor::Plan(uint64_t begin, uint64_t end) {
     // A window's samples (a CAD face's) are found first, so only they are
     // warped and sorted: one face's cursor costs its own share of the set,
     // not the whole set's warp and sort.
-    std::vector<uint64_t> in_window;
-    if (sequence.windowed()) {
+    std::vector<uint32_t> found;
+    if (sequence.windowed() && in_window == nullptr) {
       for (uint64_t k = 0; k < count; ++k) {
-        if (sequence.InWindow(k)) in_window.push_back(k);
+        if (sequence.InWindow(k)) found.push_back(static_cast<uint32_t>(k));
       }
+      in_window = &found;
     }
-    const uint64_t m = sequence.windowed() ? in_window.size() : count;
+    const uint32_t* ks = sequence.windowed() ? in_window->data() : nullptr;
+    const uint64_t m = sequence.windowed() ? in_window->size() : count;
     addresses_.resize(m);
     const int parts = m >= 8192 ? threads_ : 1;
     WorkerPool::Shared().ParallelFor(parts, [&](int i) {
       const uint64_t j0 = m * i / parts, j1 = m * (i + 1) / parts;
-      samples.AddressesOf(sequence.windowed() ? in_window.data() + j0 : nullptr, j0, j1 - j0,
-                          addresses_.data() + j0);
+      samples.AddressesOf(ks != nullptr ? ks + j0 : nullptr, j0, j1 - j0, addresses_.data() + j0);
     });
     SortAddresses(&addresses_, parts);
     const uint64_t kept = addresses_.size();
