@@ -30,10 +30,7 @@ void CurveSamples::AddressesOf(const uint32_t* ks, uint64_t k0, size_t n, CurveA
   double a[kBatch], b[kBatch];
   for (size_t i0 = 0; i0 < n; i0 += kBatch) {
     const size_t m = std::min(kBatch, n - i0);
-    for (size_t i = 0; i < m; ++i) {
-      const uint64_t k = ks != nullptr ? ks[i0 + i] : k0 + i0 + i;
-      a[i] = sequence_.At(k), b[i] = sequence_.Second(k);
-    }
+    sequence_.PointsMany(ks != nullptr ? ks + i0 : nullptr, k0 + i0, m, a, b);
     WarpMany(m, a, b, out + i0);
     for (size_t i = 0; i < m; ++i) {
       out[i0 + i].index = static_cast<uint32_t>(ks != nullptr ? ks[i0 + i] : k0 + i0 + i);

@@ -41,12 +41,29 @@ double OwenScrambledRadicalInverse(uint64_t k, uint64_t seed) {
 // (v_{i-1} >> 1). With the base-2 radical inverse as the first dimension it
 // is a (0,2)-sequence: every 2^m-prefix is a (0,m,2)-net (Sobol 1967; Niederreiter
 // 1992, Sect. 4.5).
-uint32_t SobolSecond(uint32_t k) {
-  uint32_t out = 0, v = 0x80000000u;
-  for (; k != 0; k >>= 1, v ^= v >> 1) {
-    if (k & 1) out ^= v;
+// It is linear in k's bits (an xor of v_i over the bits set), so four tables
+// of 256 entries, one a byte of k, give it in four look-ups.
+struct SobolSecondTables {
+  uint32_t byte[4][256];
+  SobolSecondTables() {
+    uint32_t v[32];
+    v[0] = 0x80000000u;
+    for (int i = 1; i < 32; ++i) v[i] = v[i - 1] ^ (v[i - 1] >> 1);
+    for (int b = 0; b < 4; ++b) {
+      for (uint32_t x = 0; x < 256; ++x) {
+        uint32_t out = 0;
+        for (int i = 0; i < 8; ++i) {
+          if (x >> i & 1) out ^= v[8 * b + i];
+        }
+        byte[b][x] = out;
+      }
+    }
   }
-  return out;
+};
+uint32_t SobolSecond(uint32_t k) {
+  static const SobolSecondTables tables;
+  return tables.byte[0][k & 255] ^ tables.byte[1][k >> 8 & 255] ^ tables.byte[2][k >> 16 & 255] ^
+         tables.byte[3][k >> 24];
 }
 
 // The flip of bit i (from the top) of the sobol coordinate `dim`, whose i
@@ -76,6 +93,7 @@ constexpr int kBlockLevels = 4;
 // kTableLevels bits are t: one look-up for the table's levels.
 struct OwenFlips {
   uint64_t key[2];
+  uint64_t tail_key[2];  // CounterKey(seed, kSobolTail[dim])
   uint32_t top[2][1 << kTableLevels];
 };
 
@@ -83,6 +101,7 @@ std::shared_ptr<const OwenFlips> Sequence::MakeOwenFlips(uint64_t seed) {
   auto t = std::make_shared<OwenFlips>();
   for (int dim = 0; dim < 2; ++dim) {
     t->key[dim] = SobolKey(seed, dim);
+    t->tail_key[dim] = CounterKey(seed, hash_stream::kSobolTail[dim]);
     // Bit (2^i - 1 + prefix) of `flips` is the flip of level i, prefix its
     // i bits above it.
     uint64_t flips[(1 << kTableLevels) / 64] = {};
@@ -114,8 +133,9 @@ namespace {
 // every 2^m-prefix of the sequence stays a (0,m,2)-net. The top levels' bits
 // come from the sequence's table, the others a block of levels per hash. The
 // bits below 2^-32 are uniform random bits of (seed, k), as a full scramble of
-// the all-zero tail would make them.
-double NestedScramble(uint32_t r, uint64_t k, uint64_t seed, int dim, const OwenFlips& table) {
+// the all-zero tail would make them (CounterUniform(seed, kSobolTail[dim], k),
+// from k's CounterMix, which both coordinates share).
+double NestedScramble(uint32_t r, uint64_t k_mix, int dim, const OwenFlips& table) {
   // The flips of all 32 levels as one mask, then one xor.
   uint32_t flips = table.top[dim][r >> (32 - kTableLevels)];
   for (int root = kTableLevels; root < 32; root += kBlockLevels) {
@@ -127,7 +147,7 @@ double NestedScramble(uint32_t r, uint64_t k, uint64_t seed, int dim, const Owen
                << (31 - i);
     }
   }
-  const double tail = CounterUniform(seed, hash_stream::kSobolTail[dim], k);
+  const double tail = UniformOf(KeyedHash(table.tail_key[dim], k_mix));
   return ((r ^ flips) + tail) * 0x1.0p-32;
 }
 
@@ -150,13 +170,27 @@ double Sequence::Raw(uint64_t k) const {
       assert(table_ != nullptr && "a blue sequence is made by Sequence::FromTable");
       return (*table_)[k];
     case SequenceKind::kSobol:
-      return NestedScramble(ReverseBits32(static_cast<uint32_t>(k)), k, seed_, 0, *flips_);
+      return NestedScramble(ReverseBits32(static_cast<uint32_t>(k)), CounterMix(k), 0, *flips_);
   }
   return 0;
 }
 
 double Sequence::Second(uint64_t k) const {
-  return NestedScramble(SobolSecond(static_cast<uint32_t>(k)), k, seed_, 1, *flips_);
+  return NestedScramble(SobolSecond(static_cast<uint32_t>(k)), CounterMix(k), 1, *flips_);
+}
+
+void Sequence::PointsMany(const uint32_t* ks, uint64_t k0, size_t n, double* a,
+                          double* b) const {
+  assert(kind_ == SequenceKind::kSobol);
+  for (size_t i = 0; i < n; ++i) {
+    const uint64_t k = ks != nullptr ? ks[i] : k0 + i;
+    const uint64_t k_mix = CounterMix(k);
+    a[i] = NestedScramble(ReverseBits32(static_cast<uint32_t>(k)), k_mix, 0, *flips_);
+    b[i] = NestedScramble(SobolSecond(static_cast<uint32_t>(k)), k_mix, 1, *flips_);
+  }
+  if (windowed_) {
+    for (size_t i = 0; i < n; ++i) a[i] = (a[i] - lo_) / (hi_ - lo_);
+  }
 }
 
 void Sequence::AtMany(uint64_t k0, size_t n, double* out) const {

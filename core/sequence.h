@@ -84,6 +84,10 @@ class Sequence {
   // Owen-scrambled (radical inverse of k, Sobol's second dimension of k): a
   // pure function of (seed, k), not of count. REQUIRES: k < 2^32.
   double Second(uint64_t k) const;
+  // a[i] = At(k), b[i] = Second(k) of k = ks[i] (k0 + i when ks is null), i <
+  // n, bit for bit, in one call (the two coordinates share k's hashing).
+  // REQUIRES: kSobol.
+  void PointsMany(const uint32_t* ks, uint64_t k0, size_t n, double* a, double* b) const;
   bool two_dimensional() const { return SequenceIsTwoDimensional(kind_); }
 
  private:
