@@ -279,16 +279,19 @@ void TreeWarp::LocateMany(size_t n, const double* a_in, const double* b_in,
     for (size_t i = 0; i < std::min(m, kAhead); ++i) {
       __builtin_prefetch(&tree_.leaf_model(static_cast<size_t>(-ref[i] - 1)));
     }
+    double x[kBatch], y[kBatch];
+    uint64_t digits[kBatch];
     for (size_t i = 0; i < m; ++i) {
       if (i + kAhead < m) {
         __builtin_prefetch(&tree_.leaf_model(static_cast<size_t>(-ref[i + kAhead] - 1)));
       }
-      const size_t l = static_cast<size_t>(-ref[i] - 1);
-      double x, y;
-      PlaceInLeaf(l, a[i], b[i], &x, &y);
+      PlaceInLeaf(static_cast<size_t>(-ref[i] - 1), a[i], b[i], &x[i], &y[i]);
+    }
+    DigitsInLeaf(m, x, y, state, digits);
+    for (size_t i = 0; i < m; ++i) {
       CurveAddress& address = out[i0 + i];
-      address.leaf = static_cast<uint32_t>(l);
-      address.digits = DigitsInLeaf(x, y, state[i]);
+      address.leaf = static_cast<uint32_t>(-ref[i] - 1);
+      address.digits = digits[i];
       address.index = 0;
     }
   }
@@ -368,47 +371,61 @@ void TreeWarp::PlaceInLeaf(size_t l, double a, double b, double* x, double* y) c
   }
 }
 
-uint64_t TreeWarp::DigitsInLeaf(double x, double y, int state) const {
+void TreeWarp::DigitsInLeaf(size_t m, const double* x, const double* y, const uint8_t* state,
+                            uint64_t* digits) const {
   // The sub-cell's column and row among g^levels, then their base-g digits
-  // a chunk at a time, from the top.
+  // a chunk at a time, from the top; each level over all m points before the
+  // next, so the points' chains of table look-ups overlap.
+  constexpr size_t kMax = 64;
+  assert(m <= kMax);
   const int levels = curve_.continuation_levels();
   const double cells = curve_.PowG(levels);
   const uint64_t top = static_cast<uint64_t>(cells) - 1;
-  uint64_t cx = std::min(static_cast<uint64_t>(std::max(0.0, x) * cells), top);
-  uint64_t cy = std::min(static_cast<uint64_t>(std::max(0.0, y) * cells), top);
   const int chunks = levels / chunk_levels_, head = levels % chunk_levels_;
-  // Chunk values of cx and cy, least significant first (constant divisors:
-  // 16 for Hilbert, 9 for the 3x3 curves).
-  uint32_t xs[32], ys[32];
-  if (grid_ == 2) {
-    for (int c = 0; c < chunks; ++c) {
-      xs[c] = static_cast<uint32_t>(cx & 15), cx >>= 4;
-      ys[c] = static_cast<uint32_t>(cy & 15), cy >>= 4;
+  // Chunk values of each point's column and row, least significant first
+  // (constant divisors: 16 for Hilbert, 9 for the 3x3 curves); what is left
+  // are the leading levels.
+  uint8_t xs[32][kMax], ys[32][kMax];
+  uint64_t cx[kMax], cy[kMax];
+  int s[kMax];
+  for (size_t i = 0; i < m; ++i) {
+    cx[i] = std::min(static_cast<uint64_t>(std::max(0.0, x[i]) * cells), top);
+    cy[i] = std::min(static_cast<uint64_t>(std::max(0.0, y[i]) * cells), top);
+    if (grid_ == 2) {
+      for (int c = 0; c < chunks; ++c) {
+        xs[c][i] = static_cast<uint8_t>(cx[i] & 15), cx[i] >>= 4;
+        ys[c][i] = static_cast<uint8_t>(cy[i] & 15), cy[i] >>= 4;
+      }
+    } else {
+      for (int c = 0; c < chunks; ++c) {
+        xs[c][i] = static_cast<uint8_t>(cx[i] % 9), cx[i] /= 9;
+        ys[c][i] = static_cast<uint8_t>(cy[i] % 9), cy[i] /= 9;
+      }
     }
-  } else {
-    for (int c = 0; c < chunks; ++c) {
-      xs[c] = static_cast<uint32_t>(cx % 9), cx /= 9;
-      ys[c] = static_cast<uint32_t>(cy % 9), cy /= 9;
-    }
+    digits[i] = 0;
+    s[i] = state[i];
   }
-  uint64_t digits = 0;
-  // The leading levels one at a time (cx, cy now hold them).
+  // The leading levels one at a time.
   uint64_t place = static_cast<uint64_t>(curve_.PowG(head));
   for (int level = 0; level < head; ++level) {
     place /= grid_;
-    const int dx = static_cast<int>(cx / place % grid_), dy = static_cast<int>(cy / place % grid_);
-    const int c = child_at_[state * arity_ + dy * grid_ + dx];
-    digits = digits * arity_ + c;
-    state = curve_.ChildOf(state, c).state;
+    for (size_t i = 0; i < m; ++i) {
+      const int dx = static_cast<int>(cx[i] / place % grid_);
+      const int dy = static_cast<int>(cy[i] / place % grid_);
+      const int c = child_at_[s[i] * arity_ + dy * grid_ + dx];
+      digits[i] = digits[i] * arity_ + c;
+      s[i] = curve_.ChildOf(s[i], c).state;
+    }
   }
   const int cells_per_chunk = chunk_cells_ * chunk_cells_;
   const uint64_t chunk_span = curve_.PowW(chunk_levels_);
   for (int c = chunks - 1; c >= 0; --c) {
-    const uint64_t e = encode_[state * cells_per_chunk + ys[c] * chunk_cells_ + xs[c]];
-    digits = digits * chunk_span + (e & ((uint64_t{1} << 56) - 1));
-    state = static_cast<int>(e >> 56);
+    for (size_t i = 0; i < m; ++i) {
+      const uint64_t e = encode_[s[i] * cells_per_chunk + ys[c][i] * chunk_cells_ + xs[c][i]];
+      digits[i] = digits[i] * chunk_span + (e & ((uint64_t{1} << 56) - 1));
+      s[i] = static_cast<int>(e >> 56);
+    }
   }
-  return digits;
 }
 
 }  // namespace sfc

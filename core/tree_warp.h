@@ -89,9 +89,11 @@ class TreeWarp {
   void Descend(size_t m, double* a, double* b, int32_t* ref, uint8_t* state) const;
   // Places (a, b) inside leaf l, in the leaf's unit coordinates.
   void PlaceInLeaf(size_t l, double a, double b, double* x, double* y) const;
-  // The digits of the leaf's curve, continuation_levels() deep, of the
-  // sub-cell holding (x, y) of a leaf with orientation `state`.
-  uint64_t DigitsInLeaf(double x, double y, int state) const;
+  // digits[i]: the digits of the leaf's curve, continuation_levels() deep,
+  // of the sub-cell holding (x[i], y[i]) of a leaf with orientation
+  // state[i], i < m <= 64.
+  void DigitsInLeaf(size_t m, const double* x, const double* y, const uint8_t* state,
+                    uint64_t* digits) const;
 
   const CurveTree& tree_;
   const Curve& curve_;
