@@ -79,66 +79,113 @@ bool NotNegative(double p0, double p1, double p2) {
 
 // The s in [0, 1] where the CDF F(s) = p0 s + p1 s^2 / 2 + p2 s^3 / 3 of a
 // density p not negative on [0, 1] reaches `share` of F(1): Newton's method
-// kept inside a shrinking bracket (bisection where a step leaves it).
-double InvertCdf(double p0, double p1, double p2, double share) {
-  auto cdf = [&](double s) { return s * (p0 + s * (p1 / 2 + s * (p2 / 3))); };
-  const double target = share * cdf(1);
-  double lo = 0, hi = 1, s = share;
-  for (int iter = 0; iter < 100; ++iter) {
-    const double f = cdf(s) - target;
-    if (f == 0) return s;
+// kept inside a shrinking bracket (bisection where a step leaves it). One
+// problem's state, so that a batch can take its steps side by side.
+class CdfInversion {
+ public:
+  CdfInversion() = default;
+  CdfInversion(const double p[3], double share)
+      : p0_(p[0]), p1_(p[1]), p2_(p[2]), target_(share * Cdf(1)), s_(share) {}
+  // One step; true when done, with the answer in s().
+  bool Step() {
+    const double f = Cdf(s_) - target_;
+    if (f == 0) return true;
     if (f > 0) {
-      hi = s;
+      hi_ = s_;
     } else {
-      lo = s;
+      lo_ = s_;
     }
-    const double d = p0 + s * (p1 + s * p2);
-    double next = d > 0 ? s - f / d : (lo + hi) / 2;
-    if (!(next > lo && next < hi)) next = (lo + hi) / 2;
+    const double d = p0_ + s_ * (p1_ + s_ * p2_);
+    double next = d > 0 ? s_ - f / d : (lo_ + hi_) / 2;
+    if (!(next > lo_ && next < hi_)) next = (lo_ + hi_) / 2;
     // A step below 2^-44 of the leaf is far below the address's 2^-26
     // (Hilbert; 3^-16 for the 3x3 curves) resolution.
-    if (std::fabs(next - s) <= 0x1.0p-44 || hi - lo <= 0x1.0p-52) return next;
-    s = next;
+    const bool done = std::fabs(next - s_) <= 0x1.0p-44 || hi_ - lo_ <= 0x1.0p-52;
+    s_ = next;
+    return done;
   }
-  return s;
+  double s() const { return s_; }
+  static constexpr int kMaxSteps = 100;  // then s() as it stands
+
+ private:
+  double Cdf(double s) const { return s * (p0_ + s * (p1_ / 2 + s * (p2_ / 3))); }
+  double p0_ = 0, p1_ = 0, p2_ = 0, target_ = 0;
+  double lo_ = 0, hi_ = 1, s_ = 0;
+};
+
+double InvertCdf(const double p[3], double share) {
+  CdfInversion inversion(p, share);
+  for (int step = 0; step < CdfInversion::kMaxSteps && !inversion.Step(); ++step) {
+  }
+  return inversion.s();
+}
+
+// InvertCdf(p[i], share[i]) into out[i] for the n <= 64 problems listed in
+// lanes, their steps taken side by side (each its own InvertCdf's steps).
+void InvertCdfs(size_t n, const uint8_t* lanes, const double (*p)[3], const double* share,
+                double* out) {
+  CdfInversion inversion[64];
+  uint8_t active[64];
+  size_t count = 0;
+  for (size_t j = 0; j < n; ++j) {
+    inversion[j] = CdfInversion(p[lanes[j]], share[lanes[j]]);
+    active[count++] = static_cast<uint8_t>(j);
+  }
+  for (int step = 0; step < CdfInversion::kMaxSteps && count > 0; ++step) {
+    size_t still = 0;
+    for (size_t c = 0; c < count; ++c) {
+      if (!inversion[active[c]].Step()) active[still++] = active[c];
+    }
+    count = still;
+  }
+  for (size_t j = 0; j < n; ++j) out[lanes[j]] = inversion[j].s();
 }
 
 // The quadratic factor of a Lagrange combination sum_i w[i] L_i(s) as
 // coefficients of 1, s, s^2.
-void PolynomialOf(const double w[3], double* p0, double* p1, double* p2) {
+void PolynomialOf(const double w[3], double p[3]) {
   const auto& k = leaf_model_internal::kBasisTable.k;
-  *p0 = w[0] * k[0][0] + w[1] * k[1][0] + w[2] * k[2][0];
-  *p1 = w[0] * k[0][1] + w[1] * k[1][1] + w[2] * k[2][1];
-  *p2 = w[0] * k[0][2] + w[1] * k[1][2] + w[2] * k[2][2];
+  p[0] = w[0] * k[0][0] + w[1] * k[1][0] + w[2] * k[2][0];
+  p[1] = w[0] * k[0][1] + w[1] * k[1][1] + w[2] * k[2][1];
+  p[2] = w[0] * k[0][2] + w[1] * k[1][2] + w[2] * k[2][2];
+}
+
+// The marginal density of s of a quadratic model in its warped coordinates
+// (s, t): sum_i L_i(s) sum_j c_ij int L_j, and int_0^1 L_j is the Gauss
+// weight w_j. False where it dips below zero on [0, 1].
+bool MarginalOf(const LeafModel& model, double p[3]) {
+  double marginal[3];
+  for (int i = 0; i < 3; ++i) {
+    marginal[i] = 0;
+    for (int j = 0; j < 3; ++j) marginal[i] += model.c[3 * i + j] * kGaussWeight[j];
+  }
+  PolynomialOf(marginal, p);
+  return NotNegative(p[0], p[1], p[2]);
+}
+
+// The density of t at s: sum_j L_j(t) sum_i c_ij L_i(s). False where it dips
+// below zero on [0, 1] or has no mass.
+bool ConditionalOf(const LeafModel& model, double s, double q[3]) {
+  using leaf_model_internal::Basis;
+  double basis_s[3], conditional[3];
+  for (int i = 0; i < 3; ++i) basis_s[i] = Basis(i, s);
+  for (int j = 0; j < 3; ++j) {
+    conditional[j] = 0;
+    for (int i = 0; i < 3; ++i) conditional[j] += model.c[3 * i + j] * basis_s[i];
+  }
+  PolynomialOf(conditional, q);
+  return NotNegative(q[0], q[1], q[2]) && q[0] + q[1] / 2 + q[2] / 3 > 0;
 }
 
 // Exact marginal-then-conditional inverse CDF of a quadratic model in its
 // warped coordinates (s, t); false where the quadratic dips below zero on the
 // cell (the caller then splits the clamped model's sub-squares).
 bool PlaceQuadratic(const LeafModel& model, double a, double b, double* s, double* t) {
-  using leaf_model_internal::Basis;
-  // The marginal density of s: sum_i L_i(s) sum_j c_ij int L_j, and
-  // int_0^1 L_j is the Gauss weight w_j.
-  double marginal[3];
-  for (int i = 0; i < 3; ++i) {
-    marginal[i] = 0;
-    for (int j = 0; j < 3; ++j) marginal[i] += model.c[3 * i + j] * kGaussWeight[j];
-  }
-  double p0, p1, p2;
-  PolynomialOf(marginal, &p0, &p1, &p2);
-  if (!NotNegative(p0, p1, p2)) return false;
-  *s = InvertCdf(p0, p1, p2, a);
-  // The density of t at that s: sum_j L_j(t) sum_i c_ij L_i(s).
-  double basis_s[3], conditional[3];
-  for (int i = 0; i < 3; ++i) basis_s[i] = Basis(i, *s);
-  for (int j = 0; j < 3; ++j) {
-    conditional[j] = 0;
-    for (int i = 0; i < 3; ++i) conditional[j] += model.c[3 * i + j] * basis_s[i];
-  }
-  double q0, q1, q2;
-  PolynomialOf(conditional, &q0, &q1, &q2);
-  if (!NotNegative(q0, q1, q2) || !(q0 + q1 / 2 + q2 / 3 > 0)) return false;
-  *t = InvertCdf(q0, q1, q2, b);
+  double p[3], q[3];
+  if (!MarginalOf(model, p)) return false;
+  *s = InvertCdf(p, a);
+  if (!ConditionalOf(model, *s, q)) return false;
+  *t = InvertCdf(q, b);
   return true;
 }
 
@@ -281,11 +328,40 @@ void TreeWarp::LocateMany(size_t n, const double* a_in, const double* b_in,
     }
     double x[kBatch], y[kBatch];
     uint64_t digits[kBatch];
+    // Quadratic leaves: each inverse CDF over the batch side by side; the
+    // others (and a quadratic that dips below zero) one at a time.
+    double p[kBatch][3], s[kBatch], t[kBatch];
+    uint8_t lanes[kBatch];
+    size_t quadratic = 0;
     for (size_t i = 0; i < m; ++i) {
       if (i + kAhead < m) {
         __builtin_prefetch(&tree_.leaf_model(static_cast<size_t>(-ref[i + kAhead] - 1)));
       }
-      PlaceInLeaf(static_cast<size_t>(-ref[i] - 1), a[i], b[i], &x[i], &y[i]);
+      const size_t l = static_cast<size_t>(-ref[i] - 1);
+      if (tree_.leaf_model_kind(l) == LeafModel::Kind::kQuadratic &&
+          MarginalOf(tree_.leaf_model(l), p[i])) {
+        lanes[quadratic++] = static_cast<uint8_t>(i);
+      }
+    }
+    InvertCdfs(quadratic, lanes, p, a, s);
+    size_t conditional = 0;
+    for (size_t j = 0; j < quadratic; ++j) {
+      const size_t i = lanes[j];
+      if (ConditionalOf(tree_.leaf_model(static_cast<size_t>(-ref[i] - 1)), s[i], p[i])) {
+        lanes[conditional++] = static_cast<uint8_t>(i);
+      }
+    }
+    InvertCdfs(conditional, lanes, p, b, t);
+    for (size_t i = 0, j = 0; i < m; ++i) {
+      const size_t l = static_cast<size_t>(-ref[i] - 1);
+      if (j < conditional && lanes[j] == i) {  // PlaceInLeaf's quadratic case
+        const LeafModel& model = tree_.leaf_model(l);
+        x[i] = Warp(model.warp[0], s[i]);
+        y[i] = Warp(model.warp[1], t[i]);
+        ++j;
+      } else {
+        PlaceInLeaf(l, a[i], b[i], &x[i], &y[i]);
+      }
     }
     DigitsInLeaf(m, x, y, state, digits);
     for (size_t i = 0; i < m; ++i) {
