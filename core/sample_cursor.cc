@@ -19,34 +19,45 @@ SampleFields ColumnsOf(const CurveSamples& samples, SampleFields fields) {
   return fields;
 }
 
-// Sorts addresses into curve order (by CurveAddress::Key): a counting sort
-// by leaf, stable, then each leaf's few addresses by key, the leaves split
-// over `parts` threads. The order is the same as one sort of the whole.
-// Many more leaves than addresses (a large mesh, a small set) take one sort.
+// Sorts addresses into curve order (by CurveAddress::Key): a counting sort,
+// stable, by the leaf and the top bits of the digits (as many as make about
+// one bucket an address), then each bucket's few addresses by key, the
+// buckets split over `parts` threads. The order is the same as one sort of
+// the whole. Many more leaves than addresses (a large mesh, a small set)
+// take one sort.
 void SortAddresses(std::vector<CurveAddress>* addresses, int parts) {
   std::vector<CurveAddress>& at = *addresses;
   uint32_t leaves = 0;
   for (const CurveAddress& a : at) leaves = std::max(leaves, a.leaf + 1);
-  if (leaves > 4 * at.size() + 1024) {
+  if (leaves > 4 * at.size() + 1024 || at.size() >= (uint64_t{1} << 32)) {
     std::sort(at.begin(), at.end());
     return;
   }
-  std::vector<uint64_t> first(size_t{leaves} + 1, 0);  // each leaf's first position
-  for (const CurveAddress& a : at) ++first[a.leaf + 1];
-  for (uint32_t l = 0; l < leaves; ++l) first[l + 1] += first[l];
+  // Digits are below 2^52 (CurveAddress::Key): the top `bits` of them.
+  int bits = 0;
+  while (bits < 20 && (uint64_t{leaves} << (bits + 1)) <= 2 * at.size()) ++bits;
+  auto bucket_of = [bits](const CurveAddress& a) {
+    return (uint64_t{a.leaf} << bits) | (a.digits >> (52 - bits));
+  };
+  const uint64_t buckets = uint64_t{leaves} << bits;
+  std::vector<uint32_t> first(buckets + 1, 0);  // each bucket's first position
+  for (const CurveAddress& a : at) ++first[bucket_of(a) + 1];
+  for (uint64_t c = 0; c < buckets; ++c) first[c + 1] += first[c];
   std::vector<CurveAddress> sorted(at.size());
   {
-    std::vector<uint64_t> next(first.begin(), first.end() - 1);
-    for (const CurveAddress& a : at) sorted[next[a.leaf]++] = a;
+    std::vector<uint32_t> next(first.begin(), first.end() - 1);
+    for (const CurveAddress& a : at) sorted[next[bucket_of(a)]++] = a;
   }
-  // Parts of about equal counts, cut at leaf boundaries.
+  // Parts of about equal counts, cut at bucket boundaries.
   WorkerPool::Shared().ParallelFor(parts, [&](int i) {
     const uint64_t from = at.size() * i / parts, to = at.size() * (i + 1) / parts;
-    uint32_t l = static_cast<uint32_t>(std::upper_bound(first.begin(), first.end(), from) -
+    uint64_t c = static_cast<uint64_t>(std::upper_bound(first.begin(), first.end(), from) -
                                        first.begin() - 1);
-    if (first[l] < from) ++l;  // the leaf across `from` is the part before's
-    for (; l < leaves && first[l] < to; ++l) {
-      std::sort(sorted.begin() + first[l], sorted.begin() + first[l + 1]);
+    if (first[c] < from) ++c;  // the bucket across `from` is the part before's
+    for (; c < buckets && first[c] < to; ++c) {
+      if (first[c + 1] - first[c] > 1) {
+        std::sort(sorted.begin() + first[c], sorted.begin() + first[c + 1]);
+      }
     }
   });
   at.swap(sorted);
