@@ -10,7 +10,10 @@
 
 namespace sfc {
 
-inline uint64_t Mix64(uint64_t z) {
+// U is uint64_t, or a vector of them (GCC's vector extensions) hashed lane
+// by lane with the same bits.
+template <typename U>
+inline U Mix64(U z) {
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
   return z ^ (z >> 31);
@@ -37,8 +40,14 @@ inline uint64_t CounterKey(uint64_t seed, uint64_t stream) {
 
 // CounterHash's two halves, for a caller that hashes one counter in several
 // streams: the counter's own mix, then with a stream's key.
-inline uint64_t CounterMix(uint64_t counter) { return Mix64(counter + 0x632be59bd9b4e019ULL); }
-inline uint64_t KeyedHash(uint64_t key, uint64_t counter_mix) { return Mix64(key ^ counter_mix); }
+template <typename U>
+inline U CounterMix(U counter) {
+  return Mix64(counter + 0x632be59bd9b4e019ULL);
+}
+template <typename U>
+inline U KeyedHash(uint64_t key, U counter_mix) {
+  return Mix64(key ^ counter_mix);
+}
 
 // 64 well-mixed bits for `counter` in the stream `stream` of `seed`.
 inline uint64_t CounterHash(uint64_t seed, uint64_t stream, uint64_t counter) {
