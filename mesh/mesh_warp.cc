@@ -131,6 +131,7 @@ MeshWarp::MeshWarp(const MeshCurveTree& tree) : tree_(tree) {
   int depth = 0;
   while (depth < 40 && (size_t{1} << depth) < tree.leaf_count()) ++depth;
   max_depth_ = std::min(depth + kExtraDepth, kMaxDepth);
+  uniform_density_ = tree.density().uniform();
   // Leaves are numbered by 32 bits (CurveAddress::leaf): nodes are never
   // narrower than 2^-44, which LocateInLeaf's search needs.
   assert(max_depth_ <= 44);
@@ -218,7 +219,9 @@ void MeshWarp::LocateInLeaf(double a, double b, size_t* leaf, double* pa, double
     lo = hi = l;
   }
   const size_t l = lo;
-  const MeshCurveTree::Cell cell = tree_.LeafCell(l);
+  // PlaceInCell reads the cell's density model alone: under a uniform
+  // density every cell's is the default (uniform), with no cell to decode.
+  const MeshCurveTree::Cell cell = uniform_density_ ? MeshCurveTree::Cell{} : tree_.LeafCell(l);
   // The node's share of the leaf, as fractions of the leaf's mass.
   const double leaf_begin = tree_.mass_begin(l), leaf_mass = ends[l] - leaf_begin;
   const double f0 =

@@ -69,6 +69,7 @@ class MeshWarp {
 
   const MeshCurveTree& tree_;
   int max_depth_ = 0;  // halvings before a node across leaves is split by mass
+  bool uniform_density_ = false;  // every leaf cell's model is uniform
   // Node j of depth bucket_bits_ meets leaves bucket_leaves_[2j] ..
   // bucket_leaves_[2j + 1]: where the search for a node's leaves starts.
   int bucket_bits_ = 0;
