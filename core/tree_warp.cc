@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <immintrin.h>
 
 #include "core/leaf_model.h"
 
@@ -65,6 +66,74 @@ int Pick(const double* bound, const double* inverse, int n, double* a) {
   const double lower = i == 0 ? 0.0 : bound[i - 1];
   *a = std::clamp((*a - lower) * inverse[i], 0.0, kBelowOne);
   return i;
+}
+
+// std::clamp(v, 0, kBelowOne), lane by lane.
+__attribute__((target("avx512f"))) inline __m512d ClampBelowOne(__m512d v) {
+  const __m512d zero = _mm512_setzero_pd(), below_one = _mm512_set1_pd(kBelowOne);
+  const __m512d r = _mm512_mask_mov_pd(v, _mm512_cmp_pd_mask(below_one, v, _CMP_LT_OQ), below_one);
+  return _mm512_mask_mov_pd(r, _mm512_cmp_pd_mask(v, zero, _CMP_LT_OQ), zero);
+}
+
+// Descend<2> (TreeWarp::Descend) for the points i < m in vectors of eight
+// lanes on AVX-512F, each lane the scalar code's steps (Pick's compare,
+// select, subtract, multiply and clamp; the nodes' entries gathered); lanes
+// at their leaves are masked. Returns how many points it took (a multiple of
+// eight); the caller descends the rest.
+__attribute__((target("avx512f"))) size_t DescendGrid2Avx512(size_t m, double* a, double* b,
+                                                             int32_t* ref, uint8_t* state,
+                                                             const double* splits,
+                                                             const int32_t* children,
+                                                             const int32_t* state_at) {
+  const __m512d zero = _mm512_setzero_pd();
+  const __m512i none = _mm512_setzero_si512(), one = _mm512_set1_epi64(1);
+  size_t i0 = 0;
+  for (; i0 + 8 <= m; i0 += 8) {
+    __m512d va = _mm512_loadu_pd(a + i0), vb = _mm512_loadu_pd(b + i0);
+    __m512i vref = _mm512_cvtepi32_epi64(_mm256_loadu_si256(reinterpret_cast<__m256i*>(ref + i0)));
+    __m512i vstate = _mm512_cvtepu8_epi64(_mm_loadl_epi64(reinterpret_cast<__m128i*>(state + i0)));
+    for (__mmask8 active = _mm512_cmpge_epi64_mask(vref, none); active != 0;
+         active = _mm512_cmpge_epi64_mask(vref, none)) {
+      // Node entries at ref * 12: the columns' bounds and inverse widths, then
+      // each column's rows' (TreeWarp::splits_, grid 2).
+      const __m512i node = _mm512_add_epi64(_mm512_slli_epi64(vref, 3), _mm512_slli_epi64(vref, 2));
+      const __m512d column_bound = _mm512_mask_i64gather_pd(zero, active, node, splits, 8);
+      const __mmask8 right = _mm512_cmp_pd_mask(va, column_bound, _CMP_GE_OQ);
+      const __m512i dx = _mm512_maskz_mov_epi64(right, one);
+      const __m512d column_inverse = _mm512_mask_i64gather_pd(
+          zero, active, _mm512_add_epi64(node, _mm512_add_epi64(dx, _mm512_set1_epi64(2))),
+          splits, 8);
+      const __m512d na =
+          ClampBelowOne(_mm512_mul_pd(_mm512_sub_pd(va, _mm512_maskz_mov_pd(right, column_bound)),
+                              column_inverse));
+      const __m512i rows =
+          _mm512_add_epi64(node, _mm512_add_epi64(_mm512_slli_epi64(dx, 2), _mm512_set1_epi64(4)));
+      const __m512d row_bound = _mm512_mask_i64gather_pd(zero, active, rows, splits, 8);
+      const __mmask8 up = _mm512_cmp_pd_mask(vb, row_bound, _CMP_GE_OQ);
+      const __m512i dy = _mm512_maskz_mov_epi64(up, one);
+      const __m512d row_inverse = _mm512_mask_i64gather_pd(
+          zero, active, _mm512_add_epi64(rows, _mm512_add_epi64(dy, _mm512_set1_epi64(2))), splits,
+          8);
+      const __m512d nb = ClampBelowOne(
+          _mm512_mul_pd(_mm512_sub_pd(vb, _mm512_maskz_mov_pd(up, row_bound)), row_inverse));
+      const __m512i at = _mm512_add_epi64(_mm512_slli_epi64(dy, 1), dx);
+      const __m512i child = _mm512_cvtepi32_epi64(_mm512_mask_i64gather_epi32(
+          _mm256_setzero_si256(), active, _mm512_add_epi64(_mm512_slli_epi64(vref, 2), at),
+          children, 4));
+      const __m512i next_state = _mm512_cvtepi32_epi64(_mm512_mask_i64gather_epi32(
+          _mm256_setzero_si256(), active, _mm512_add_epi64(_mm512_slli_epi64(vstate, 2), at),
+          state_at, 4));
+      va = _mm512_mask_mov_pd(va, active, na);
+      vb = _mm512_mask_mov_pd(vb, active, nb);
+      vref = _mm512_mask_mov_epi64(vref, active, child);
+      vstate = _mm512_mask_mov_epi64(vstate, active, next_state);
+    }
+    _mm512_storeu_pd(a + i0, va);
+    _mm512_storeu_pd(b + i0, vb);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(ref + i0), _mm512_cvtepi64_epi32(vref));
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(state + i0), _mm512_cvtepi64_epi8(vstate));
+  }
+  return i0;
 }
 
 // p(s) = p0 + p1 s + p2 s^2 >= 0 on [0, 1].
@@ -296,14 +365,14 @@ void TreeWarp::Descend(size_t m, double* a, double* b, int32_t* ref, uint8_t* st
       const int dy = Pick(rows, rows + G, G, &b[i]);
       const int at = dy * G + dx;
       ref[i] = children_[ref[i] * kArity + at];
-      state[i] = state_at_[state[i] * kArity + at];
+      state[i] = static_cast<uint8_t>(state_at_[state[i] * kArity + at]);
       descending |= ref[i] >= 0;
     }
   }
 }
 
-void TreeWarp::LocateMany(size_t n, const double* a_in, const double* b_in,
-                          CurveAddress* out) const {
+void TreeWarp::LocateMany(size_t n, const double* a_in, const double* b_in, CurveAddress* out,
+                          math::VectorPath path) const {
   constexpr size_t kBatch = 64;
   double a[kBatch], b[kBatch];
   int32_t ref[kBatch];
@@ -317,7 +386,12 @@ void TreeWarp::LocateMany(size_t n, const double* a_in, const double* b_in,
       state[i] = Curve::kRootState;
     }
     if (grid_ == 2) {
-      Descend<2>(m, a, b, ref, state);
+      const size_t vectored =
+          path == math::VectorPath::kAvx512
+              ? DescendGrid2Avx512(m, a, b, ref, state, splits_.data(), children_.data(),
+                                   state_at_.data())
+              : 0;
+      Descend<2>(m - vectored, a + vectored, b + vectored, ref + vectored, state + vectored);
     } else {
       Descend<3>(m, a, b, ref, state);
     }

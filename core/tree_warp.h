@@ -41,6 +41,7 @@
 
 #include "core/curve_samples.h"
 #include "core/curve_tree.h"
+#include "core/vector_math.h"
 
 namespace sfc {
 
@@ -60,7 +61,10 @@ class TreeWarp {
   // out[i] = Locate(a[i], b[i]) for i < n, bit for bit: the points descend
   // the tree a level at a time together, so their chains of dependent loads
   // overlap instead of following one another.
-  void LocateMany(size_t n, const double* a, const double* b, CurveAddress* out) const;
+  // On the AVX-512F vector path (`path`, for tests) a Hilbert tree's points
+  // descend eight lanes to a vector, with the same bits.
+  void LocateMany(size_t n, const double* a, const double* b, CurveAddress* out,
+                  math::VectorPath path = math::BestVectorPath()) const;
 
   struct Point {
     double u, v;            // unit-square parameters
@@ -119,7 +123,7 @@ class TreeWarp {
   // child_at_[state * arity + dy * grid + dx]: the child at (dx, dy).
   std::vector<uint8_t> child_at_;
   // state_at_[state * arity + dy * grid + dx]: that child's orientation.
-  std::vector<uint8_t> state_at_;
+  std::vector<int32_t> state_at_;
 };
 
 }  // namespace sfc

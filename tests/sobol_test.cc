@@ -7,6 +7,7 @@
 // on the sphere meet the closed form at quasi-Monte Carlo rates.
 #include <cmath>
 #include <cstdint>
+#include <random>
 #include <set>
 #include <vector>
 
@@ -219,6 +220,34 @@ TEST(TreeWarp, MapsTheUnitSquareOntoTheLeavesByMass) {
     worst = std::max(worst, std::fabs(hits[l] - expected) / (4 * std::sqrt(expected) + 4));
   }
   EXPECT_LT(worst, 1.0);
+}
+
+// The batch descent's vector path gives the scalar path's addresses, bit for
+// bit, on a Hilbert tree with a density (leaves at several depths, so lanes
+// reach their leaves in different rounds), at random points, the square's
+// edges and its dyadic lines, in batches whose size is not a multiple of 8.
+TEST(TreeWarp, LocateManyGivesTheSameAddressesOnEveryVectorPath) {
+  const auto s = MakeSetup("monkey_saddle", "gaussian:floor=0.05", 1 << 14);
+  const TreeWarp warp(*s.tree);
+  std::mt19937_64 rng(36);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<double> a, b;
+  for (int i = 0; i < 5003; ++i) a.push_back(unit(rng)), b.push_back(unit(rng));
+  for (double x : {0.0, 0.25, 0.5, 0.75, 1.0, -0.5, 1.5}) {
+    for (double y : {0.0, 0.5, 1.0}) a.push_back(x), b.push_back(y);
+  }
+  std::vector<CurveAddress> expected(a.size());
+  warp.LocateMany(a.size(), a.data(), b.data(), expected.data(), math::VectorPath::kScalar);
+  for (math::VectorPath path : {math::VectorPath::kSse2, math::VectorPath::kAvx,
+                                math::VectorPath::kAvx512}) {
+    if (!math::Runs(path)) continue;
+    std::vector<CurveAddress> got(a.size());
+    warp.LocateMany(a.size(), a.data(), b.data(), got.data(), path);
+    for (size_t i = 0; i < a.size(); ++i) {
+      ASSERT_EQ(got[i].leaf, expected[i].leaf) << math::VectorPathName(path) << " point " << i;
+      ASSERT_EQ(got[i].digits, expected[i].digits) << math::VectorPathName(path) << " point " << i;
+    }
+  }
 }
 
 }  // namespace
