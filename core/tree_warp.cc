@@ -79,7 +79,7 @@ __attribute__((target("avx512f"))) inline __m512d ClampBelowOne(__m512d v) {
 // lanes on AVX-512F, each lane the scalar code's steps (Pick's compare,
 // select, subtract, multiply and clamp; the nodes' entries gathered); lanes
 // at their leaves are masked. Returns how many points it took (a multiple of
-// eight); the caller descends the rest.
+// eight, at most 64); the caller descends the rest.
 __attribute__((target("avx512f"))) size_t DescendGrid2Avx512(size_t m, double* a, double* b,
                                                              int32_t* ref, uint8_t* state,
                                                              const double* splits,
@@ -87,53 +87,66 @@ __attribute__((target("avx512f"))) size_t DescendGrid2Avx512(size_t m, double* a
                                                              const int32_t* state_at) {
   const __m512d zero = _mm512_setzero_pd();
   const __m512i none = _mm512_setzero_si512(), one = _mm512_set1_epi64(1);
-  size_t i0 = 0;
-  for (; i0 + 8 <= m; i0 += 8) {
-    __m512d va = _mm512_loadu_pd(a + i0), vb = _mm512_loadu_pd(b + i0);
-    __m512i vref = _mm512_cvtepi32_epi64(_mm256_loadu_si256(reinterpret_cast<__m256i*>(ref + i0)));
-    __m512i vstate = _mm512_cvtepu8_epi64(_mm_loadl_epi64(reinterpret_cast<__m128i*>(state + i0)));
-    for (__mmask8 active = _mm512_cmpge_epi64_mask(vref, none); active != 0;
-         active = _mm512_cmpge_epi64_mask(vref, none)) {
+  // Up to 8 vectors side by side, a level each per round, so that their
+  // gathers overlap.
+  constexpr size_t kVectors = 8;
+  const size_t vectors = std::min(m / 8, kVectors);
+  __m512d va[kVectors], vb[kVectors];
+  __m512i vref[kVectors], vstate[kVectors];
+  for (size_t v = 0; v < vectors; ++v) {
+    va[v] = _mm512_loadu_pd(a + 8 * v), vb[v] = _mm512_loadu_pd(b + 8 * v);
+    vref[v] = _mm512_cvtepi32_epi64(_mm256_loadu_si256(reinterpret_cast<__m256i*>(ref + 8 * v)));
+    vstate[v] =
+        _mm512_cvtepu8_epi64(_mm_loadl_epi64(reinterpret_cast<__m128i*>(state + 8 * v)));
+  }
+  for (bool descending = vectors > 0; descending;) {
+    descending = false;
+    for (size_t v = 0; v < vectors; ++v) {
+      const __mmask8 active = _mm512_cmpge_epi64_mask(vref[v], none);
+      if (active == 0) continue;
+      descending = true;
       // Node entries at ref * 12: the columns' bounds and inverse widths, then
       // each column's rows' (TreeWarp::splits_, grid 2).
-      const __m512i node = _mm512_add_epi64(_mm512_slli_epi64(vref, 3), _mm512_slli_epi64(vref, 2));
+      const __m512i node =
+          _mm512_add_epi64(_mm512_slli_epi64(vref[v], 3), _mm512_slli_epi64(vref[v], 2));
       const __m512d column_bound = _mm512_mask_i64gather_pd(zero, active, node, splits, 8);
-      const __mmask8 right = _mm512_cmp_pd_mask(va, column_bound, _CMP_GE_OQ);
+      const __mmask8 right = _mm512_cmp_pd_mask(va[v], column_bound, _CMP_GE_OQ);
       const __m512i dx = _mm512_maskz_mov_epi64(right, one);
       const __m512d column_inverse = _mm512_mask_i64gather_pd(
-          zero, active, _mm512_add_epi64(node, _mm512_add_epi64(dx, _mm512_set1_epi64(2))),
-          splits, 8);
-      const __m512d na =
-          ClampBelowOne(_mm512_mul_pd(_mm512_sub_pd(va, _mm512_maskz_mov_pd(right, column_bound)),
-                              column_inverse));
+          zero, active, _mm512_add_epi64(node, _mm512_add_epi64(dx, _mm512_set1_epi64(2))), splits,
+          8);
+      const __m512d na = ClampBelowOne(_mm512_mul_pd(
+          _mm512_sub_pd(va[v], _mm512_maskz_mov_pd(right, column_bound)), column_inverse));
       const __m512i rows =
           _mm512_add_epi64(node, _mm512_add_epi64(_mm512_slli_epi64(dx, 2), _mm512_set1_epi64(4)));
       const __m512d row_bound = _mm512_mask_i64gather_pd(zero, active, rows, splits, 8);
-      const __mmask8 up = _mm512_cmp_pd_mask(vb, row_bound, _CMP_GE_OQ);
+      const __mmask8 up = _mm512_cmp_pd_mask(vb[v], row_bound, _CMP_GE_OQ);
       const __m512i dy = _mm512_maskz_mov_epi64(up, one);
       const __m512d row_inverse = _mm512_mask_i64gather_pd(
           zero, active, _mm512_add_epi64(rows, _mm512_add_epi64(dy, _mm512_set1_epi64(2))), splits,
           8);
       const __m512d nb = ClampBelowOne(
-          _mm512_mul_pd(_mm512_sub_pd(vb, _mm512_maskz_mov_pd(up, row_bound)), row_inverse));
+          _mm512_mul_pd(_mm512_sub_pd(vb[v], _mm512_maskz_mov_pd(up, row_bound)), row_inverse));
       const __m512i at = _mm512_add_epi64(_mm512_slli_epi64(dy, 1), dx);
       const __m512i child = _mm512_cvtepi32_epi64(_mm512_mask_i64gather_epi32(
-          _mm256_setzero_si256(), active, _mm512_add_epi64(_mm512_slli_epi64(vref, 2), at),
+          _mm256_setzero_si256(), active, _mm512_add_epi64(_mm512_slli_epi64(vref[v], 2), at),
           children, 4));
       const __m512i next_state = _mm512_cvtepi32_epi64(_mm512_mask_i64gather_epi32(
-          _mm256_setzero_si256(), active, _mm512_add_epi64(_mm512_slli_epi64(vstate, 2), at),
+          _mm256_setzero_si256(), active, _mm512_add_epi64(_mm512_slli_epi64(vstate[v], 2), at),
           state_at, 4));
-      va = _mm512_mask_mov_pd(va, active, na);
-      vb = _mm512_mask_mov_pd(vb, active, nb);
-      vref = _mm512_mask_mov_epi64(vref, active, child);
-      vstate = _mm512_mask_mov_epi64(vstate, active, next_state);
+      va[v] = _mm512_mask_mov_pd(va[v], active, na);
+      vb[v] = _mm512_mask_mov_pd(vb[v], active, nb);
+      vref[v] = _mm512_mask_mov_epi64(vref[v], active, child);
+      vstate[v] = _mm512_mask_mov_epi64(vstate[v], active, next_state);
     }
-    _mm512_storeu_pd(a + i0, va);
-    _mm512_storeu_pd(b + i0, vb);
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(ref + i0), _mm512_cvtepi64_epi32(vref));
-    _mm_storel_epi64(reinterpret_cast<__m128i*>(state + i0), _mm512_cvtepi64_epi8(vstate));
   }
-  return i0;
+  for (size_t v = 0; v < vectors; ++v) {
+    _mm512_storeu_pd(a + 8 * v, va[v]);
+    _mm512_storeu_pd(b + 8 * v, vb[v]);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(ref + 8 * v), _mm512_cvtepi64_epi32(vref[v]));
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(state + 8 * v), _mm512_cvtepi64_epi8(vstate[v]));
+  }
+  return 8 * vectors;
 }
 
 // p(s) = p0 + p1 s + p2 s^2 >= 0 on [0, 1].
