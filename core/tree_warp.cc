@@ -204,8 +204,83 @@ double InvertCdf(const double p[3], double share) {
 
 // InvertCdf(p[i], share[i]) into out[i] for the n <= 64 problems listed in
 // lanes, their steps taken side by side (each its own InvertCdf's steps).
+// CdfInversion's F(x) = x (p0 + x (p1 / 2 + x (p2 / 3))), lane by lane.
+__attribute__((target("avx512f"))) inline __m512d CdfLanes(__m512d x, __m512d p0,
+                                                           __m512d half_p1, __m512d third_p2) {
+  return _mm512_mul_pd(
+      x, _mm512_add_pd(p0, _mm512_mul_pd(x, _mm512_add_pd(half_p1, _mm512_mul_pd(x, third_p2)))));
+}
+
+// InvertCdfs on AVX-512F: the problems eight lanes to a vector, each lane
+// CdfInversion::Step's operations (both of its branches computed, one
+// selected; a lane that is done keeps its value), up to eight vectors a step
+// each per round.
+__attribute__((target("avx512f"))) void InvertCdfsAvx512(size_t n, const uint8_t* lanes,
+                                                         const double (*p)[3],
+                                                         const double* share, double* out) {
+  constexpr size_t kMax = 64;
+  alignas(64) double p0[kMax], p1[kMax], p2[kMax], sh[kMax], result[kMax];
+  for (size_t j = 0; j < kMax; ++j) {  // the padding: a problem of its own, never read
+    p0[j] = j < n ? p[lanes[j]][0] : 1.0;
+    p1[j] = j < n ? p[lanes[j]][1] : 0.0;
+    p2[j] = j < n ? p[lanes[j]][2] : 0.0;
+    sh[j] = j < n ? share[lanes[j]] : 0.5;
+  }
+  const size_t vectors = (n + 7) / 8;
+  const __m512d zero = _mm512_setzero_pd(), one = _mm512_set1_pd(1.0);
+  const __m512d two = _mm512_set1_pd(2.0), three = _mm512_set1_pd(3.0);
+  const __m512d tiny_step = _mm512_set1_pd(0x1.0p-44), tiny_bracket = _mm512_set1_pd(0x1.0p-52);
+  __m512d c0[8], c1[8], c2[8], half_c1[8], third_c2[8], target[8], lo[8], hi[8], s[8];
+  __mmask8 active[8];
+  for (size_t v = 0; v < vectors; ++v) {
+    c0[v] = _mm512_load_pd(p0 + 8 * v), c1[v] = _mm512_load_pd(p1 + 8 * v);
+    c2[v] = _mm512_load_pd(p2 + 8 * v);
+    half_c1[v] = _mm512_div_pd(c1[v], two), third_c2[v] = _mm512_div_pd(c2[v], three);
+    const __m512d share_v = _mm512_load_pd(sh + 8 * v);
+    target[v] = _mm512_mul_pd(share_v, CdfLanes(one, c0[v], half_c1[v], third_c2[v]));
+    lo[v] = zero, hi[v] = one, s[v] = share_v;
+    active[v] = 0xff;
+  }
+  for (int step = 0; step < CdfInversion::kMaxSteps; ++step) {
+    bool any = false;
+    for (size_t v = 0; v < vectors; ++v) {
+      if (active[v] == 0) continue;
+      any = true;
+      const __m512d f =
+          _mm512_sub_pd(CdfLanes(s[v], c0[v], half_c1[v], third_c2[v]), target[v]);
+      const __mmask8 hit = _mm512_cmp_pd_mask(f, zero, _CMP_EQ_OQ);
+      const __mmask8 moving = active[v] & ~hit;
+      const __mmask8 above = _mm512_cmp_pd_mask(f, zero, _CMP_GT_OQ);
+      const __m512d new_hi = _mm512_mask_mov_pd(hi[v], moving & above, s[v]);
+      const __m512d new_lo = _mm512_mask_mov_pd(lo[v], moving & ~above, s[v]);
+      const __m512d d = _mm512_add_pd(
+          c0[v], _mm512_mul_pd(s[v], _mm512_add_pd(c1[v], _mm512_mul_pd(s[v], c2[v]))));
+      const __m512d middle = _mm512_div_pd(_mm512_add_pd(new_lo, new_hi), two);
+      __m512d next = _mm512_mask_mov_pd(middle, _mm512_cmp_pd_mask(d, zero, _CMP_GT_OQ),
+                                        _mm512_sub_pd(s[v], _mm512_div_pd(f, d)));
+      const __mmask8 inside = _mm512_cmp_pd_mask(next, new_lo, _CMP_GT_OQ) &
+                              _mm512_cmp_pd_mask(next, new_hi, _CMP_LT_OQ);
+      next = _mm512_mask_mov_pd(middle, inside, next);
+      const __mmask8 converged =
+          _mm512_cmp_pd_mask(_mm512_abs_pd(_mm512_sub_pd(next, s[v])), tiny_step, _CMP_LE_OQ) |
+          _mm512_cmp_pd_mask(_mm512_sub_pd(new_hi, new_lo), tiny_bracket, _CMP_LE_OQ);
+      lo[v] = _mm512_mask_mov_pd(lo[v], moving, new_lo);
+      hi[v] = _mm512_mask_mov_pd(hi[v], moving, new_hi);
+      s[v] = _mm512_mask_mov_pd(s[v], moving, next);
+      active[v] = moving & ~converged;
+    }
+    if (!any) break;
+  }
+  for (size_t v = 0; v < vectors; ++v) _mm512_store_pd(result + 8 * v, s[v]);
+  for (size_t j = 0; j < n; ++j) out[lanes[j]] = result[j];
+}
+
 void InvertCdfs(size_t n, const uint8_t* lanes, const double (*p)[3], const double* share,
-                double* out) {
+                double* out, math::VectorPath path) {
+  if (path == math::VectorPath::kAvx512) {
+    InvertCdfsAvx512(n, lanes, p, share, out);
+    return;
+  }
   CdfInversion inversion[64];
   uint8_t active[64];
   size_t count = 0;
@@ -430,7 +505,7 @@ void TreeWarp::LocateMany(size_t n, const double* a_in, const double* b_in, Curv
         lanes[quadratic++] = static_cast<uint8_t>(i);
       }
     }
-    InvertCdfs(quadratic, lanes, p, a, s);
+    InvertCdfs(quadratic, lanes, p, a, s, path);
     size_t conditional = 0;
     for (size_t j = 0; j < quadratic; ++j) {
       const size_t i = lanes[j];
@@ -438,7 +513,7 @@ void TreeWarp::LocateMany(size_t n, const double* a_in, const double* b_in, Curv
         lanes[conditional++] = static_cast<uint8_t>(i);
       }
     }
-    InvertCdfs(conditional, lanes, p, b, t);
+    InvertCdfs(conditional, lanes, p, b, t, path);
     for (size_t i = 0, j = 0; i < m; ++i) {
       const size_t l = static_cast<size_t>(-ref[i] - 1);
       if (j < conditional && lanes[j] == i) {  // PlaceInLeaf's quadratic case
