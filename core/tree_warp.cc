@@ -204,6 +204,62 @@ double InvertCdf(const double p[3], double share) {
 
 // InvertCdf(p[i], share[i]) into out[i] for the n <= 64 problems listed in
 // lanes, their steps taken side by side (each its own InvertCdf's steps).
+// min(uint64(std::max(0.0, v) * cells), top) lane by lane, for v * cells <
+// 2^32 (std::max keeps 0 unless 0 < v).
+__attribute__((target("avx512f"))) inline __m512i CellsOf(__m512d v, __m512d cells,
+                                                          __m512i top) {
+  const __m512d zero = _mm512_setzero_pd();
+  const __m512d kept = _mm512_mask_mov_pd(zero, _mm512_cmp_pd_mask(zero, v, _CMP_LT_OQ), v);
+  const __m512i c = _mm512_cvtepu32_epi64(_mm512_cvttpd_epu32(_mm512_mul_pd(kept, cells)));
+  return _mm512_min_epu64(c, top);
+}
+
+// TreeWarp::DigitsInLeaf for a Hilbert tree (grid 2, chunks of 4 levels:
+// encode's 16 x 16 cells) on AVX-512F, eight points to a vector: the same
+// integer steps (the column and row by the same double product and
+// truncation, each level's and chunk's look-ups gathered). Returns how many
+// points it took (a multiple of eight); the caller encodes the rest.
+__attribute__((target("avx512f"))) size_t DigitsGrid2Avx512(
+    size_t m, const double* x, const double* y, const uint8_t* state, double cells,
+    uint64_t top, int chunks, int head, const int32_t* child_at, const int32_t* state_at,
+    const uint64_t* encode, uint64_t* digits) {
+  const __m512d scale = _mm512_set1_pd(cells);
+  const __m512i top_v = _mm512_set1_epi64(static_cast<int64_t>(top));
+  const __m512i low4 = _mm512_set1_epi64(15), low1 = _mm512_set1_epi64(1);
+  const __m512i digit_mask = _mm512_set1_epi64(static_cast<int64_t>((uint64_t{1} << 56) - 1));
+  size_t i0 = 0;
+  for (; i0 + 8 <= m; i0 += 8) {
+    const __m512i cx = CellsOf(_mm512_loadu_pd(x + i0), scale, top_v);
+    const __m512i cy = CellsOf(_mm512_loadu_pd(y + i0), scale, top_v);
+    __m512i s =
+        _mm512_cvtepu8_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(state + i0)));
+    __m512i d = _mm512_setzero_si512();
+    // The leading levels, above the chunks, one at a time.
+    for (int level = head - 1; level >= 0; --level) {
+      const int shift = 4 * chunks + level;
+      const __m512i dx = _mm512_and_si512(_mm512_srli_epi64(cx, shift), low1);
+      const __m512i dy = _mm512_and_si512(_mm512_srli_epi64(cy, shift), low1);
+      const __m512i at = _mm512_add_epi64(_mm512_add_epi64(_mm512_slli_epi64(s, 2),
+                                                           _mm512_slli_epi64(dy, 1)),
+                                          dx);
+      const __m512i child = _mm512_cvtepi32_epi64(_mm512_i64gather_epi32(at, child_at, 4));
+      d = _mm512_add_epi64(_mm512_slli_epi64(d, 2), child);
+      s = _mm512_cvtepi32_epi64(_mm512_i64gather_epi32(at, state_at, 4));
+    }
+    for (int c = chunks - 1; c >= 0; --c) {
+      const __m512i xs = _mm512_and_si512(_mm512_srli_epi64(cx, 4 * c), low4);
+      const __m512i ys = _mm512_and_si512(_mm512_srli_epi64(cy, 4 * c), low4);
+      const __m512i cell = _mm512_add_epi64(
+          _mm512_slli_epi64(s, 8), _mm512_add_epi64(_mm512_slli_epi64(ys, 4), xs));
+      const __m512i e = _mm512_i64gather_epi64(cell, encode, 8);
+      d = _mm512_add_epi64(_mm512_slli_epi64(d, 8), _mm512_and_si512(e, digit_mask));
+      s = _mm512_srli_epi64(e, 56);
+    }
+    _mm512_storeu_si512(digits + i0, d);
+  }
+  return i0;
+}
+
 // CdfInversion's F(x) = x (p0 + x (p1 / 2 + x (p2 / 3))), lane by lane.
 __attribute__((target("avx512f"))) inline __m512d CdfLanes(__m512d x, __m512d p0,
                                                            __m512d half_p1, __m512d third_p2) {
@@ -366,7 +422,7 @@ TreeWarp::TreeWarp(const CurveTree& tree)
   for (int s = 0; s < kStates; ++s) {
     for (int c = 0; c < arity_; ++c) {
       const Curve::Child& ch = curve_.ChildOf(s, c);
-      child_at_[s * arity_ + ch.dy * grid_ + ch.dx] = static_cast<uint8_t>(c);
+      child_at_[s * arity_ + ch.dy * grid_ + ch.dx] = c;
     }
   }
   state_at_.assign(kStates * arity_, 0);
@@ -525,7 +581,7 @@ void TreeWarp::LocateMany(size_t n, const double* a_in, const double* b_in, Curv
         PlaceInLeaf(l, a[i], b[i], &x[i], &y[i]);
       }
     }
-    DigitsInLeaf(m, x, y, state, digits);
+    DigitsInLeaf(m, x, y, state, digits, path);
     for (size_t i = 0; i < m; ++i) {
       CurveAddress& address = out[i0 + i];
       address.leaf = static_cast<uint32_t>(-ref[i] - 1);
@@ -610,7 +666,7 @@ void TreeWarp::PlaceInLeaf(size_t l, double a, double b, double* x, double* y) c
 }
 
 void TreeWarp::DigitsInLeaf(size_t m, const double* x, const double* y, const uint8_t* state,
-                            uint64_t* digits) const {
+                            uint64_t* digits, math::VectorPath path) const {
   // The sub-cell's column and row among g^levels, then their base-g digits
   // a chunk at a time, from the top; each level over all m points before the
   // next, so the points' chains of table look-ups overlap.
@@ -620,6 +676,12 @@ void TreeWarp::DigitsInLeaf(size_t m, const double* x, const double* y, const ui
   const double cells = curve_.PowG(levels);
   const uint64_t top = static_cast<uint64_t>(cells) - 1;
   const int chunks = levels / chunk_levels_, head = levels % chunk_levels_;
+  if (grid_ == 2 && path == math::VectorPath::kAvx512) {
+    const size_t vectored = DigitsGrid2Avx512(m, x, y, state, cells, top, chunks, head,
+                                              child_at_.data(), state_at_.data(), encode_.data(),
+                                              digits);
+    x += vectored, y += vectored, state += vectored, digits += vectored, m -= vectored;
+  }
   // Chunk values of each point's column and row, least significant first
   // (constant divisors: 16 for Hilbert, 9 for the 3x3 curves); what is left
   // are the leading levels.

@@ -97,7 +97,7 @@ class TreeWarp {
   // of the sub-cell holding (x[i], y[i]) of a leaf with orientation
   // state[i], i < m <= 64.
   void DigitsInLeaf(size_t m, const double* x, const double* y, const uint8_t* state,
-                    uint64_t* digits) const;
+                    uint64_t* digits, math::VectorPath path) const;
 
   const CurveTree& tree_;
   const Curve& curve_;
@@ -121,7 +121,7 @@ class TreeWarp {
   std::vector<uint64_t> encode_;
   int32_t root_ = 0;
   // child_at_[state * arity + dy * grid + dx]: the child at (dx, dy).
-  std::vector<uint8_t> child_at_;
+  std::vector<int32_t> child_at_;
   // state_at_[state * arity + dy * grid + dx]: that child's orientation.
   std::vector<int32_t> state_at_;
 };
