@@ -20,10 +20,12 @@ constexpr int kMaxDepth = 52;
 // depth at which nodes hold one leaf on average, at most 2^20 (8 MB).
 constexpr int kMaxBucketBits = 20;
 
-// 2^k, for |k| <= 62, exactly.
+// 2^k for |k| <= 1022, exactly: its exponent field (no division).
 double Pow2(int k) {
-  return k >= 0 ? static_cast<double>(uint64_t{1} << k)
-                : 1.0 / static_cast<double>(uint64_t{1} << -k);
+  const uint64_t bits = static_cast<uint64_t>(1023 + k) << 52;
+  double x;
+  std::memcpy(&x, &bits, sizeof x);
+  return x;
 }
 
 // Bit i of x at bit 2i, for x < 2^32.
