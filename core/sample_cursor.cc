@@ -19,48 +19,61 @@ SampleFields ColumnsOf(const CurveSamples& samples, SampleFields fields) {
   return fields;
 }
 
-// Sorts addresses into curve order (by CurveAddress::Key): a counting sort,
-// stable, by the leaf and the top bits of the digits (as many as make about
-// one bucket an address), then each bucket's few addresses by key, the
-// buckets split over `parts` threads. The order is the same as one sort of
-// the whole. Many more leaves than addresses (a large mesh, a small set)
+// Sorts addresses into curve order (by CurveAddress::Key), in place: a
+// bucket sort by the leaf and the digits' top bits (as many as make about
+// four addresses a bucket; the addresses permuted into their buckets as in
+// McIlroy, Bostic and McIlroy's American flag sort, 1993), then each bucket's
+// few addresses by key, the buckets split over `parts` threads. The order is
+// that of one sort of the whole (keys are distinct: they hold the index).
+// Beside the addresses it holds 8 bytes a bucket, at most 4 bytes an address
+// and 8 KB. More leaves than half the addresses (a large mesh, a small set)
 // take one sort.
 void SortAddresses(std::vector<CurveAddress>* addresses, int parts) {
   std::vector<CurveAddress>& at = *addresses;
   uint32_t leaves = 0;
   for (const CurveAddress& a : at) leaves = std::max(leaves, a.leaf + 1);
-  if (leaves > 4 * at.size() + 1024 || at.size() >= (uint64_t{1} << 32)) {
+  if (leaves > at.size() / 2 + 1024 || at.size() >= (uint64_t{1} << 32)) {
     std::sort(at.begin(), at.end());
     return;
   }
   // Digits are below 2^52 (CurveAddress::Key): the top `bits` of them.
   int bits = 0;
-  while (bits < 20 && (uint64_t{leaves} << (bits + 1)) <= 2 * at.size()) ++bits;
+  while (bits < 20 && (uint64_t{leaves} << (bits + 1)) <= at.size() / 4) ++bits;
   auto bucket_of = [bits](const CurveAddress& a) {
     return (uint64_t{a.leaf} << bits) | (a.digits >> (52 - bits));
   };
   const uint64_t buckets = uint64_t{leaves} << bits;
-  std::vector<uint32_t> first(buckets + 1, 0);  // each bucket's first position
-  for (const CurveAddress& a : at) ++first[bucket_of(a) + 1];
-  for (uint64_t c = 0; c < buckets; ++c) first[c + 1] += first[c];
-  std::vector<CurveAddress> sorted(at.size());
-  {
-    std::vector<uint32_t> next(first.begin(), first.end() - 1);
-    for (const CurveAddress& a : at) sorted[next[bucket_of(a)]++] = a;
+  // end[c]: where bucket c ends; next[c]: its first place not yet filled.
+  std::vector<uint32_t> end(buckets, 0), next(buckets);
+  for (const CurveAddress& a : at) ++end[bucket_of(a)];
+  uint32_t running = 0;
+  for (uint64_t c = 0; c < buckets; ++c) next[c] = running, running += end[c], end[c] = running;
+  for (uint64_t c = 0; c < buckets; ++c) {
+    while (next[c] < end[c]) {
+      // Carry the address at c's next place along its cycle until one of
+      // c's own comes back to it.
+      CurveAddress carried = at[next[c]];
+      for (uint64_t b = bucket_of(carried); b != c; b = bucket_of(carried)) {
+        std::swap(carried, at[next[b]++]);
+      }
+      at[next[c]++] = carried;
+    }
   }
   // Parts of about equal counts, cut at bucket boundaries.
   WorkerPool::Shared().ParallelFor(parts, [&](int i) {
     const uint64_t from = at.size() * i / parts, to = at.size() * (i + 1) / parts;
-    uint64_t c = static_cast<uint64_t>(std::upper_bound(first.begin(), first.end(), from) -
-                                       first.begin() - 1);
-    if (first[c] < from) ++c;  // the bucket across `from` is the part before's
-    for (; c < buckets && first[c] < to; ++c) {
-      if (first[c + 1] - first[c] > 1) {
-        std::sort(sorted.begin() + first[c], sorted.begin() + first[c + 1]);
-      }
+    // The buckets that begin in [from, to) (bucket c begins at end[c - 1]):
+    // each bucket with addresses is one part's.
+    uint64_t c = from == 0 ? 0
+                           : static_cast<uint64_t>(std::lower_bound(end.begin(), end.end(), from) -
+                                                   end.begin()) +
+                                 1;
+    for (; c < buckets; ++c) {
+      const uint64_t begin = c == 0 ? 0 : end[c - 1];
+      if (begin >= to) break;
+      if (end[c] - begin > 1) std::sort(at.begin() + begin, at.begin() + end[c]);
     }
   });
-  at.swap(sorted);
 }
 
 }  // namespace
