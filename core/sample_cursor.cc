@@ -19,17 +19,45 @@ SampleFields ColumnsOf(const CurveSamples& samples, SampleFields fields) {
   return fields;
 }
 
-// Sorts addresses into curve order (by CurveAddress::Key), in place: a
-// bucket sort by the leaf and the digits' top bits (as many as make about
-// four addresses a bucket; the addresses permuted into their buckets as in
-// McIlroy, Bostic and McIlroy's American flag sort, 1993), then each bucket's
-// few addresses by key, the buckets split over `parts` threads. The order is
+// Permutes at[0, n) in place so that the addresses of each bucket come
+// together, buckets in increasing order (McIlroy, Bostic and McIlroy's
+// American flag sort, 1993): bucket(a) in [0, buckets). `end` (buckets
+// entries) returns where each bucket ends.
+template <typename Bucket>
+void PermuteIntoBuckets(CurveAddress* at, size_t n, uint64_t buckets, const Bucket& bucket,
+                        std::vector<uint32_t>* end) {
+  end->assign(buckets, 0);
+  std::vector<uint32_t> next(buckets);  // each bucket's first place not yet filled
+  for (size_t j = 0; j < n; ++j) ++(*end)[bucket(at[j])];
+  uint32_t running = 0;
+  for (uint64_t c = 0; c < buckets; ++c) {
+    next[c] = running, running += (*end)[c], (*end)[c] = running;
+  }
+  for (uint64_t c = 0; c < buckets; ++c) {
+    while (next[c] < (*end)[c]) {
+      // Carry the address at c's next place along its cycle until one of
+      // c's own comes back to it.
+      CurveAddress carried = at[next[c]];
+      for (uint64_t b = bucket(carried); b != c; b = bucket(carried)) {
+        std::swap(carried, at[next[b]++]);
+      }
+      at[next[c]++] = carried;
+    }
+  }
+}
+
+// Sorts addresses into curve order (by CurveAddress::Key), in place: by
+// buckets of the leaf and the digits' top bits (as many as make about four
+// addresses a bucket), permuted in two passes, first by the top 8 bits of
+// the bucket (so the first pass writes to 256 places at a time), then each
+// of those by the rest while it is in cache, each bucket's few addresses
+// then by key; the second pass split over `parts` threads. The order is
 // that of one sort of the whole (keys are distinct: they hold the index).
-// Beside the addresses it holds 8 bytes a bucket, at most 4 bytes an address
-// and 8 KB. More leaves than half the addresses (a large mesh, a small set)
-// take one sort.
+// Beside the addresses it holds a few KB a thread. More leaves than half the
+// addresses (a large mesh, a small set) take one sort.
 void SortAddresses(std::vector<CurveAddress>* addresses, int parts) {
   std::vector<CurveAddress>& at = *addresses;
+  if (at.size() < 2) return;
   uint32_t leaves = 0;
   for (const CurveAddress& a : at) leaves = std::max(leaves, a.leaf + 1);
   if (leaves > at.size() / 2 + 1024 || at.size() >= (uint64_t{1} << 32)) {
@@ -43,35 +71,29 @@ void SortAddresses(std::vector<CurveAddress>* addresses, int parts) {
     return (uint64_t{a.leaf} << bits) | (a.digits >> (52 - bits));
   };
   const uint64_t buckets = uint64_t{leaves} << bits;
-  // end[c]: where bucket c ends; next[c]: its first place not yet filled.
-  std::vector<uint32_t> end(buckets, 0), next(buckets);
-  for (const CurveAddress& a : at) ++end[bucket_of(a)];
-  uint32_t running = 0;
-  for (uint64_t c = 0; c < buckets; ++c) next[c] = running, running += end[c], end[c] = running;
-  for (uint64_t c = 0; c < buckets; ++c) {
-    while (next[c] < end[c]) {
-      // Carry the address at c's next place along its cycle until one of
-      // c's own comes back to it.
-      CurveAddress carried = at[next[c]];
-      for (uint64_t b = bucket_of(carried); b != c; b = bucket_of(carried)) {
-        std::swap(carried, at[next[b]++]);
-      }
-      at[next[c]++] = carried;
-    }
-  }
-  // Parts of about equal counts, cut at bucket boundaries.
+  int fine_bits = 0;  // buckets >> fine_bits <= 256
+  while ((buckets - 1) >> fine_bits >= 256) ++fine_bits;
+  const uint64_t coarse = ((buckets - 1) >> fine_bits) + 1;
+  std::vector<uint32_t> coarse_end;
+  PermuteIntoBuckets(at.data(), at.size(), coarse,
+                     [&](const CurveAddress& a) { return bucket_of(a) >> fine_bits; },
+                     &coarse_end);
+  // Coarse buckets to parts of about equal counts.
   WorkerPool::Shared().ParallelFor(parts, [&](int i) {
     const uint64_t from = at.size() * i / parts, to = at.size() * (i + 1) / parts;
-    // The buckets that begin in [from, to) (bucket c begins at end[c - 1]):
-    // each bucket with addresses is one part's.
-    uint64_t c = from == 0 ? 0
-                           : static_cast<uint64_t>(std::lower_bound(end.begin(), end.end(), from) -
-                                                   end.begin()) +
-                                 1;
-    for (; c < buckets; ++c) {
-      const uint64_t begin = c == 0 ? 0 : end[c - 1];
-      if (begin >= to) break;
-      if (end[c] - begin > 1) std::sort(at.begin() + begin, at.begin() + end[c]);
+    std::vector<uint32_t> end;
+    for (uint64_t c = 0; c < coarse; ++c) {
+      const uint64_t begin = c == 0 ? 0 : coarse_end[c - 1];
+      // Each coarse bucket with addresses is the part's where it begins.
+      if (begin < from || begin >= to || coarse_end[c] == begin) continue;
+      CurveAddress* first = at.data() + begin;
+      const uint64_t base = c << fine_bits;
+      PermuteIntoBuckets(first, coarse_end[c] - begin, uint64_t{1} << fine_bits,
+                         [&](const CurveAddress& a) { return bucket_of(a) - base; }, &end);
+      for (size_t f = 0; f < end.size(); ++f) {
+        const uint32_t b = f == 0 ? 0 : end[f - 1];
+        if (end[f] - b > 1) std::sort(first + b, first + end[f]);
+      }
     }
   });
 }
