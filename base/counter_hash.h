@@ -10,7 +10,10 @@
 
 namespace sfc {
 
-inline uint64_t Mix64(uint64_t z) {
+// U is uint64_t, or a vector of them (GCC's vector extensions) hashed lane
+// by lane with the same bits.
+template <typename U>
+inline U Mix64(U z) {
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
   return z ^ (z >> 31);
@@ -35,14 +38,28 @@ inline uint64_t CounterKey(uint64_t seed, uint64_t stream) {
   return Mix64(seed + 0x9e3779b97f4a7c15ULL * (stream + 1));
 }
 
+// CounterHash's two halves, for a caller that hashes one counter in several
+// streams: the counter's own mix, then with a stream's key.
+template <typename U>
+inline U CounterMix(U counter) {
+  return Mix64(counter + 0x632be59bd9b4e019ULL);
+}
+template <typename U>
+inline U KeyedHash(uint64_t key, U counter_mix) {
+  return Mix64(key ^ counter_mix);
+}
+
 // 64 well-mixed bits for `counter` in the stream `stream` of `seed`.
 inline uint64_t CounterHash(uint64_t seed, uint64_t stream, uint64_t counter) {
-  return Mix64(CounterKey(seed, stream) ^ Mix64(counter + 0x632be59bd9b4e019ULL));
+  return KeyedHash(CounterKey(seed, stream), CounterMix(counter));
 }
+
+// The double uniform in [0,1) of 53 of a hash's bits (CounterUniform's).
+inline double UniformOf(uint64_t hash) { return static_cast<double>(hash >> 11) * 0x1.0p-53; }
 
 // A double uniform in [0,1) with 53 random bits.
 inline double CounterUniform(uint64_t seed, uint64_t stream, uint64_t counter) {
-  return static_cast<double>(CounterHash(seed, stream, counter) >> 11) * 0x1.0p-53;
+  return UniformOf(CounterHash(seed, stream, counter));
 }
 
 }  // namespace sfc

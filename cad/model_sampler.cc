@@ -222,15 +222,21 @@ absl::StatusOr<std::unique_ptr<ModelSampleCursor>> ModelSampleCursor::Create(
   cursor->end_ = end;
   if (sequence.two_dimensional()) {
     // [begin, end) are positions of the whole set in curve order: each
-    // piece's samples are counted, so a piece takes its part of the range.
+    // piece's samples are found, in one pass over the set, so a piece takes
+    // its part of the range and its cursor warps its own samples alone.
     const auto& pieces = cursor->tree_->pieces();
-    cursor->piece_counts_.assign(pieces.size(), 0);
+    cursor->piece_members_.assign(pieces.size(), {});
     std::vector<double> his(pieces.size());
     for (size_t p = 0; p < pieces.size(); ++p) his[p] = pieces[p].hi;
-    // Windows [lo, hi) meet end to end, and q_k = 1 is the last piece's.
+    // Windows [lo, hi) meet end to end, and q_k = 1 is the last piece's
+    // (Sequence::InWindow's choice).
     for (uint64_t k = 0; k < sequence.count(); ++k) {
       const size_t p = std::upper_bound(his.begin(), his.end(), sequence.At(k)) - his.begin();
-      ++cursor->piece_counts_[std::min(p, pieces.size() - 1)];
+      cursor->piece_members_[std::min(p, pieces.size() - 1)].push_back(static_cast<uint32_t>(k));
+    }
+    cursor->piece_counts_.resize(pieces.size());
+    for (size_t p = 0; p < pieces.size(); ++p) {
+      cursor->piece_counts_[p] = cursor->piece_members_[p].size();
     }
   }
   return cursor;
@@ -259,7 +265,11 @@ absl::Status ModelSampleCursor::OpenPiece() {
   auto sampler = std::make_shared<const Sampler>(piece.tree, piece.surface, piece.density, window);
   SampleFields core_fields = fields_;
   core_fields.face = core_fields.triangle = false;
-  ASSIGN_OR_RETURN(cursor_, SampleCursor::Create(sampler, kb, ke, Region{}, core_fields, threads_));
+  const std::vector<uint32_t>* members =
+      sequence_.two_dimensional() ? &piece_members_[piece_] : nullptr;
+  ASSIGN_OR_RETURN(cursor_, SampleCursor::Create(sampler, kb, ke, Region{}, core_fields, threads_,
+                                                 members));
+  if (members != nullptr) std::vector<uint32_t>().swap(piece_members_[piece_]);  // spent
   return absl::OkStatus();
 }
 

@@ -119,8 +119,10 @@ class ModelSampleCursor {
   const int threads_;
   uint64_t begin_ = 0, end_ = 0;
   // Two-dimensional sequences (sobol): each piece's number of samples, whose
-  // running sums turn [begin_, end_) into positions inside each piece.
+  // running sums turn [begin_, end_) into positions inside each piece, and
+  // its samples' indices (increasing; freed once its cursor is made).
   std::vector<uint64_t> piece_counts_;
+  std::vector<std::vector<uint32_t>> piece_members_;
   size_t piece_ = 0;                      // the piece being read
   std::unique_ptr<SampleCursor> cursor_;  // its cursor, null until opened
   SampleBatch scratch_;

@@ -24,6 +24,20 @@ absl::Status CurveSamples::AcceptsSequence(const Sequence& sequence) const {
                       SequenceName(sequence.kind())));
 }
 
+void CurveSamples::AddressesOf(const uint32_t* ks, uint64_t k0, size_t n, CurveAddress* out) const {
+  // A batch's points first, then one call of the kind's warp for them.
+  constexpr size_t kBatch = 256;
+  double a[kBatch], b[kBatch];
+  for (size_t i0 = 0; i0 < n; i0 += kBatch) {
+    const size_t m = std::min(kBatch, n - i0);
+    sequence_.PointsMany(ks != nullptr ? ks + i0 : nullptr, k0 + i0, m, a, b);
+    WarpMany(m, a, b, out + i0);
+    for (size_t i = 0; i < m; ++i) {
+      out[i0 + i].index = static_cast<uint32_t>(ks != nullptr ? ks[i0 + i] : k0 + i0 + i);
+    }
+  }
+}
+
 uint64_t CurveSamples::FirstIndexAtOrAbove(double m) const {
   return FirstIndexWhere(sequence_.count(), [&](uint64_t k) { return MassCoordinate(k) >= m; });
 }

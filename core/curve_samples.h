@@ -93,15 +93,12 @@ class CurveSamples {
   // rectangle, not kAll); they may hold more. Monotone sequences only.
   virtual absl::Status PlanRegion(const Region& region, uint64_t begin, uint64_t end,
                                   std::vector<IndexSegment>* segments) const = 0;
-  // Two-dimensional sequences (Sequence::two_dimensional): sample k's
-  // address, its point of the unit square (Sequence::At, Second) through the
-  // kind's warp (Warped), by which the cursor sorts the whole set and the
-  // filler places it.
-  CurveAddress AddressOf(uint64_t k) const {
-    CurveAddress at = Warped(sequence_.At(k), sequence_.Second(k));
-    at.index = static_cast<uint32_t>(k);
-    return at;
-  }
+  // Two-dimensional sequences (Sequence::two_dimensional): the addresses of
+  // samples ks[i] (k0 + i when ks is null), i < n, into out[i]: each
+  // sample's point of the unit square (Sequence::At, Second) through the
+  // kind's warp (WarpMany, a batch at a time), by which the cursor sorts the
+  // whole set and the filler places it. A pure function of each k.
+  void AddressesOf(const uint32_t* ks, uint64_t k0, size_t n, CurveAddress* out) const;
   // OK when the kind can place `sequence`'s samples; INVALID_ARGUMENT with
   // the reason otherwise (a kind without a warp for two-dimensional ones).
   virtual absl::Status AcceptsSequence(const Sequence& sequence) const;
@@ -118,9 +115,11 @@ class CurveSamples {
   // to `segments`, joined to the last one when they meet it.
   void AddMassRange(double m0, double m1, bool through_end, uint64_t begin, uint64_t end,
                     std::vector<IndexSegment>* segments) const;
-  // The address (index 0) of the point (a, b) of the unit square through the
-  // kind's warp. Kinds without a warp are refused by AcceptsSequence before.
-  virtual CurveAddress Warped(double a, double b) const { return {}; }
+  // The addresses (index 0) of the points (a[i], b[i]) of the unit square,
+  // i < n, through the kind's warp, into out[i]; each a pure function of its
+  // point (a batch lets a kind overlap the points' descents). Kinds without
+  // a warp are refused by AcceptsSequence before.
+  virtual void WarpMany(size_t n, const double* a, const double* b, CurveAddress* out) const {}
 
  private:
   Sequence sequence_;

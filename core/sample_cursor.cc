@@ -19,6 +19,85 @@ SampleFields ColumnsOf(const CurveSamples& samples, SampleFields fields) {
   return fields;
 }
 
+// Permutes at[0, n) in place so that the addresses of each bucket come
+// together, buckets in increasing order (McIlroy, Bostic and McIlroy's
+// American flag sort, 1993): bucket(a) in [0, buckets). `end` (buckets
+// entries) returns where each bucket ends.
+template <typename Bucket>
+void PermuteIntoBuckets(CurveAddress* at, size_t n, uint64_t buckets, const Bucket& bucket,
+                        std::vector<uint32_t>* end) {
+  end->assign(buckets, 0);
+  std::vector<uint32_t> next(buckets);  // each bucket's first place not yet filled
+  for (size_t j = 0; j < n; ++j) ++(*end)[bucket(at[j])];
+  uint32_t running = 0;
+  for (uint64_t c = 0; c < buckets; ++c) {
+    next[c] = running, running += (*end)[c], (*end)[c] = running;
+  }
+  for (uint64_t c = 0; c < buckets; ++c) {
+    while (next[c] < (*end)[c]) {
+      // Carry the address at c's next place along its cycle until one of
+      // c's own comes back to it.
+      CurveAddress carried = at[next[c]];
+      for (uint64_t b = bucket(carried); b != c; b = bucket(carried)) {
+        std::swap(carried, at[next[b]++]);
+      }
+      at[next[c]++] = carried;
+    }
+  }
+}
+
+// Sorts addresses into curve order (by CurveAddress::Key), in place: by
+// buckets of the leaf and the digits' top bits (as many as make about four
+// addresses a bucket), permuted in two passes, first by the top 8 bits of
+// the bucket (so the first pass writes to 256 places at a time), then each
+// of those by the rest while it is in cache, each bucket's few addresses
+// then by key; the second pass split over `parts` threads. The order is
+// that of one sort of the whole (keys are distinct: they hold the index).
+// Beside the addresses it holds a few KB a thread. More leaves than half the
+// addresses (a large mesh, a small set) take one sort.
+void SortAddresses(std::vector<CurveAddress>* addresses, int parts) {
+  std::vector<CurveAddress>& at = *addresses;
+  if (at.size() < 2) return;
+  uint32_t leaves = 0;
+  for (const CurveAddress& a : at) leaves = std::max(leaves, a.leaf + 1);
+  if (leaves > at.size() / 2 + 1024 || at.size() >= (uint64_t{1} << 32)) {
+    std::sort(at.begin(), at.end());
+    return;
+  }
+  // Digits are below 2^52 (CurveAddress::Key): the top `bits` of them.
+  int bits = 0;
+  while (bits < 20 && (uint64_t{leaves} << (bits + 1)) <= at.size() / 4) ++bits;
+  auto bucket_of = [bits](const CurveAddress& a) {
+    return (uint64_t{a.leaf} << bits) | (a.digits >> (52 - bits));
+  };
+  const uint64_t buckets = uint64_t{leaves} << bits;
+  int fine_bits = 0;  // buckets >> fine_bits <= 256
+  while ((buckets - 1) >> fine_bits >= 256) ++fine_bits;
+  const uint64_t coarse = ((buckets - 1) >> fine_bits) + 1;
+  std::vector<uint32_t> coarse_end;
+  PermuteIntoBuckets(at.data(), at.size(), coarse,
+                     [&](const CurveAddress& a) { return bucket_of(a) >> fine_bits; },
+                     &coarse_end);
+  // Coarse buckets to parts of about equal counts.
+  WorkerPool::Shared().ParallelFor(parts, [&](int i) {
+    const uint64_t from = at.size() * i / parts, to = at.size() * (i + 1) / parts;
+    std::vector<uint32_t> end;
+    for (uint64_t c = 0; c < coarse; ++c) {
+      const uint64_t begin = c == 0 ? 0 : coarse_end[c - 1];
+      // Each coarse bucket with addresses is the part's where it begins.
+      if (begin < from || begin >= to || coarse_end[c] == begin) continue;
+      CurveAddress* first = at.data() + begin;
+      const uint64_t base = c << fine_bits;
+      PermuteIntoBuckets(first, coarse_end[c] - begin, uint64_t{1} << fine_bits,
+                         [&](const CurveAddress& a) { return bucket_of(a) - base; }, &end);
+      for (size_t f = 0; f < end.size(); ++f) {
+        const uint32_t b = f == 0 ? 0 : end[f - 1];
+        if (end[f] - b > 1) std::sort(first + b, first + end[f]);
+      }
+    }
+  });
+}
+
 }  // namespace
 
 SampleCursor::SampleCursor(std::shared_ptr<const CurveSamples> samples, Region region,
@@ -30,7 +109,8 @@ SampleCursor::SampleCursor(std::shared_ptr<const CurveSamples> samples, Region r
 
 absl::StatusOr<std::unique_ptr<SampleCursor>> SampleCursor::Create(
     std::shared_ptr<const CurveSamples> samples, uint64_t begin, uint64_t end,
-    const Region& region, const SampleFields& fields, int threads) {
+    const Region& region, const SampleFields& fields, int threads,
+    const std::vector<uint32_t>* in_window) {
   const uint64_t count = samples->sequence().count();
   if (begin > end || end > count) {
     return absl::InvalidArgumentError(absl::StrFormat(
@@ -43,11 +123,12 @@ absl::StatusOr<std::unique_ptr<SampleCursor>> SampleCursor::Create(
   RETURN_IF_ERROR(region.Validate());
   auto cursor = std::unique_ptr<SampleCursor>(new SampleCursor(std::move(samples), region, fields));
   cursor->threads_ = std::max(1, threads);
-  RETURN_IF_ERROR(cursor->Plan(begin, end));
+  RETURN_IF_ERROR(cursor->Plan(begin, end, in_window));
   return cursor;
 }
 
-absl::Status SampleCursor::Plan(uint64_t begin, uint64_t end) {
+absl::Status SampleCursor::Plan(uint64_t begin, uint64_t end,
+                                const std::vector<uint32_t>* in_window) {
   const CurveSamples& samples = *samples_;
   if (samples.sequence().two_dimensional()) {
     // Points warped onto the surface: the whole set in curve order, of which
@@ -58,21 +139,22 @@ absl::Status SampleCursor::Plan(uint64_t begin, uint64_t end) {
     // A window's samples (a CAD face's) are found first, so only they are
     // warped and sorted: one face's cursor costs its own share of the set,
     // not the whole set's warp and sort.
-    std::vector<uint64_t> in_window;
-    if (sequence.windowed()) {
+    std::vector<uint32_t> found;
+    if (sequence.windowed() && in_window == nullptr) {
       for (uint64_t k = 0; k < count; ++k) {
-        if (sequence.InWindow(k)) in_window.push_back(k);
+        if (sequence.InWindow(k)) found.push_back(static_cast<uint32_t>(k));
       }
+      in_window = &found;
     }
-    const uint64_t m = sequence.windowed() ? in_window.size() : count;
+    const uint32_t* ks = sequence.windowed() ? in_window->data() : nullptr;
+    const uint64_t m = sequence.windowed() ? in_window->size() : count;
     addresses_.resize(m);
     const int parts = m >= 8192 ? threads_ : 1;
     WorkerPool::Shared().ParallelFor(parts, [&](int i) {
-      for (uint64_t j = m * i / parts; j < m * (i + 1) / parts; ++j) {
-        addresses_[j] = samples.AddressOf(sequence.windowed() ? in_window[j] : j);
-      }
+      const uint64_t j0 = m * i / parts, j1 = m * (i + 1) / parts;
+      samples.AddressesOf(ks != nullptr ? ks + j0 : nullptr, j0, j1 - j0, addresses_.data() + j0);
     });
-    std::sort(addresses_.begin(), addresses_.end());
+    SortAddresses(&addresses_, parts);
     const uint64_t kept = addresses_.size();
     addresses_.erase(addresses_.begin() + std::min(end, kept), addresses_.end());
     addresses_.erase(addresses_.begin(), addresses_.begin() + std::min(begin, kept));
@@ -116,7 +198,13 @@ absl::StatusOr<size_t> SampleCursor::NextRuns(size_t max, SampleBatch* batch) {
     if (use_addresses_) {
       if (order_pos_ >= addresses_.size()) break;
       const size_t n = std::min<size_t>(max - produced, addresses_.size() - order_pos_);
-      ASSIGN_OR_RETURN(kept, Generate(0, nullptr, n, batch, addresses_.data() + order_pos_));
+      const CurveAddress* at = addresses_.data() + order_pos_;
+      if (threads_ > 1 && region_.kind == Region::Kind::kAll && n >= kMinParallel) {
+        RETURN_IF_ERROR(GenerateParallel(0, n, batch, at));
+        kept = n;
+      } else {
+        ASSIGN_OR_RETURN(kept, Generate(0, nullptr, n, batch, at));
+      }
       order_pos_ += n;
     } else if (use_order_) {
       if (order_pos_ >= order_.size()) break;
@@ -218,7 +306,8 @@ absl::StatusOr<size_t> SampleCursor::Generate(uint64_t k0, const uint64_t* order
   return kept;
 }
 
-absl::Status SampleCursor::GenerateParallel(uint64_t k0, size_t n, SampleBatch* batch) {
+absl::Status SampleCursor::GenerateParallel(uint64_t k0, size_t n, SampleBatch* batch,
+                                            const CurveAddress* at) {
   // threads_ contiguous parts of the run, on the shared pool, each filling its
   // own rows of the grown columns; part 0 with the cursor's filler, the others
   // with their own. A sample is a pure function of k, so the bytes are the
@@ -230,11 +319,12 @@ absl::Status SampleCursor::GenerateParallel(uint64_t k0, size_t n, SampleBatch* 
   auto bound = [&](int i) { return n * i / parts; };
   WorkerPool::Shared().ParallelFor(parts, [&](int i) {
     const size_t begin = bound(i), count = bound(i + 1) - begin;
+    const CurveAddress* part_at = at != nullptr ? at + begin : nullptr;
     if (i == 0) {
-      status[i] = Fill(k0, nullptr, count, *filler_, out);
+      status[i] = Fill(k0, nullptr, count, *filler_, out, part_at);
     } else {
       const std::unique_ptr<SampleFiller> filler = samples_->NewFiller(region_, fields_);
-      status[i] = Fill(k0 + begin, nullptr, count, *filler, out.From(begin));
+      status[i] = Fill(k0 + begin, nullptr, count, *filler, out.From(begin), part_at);
     }
   });
   for (const absl::Status& st : status) {

@@ -8,6 +8,7 @@
 #ifndef SFCSAMPLER_CORE_SAMPLE_CURSOR_H_
 #define SFCSAMPLER_CORE_SAMPLE_CURSOR_H_
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -30,11 +31,18 @@ class SampleCursor {
   // n = end - begin). Errors: INVALID_ARGUMENT for begin > end, end > count,
   // a region the kind rejects, or an empty region; RESOURCE_EXHAUSTED is not
   // raised here (the caller bounds count). `threads` > 1 lets Next() fill
-  // large batches of plain index ranges with that many threads of the shared
-  // pool (base/worker_pool.h); the samples and their order do not change.
+  // large batches of plain index ranges (and a two-dimensional sequence's
+  // warp, sort and batches) with that many threads of the shared pool
+  // (base/worker_pool.h); the samples and their order do not change.
+  // For a windowed two-dimensional sequence, `in_window` (when not null)
+  // lists the indices k that Sequence::InWindow accepts, increasing, as a
+  // caller that splits one set into windows finds them all in one pass
+  // (cad/model_sampler.h); else the cursor tests every index. Read only
+  // during Create.
   static absl::StatusOr<std::unique_ptr<SampleCursor>> Create(
       std::shared_ptr<const CurveSamples> samples, uint64_t begin, uint64_t end,
-      const Region& region, const SampleFields& fields, int threads = 1);
+      const Region& region, const SampleFields& fields, int threads = 1,
+      const std::vector<uint32_t>* in_window = nullptr);
 
   // Appends up to `max` samples to `batch` (which it does not clear) and
   // returns how many; 0 once the cursor is exhausted. Errors: the filler's
@@ -44,7 +52,7 @@ class SampleCursor {
 
  private:
   SampleCursor(std::shared_ptr<const CurveSamples> samples, Region region, SampleFields fields);
-  absl::Status Plan(uint64_t begin, uint64_t end);
+  absl::Status Plan(uint64_t begin, uint64_t end, const std::vector<uint32_t>* in_window);
   absl::StatusOr<size_t> NextRuns(size_t max, SampleBatch* batch);
   // Grows the batch's columns by n rows and returns the new rows.
   SampleRows Grow(SampleBatch* batch, size_t n) const;
@@ -59,8 +67,10 @@ class SampleCursor {
   // in the region; returns how many.
   absl::StatusOr<size_t> Generate(uint64_t k0, const uint64_t* order, size_t n,
                                   SampleBatch* batch, const CurveAddress* at = nullptr);
-  // Appends [k0, k0 + n) (all kept: no region), split over threads_ threads.
-  absl::Status GenerateParallel(uint64_t k0, size_t n, SampleBatch* batch);
+  // Appends [k0, k0 + n) (or the samples at at[i], i < n), all kept (no
+  // region), split over threads_ threads.
+  absl::Status GenerateParallel(uint64_t k0, size_t n, SampleBatch* batch,
+                                const CurveAddress* at = nullptr);
 
   const std::shared_ptr<const CurveSamples> samples_;
   const Region region_;

@@ -41,12 +41,7 @@ absl::Status SurfaceFiller::Fill(size_t n, const SampleRows& out) {
 
 absl::Status SurfaceFiller::FillAddressed(size_t n, const CurveAddress* at,
                                           const SampleRows& out) {
-  const TreeWarp& warp = *sampler_.warp();
-  for (size_t i = 0; i < n; ++i) {
-    const TreeWarp::Point p = warp.Place(at[i]);
-    out.u[i] = p.u, out.v[i] = p.v;
-    if (out.curve_position != nullptr) out.curve_position[i] = p.curve_position;
-  }
+  sampler_.warp()->PlaceMany(n, at, out.u, out.v, out.curve_position);
   return Evaluate(n, out);
 }
 
@@ -100,7 +95,9 @@ Sampler::Sampler(std::shared_ptr<const CurveTree> tree, std::shared_ptr<const Su
   if (sequence.two_dimensional()) warp_ = std::make_unique<const TreeWarp>(*tree_);
 }
 
-CurveAddress Sampler::Warped(double a, double b) const { return warp_->Locate(a, b); }
+void Sampler::WarpMany(size_t n, const double* a, const double* b, CurveAddress* out) const {
+  warp_->LocateMany(n, a, b, out);
+}
 
 std::unique_ptr<SampleFiller> Sampler::NewFiller(const Region&, const SampleFields& fields) const {
   return std::make_unique<SurfaceFiller>(*this, fields);

@@ -41,9 +41,9 @@ class Sampler final : public CurveSamples {
   // Every sequence: a two-dimensional one (sobol) through a TreeWarp of the
   // tree, made with the sampler (O(leaves)).
   absl::Status AcceptsSequence(const Sequence&) const override { return absl::OkStatus(); }
-  // The point (a, b) of the unit square through the TreeWarp. REQUIRES: a
-  // two-dimensional sequence.
-  CurveAddress Warped(double a, double b) const override;
+  // The points (a[i], b[i]) of the unit square through the TreeWarp.
+  // REQUIRES: a two-dimensional sequence.
+  void WarpMany(size_t n, const double* a, const double* b, CurveAddress* out) const override;
   // The warp of a two-dimensional sequence; null for the others.
   const TreeWarp* warp() const { return warp_.get(); }
 

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/types/sequence_kind.h"
+#include "core/vector_math.h"
 
 namespace sfc {
 
@@ -84,6 +85,12 @@ class Sequence {
   // Owen-scrambled (radical inverse of k, Sobol's second dimension of k): a
   // pure function of (seed, k), not of count. REQUIRES: k < 2^32.
   double Second(uint64_t k) const;
+  // a[i] = At(k), b[i] = Second(k) of k = ks[i] (k0 + i when ks is null), i <
+  // n, bit for bit, in one call (the two coordinates share k's hashing;
+  // eight points at a time on the AVX-512F vector path). REQUIRES: kSobol,
+  // math::Runs(path).
+  void PointsMany(const uint32_t* ks, uint64_t k0, size_t n, double* a, double* b,
+                  math::VectorPath path = math::BestVectorPath()) const;
   bool two_dimensional() const { return SequenceIsTwoDimensional(kind_); }
 
  private:

@@ -196,7 +196,8 @@ absl::StatusOr<std::string> IntegrationTables(const IntegrationOptions& o,
   std::string out = absl::StrFormat(
       "## Integration: sample means against exact values (issue 36)\n\n"
       "f = x^2 + 0.3 y z + exp(z); g = x^2 + 0.3 y z + z on the mesh. Exact means computed from "
-      "the surfaces' formulas (evaluation/integration.h). Mean |error| over seeds %s at each N; "
+      "the surfaces' formulas (evaluation/integration.h). Mean |error| over seeds %s at each N, "
+      "+- its standard error over the seeds; "
       "slope of log error on log N; points and time (the mean run's wall time "
       "fitted as a + b N) to reach 1e-4 and 1e-5 on the fitted line, ~ where it is "
       "extrapolated past N = %d.\n\n",
@@ -210,9 +211,10 @@ absl::StatusOr<std::string> IntegrationTables(const IntegrationOptions& o,
     absl::StrAppend(&out, "\n");
     std::map<SequenceKind, double> last;
     for (SequenceKind mode : modes) {
-      std::vector<double> errors, seconds;
+      std::vector<double> errors, standard_errors, seconds;
       for (double n : sizes) {
-        double sum = 0, time = 0;
+        std::vector<double> seed_errors;  // |error| of each seed's sample mean
+        double time = 0;
         for (uint64_t seed : o.seeds) {
           const auto start = std::chrono::steady_clock::now();
           ASSIGN_OR_RETURN(const SampleBatch b, source(c.spec, "uniform", uint64_t(n), seed, mode));
@@ -230,14 +232,19 @@ absl::StatusOr<std::string> IntegrationTables(const IntegrationOptions& o,
           for (size_t i = 0; i < b.size(); ++i) {
             mean += c.func(b.x[i] / scale, b.y[i] / scale, b.z[i] / scale);
           }
-          sum += std::fabs(mean / b.size() - c.exact);
+          seed_errors.push_back(std::fabs(mean / b.size() - c.exact));
         }
-        errors.push_back(std::max(sum / o.seeds.size(), 1e-300));
+        double mean_error, standard_error;
+        MeanAndStandardError(seed_errors, &mean_error, &standard_error);
+        errors.push_back(std::max(mean_error, 1e-300));
+        standard_errors.push_back(standard_error);
         seconds.push_back(time / o.seeds.size());
       }
       last[mode] = errors.back();
       std::string row = absl::StrCat("| ", std::string(SequenceName(mode)), " |");
-      for (double e : errors) absl::StrAppend(&row, absl::StrFormat(" %.2e |", e));
+      for (size_t i = 0; i < errors.size(); ++i) {
+        absl::StrAppend(&row, absl::StrFormat(" %.2e +- %.1e |", errors[i], standard_errors[i]));
+      }
       absl::StrAppend(&row, absl::StrFormat(" %.2f |", LogLogSlope(sizes, errors)));
       for (double target : {1e-4, 1e-5}) {
         const double n = Reach(sizes, errors, target);

@@ -10,9 +10,10 @@
 //  - g = x^2 + 0.3 y z + z on an icosphere of 5120 flat triangles that this
 //    file builds and writes as OBJ (the edge-midpoint rule is exact for a
 //    quadratic on a flat triangle).
-// Mean |error| over the seeds at each N, the least-squares slope of its log
-// against log N, and the points and time to reach 1e-4 and 1e-5 read off the
-// fitted lines (extrapolated past the largest N, marked so).
+// Mean |error| over the seeds at each N with its standard error over the
+// seeds (the spread of one seed's error over sqrt(seeds)), the least-squares
+// slope of its log against log N, and the points and time to reach 1e-4 and
+// 1e-5 read off the fitted lines (extrapolated past the largest N, marked so).
 //
 // Thread-safety: reentrant.
 #ifndef SFCSAMPLER_EVALUATION_INTEGRATION_H_

@@ -155,7 +155,9 @@ MeshSampler::MeshSampler(std::shared_ptr<const MeshCurveTree> tree, Sequence seq
   if (sequence.two_dimensional()) warp_ = std::make_unique<const MeshWarp>(*tree_);
 }
 
-CurveAddress MeshSampler::Warped(double a, double b) const { return warp_->Locate(a, b); }
+void MeshSampler::WarpMany(size_t n, const double* a, const double* b, CurveAddress* out) const {
+  warp_->LocateMany(n, a, b, out);
+}
 
 size_t MeshSampler::LeafForMass(double m) const {
   const auto& ends = tree_->mass_ends();

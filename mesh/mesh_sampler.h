@@ -81,9 +81,9 @@ class MeshSampler final : public CurveSamples {
   // Every sequence: a two-dimensional one (sobol) through a MeshWarp made
   // with the sampler (O(1)).
   absl::Status AcceptsSequence(const Sequence&) const override { return absl::OkStatus(); }
-  // The point (a, b) of the unit square through the MeshWarp. REQUIRES: a
-  // two-dimensional sequence.
-  CurveAddress Warped(double a, double b) const override;
+  // The points (a[i], b[i]) of the unit square through the MeshWarp.
+  // REQUIRES: a two-dimensional sequence.
+  void WarpMany(size_t n, const double* a, const double* b, CurveAddress* out) const override;
   const MeshWarp* warp() const { return warp_.get(); }
 
   // INVALID_ARGUMENT for a parameter rectangle: a mesh has no parameter

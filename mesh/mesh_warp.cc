@@ -1,7 +1,10 @@
 #include "mesh/mesh_warp.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
+#include <cstring>
+#include <vector>
 
 namespace sfc {
 namespace {
@@ -13,12 +16,46 @@ constexpr double kBelowOne = 1.0 - 0x1.0p-53;
 constexpr int kExtraDepth = 12;
 // At most 26 halvings of each coordinate, far below the net's 2^-32.
 constexpr int kMaxDepth = 52;
+// The buckets that start the search for a leaf: 2^(depth + 1) nodes of the
+// depth at which nodes hold one leaf on average, at most 2^20 (8 MB).
+constexpr int kMaxBucketBits = 20;
 
-// Halves *c at 1/2: the side it falls on, *c rescaled to it (exact).
-int Halve(double* c) {
-  const int side = *c < 0.5 ? 0 : 1;
-  *c = 2 * *c - side;
-  return side;
+// 2^k for |k| <= 1022, exactly: its exponent field (no division).
+double Pow2(int k) {
+  const uint64_t bits = static_cast<uint64_t>(1023 + k) << 52;
+  double x;
+  std::memcpy(&x, &bits, sizeof x);
+  return x;
+}
+
+// Bit i of x at bit 2i, for x < 2^32.
+uint64_t Spread(uint64_t x) {
+  x = (x | x << 16) & 0x0000ffff0000ffffULL;
+  x = (x | x << 8) & 0x00ff00ff00ff00ffULL;
+  x = (x | x << 4) & 0x0f0f0f0f0f0f0f0fULL;
+  x = (x | x << 2) & 0x3333333333333333ULL;
+  return (x | x << 1) & 0x5555555555555555ULL;
+}
+
+// The first i < n with e[i] > x (FirstAbove) or e[i] >= x (FirstAtOrAbove),
+// n if none, in a sorted e: std::upper_bound's and std::lower_bound's answer
+// by a search whose steps are selects, not branches.
+template <typename Before>
+size_t FirstNotBefore(const double* e, size_t n, double x, const Before& before) {
+  if (n == 0) return 0;
+  const double* base = e;
+  for (size_t len = n; len > 1;) {
+    const size_t half = len / 2;
+    base = before(base[half - 1], x) ? base + half : base;
+    len -= half;
+  }
+  return static_cast<size_t>(base - e) + (before(*base, x) ? 1 : 0);
+}
+size_t FirstAbove(const double* e, size_t n, double x) {
+  return FirstNotBefore(e, n, x, [](double v, double y) { return v <= y; });
+}
+size_t FirstAtOrAbove(const double* e, size_t n, double x) {
+  return FirstNotBefore(e, n, x, [](double v, double y) { return v < y; });
 }
 
 // The u in [0, 1] where the mass of a density linear on [0, 1], from d0 at 0
@@ -96,42 +133,87 @@ MeshWarp::MeshWarp(const MeshCurveTree& tree) : tree_(tree) {
   int depth = 0;
   while (depth < 40 && (size_t{1} << depth) < tree.leaf_count()) ++depth;
   max_depth_ = std::min(depth + kExtraDepth, kMaxDepth);
+  uniform_density_ = tree.density().uniform();
+  // Leaves are numbered by 32 bits (CurveAddress::leaf): nodes are never
+  // narrower than 2^-44, which LocateInLeaf's search needs.
+  assert(max_depth_ <= 44);
+  // The buckets: node j of depth bucket_bits_ meets leaves FirstAbove(its
+  // begin) .. FirstAtOrAbove(its end), and every node inside it a sub-range.
+  // Two pointers walk the leaves once.
+  bucket_bits_ = std::min(max_depth_, std::min(depth + 1, kMaxBucketBits));
+  const size_t buckets = size_t{1} << bucket_bits_;
+  const auto& ends = tree.mass_ends();
+  const double total = tree.total_mass();
+  bucket_leaves_.resize(2 * buckets);
+  size_t first = 0, last = 0;
+  for (size_t j = 0; j < buckets; ++j) {
+    const double begin = std::ldexp(static_cast<double>(j), -bucket_bits_) * total;
+    const double end = std::ldexp(static_cast<double>(j + 1), -bucket_bits_) * total;
+    while (first < ends.size() && ends[first] <= begin) ++first;
+    while (last < ends.size() && ends[last] < end) ++last;
+    bucket_leaves_[2 * j] = static_cast<uint32_t>(first);
+    bucket_leaves_[2 * j + 1] = static_cast<uint32_t>(last);
+  }
 }
 
-CurveAddress MeshWarp::Locate(double a, double b) const {
+void MeshWarp::LocateInLeaf(double a, double b, size_t* leaf, double* pa, double* pb) const {
   double c[2] = {std::clamp(a, 0.0, kBelowOne), std::clamp(b, 0.0, kBelowOne)};
   const auto& ends = tree_.mass_ends();
   const double total = tree_.total_mass();
-  // The node is the mass interval [t0, t0 + w) x total; the leaves that meet
-  // it are lo..hi (the leaves holding its first and last mass).
-  double t0 = 0, w = 1;
-  auto leaf_at = [&](double t, size_t from, size_t to) {
-    // The first leaf in [from, to] whose end passes t x total.
-    return static_cast<size_t>(std::upper_bound(ends.begin() + from, ends.begin() + to, t * total) -
-                               ends.begin());
+  // The node is the mass interval [t0, t0 + w) x total. Dyadic halves of the
+  // square hold equal masses: their line is a line of the net's elementary
+  // intervals, which every scrambled (0, m, 2)-net fills exactly, whatever
+  // the integrand does across it. The node at depth d holds the point whose
+  // top bits, the first coordinate's at even depths and the second's at odd
+  // ones, interleaved, are the top d bits of t0 (and c is what is left of
+  // each coordinate below them). The leaves that meet a node are lo..hi, the
+  // leaves holding its first and last mass: lo the first leaf ending above
+  // t0 x total, hi the first ending at or above (t0 + w) x total; both move
+  // inward as nodes nest (their ends differ by far more than their rounding:
+  // w >= 2^-44). The halving stops at the first node inside one leaf, or at
+  // the depth cap: the leaves of the node at the cap are found first, then
+  // the depth where the node's lo and hi first meet, by bisection.
+  const int bits_a = (max_depth_ + 1) / 2, bits_b = max_depth_ / 2;
+  const uint64_t top_a = Spread(static_cast<uint64_t>(c[0] * Pow2(bits_a)));
+  const uint64_t top_b = Spread(static_cast<uint64_t>(c[1] * Pow2(bits_b)));
+  const uint64_t cap_node = max_depth_ % 2 == 0 ? top_a << 1 | top_b : top_a | top_b << 1;
+  // The node of depth d: t0, and t0 + w (exact dyadic values).
+  auto begin_at = [&](int d) {
+    return static_cast<double>(cap_node >> (max_depth_ - d)) * Pow2(-d);
   };
-  const size_t last = ends.size() - 1;
-  size_t lo = leaf_at(0, 0, last), hi = last;
-  while (hi > 0 && !(ends[hi] > tree_.mass_begin(hi))) --hi;  // the last leaf with mass
-  int axis = 0, depth = 0;
-  for (; lo < hi && depth < max_depth_; ++depth) {
-    // Dyadic halves of the square hold equal masses: their line is a line of
-    // the net's elementary intervals, which every scrambled (0, m, 2)-net
-    // fills exactly, whatever the integrand does across it.
-    w *= 0.5;
-    const double m = (t0 + w) * total;
-    if (Halve(&c[axis]) == 0) {  // the last leaf holding mass below m
-      hi = static_cast<size_t>(std::lower_bound(ends.begin() + lo, ends.begin() + hi, m) -
-                               ends.begin());
-    } else {  // the first leaf holding mass above m
-      t0 += w, lo = leaf_at(t0, lo, hi);
+  auto end_at = [&](int d) {
+    return static_cast<double>((cap_node >> (max_depth_ - d)) + 1) * Pow2(-d);
+  };
+  // Both lie among the leaves that meet the cap node's bucket.
+  const size_t bucket = static_cast<size_t>(cap_node >> (max_depth_ - bucket_bits_));
+  const size_t from = bucket_leaves_[2 * bucket], to = bucket_leaves_[2 * bucket + 1] + size_t{1};
+  size_t lo = from + FirstAbove(ends.data() + from, to - from, begin_at(max_depth_) * total);
+  size_t hi = from + FirstAtOrAbove(ends.data() + from, to - from, end_at(max_depth_) * total);
+  int depth = max_depth_;
+  if (lo == hi) {
+    // The first depth whose node holds mass of leaf lo alone: t0 x total >=
+    // lo's begin and (t0 + w) x total <= lo's end, false and then true.
+    const double lo_begin = tree_.mass_begin(lo), lo_end = ends[lo];
+    int shallow = 0;
+    while (shallow < depth) {
+      const int mid = (shallow + depth) / 2;
+      if (begin_at(mid) * total >= lo_begin && end_at(mid) * total <= lo_end) {
+        depth = mid;
+      } else {
+        shallow = mid + 1;
+      }
     }
-    axis ^= 1;
   }
+  // What is left of each coordinate below the node's bits (exact).
+  const double scaled_a = c[0] * Pow2((depth + 1) / 2), scaled_b = c[1] * Pow2(depth / 2);
+  c[0] = scaled_a - std::floor(scaled_a), c[1] = scaled_b - std::floor(scaled_b);
+  const int axis = depth % 2;
+  double t0 = begin_at(depth), w = Pow2(-depth);
   if (lo < hi) {
     // Still across leaves at the depth cap: the coordinate picks the mass.
     const double t = t0 + c[axis] * w;
-    const size_t l = leaf_at(t, lo, hi);
+    const size_t l = static_cast<size_t>(
+        std::upper_bound(ends.begin() + lo, ends.begin() + hi, t * total) - ends.begin());
     const double begin = std::max(t0 * total, tree_.mass_begin(l));
     const double end = std::min((t0 + w) * total, ends[l]);
     c[axis] = end > begin ? std::clamp((t * total - begin) / (end - begin), 0.0, kBelowOne) : 0.0;
@@ -139,7 +221,9 @@ CurveAddress MeshWarp::Locate(double a, double b) const {
     lo = hi = l;
   }
   const size_t l = lo;
-  const MeshCurveTree::Cell cell = tree_.LeafCell(l);
+  // PlaceInCell reads the cell's density model alone: under a uniform
+  // density every cell's is the default (uniform), with no cell to decode.
+  const MeshCurveTree::Cell cell = uniform_density_ ? MeshCurveTree::Cell{} : tree_.LeafCell(l);
   // The node's share of the leaf, as fractions of the leaf's mass.
   const double leaf_begin = tree_.mass_begin(l), leaf_mass = ends[l] - leaf_begin;
   const double f0 =
@@ -148,13 +232,103 @@ CurveAddress MeshWarp::Locate(double a, double b) const {
       leaf_mass > 0 ? std::clamp(((t0 + w) * total - leaf_begin) / leaf_mass, 0.0, 1.0) : 1.0;
   // The node's share of the leaf: the next coordinate to be halved takes the
   // mass along it, the other the way across.
-  double pa, pb;
-  PlaceInCell(cell, f0 + c[axis] * (f1 - f0), c[axis ^ 1], &pa, &pb);
-  CurveAddress address;
-  address.digits = MeshCurveTree::PathOf(pa, pb);
-  address.leaf = static_cast<uint32_t>(l);
-  address.index = 0;
-  return address;
+  PlaceInCell(cell, f0 + c[axis] * (f1 - f0), c[axis ^ 1], pa, pb);
+  *leaf = l;
+}
+
+void MeshWarp::LocateMany(size_t n, const double* a, const double* b, CurveAddress* out) const {
+  constexpr size_t kBatch = 64;
+  double pa[kBatch], pb[kBatch];
+  uint64_t paths[kBatch];
+  const math::VectorPath vector_path = math::BestVectorPath();
+  for (size_t i0 = 0; i0 < n; i0 += kBatch) {
+    const size_t m = std::min(kBatch, n - i0);
+    for (size_t i = 0; i < m; ++i) {
+      size_t leaf;
+      LocateInLeaf(a[i0 + i], b[i0 + i], &leaf, &pa[i], &pb[i]);
+      out[i0 + i].leaf = static_cast<uint32_t>(leaf);
+      out[i0 + i].index = 0;
+    }
+    PathsOf(m, pa, pb, paths, vector_path);
+    for (size_t i = 0; i < m; ++i) out[i0 + i].digits = paths[i];
+  }
+}
+
+namespace {
+
+// MeshCurveTree::PathOf over 8 lanes x kVectors vectors at once, in GCC's
+// vector extensions: the same IEEE operations in the same order as the
+// scalar code (comparisons and selects for its branches and clamps), so the
+// same bits on any instruction set. The vectors are independent chains of
+// kLevels steps that the CPU overlaps.
+typedef double Lanes8 __attribute__((vector_size(64)));
+typedef int64_t Mask8 __attribute__((vector_size(64)));
+typedef uint64_t Bits8 __attribute__((vector_size(64)));
+constexpr int kLanes = 8, kVectors = 4, kBlock = kLanes * kVectors;
+
+__attribute__((always_inline)) inline void PathsOfBlock(const double* pa, const double* pb,
+                                                        uint64_t* paths) {
+  Lanes8 a[kVectors], b[kVectors];
+  Bits8 p[kVectors];
+  for (int v = 0; v < kVectors; ++v) {
+    std::memcpy(&a[v], pa + v * kLanes, sizeof(Lanes8));
+    std::memcpy(&b[v], pb + v * kLanes, sizeof(Lanes8));
+    p[v] = Bits8{};
+  }
+  const Lanes8 zero{}, one = zero + 1.0;
+  for (int level = 0; level < MeshCurveTree::kLevels; ++level) {
+    for (int v = 0; v < kVectors; ++v) {
+      // Child (E, A, M): (a, b) -> (b, 2a); child (A, X, M): (a, b) ->
+      // (2a + b - 1, 2 (1 - a - b)).
+      const Lanes8 s = 2 * a[v] + b[v];
+      const Mask8 first = s < one;
+      const Lanes8 na = first ? b[v] : s - 1;
+      const Lanes8 nb = first ? 2 * a[v] : 2 * (1 - a[v] - b[v]);
+      // std::clamp(na, 0, 1), then std::clamp(nb, 0, 1 - a).
+      a[v] = na < zero ? zero : (one < na ? one : na);
+      const Lanes8 top = 1 - a[v];
+      b[v] = nb < zero ? zero : (top < nb ? top : nb);
+      p[v] = (p[v] << 1) | (Bits8)(first + 1);
+    }
+  }
+  for (int v = 0; v < kVectors; ++v) std::memcpy(paths + v * kLanes, &p[v], sizeof(Bits8));
+}
+
+// n <= kBlock points: padded to a block.
+__attribute__((always_inline)) inline void PathsOfPadded(size_t n, const double* pa,
+                                                         const double* pb, uint64_t* paths) {
+  double a[kBlock] = {}, b[kBlock] = {};
+  uint64_t p[kBlock];
+  std::copy(pa, pa + n, a), std::copy(pb, pb + n, b);
+  PathsOfBlock(a, b, p);
+  std::copy(p, p + n, paths);
+}
+
+// The same loop compiled for the baseline (SSE2 pairs) and for AVX-512F.
+void PathsOfBaseline(size_t n, const double* pa, const double* pb, uint64_t* paths) {
+  size_t i = 0;
+  for (; i + kBlock <= n; i += kBlock) PathsOfBlock(pa + i, pb + i, paths + i);
+  if (i < n) PathsOfPadded(n - i, pa + i, pb + i, paths + i);
+}
+
+__attribute__((target("avx512f"))) void PathsOfAvx512(size_t n, const double* pa,
+                                                      const double* pb, uint64_t* paths) {
+  size_t i = 0;
+  for (; i + kBlock <= n; i += kBlock) PathsOfBlock(pa + i, pb + i, paths + i);
+  if (i < n) PathsOfPadded(n - i, pa + i, pb + i, paths + i);
+}
+
+}  // namespace
+
+void MeshWarp::PathsOf(size_t n, const double* pa, const double* pb, uint64_t* paths,
+                       math::VectorPath path) {
+  if (path == math::VectorPath::kScalar) {
+    for (size_t i = 0; i < n; ++i) paths[i] = MeshCurveTree::PathOf(pa[i], pb[i]);
+  } else if (path == math::VectorPath::kAvx512) {
+    PathsOfAvx512(n, pa, pb, paths);
+  } else {
+    PathsOfBaseline(n, pa, pb, paths);
+  }
 }
 
 }  // namespace sfc

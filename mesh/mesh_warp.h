@@ -30,24 +30,50 @@
 #define SFCSAMPLER_MESH_MESH_WARP_H_
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "core/curve_samples.h"
+#include "core/vector_math.h"
 #include "mesh/mesh_curve_tree.h"
 
 namespace sfc {
 
 class MeshWarp {
  public:
-  // O(1). REQUIRES: `tree` outlives the warp.
+  // O(leaves) time and at most 32 bytes a leaf (and 8 MB). REQUIRES: `tree`
+  // outlives the warp.
   explicit MeshWarp(const MeshCurveTree& tree);
 
   // The address of the image of (a, b) in [0, 1]^2 (clamped); index 0.
-  CurveAddress Locate(double a, double b) const;
+  CurveAddress Locate(double a, double b) const {
+    CurveAddress at;
+    LocateMany(1, &a, &b, &at);
+    return at;
+  }
+  // out[i] = Locate(a[i], b[i]) for i < n, bit for bit; the bisections
+  // below the leaves (PathsOf) run over the batch at once.
+  void LocateMany(size_t n, const double* a, const double* b, CurveAddress* out) const;
+
+  // paths[i] = MeshCurveTree::PathOf(pa[i], pb[i]) for i < n, bit for bit,
+  // on the vector path `path` (8 lanes of the same IEEE operations; AVX-512F
+  // or the baseline's). REQUIRES: math::Runs(path).
+  static void PathsOf(size_t n, const double* pa, const double* pb, uint64_t* paths,
+                      math::VectorPath path = math::BestVectorPath());
 
  private:
+  // The leaf holding the image of (a, b) and the point's place in the
+  // leaf's frame (E (0, 0), X (1, 0), A (0, 1)).
+  void LocateInLeaf(double a, double b, size_t* leaf, double* pa, double* pb) const;
+
   const MeshCurveTree& tree_;
   int max_depth_ = 0;  // halvings before a node across leaves is split by mass
+  bool uniform_density_ = false;  // every leaf cell's model is uniform
+  // Node j of depth bucket_bits_ meets leaves bucket_leaves_[2j] ..
+  // bucket_leaves_[2j + 1]: where the search for a node's leaves starts.
+  int bucket_bits_ = 0;
+  std::vector<uint32_t> bucket_leaves_;
 };
 
 }  // namespace sfc

@@ -38,6 +38,9 @@ for row in "^### sphere, f (exact mean 1.5085345269771" "^### torus R = 2, r = 1
            "^### icosphere mesh (5120 triangles), g (exact mean 0.3328530394366" "^| sobol | " "^| progressive | "; do
   grep -q "$row" "$tmp/int.md" || fail "missing integration row: $row"
 done
+# Each mean |error| carries its standard error over the seeds.
+grep -qE '^\| sobol \| [0-9.]+e-[0-9]+ \+- [0-9.]+e-[0-9]+ \|' "$tmp/int.md" ||
+  fail "no standard error beside the sobol row's mean |error|"
 # Every summary row has a verdict.
 rows=$(sed -n '/## Summary/,$p' "$tmp/out.md" | grep -c '^| [a-zA-Z]' || true)
 verdicts=$(sed -n '/## Summary/,$p' "$tmp/out.md" | grep -cE '\| (PASS|\*\*FAIL\*\*|INFO) \|$' || true)

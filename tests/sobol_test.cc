@@ -6,11 +6,14 @@
 // the warp keeps a density's mass split; sample means of a smooth function
 // on the sphere meet the closed form at quasi-Monte Carlo rates.
 #include <cmath>
+#include <cstdint>
+#include <random>
 #include <set>
 #include <vector>
 
 #include "core/sequence.h"
 #include "core/tree_warp.h"
+#include "core/vector_math.h"
 #include "gtest/gtest.h"
 #include "tests/test_util.h"
 
@@ -58,6 +61,32 @@ TEST(SobolSequence, EveryAlignedBlockOfTwoToTheMIsANet) {
   const Sequence c(SequenceKind::kSobol, 1 << 20, 1);
   EXPECT_EQ(a.At(5), c.At(5));
   EXPECT_EQ(a.Second(5), c.Second(5));
+}
+
+// The batch of points (eight lanes at a time on AVX-512F) gives At's and
+// Second's bits on every vector path, for index runs, index lists and
+// windows, with a tail that is not a multiple of eight.
+TEST(SobolSequence, PointsManyIsAtAndSecondOnEveryVectorPath) {
+  const Sequence whole(SequenceKind::kSobol, uint64_t{1} << 32, 11);
+  const Sequence window = whole.Window(0.25, 0.625);
+  std::vector<uint32_t> ks;
+  for (uint64_t k = 0; k < 1003; ++k) ks.push_back(static_cast<uint32_t>(k * 2654435761u));
+  for (math::VectorPath path : {math::VectorPath::kScalar, math::VectorPath::kSse2,
+                                math::VectorPath::kAvx, math::VectorPath::kAvx512}) {
+    if (!math::Runs(path)) continue;
+    for (const Sequence* s : {&whole, &window}) {
+      for (bool listed : {false, true}) {
+        std::vector<double> a(ks.size()), b(ks.size());
+        const uint64_t k0 = 4000000000u;
+        s->PointsMany(listed ? ks.data() : nullptr, k0, ks.size(), a.data(), b.data(), path);
+        for (size_t i = 0; i < ks.size(); ++i) {
+          const uint64_t k = listed ? ks[i] : k0 + i;
+          ASSERT_EQ(a[i], s->At(k)) << math::VectorPathName(path) << " k " << k;
+          ASSERT_EQ(b[i], s->Second(k)) << math::VectorPathName(path) << " k " << k;
+        }
+      }
+    }
+  }
 }
 
 TEST(SobolSampler, ExactCountEveryIndexOnceInCurveOrder) {
@@ -191,6 +220,34 @@ TEST(TreeWarp, MapsTheUnitSquareOntoTheLeavesByMass) {
     worst = std::max(worst, std::fabs(hits[l] - expected) / (4 * std::sqrt(expected) + 4));
   }
   EXPECT_LT(worst, 1.0);
+}
+
+// The batch descent's vector path gives the scalar path's addresses, bit for
+// bit, on a Hilbert tree with a density (leaves at several depths, so lanes
+// reach their leaves in different rounds), at random points, the square's
+// edges and its dyadic lines, in batches whose size is not a multiple of 8.
+TEST(TreeWarp, LocateManyGivesTheSameAddressesOnEveryVectorPath) {
+  const auto s = MakeSetup("monkey_saddle", "gaussian:floor=0.05", 1 << 14);
+  const TreeWarp warp(*s.tree);
+  std::mt19937_64 rng(36);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<double> a, b;
+  for (int i = 0; i < 5003; ++i) a.push_back(unit(rng)), b.push_back(unit(rng));
+  for (double x : {0.0, 0.25, 0.5, 0.75, 1.0, -0.5, 1.5}) {
+    for (double y : {0.0, 0.5, 1.0}) a.push_back(x), b.push_back(y);
+  }
+  std::vector<CurveAddress> expected(a.size());
+  warp.LocateMany(a.size(), a.data(), b.data(), expected.data(), math::VectorPath::kScalar);
+  for (math::VectorPath path : {math::VectorPath::kSse2, math::VectorPath::kAvx,
+                                math::VectorPath::kAvx512}) {
+    if (!math::Runs(path)) continue;
+    std::vector<CurveAddress> got(a.size());
+    warp.LocateMany(a.size(), a.data(), b.data(), got.data(), path);
+    for (size_t i = 0; i < a.size(); ++i) {
+      ASSERT_EQ(got[i].leaf, expected[i].leaf) << math::VectorPathName(path) << " point " << i;
+      ASSERT_EQ(got[i].digits, expected[i].digits) << math::VectorPathName(path) << " point " << i;
+    }
+  }
 }
 
 }  // namespace
