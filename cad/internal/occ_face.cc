@@ -175,7 +175,9 @@ void FaceSurface::JetGrid(const double* us, int nu, const double* vs, int nv, in
   ClosedForm::TrigsOf(a, trigs, t);
   std::fill(t + trigs, t + n, ClosedForm::Trig{});
   for (int i = 0; i < nu; ++i) {
-    for (int j = 0; j < nv; ++j) ClosedJet(a[i], a[nu + j], t[i], t[nu + j], order, &out[i * nv + j]);
+    for (int j = 0; j < nv; ++j) {
+      ClosedJet(a[i], a[nu + j], t[i], t[nu + j], order, &out[i * nv + j]);
+    }
   }
 }
 
@@ -295,7 +297,8 @@ double FaceTrim::Clearance(double s, double t) const {
     const Box2 w{box.s0 - ms, box.s1 + ms, box.t0 - mt, box.t1 + mt};
     const double ds = std::max({w.s0 - s, s - w.s1, 0.0});
     const double dt = std::max({w.t0 - t, t - w.t1, 0.0});
-    return Piece{std::hypot(ds, dt), w, node, edge, a, b};
+    // sqrt, not hypot: correctly rounded, so the same bits everywhere.
+    return Piece{std::sqrt(ds * ds + dt * dt), w, node, edge, a, b};
   };
   auto of_node = [&](int n) {
     const Node& node = nodes_[n];
