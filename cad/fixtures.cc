@@ -54,6 +54,7 @@
 #include "absl/strings/str_format.h"
 #include "base/status_macros.h"
 #include "cad/internal/kernel_setup.h"
+#include "core/vector_math.h"
 
 namespace sfc::cad::fixtures {
 namespace {
@@ -71,8 +72,10 @@ Handle(Geom_BSplineCurve) SplineHole() {
   const int n = 40;
   Handle(TColgp_HArray1OfPnt) points = new TColgp_HArray1OfPnt(1, n);
   for (int i = 0; i < n; ++i) {
-    const double a = 2 * M_PI * i / n, r = 10 + 3 * std::sin(7 * a);
-    points->SetValue(i + 1, gp_Pnt(r * std::cos(a), r * std::sin(a), 0));
+    // SLEEF's sines (core/vector_math.h): the same file on every machine.
+    const double a = 2 * M_PI * i / n, r = 10 + 3 * math::SinCosOf(7 * a).sin;
+    const math::SinCos t = math::SinCosOf(a);
+    points->SetValue(i + 1, gp_Pnt(r * t.cos, r * t.sin, 0));
   }
   GeomAPI_Interpolate interpolate(points, /*periodic=*/true, 1e-9);
   interpolate.Perform();
@@ -311,8 +314,8 @@ std::string CollinearFacesStep(int collinear, bool with_square) {
 std::string PolygonFaceStep(int corners) {
   std::vector<std::pair<double, double>> loop;
   for (int k = 0; k < corners; ++k) {
-    const double a = 2 * M_PI * k / corners;
-    loop.push_back({std::cos(a), std::sin(a)});
+    const math::SinCos t = math::SinCosOf(2 * M_PI * k / corners);
+    loop.push_back({t.cos, t.sin});
   }
   return PolyLoopFacesStep({loop});
 }

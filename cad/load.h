@@ -43,9 +43,10 @@ struct LoadOptions {
   // Default 1e-9.
   double trim_tolerance = 1e-9;
   // Planes, cylinders, cones, spheres and tori without a transformation are
-  // evaluated from their closed forms (Face::closed_form(): the same bits as
-  // the kernel, checked at load); false evaluates every face through the
-  // kernel, to compare the two.
+  // evaluated from their closed forms (Face::closed_form(): SLEEF's sines and
+  // cosines, so the same bits on every machine; within a few ulp of the
+  // kernel's values, checked at load); false evaluates every face through
+  // the kernel, to compare the two.
   bool closed_forms = true;
   // What the kernel's readers are spared (cad/preflight.h).
   PreflightLimits preflight;

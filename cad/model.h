@@ -92,8 +92,10 @@ class Face {
   const Surface& surface() const { return *surface_; }
   // True when the surface is evaluated from its closed form (a plane,
   // cylinder, cone, sphere or torus without a transformation: the kernel's
-  // arithmetic without its adaptors, checked bit for bit against them at
-  // load), false when through the kernel.
+  // formulas without its adaptors, with SLEEF's sines and cosines, so the
+  // same bits on every machine; checked against the kernel within a few ulp
+  // at load), false when through the kernel (whose elementary functions are
+  // the C library's).
   bool closed_form() const;
   std::shared_ptr<const Surface> shared_surface() const { return surface_; }
 

@@ -8,9 +8,9 @@
 #include <gp_Sphere.hxx>
 #include <gp_Torus.hxx>
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
-#include <cstring>
 
 namespace sfc::cad {
 namespace {
@@ -41,6 +41,16 @@ void KernelAt(const BRepAdaptor_Surface& adaptor, double u, double v, int order,
 }
 
 }  // namespace
+
+void ClosedForm::TrigsOf(const double* a, size_t n, Trig* out) {
+  constexpr size_t kChunk = 64;
+  double s[kChunk], c[kChunk];
+  for (size_t b = 0; b < n; b += kChunk) {
+    const size_t m = std::min(kChunk, n - b);
+    math::SinCosOf(a + b, m, s, c);
+    for (size_t i = 0; i < m; ++i) out[b + i] = {c[i], s[i]};
+  }
+}
 
 // Each formula is the one ElSLib (OpenCASCADE 7.6) evaluates for the type
 // and order: PlaneD0/D1, CylinderD0/D1/D2, ConeD0/D1/D2, SphereD0/D1/D2,
@@ -171,10 +181,19 @@ void ClosedForm::Points(const double* u, const double* v, size_t n, double* px, 
     }
     return;
   }
-  for (size_t i = 0; i < n; ++i) {
-    double d[6][3];
-    Evaluate(u[i], v[i], 0, d);
-    px[i] = d[0][0], py[i] = d[0][1], pz[i] = d[0][2];
+  // The sines and cosines a chunk at a time (the same bits as TrigU and
+  // TrigV point by point), then EvaluateWith's formulas.
+  constexpr size_t kChunk = 128;
+  Trig tu[kChunk], tv[kChunk];
+  for (size_t b = 0; b < n; b += kChunk) {
+    const size_t m = std::min(kChunk, n - b);
+    TrigsOf(u + b, m, tu);
+    if (TakesTrigV()) TrigsOf(v + b, m, tv);
+    for (size_t i = 0; i < m; ++i) {
+      double d[6][3];
+      EvaluateWith(u[b + i], v[b + i], tu[i], TakesTrigV() ? tv[i] : Trig{}, 0, d);
+      px[b + i] = d[0][0], py[b + i] = d[0][1], pz[b + i] = d[0][2];
+    }
   }
 }
 
@@ -197,8 +216,8 @@ std::optional<ClosedForm> ClosedForm::Extract(const BRepAdaptor_Surface& adaptor
         form.type = Type::kCone;
         Place(local.Cone().Position(), &form);
         form.radius = local.Cone().RefRadius();
-        form.sin_angle = std::sin(local.Cone().SemiAngle());
-        form.cos_angle = std::cos(local.Cone().SemiAngle());
+        form.sin_angle = math::SinCosOf(local.Cone().SemiAngle()).sin;
+        form.cos_angle = math::SinCosOf(local.Cone().SemiAngle()).cos;
         break;
       case GeomAbs_Sphere:
         form.type = Type::kSphere;
@@ -215,19 +234,38 @@ std::optional<ClosedForm> ClosedForm::Extract(const BRepAdaptor_Surface& adaptor
         return std::nullopt;
     }
     // The kernel's values on a grid of its parameter box, and well outside
-    // it, for every order, bit for bit.
+    // it, for every order, within kTolerance of the form's size (or of the
+    // value's, where that is larger: a derivative along a length is a unit
+    // vector's size).
     const double u0 = adaptor.FirstUParameter(), u1 = adaptor.LastUParameter();
     const double v0 = adaptor.FirstVParameter(), v1 = adaptor.LastVParameter();
+    auto at = [](double a0, double a1, int i, double step, double shift) {
+      return a0 + (a1 - a0) * (i * step + shift) - 0.05 * (a1 - a0);
+    };
+    double size = std::max({std::abs(form.o[0]), std::abs(form.o[1]), std::abs(form.o[2]),
+                            std::abs(form.radius) + std::abs(form.minor)});
+    for (int i = 0; i <= 8; ++i) {
+      size = std::max({size, std::abs(at(u0, u1, i, 0.1371, 0.0113)),
+                       std::abs(at(v0, v1, i, 0.1297, 0.0171))});
+    }
+    if (!std::isfinite(size)) return std::nullopt;
     for (int i = 0; i <= 8; ++i) {
       for (int j = 0; j <= 8; ++j) {
-        const double u = u0 + (u1 - u0) * (i * 0.1371 + 0.0113) - 0.05 * (u1 - u0);
-        const double v = v0 + (v1 - v0) * (j * 0.1297 + 0.0171) - 0.05 * (v1 - v0);
+        const double u = at(u0, u1, i, 0.1371, 0.0113), v = at(v0, v1, j, 0.1297, 0.0171);
         for (int order = 0; order <= 2; ++order) {
           double ours[6][3], theirs[6][3];
           form.Evaluate(u, v, order, ours);
           KernelAt(adaptor, u, v, order, theirs);
           const int rows = order == 0 ? 1 : order == 1 ? 3 : 6;
-          if (std::memcmp(ours, theirs, rows * sizeof(ours[0])) != 0) return std::nullopt;
+          for (int r = 0; r < rows; ++r) {
+            const double scale = std::max(
+                {size, std::abs(theirs[r][0]), std::abs(theirs[r][1]), std::abs(theirs[r][2])});
+            for (int k = 0; k < 3; ++k) {
+              if (!(std::abs(ours[r][k] - theirs[r][k]) <= kTolerance * scale)) {
+                return std::nullopt;
+              }
+            }
+          }
         }
       }
     }

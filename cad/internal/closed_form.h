@@ -1,11 +1,13 @@
 // Internal to cad/: a face's plane, cylinder, cone, sphere or torus
 // evaluated from its closed form, without the kernel's adaptors (no lease, no virtual calls):
 // issue 20's "the face's analytic form extracted once into a plain
-// evaluator". The arithmetic is the kernel's own (OpenCASCADE 7.6's ElSLib
-// formulas, the same operations in the same order, glibc's sin and cos), so
-// the values are the kernel's bit for bit; Extract checks that on sample
-// points and declines a face where any bit differs, which then stays with
-// the kernel.
+// evaluator". The formulas are the kernel's own (OpenCASCADE 7.6's ElSLib,
+// the same operations in the same order), but the sines and cosines are
+// SLEEF's (math::SinCosOf, core/vector_math.h), not glibc's, so a face's
+// values are the same bits on every machine (glibc picks FMA variants of sin
+// and cos where the CPU has FMA). They are within a few ulp of the kernel's:
+// Extract checks that on sample points (kTolerance) and declines a face that
+// differs more, which then stays with the kernel.
 #ifndef SFCSAMPLER_CAD_INTERNAL_CLOSED_FORM_H_
 #define SFCSAMPLER_CAD_INTERNAL_CLOSED_FORM_H_
 
@@ -13,6 +15,8 @@
 
 #include <cmath>
 #include <optional>
+
+#include "core/vector_math.h"
 
 namespace sfc::cad {
 
@@ -30,31 +34,46 @@ struct ClosedForm {
   // as BRepAdaptor_Surface::D0, D1 and D2 give them for `order` 0, 1, 2.
   void Evaluate(double u, double v, int order, double d[][3]) const;
 
-  // The cosine and sine of a parameter, as the kernel's formulas take them
-  // (glibc's cos and sin): computed once for a row or column of a grid, they
-  // give the same values as Evaluate computes point by point.
+  // The cosine and sine of a parameter (math::SinCosOf): computed once for
+  // a row or column of a grid, or a batch at a time (TrigsOf), they give the
+  // same values as Evaluate computes point by point.
   struct Trig {
     double cos, sin;
   };
-  static Trig TrigOf(double a) { return {std::cos(a), std::sin(a)}; }
+  static Trig TrigOf(double a) {
+    const math::SinCos t = math::SinCosOf(a);
+    return {t.cos, t.sin};
+  }
+  // TrigOf(a[i]) for i < n into out[i], bit for bit, on the widest vector
+  // path (math::SinCosOf's batch).
+  static void TrigsOf(const double* a, size_t n, Trig* out);
+  // Whether the type's formulas take the sine and cosine of u (every type but
+  // the plane) and of v (the sphere and the torus).
+  bool TakesTrigU() const { return type != Type::kPlane; }
+  bool TakesTrigV() const { return type == Type::kSphere || type == Type::kTorus; }
   // TrigOf(u) and TrigOf(v) when the type's formulas take them (u: every
   // type but the plane; v: the sphere and the torus), else nothing computed.
-  Trig TrigU(double u) const { return type != Type::kPlane ? TrigOf(u) : Trig{}; }
-  Trig TrigV(double v) const {
-    return type == Type::kSphere || type == Type::kTorus ? TrigOf(v) : Trig{};
-  }
+  Trig TrigU(double u) const { return TakesTrigU() ? TrigOf(u) : Trig{}; }
+  Trig TrigV(double v) const { return TakesTrigV() ? TrigOf(v) : Trig{}; }
   // Evaluate's points (order 0) at native (u[i], v[i]) for i < n, into x, y
-  // and z; a plane's in one loop the compiler vectorises (the same
-  // operations, so the same bits).
+  // and z, bit for bit: a plane's in one loop the compiler vectorises (the
+  // same operations), the other types' sines and cosines in batches.
   void Points(const double* u, const double* v, size_t n, double* x, double* y, double* z) const;
   // Evaluate with tu = TrigU(u) and tv = TrigV(v) given.
   void EvaluateWith(double u, double v, const Trig& tu, const Trig& tv, int order,
                     double d[][3]) const;
 
+  // How far Extract lets a closed form's value be from the kernel's, as a
+  // fraction of the form's size (the largest of its origin's coordinates, its
+  // radii and the parameters checked): a few ulp, as the two sines differ by
+  // at most 2 ulp and the formulas are the same operations. A wrong formula
+  // is off by a fraction of the size itself.
+  static constexpr double kTolerance = 16 * 2.220446049250313e-16;
   // The closed form of `adaptor`'s surface, if it is a plane, cylinder, cone,
   // sphere or torus without a transformation (identity location) and
-  // evaluates as the kernel does at every checked point, for every order;
-  // nullopt otherwise.
+  // evaluates as the kernel does, within kTolerance, at every checked point
+  // for every order (points and first and second derivatives); nullopt
+  // otherwise.
   static std::optional<ClosedForm> Extract(const BRepAdaptor_Surface& adaptor);
 };
 

@@ -15,13 +15,18 @@
 namespace sfc::cad {
 namespace {
 
+// The length of (a, b) by sqrt (correctly rounded under IEEE 754, so the same
+// bits on every machine, unlike the C library's hypot; parameters are far
+// from overflow).
+double Length(double a, double b) { return std::sqrt(a * a + b * b); }
+
 // The distance from (u, v) to the segment from (u0, v0) to (u1, v1).
 double SegmentDistance(double u0, double v0, double u1, double v1, double u, double v) {
   const double du = u1 - u0, dv = v1 - v0;
   const double length2 = du * du + dv * dv;
   double f = length2 > 0 ? ((u - u0) * du + (v - v0) * dv) / length2 : 0.0;
   f = f < 0 ? 0.0 : f > 1 ? 1.0 : f;
-  return std::hypot(u - (u0 + f * du), v - (v0 + f * dv));
+  return Length(u - (u0 + f * du), v - (v0 + f * dv));
 }
 
 double Cross(double au, double av, double bu, double bv) { return au * bv - av * bu; }
@@ -49,7 +54,7 @@ std::optional<LineCircleTrim> LineCircleTrim::Extract(const TopoDS_Face& face, d
         const gp_Pnt2d m = curve.Value(0.5 * (first + last));
         Arc arc{circle.Location().X(), circle.Location().Y(), circle.Radius(),
                 s.X(), s.Y(), e.X(), e.Y(), m.X(), m.Y(), false};
-        arc.full = std::hypot(e.X() - s.X(), e.Y() - s.Y()) <= band;
+        arc.full = Length(e.X() - s.X(), e.Y() - s.Y()) <= band;
         trim.arcs_.push_back(arc);
       } else {
         return std::nullopt;
@@ -76,7 +81,7 @@ LineCircleTrim::Side LineCircleTrim::Classify(double u, double v) const {
   for (const Arc& a : arcs_) {
     const double du = u - a.cu, dv = v - a.cv;
     // Near the circle (so near the arc, or not: either way the kernel's).
-    if (std::fabs(std::hypot(du, dv) - a.r) <= band_) return Side::kUnsure;
+    if (std::fabs(Length(du, dv) - a.r) <= band_) return Side::kUnsure;
     if (!a.full && (std::fabs(v - a.sv) <= band_ || std::fabs(v - a.ev) <= band_)) {
       return Side::kUnsure;
     }

@@ -159,17 +159,25 @@ void FaceSurface::JetGrid(const double* us, int nu, const double* vs, int nv, in
     }
     return;
   }
-  // The cosines and sines once a row and once a column, not once a point:
-  // the same values, so the same bits.
-  // The tree build asks for 3 x 3 grids: no allocation for those.
-  ClosedForm::Trig on_stack[16];
-  std::vector<ClosedForm::Trig> on_heap(nv > 16 ? nv : 0);
-  ClosedForm::Trig* tv = nv > 16 ? on_heap.data() : on_stack;
-  for (int j = 0; j < nv; ++j) tv[j] = closed_->TrigV(map_.V(vs[j]));
+  // The cosines and sines once a row and once a column, not once a point,
+  // all in one batch (ClosedForm::TrigsOf: the same bits as TrigU and
+  // TrigV). The tree build asks for 3 x 3 grids: no allocation for those.
+  const int n = nu + nv;
+  double a_on_stack[16];
+  ClosedForm::Trig t_on_stack[16];
+  std::vector<double> a_on_heap(n > 16 ? n : 0);
+  std::vector<ClosedForm::Trig> t_on_heap(n > 16 ? n : 0);
+  double* a = n > 16 ? a_on_heap.data() : a_on_stack;
+  ClosedForm::Trig* t = n > 16 ? t_on_heap.data() : t_on_stack;
+  for (int i = 0; i < nu; ++i) a[i] = map_.U(us[i]);
+  for (int j = 0; j < nv; ++j) a[nu + j] = map_.V(vs[j]);
+  const int trigs = closed_->TakesTrigV() ? n : closed_->TakesTrigU() ? nu : 0;
+  ClosedForm::TrigsOf(a, trigs, t);
+  std::fill(t + trigs, t + n, ClosedForm::Trig{});
   for (int i = 0; i < nu; ++i) {
-    const double u = map_.U(us[i]);
-    const ClosedForm::Trig tu = closed_->TrigU(u);
-    for (int j = 0; j < nv; ++j) ClosedJet(u, map_.V(vs[j]), tu, tv[j], order, &out[i * nv + j]);
+    for (int j = 0; j < nv; ++j) {
+      ClosedJet(a[i], a[nu + j], t[i], t[nu + j], order, &out[i * nv + j]);
+    }
   }
 }
 
@@ -289,7 +297,8 @@ double FaceTrim::Clearance(double s, double t) const {
     const Box2 w{box.s0 - ms, box.s1 + ms, box.t0 - mt, box.t1 + mt};
     const double ds = std::max({w.s0 - s, s - w.s1, 0.0});
     const double dt = std::max({w.t0 - t, t - w.t1, 0.0});
-    return Piece{std::hypot(ds, dt), w, node, edge, a, b};
+    // sqrt, not hypot: correctly rounded, so the same bits everywhere.
+    return Piece{std::sqrt(ds * ds + dt * dt), w, node, edge, a, b};
   };
   auto of_node = [&](int n) {
     const Node& node = nodes_[n];
