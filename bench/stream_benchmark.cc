@@ -316,6 +316,14 @@ int Run(uint64_t n) {
                 options.limits.generation_threads, generate);
     std::printf("| of the hit: a hit streaming 1 sample (lookup, header, round trip) | %.4f s |\n",
                 fixed);
+    // The hit's columns (u v x y z float64) as raw bytes over the same
+    // loopback: no server can stream them faster, so first / floor bounds
+    // the first / hit ratio of any cache.
+    const uint64_t hit_payload = request.count * 5 * 8;
+    const double floor = Best([&] { return RawSeconds(raw_target, hit_payload, 65536 * 5 * 8); });
+    std::printf("| the hit's %llu MB of columns as raw bytes (a floor for any hit) | %.3f s |\n",
+                static_cast<unsigned long long>(hit_payload / 1000000), floor);
+    std::printf("| first / that floor: the most any cache could save | %.1fx |\n", first / floor);
   }
 
   {
