@@ -17,23 +17,6 @@ using sequence_internal::ReverseBits32;
 
 namespace {
 
-// Owen's nested uniform scrambling of the 32-bit radical inverse of k: bit i
-// (from the top) is flipped by a random bit that depends on the bits above it,
-// which permutes every dyadic level and so keeps each 2^m-prefix stratified.
-// The bits below 2^-32 are filled with uniform random bits, as a full scramble
-// of the all-zero tail would.
-double OwenScrambledRadicalInverse(uint64_t k, uint64_t seed) {
-  const uint32_t r = ReverseBits32(static_cast<uint32_t>(k));
-  uint32_t out = 0;
-  for (int i = 0; i < 32; ++i) {
-    const uint32_t prefix = i == 0 ? 0 : r >> (32 - i);
-    const uint32_t flip = CounterHash(seed, hash_stream::kOwen, (uint64_t{prefix} << 6) | i) & 1;
-    out |= (((r >> (31 - i)) & 1) ^ flip) << (31 - i);
-  }
-  const double tail = CounterUniform(seed, hash_stream::kOwenTail, k);
-  return (out + tail) * 0x1.0p-32;
-}
-
 // The flip of bit i (from the top) of the coordinate with scramble key `key`
 // whose i bits above it are `prefix`.
 uint32_t SobolFlip(uint64_t key, uint64_t prefix, int i) {
@@ -75,11 +58,15 @@ const sequence_internal::SobolSecondBytes& sequence_internal::SobolSecondTables(
   return tables.byte;
 }
 
-std::shared_ptr<const OwenFlips> Sequence::MakeOwenFlips(uint64_t seed) {
+std::shared_ptr<const OwenFlips> Sequence::MakeOwenFlips(SequenceKind kind, uint64_t seed) {
   auto t = std::make_shared<OwenFlips>();
-  for (int dim = 0; dim < 2; ++dim) {
-    t->key[dim] = CounterKey(seed, hash_stream::kSobol[dim]);
-    t->tail_key[dim] = CounterKey(seed, hash_stream::kSobolTail[dim]);
+  // progressive: one coordinate with streams of its own, so that it and
+  // sobol's first coordinate are independent scrambles of the same digits.
+  const bool sobol = kind == SequenceKind::kSobol;
+  for (int dim = 0; dim < (sobol ? 2 : 1); ++dim) {
+    t->key[dim] = CounterKey(seed, sobol ? hash_stream::kSobol[dim] : hash_stream::kOwen);
+    t->tail_key[dim] =
+        CounterKey(seed, sobol ? hash_stream::kSobolTail[dim] : hash_stream::kOwenTail);
     // Bit (2^i - 1 + prefix) of `flips` is the flip of level i, prefix its
     // i bits above it.
     uint64_t flips[(1 << kTableLevels) / 64] = {};
@@ -114,11 +101,10 @@ double Sequence::Raw(uint64_t k) const {
       return CounterUniform(seed_, hash_stream::kRandom, k);
     case SequenceKind::kVanDerCorput:
       return ReverseBits32(static_cast<uint32_t>(k)) * 0x1.0p-32;
-    case SequenceKind::kProgressive:
-      return OwenScrambledRadicalInverse(k, seed_);
     case SequenceKind::kBlue:
       assert(table_ != nullptr && "a blue sequence is made by Sequence::FromTable");
       return (*table_)[k];
+    case SequenceKind::kProgressive:
     case SequenceKind::kSobol:
       return NestedScramble<uint64_t>(ReverseBits32(static_cast<uint32_t>(k)), CounterMix(k), 0,
                                       *flips_);
