@@ -25,8 +25,8 @@ inline U Mix64(U z) {
 namespace hash_stream {
 inline constexpr uint64_t kJitter = 1;
 inline constexpr uint64_t kRandom = 2;
-inline constexpr uint64_t kOwen = 3;
-inline constexpr uint64_t kOwenTail = 4;
+inline constexpr uint64_t kOwen = 3;                    // the progressive scramble
+inline constexpr uint64_t kOwenTail = 4;                // and its bits below 2^-32
 inline constexpr uint64_t kSobol[2] = {5, 6};           // the sobol coordinates' scrambles
 inline constexpr uint64_t kSobolTail[2] = {7, 8};       // and their bits below 2^-32
 inline constexpr uint64_t kBlueCandidate = 0x626c7565;  // "blue" in ASCII

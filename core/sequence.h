@@ -20,9 +20,8 @@
 
 namespace sfc {
 
-
-// The sobol scramble's flips of its top levels, computed once per sequence
-// (core/sequence.cc).
+// The nested scrambles of sobol and progressive, computed once per sequence
+// (core/sequence_internal.h).
 struct OwenFlips;
 
 class Sequence {
@@ -31,7 +30,9 @@ class Sequence {
   // come from a relaxation: FromTable).
   Sequence(SequenceKind kind, uint64_t count, uint64_t seed)
       : kind_(kind), count_(count), seed_(seed) {
-    if (kind == SequenceKind::kSobol) flips_ = MakeOwenFlips(seed);
+    if (kind == SequenceKind::kSobol || kind == SequenceKind::kProgressive) {
+      flips_ = MakeOwenFlips(kind, seed);
+    }
   }
 
   // A kBlue sequence whose q_k is (*q)[k], shared: the result of
@@ -95,7 +96,7 @@ class Sequence {
 
  private:
   double Raw(uint64_t k) const;  // q_k
-  static std::shared_ptr<const OwenFlips> MakeOwenFlips(uint64_t seed);
+  static std::shared_ptr<const OwenFlips> MakeOwenFlips(SequenceKind kind, uint64_t seed);
 
   SequenceKind kind_;
   uint64_t count_;
@@ -103,7 +104,8 @@ class Sequence {
   std::shared_ptr<const std::vector<double>> table_;  // kBlue's q_k
   bool windowed_ = false;
   double lo_ = 0, hi_ = 1;
-  std::shared_ptr<const OwenFlips> flips_;  // sobol only: shared by copies and windows
+  // The scrambles of sobol and progressive: shared by copies and windows.
+  std::shared_ptr<const OwenFlips> flips_;
 };
 
 // The first k in [0, count) for which reached(k) holds, for a predicate that

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <random>
 #include <set>
+#include <utility>
 #include <vector>
 
 #include "core/sequence.h"
@@ -61,6 +62,41 @@ TEST(SobolSequence, EveryAlignedBlockOfTwoToTheMIsANet) {
   const Sequence c(SequenceKind::kSobol, 1 << 20, 1);
   EXPECT_EQ(a.At(5), c.At(5));
   EXPECT_EQ(a.Second(5), c.Second(5));
+}
+
+// progressive is the same nested scramble of the radical inverse with a key
+// of its own: every aligned block of 2^m indices puts exactly one q in each
+// [j 2^-m, (j+1) 2^-m), for levels in the flips' table (m <= 12) and in the
+// hashed blocks below it; a value does not depend on the set's size; and its
+// scramble is not sobol's first coordinate's.
+TEST(ProgressiveSequence, EveryAlignedBlockIsStratifiedAndIndependentOfSobol) {
+  for (uint64_t seed : {1, 2, 99}) {
+    const Sequence s(SequenceKind::kProgressive, uint64_t{1} << 32, seed);
+    for (const auto& [k0, m] : {std::pair<uint64_t, int>{0, 20}, {3 << 14, 14}, {5 << 9, 9}}) {
+      const uint64_t n = uint64_t{1} << m;
+      std::vector<uint8_t> hits(n, 0);
+      for (uint64_t k = k0; k < k0 + n; ++k) {
+        const double q = s.At(k);
+        ASSERT_GE(q, 0);
+        ASSERT_LT(q, 1);
+        ++hits[static_cast<uint64_t>(std::ldexp(q, m))];
+      }
+      for (uint64_t c = 0; c < n; ++c) ASSERT_EQ(hits[c], 1) << "m " << m << " stratum " << c;
+    }
+    const Sequence small(SequenceKind::kProgressive, 16, seed);
+    EXPECT_EQ(small.At(7), s.At(7));
+    // Same digits, other flips: the top ten bits of the two scrambles do not
+    // differ by one constant mask.
+    const Sequence sobol(SequenceKind::kSobol, 1 << 10, seed);
+    std::set<uint64_t> masks;
+    for (uint64_t k = 0; k < 1024; ++k) {
+      masks.insert(static_cast<uint64_t>(std::ldexp(s.At(k), 10)) ^
+                   static_cast<uint64_t>(std::ldexp(sobol.At(k), 10)));
+    }
+    EXPECT_GT(masks.size(), 1u);
+  }
+  const Sequence a(SequenceKind::kProgressive, 16, 1), b(SequenceKind::kProgressive, 16, 2);
+  EXPECT_NE(a.At(3), b.At(3));
 }
 
 // The batch of points (eight lanes at a time on AVX-512F) gives At's and
@@ -238,8 +274,8 @@ TEST(TreeWarp, LocateManyGivesTheSameAddressesOnEveryVectorPath) {
   }
   std::vector<CurveAddress> expected(a.size());
   warp.LocateMany(a.size(), a.data(), b.data(), expected.data(), math::VectorPath::kScalar);
-  for (math::VectorPath path : {math::VectorPath::kSse2, math::VectorPath::kAvx,
-                                math::VectorPath::kAvx512}) {
+  for (math::VectorPath path :
+       {math::VectorPath::kSse2, math::VectorPath::kAvx, math::VectorPath::kAvx512}) {
     if (!math::Runs(path)) continue;
     std::vector<CurveAddress> got(a.size());
     warp.LocateMany(a.size(), a.data(), b.data(), got.data(), path);

@@ -1,0 +1,39 @@
+// The AVX-512F paths of TreeWarp (core/tree_warp.h), built apart with
+// -mavx512f in core/tree_warp_avx512.cc; TreeWarp calls them only on the
+// kAvx512 vector path (math::BestVectorPath()), and each gives the bits of
+// the scalar code in core/tree_warp.cc. Not for use outside TreeWarp.
+#ifndef SFCSAMPLER_CORE_TREE_WARP_INTERNAL_H_
+#define SFCSAMPLER_CORE_TREE_WARP_INTERNAL_H_
+
+#include <cstddef>
+#include <cstdint>
+
+namespace sfc::tree_warp_internal {
+
+// The largest double below 1: a rescaled coordinate stays in [0, 1).
+inline constexpr double kBelowOne = 1.0 - 0x1.0p-53;
+
+// The Newton steps an inverse CDF takes at most (then its value as it stands).
+inline constexpr int kCdfMaxSteps = 100;
+
+// TreeWarp::Descend<2> for the points i < m, eight lanes to a vector; see
+// core/tree_warp_avx512.cc. Returns how many points it took (a multiple of
+// eight, at most 64); the caller descends the rest.
+size_t DescendGrid2Avx512(size_t m, double* a, double* b, int32_t* ref, uint8_t* state,
+                          const double* splits, const int32_t* children, const int32_t* state_at);
+
+// TreeWarp::DigitsInLeaf for a Hilbert tree, eight points to a vector.
+// Returns how many points it took (a multiple of eight); the caller encodes
+// the rest.
+size_t DigitsGrid2Avx512(size_t m, const double* x, const double* y, const uint8_t* state,
+                         double cells, uint64_t top, int chunks, int head, const int32_t* child_at,
+                         const int32_t* state_at, const uint64_t* encode, uint64_t* digits);
+
+// out[lanes[j]]: the inverse CDF of problem lanes[j] (density p, share), j <
+// n <= 64, each lane the scalar inversion's steps.
+void InvertCdfsAvx512(size_t n, const uint8_t* lanes, const double (*p)[3], const double* share,
+                      double* out);
+
+}  // namespace sfc::tree_warp_internal
+
+#endif  // SFCSAMPLER_CORE_TREE_WARP_INTERNAL_H_
