@@ -17,6 +17,10 @@
 #include <cstdint>
 #include <cstring>
 
+#ifdef __AVX512F__
+#include <immintrin.h>
+#endif
+
 #include "mesh/mesh_curve_tree.h"
 
 namespace sfc::mesh_warp_lanes {
@@ -102,18 +106,48 @@ __attribute__((always_inline)) inline void PathsOfLanes(size_t n, const double* 
 }
 
 __attribute__((always_inline)) inline bool Any(Ints8 mask) {
+#ifdef __AVX512F__
+  return _mm512_test_epi64_mask((__m512i)mask, (__m512i)mask) != 0;
+#else
   int64_t any = 0;
   for (int k = 0; k < kLanes; ++k) any |= mask[k];
   return any != 0;
+#endif
 }
+// p[index[k]] in each lane: one gather instruction where the build has
+// AVX-512F.
 __attribute__((always_inline)) inline Lanes8 Gather(const double* p, Ints8 index) {
+#ifdef __AVX512F__
+  return (Lanes8)_mm512_mask_i64gather_pd(_mm512_setzero_pd(), 0xff, (__m512i)index, p, 8);
+#else
   Lanes8 r;
   for (int k = 0; k < kLanes; ++k) r[k] = p[index[k]];
   return r;
+#endif
+}
+__attribute__((always_inline)) inline Ints8 Gather(const uint32_t* p, Ints8 index) {
+#ifdef __AVX512F__
+  const __m256i r = _mm512_mask_i64gather_epi32(_mm256_setzero_si256(), 0xff, (__m512i)index, p, 4);
+  typedef uint32_t Words8 __attribute__((vector_size(32)));
+  return __builtin_convertvector((Words8)r, Ints8);
+#else
+  Ints8 r;
+  for (int k = 0; k < kLanes; ++k) r[k] = p[index[k]];
+  return r;
+#endif
 }
 // x exactly, for 0 <= x < 2^52: x in the mantissa of 2^52, less 2^52.
 __attribute__((always_inline)) inline Lanes8 ExactDouble(Ints8 x) {
   return (Lanes8)(x | 0x4330000000000000LL) - 0x1.0p52;
+}
+// floor(x) as an integer, exactly, for 0 <= x < 2^51 (-0 included): x + 2^52
+// rounds x to an integer in the mantissa, one less where that went up. Vector
+// operations of AVX-512F alone (its conversions to 64-bit integers are
+// AVX-512DQ's), and static_cast's truncation for these x.
+__attribute__((always_inline)) inline Ints8 FloorOf(Lanes8 x) {
+  const Lanes8 big = x + 0x1.0p52;
+  const Ints8 up = big - 0x1.0p52 > x;
+  return ((Ints8)big - 0x4330000000000000LL) + up;  // up is -1 where true
 }
 // 2^k for |k| <= 1022 (the scalar Pow2's exponent field).
 __attribute__((always_inline)) inline Lanes8 Pow2(Ints8 k) { return (Lanes8)((k + 1023) << 52); }
@@ -156,15 +190,12 @@ __attribute__((always_inline)) inline void LeafShareVector(const LeafTables& t, 
   c1 = c1 < zero ? zero : (below < c1 ? below : c1);
   const int64_t max_depth = t.max_depth;
   const int64_t bits_a = (max_depth + 1) / 2, bits_b = max_depth / 2;
-  const Bits8 top_a = Spread((Bits8) __builtin_convertvector(c0 * Pow2(izero + bits_a), Ints8));
-  const Bits8 top_b = Spread((Bits8) __builtin_convertvector(c1 * Pow2(izero + bits_b), Ints8));
+  const Bits8 top_a = Spread((Bits8)FloorOf(c0 * Pow2(izero + bits_a)));
+  const Bits8 top_b = Spread((Bits8)FloorOf(c1 * Pow2(izero + bits_b)));
   const Bits8 cap_node = max_depth % 2 == 0 ? top_a << 1 | top_b : top_a | top_b << 1;
   const Ints8 bucket = (Ints8)(cap_node >> (max_depth - t.bucket_bits));
-  Ints8 from, to;
-  for (int k = 0; k < kLanes; ++k) {
-    from[k] = t.bucket_leaves[2 * bucket[k]];
-    to[k] = t.bucket_leaves[2 * bucket[k] + 1] + int64_t{1};
-  }
+  const Ints8 from = Gather(t.bucket_leaves, 2 * bucket);
+  const Ints8 to = Gather(t.bucket_leaves, 2 * bucket + 1) + 1;
   const Lanes8 cap_scale = Pow2(izero - max_depth);
   Ints8 lo = FirstNotBefore<false>(t.ends, from, to - from,
                                    ExactDouble((Ints8)cap_node) * cap_scale * t.total);
@@ -185,11 +216,11 @@ __attribute__((always_inline)) inline void LeafShareVector(const LeafTables& t, 
     depth = (active & inside) ? mid : depth;
     shallow = (active & ~inside) ? mid + 1 : shallow;
   }
-  // What is left of each coordinate below the node's bits: floor by
-  // truncation (the values are >= 0), and + 0 makes -0 the scalar's +0.
+  // What is left of each coordinate below the node's bits (+ 0 makes the
+  // -0 of -0 - 0 the scalar's +0).
   const Lanes8 scaled_a = c0 * Pow2((depth + 1) >> 1), scaled_b = c1 * Pow2(depth >> 1);
-  c0 = (scaled_a - ExactDouble(__builtin_convertvector(scaled_a, Ints8))) + 0.0;
-  c1 = (scaled_b - ExactDouble(__builtin_convertvector(scaled_b, Ints8))) + 0.0;
+  c0 = (scaled_a - ExactDouble(FloorOf(scaled_a))) + 0.0;
+  c1 = (scaled_b - ExactDouble(FloorOf(scaled_b))) + 0.0;
   const Ints8 axis = (depth & 1) != izero;
   const Lanes8 w = Pow2(-depth);
   const Lanes8 t0 = ExactDouble((Ints8)(cap_node >> (Bits8)(max_depth - depth))) * w;
