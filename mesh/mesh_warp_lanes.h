@@ -152,106 +152,136 @@ __attribute__((always_inline)) inline Ints8 FloorOf(Lanes8 x) {
 // 2^k for |k| <= 1022 (the scalar Pow2's exponent field).
 __attribute__((always_inline)) inline Lanes8 Pow2(Ints8 k) { return (Lanes8)((k + 1023) << 52); }
 
+// LeafShareBlock's vectors: independent chains of dependent gathers, which
+// the CPU overlaps.
+constexpr int kShareVectors = 4, kShareBlock = kLanes * kShareVectors;
+
 // The first index i in [base, base + len) with e[i] > x (kAtOrAbove false)
-// or e[i] >= x (true), base + len if none, in each lane: std::upper_bound's
-// and std::lower_bound's answer (mesh_warp.cc's FirstAbove, FirstAtOrAbove).
+// or e[i] >= x (true), base + len if none, in each lane of kShareVectors
+// vectors: std::upper_bound's and std::lower_bound's answer (mesh_warp.cc's
+// FirstAbove, FirstAtOrAbove), into base.
 template <bool kAtOrAbove>
-__attribute__((always_inline)) inline Ints8 FirstNotBefore(const double* e, Ints8 base, Ints8 len,
-                                                           Lanes8 x) {
+__attribute__((always_inline)) inline void FirstNotBefore(const double* e, Ints8* base, Ints8* len,
+                                                          const Lanes8* x) {
   const Ints8 none{};
   for (;;) {
-    const Ints8 half = len >> 1;
-    const Ints8 step = half > none;
-    if (!Any(step)) break;
-    const Lanes8 v = Gather(e, step ? base + half - 1 : base);
-    const Ints8 before = kAtOrAbove ? v < x : v <= x;
-    base = (step & before) ? base + half : base;
-    len -= half;
+    Ints8 half[kShareVectors], step[kShareVectors], any{};
+    for (int v = 0; v < kShareVectors; ++v) {
+      half[v] = len[v] >> 1, step[v] = half[v] > none;
+      any |= step[v];
+    }
+    if (!Any(any)) break;
+    for (int v = 0; v < kShareVectors; ++v) {
+      const Lanes8 probe = Gather(e, step[v] ? base[v] + half[v] - 1 : base[v]);
+      const Ints8 before = kAtOrAbove ? probe < x[v] : probe <= x[v];
+      base[v] = (step[v] & before) ? base[v] + half[v] : base[v];
+      len[v] -= half[v];
+    }
   }
-  const Lanes8 v = Gather(e, base);
-  const Ints8 before = kAtOrAbove ? v < x : v <= x;
-  return ((len > none) & before) ? base + 1 : base;
+  for (int v = 0; v < kShareVectors; ++v) {
+    const Lanes8 probe = Gather(e, base[v]);
+    const Ints8 before = kAtOrAbove ? probe < x[v] : probe <= x[v];
+    base[v] = ((len[v] > none) & before) ? base[v] + 1 : base[v];
+  }
 }
 
-// MeshWarp::LeafShare for 8 points (its comments give the steps): leaf[k],
-// f[k], g[k] its results, bit for bit, where across[k] is 0; where it is not,
-// the point's node still straddles leaves at the depth cap, and the scalar
-// code places it.
-__attribute__((always_inline)) inline void LeafShareVector(const LeafTables& t, const double* a_in,
-                                                           const double* b_in, int64_t* leaf_out,
-                                                           double* f_out, double* g_out,
-                                                           int64_t* across_out) {
-  Lanes8 c0, c1;
-  std::memcpy(&c0, a_in, sizeof c0);
-  std::memcpy(&c1, b_in, sizeof c1);
+// MeshWarp::LeafShare for kShareBlock points (its comments give the steps):
+// leaf[k], f[k], g[k] its results, bit for bit, where across[k] is 0; where
+// it is not, the point's node still straddles leaves at the depth cap, and
+// the scalar code places it.
+__attribute__((always_inline)) inline void LeafShareBlock(const LeafTables& t, const double* a_in,
+                                                          const double* b_in, int64_t* leaf_out,
+                                                          double* f_out, double* g_out,
+                                                          int64_t* across_out) {
+  constexpr int V = kShareVectors;
   const Lanes8 zero{}, below = zero + kBelowOne, one = zero + 1.0;
   const Ints8 izero{};
-  c0 = c0 < zero ? zero : (below < c0 ? below : c0);
-  c1 = c1 < zero ? zero : (below < c1 ? below : c1);
   const int64_t max_depth = t.max_depth;
   const int64_t bits_a = (max_depth + 1) / 2, bits_b = max_depth / 2;
-  const Bits8 top_a = Spread((Bits8)FloorOf(c0 * Pow2(izero + bits_a)));
-  const Bits8 top_b = Spread((Bits8)FloorOf(c1 * Pow2(izero + bits_b)));
-  const Bits8 cap_node = max_depth % 2 == 0 ? top_a << 1 | top_b : top_a | top_b << 1;
-  const Ints8 bucket = (Ints8)(cap_node >> (max_depth - t.bucket_bits));
-  const Ints8 from = Gather(t.bucket_leaves, 2 * bucket);
-  const Ints8 to = Gather(t.bucket_leaves, 2 * bucket + 1) + 1;
   const Lanes8 cap_scale = Pow2(izero - max_depth);
-  Ints8 lo = FirstNotBefore<false>(t.ends, from, to - from,
-                                   ExactDouble((Ints8)cap_node) * cap_scale * t.total);
-  const Ints8 hi = FirstNotBefore<true>(t.ends, from, to - from,
-                                        ExactDouble((Ints8)cap_node + 1) * cap_scale * t.total);
-  const Ints8 across = lo != hi;
-  lo = across ? from : lo;  // the scalar code takes these lanes: any valid leaf
-  // The bisection for the first depth whose node holds mass of leaf lo alone.
-  const Lanes8 lo_begin = lo == izero ? zero : Gather(t.ends, lo == izero ? lo : lo - 1);
-  const Lanes8 lo_end = Gather(t.ends, lo);
-  Ints8 depth = izero + max_depth, shallow = across ? depth : izero;
-  for (Ints8 active = shallow < depth; Any(active); active = shallow < depth) {
-    const Ints8 mid = (shallow + depth) >> 1;
-    const Ints8 node = (Ints8)(cap_node >> (Bits8)(max_depth - mid));
-    const Lanes8 scale = Pow2(-mid);
-    const Ints8 inside = (ExactDouble(node) * scale * t.total >= lo_begin) &
-                         (ExactDouble(node + 1) * scale * t.total <= lo_end);
-    depth = (active & inside) ? mid : depth;
-    shallow = (active & ~inside) ? mid + 1 : shallow;
+  Lanes8 c0[V], c1[V], x_lo[V], x_hi[V];
+  Bits8 cap_node[V];
+  Ints8 from[V], lo[V], hi[V], len_lo[V], len_hi[V];
+  for (int v = 0; v < V; ++v) {
+    std::memcpy(&c0[v], a_in + v * kLanes, sizeof(Lanes8));
+    std::memcpy(&c1[v], b_in + v * kLanes, sizeof(Lanes8));
+    c0[v] = c0[v] < zero ? zero : (below < c0[v] ? below : c0[v]);
+    c1[v] = c1[v] < zero ? zero : (below < c1[v] ? below : c1[v]);
+    const Bits8 top_a = Spread((Bits8)FloorOf(c0[v] * Pow2(izero + bits_a)));
+    const Bits8 top_b = Spread((Bits8)FloorOf(c1[v] * Pow2(izero + bits_b)));
+    cap_node[v] = max_depth % 2 == 0 ? top_a << 1 | top_b : top_a | top_b << 1;
+    const Ints8 bucket = (Ints8)(cap_node[v] >> (max_depth - t.bucket_bits));
+    from[v] = Gather(t.bucket_leaves, 2 * bucket);
+    len_lo[v] = Gather(t.bucket_leaves, 2 * bucket + 1) + 1 - from[v];
+    len_hi[v] = len_lo[v], lo[v] = from[v], hi[v] = from[v];
+    x_lo[v] = ExactDouble((Ints8)cap_node[v]) * cap_scale * t.total;
+    x_hi[v] = ExactDouble((Ints8)cap_node[v] + 1) * cap_scale * t.total;
   }
-  // What is left of each coordinate below the node's bits (+ 0 makes the
-  // -0 of -0 - 0 the scalar's +0).
-  const Lanes8 scaled_a = c0 * Pow2((depth + 1) >> 1), scaled_b = c1 * Pow2(depth >> 1);
-  c0 = (scaled_a - ExactDouble(FloorOf(scaled_a))) + 0.0;
-  c1 = (scaled_b - ExactDouble(FloorOf(scaled_b))) + 0.0;
-  const Ints8 axis = (depth & 1) != izero;
-  const Lanes8 w = Pow2(-depth);
-  const Lanes8 t0 = ExactDouble((Ints8)(cap_node >> (Bits8)(max_depth - depth))) * w;
-  const Lanes8 leaf_begin = lo_begin, leaf_mass = lo_end - lo_begin;
-  const Ints8 has_mass = leaf_mass > zero;
-  const Lanes8 r0 = (t0 * t.total - leaf_begin) / leaf_mass;
-  const Lanes8 r1 = ((t0 + w) * t.total - leaf_begin) / leaf_mass;
-  const Lanes8 f0 = has_mass ? (r0 < zero ? zero : (one < r0 ? one : r0)) : zero;
-  const Lanes8 f1 = has_mass ? (r1 < zero ? zero : (one < r1 ? one : r1)) : one;
-  const Lanes8 along = axis ? c1 : c0, across_leaf = axis ? c0 : c1;
-  const Lanes8 f = f0 + along * (f1 - f0);
-  std::memcpy(leaf_out, &lo, sizeof lo);
-  std::memcpy(f_out, &f, sizeof f);
-  std::memcpy(g_out, &across_leaf, sizeof across_leaf);
-  std::memcpy(across_out, &across, sizeof across);
+  FirstNotBefore<false>(t.ends, lo, len_lo, x_lo);
+  FirstNotBefore<true>(t.ends, hi, len_hi, x_hi);
+  // The bisection for the first depth whose node holds mass of leaf lo alone.
+  Lanes8 lo_begin[V], lo_end[V];
+  Ints8 across[V], depth[V], shallow[V];
+  for (int v = 0; v < V; ++v) {
+    across[v] = lo[v] != hi[v];
+    lo[v] = across[v] ? from[v] : lo[v];  // the scalar code takes these lanes: any valid leaf
+    lo_begin[v] = lo[v] == izero ? zero : Gather(t.ends, lo[v] == izero ? lo[v] : lo[v] - 1);
+    lo_end[v] = Gather(t.ends, lo[v]);
+    depth[v] = izero + max_depth, shallow[v] = across[v] ? depth[v] : izero;
+  }
+  for (;;) {
+    Ints8 active[V], any{};
+    for (int v = 0; v < V; ++v) active[v] = shallow[v] < depth[v], any |= active[v];
+    if (!Any(any)) break;
+    for (int v = 0; v < V; ++v) {
+      const Ints8 mid = (shallow[v] + depth[v]) >> 1;
+      const Ints8 node = (Ints8)(cap_node[v] >> (Bits8)(max_depth - mid));
+      const Lanes8 scale = Pow2(-mid);
+      const Ints8 inside = (ExactDouble(node) * scale * t.total >= lo_begin[v]) &
+                           (ExactDouble(node + 1) * scale * t.total <= lo_end[v]);
+      depth[v] = (active[v] & inside) ? mid : depth[v];
+      shallow[v] = (active[v] & ~inside) ? mid + 1 : shallow[v];
+    }
+  }
+  for (int v = 0; v < V; ++v) {
+    // What is left of each coordinate below the node's bits (+ 0 makes the
+    // -0 of -0 - 0 the scalar's +0).
+    const Lanes8 scaled_a = c0[v] * Pow2((depth[v] + 1) >> 1);
+    const Lanes8 scaled_b = c1[v] * Pow2(depth[v] >> 1);
+    const Lanes8 rest_a = (scaled_a - ExactDouble(FloorOf(scaled_a))) + 0.0;
+    const Lanes8 rest_b = (scaled_b - ExactDouble(FloorOf(scaled_b))) + 0.0;
+    const Ints8 axis = (depth[v] & 1) != izero;
+    const Lanes8 w = Pow2(-depth[v]);
+    const Lanes8 t0 = ExactDouble((Ints8)(cap_node[v] >> (Bits8)(max_depth - depth[v]))) * w;
+    const Lanes8 leaf_begin = lo_begin[v], leaf_mass = lo_end[v] - lo_begin[v];
+    const Ints8 has_mass = leaf_mass > zero;
+    const Lanes8 r0 = (t0 * t.total - leaf_begin) / leaf_mass;
+    const Lanes8 r1 = ((t0 + w) * t.total - leaf_begin) / leaf_mass;
+    const Lanes8 f0 = has_mass ? (r0 < zero ? zero : (one < r0 ? one : r0)) : zero;
+    const Lanes8 f1 = has_mass ? (r1 < zero ? zero : (one < r1 ? one : r1)) : one;
+    const Lanes8 along = axis ? rest_b : rest_a, across_leaf = axis ? rest_a : rest_b;
+    const Lanes8 f = f0 + along * (f1 - f0);
+    std::memcpy(leaf_out + v * kLanes, &lo[v], sizeof(Ints8));
+    std::memcpy(f_out + v * kLanes, &f, sizeof f);
+    std::memcpy(g_out + v * kLanes, &across_leaf, sizeof across_leaf);
+    std::memcpy(across_out + v * kLanes, &across[v], sizeof(Ints8));
+  }
 }
 
-// LeafShareVector over n points, the tail padded with (0, 0).
+// LeafShareBlock over n points, the tail padded with (0, 0).
 __attribute__((always_inline)) inline void LeafSharesOf(const LeafTables& tables, size_t n,
                                                         const double* a, const double* b,
                                                         int64_t* leaf, double* f, double* g,
                                                         int64_t* across) {
   size_t i = 0;
-  for (; i + kLanes <= n; i += kLanes) {
-    LeafShareVector(tables, a + i, b + i, leaf + i, f + i, g + i, across + i);
+  for (; i + kShareBlock <= n; i += kShareBlock) {
+    LeafShareBlock(tables, a + i, b + i, leaf + i, f + i, g + i, across + i);
   }
   if (i < n) {
-    double pa[kLanes] = {}, pb[kLanes] = {}, pf[kLanes], pg[kLanes];
-    int64_t pl[kLanes], px[kLanes];
+    double pa[kShareBlock] = {}, pb[kShareBlock] = {}, pf[kShareBlock], pg[kShareBlock];
+    int64_t pl[kShareBlock], px[kShareBlock];
     std::copy(a + i, a + n, pa), std::copy(b + i, b + n, pb);
-    LeafShareVector(tables, pa, pb, pl, pf, pg, px);
+    LeafShareBlock(tables, pa, pb, pl, pf, pg, px);
     std::copy(pl, pl + (n - i), leaf + i), std::copy(pf, pf + (n - i), f + i);
     std::copy(pg, pg + (n - i), g + i), std::copy(px, px + (n - i), across + i);
   }
