@@ -6,10 +6,14 @@
 #include <cstring>
 #include <vector>
 
+#include "mesh/mesh_warp_lanes.h"
+
 namespace sfc {
 namespace {
 
-constexpr double kBelowOne = 1.0 - 0x1.0p-53;
+using mesh_warp_lanes::kBelowOne;
+using mesh_warp_lanes::Spread;
+
 // Halvings past the depth at which nodes hold one leaf's mass on average
 // before a node that still straddles leaves is split by mass: the straddling
 // nodes' share of the error falls as 2^-kExtraDepth of the leaf level's.
@@ -26,15 +30,6 @@ double Pow2(int k) {
   double x;
   std::memcpy(&x, &bits, sizeof x);
   return x;
-}
-
-// Bit i of x at bit 2i, for x < 2^32.
-uint64_t Spread(uint64_t x) {
-  x = (x | x << 16) & 0x0000ffff0000ffffULL;
-  x = (x | x << 8) & 0x00ff00ff00ff00ffULL;
-  x = (x | x << 4) & 0x0f0f0f0f0f0f0f0fULL;
-  x = (x | x << 2) & 0x3333333333333333ULL;
-  return (x | x << 1) & 0x5555555555555555ULL;
 }
 
 // The first i < n with e[i] > x (FirstAbove) or e[i] >= x (FirstAtOrAbove),
@@ -157,6 +152,14 @@ MeshWarp::MeshWarp(const MeshCurveTree& tree) : tree_(tree) {
 }
 
 void MeshWarp::LocateInLeaf(double a, double b, size_t* leaf, double* pa, double* pb) const {
+  double f, g;
+  LeafShare(a, b, leaf, &f, &g);
+  // PlaceInCell reads the cell's density model alone: under a uniform
+  // density every cell's is the default (uniform), with no cell to decode.
+  PlaceInCell(uniform_density_ ? MeshCurveTree::Cell{} : tree_.LeafCell(*leaf), f, g, pa, pb);
+}
+
+void MeshWarp::LeafShare(double a, double b, size_t* leaf, double* f, double* g) const {
   double c[2] = {std::clamp(a, 0.0, kBelowOne), std::clamp(b, 0.0, kBelowOne)};
   const auto& ends = tree_.mass_ends();
   const double total = tree_.total_mass();
@@ -221,9 +224,6 @@ void MeshWarp::LocateInLeaf(double a, double b, size_t* leaf, double* pa, double
     lo = hi = l;
   }
   const size_t l = lo;
-  // PlaceInCell reads the cell's density model alone: under a uniform
-  // density every cell's is the default (uniform), with no cell to decode.
-  const MeshCurveTree::Cell cell = uniform_density_ ? MeshCurveTree::Cell{} : tree_.LeafCell(l);
   // The node's share of the leaf, as fractions of the leaf's mass.
   const double leaf_begin = tree_.mass_begin(l), leaf_mass = ends[l] - leaf_begin;
   const double f0 =
@@ -232,102 +232,69 @@ void MeshWarp::LocateInLeaf(double a, double b, size_t* leaf, double* pa, double
       leaf_mass > 0 ? std::clamp(((t0 + w) * total - leaf_begin) / leaf_mass, 0.0, 1.0) : 1.0;
   // The node's share of the leaf: the next coordinate to be halved takes the
   // mass along it, the other the way across.
-  PlaceInCell(cell, f0 + c[axis] * (f1 - f0), c[axis ^ 1], pa, pb);
+  *f = f0 + c[axis] * (f1 - f0);
+  *g = c[axis ^ 1];
   *leaf = l;
 }
 
-void MeshWarp::LocateMany(size_t n, const double* a, const double* b, CurveAddress* out) const {
+void MeshWarp::LocateMany(size_t n, const double* a, const double* b, CurveAddress* out,
+                          math::VectorPath path) const {
   constexpr size_t kBatch = 64;
-  double pa[kBatch], pb[kBatch];
+  double pa[kBatch], pb[kBatch], f[kBatch], g[kBatch];
+  int64_t leaf[kBatch], across[kBatch];
   uint64_t paths[kBatch];
-  const math::VectorPath vector_path = math::BestVectorPath();
+  const mesh_warp_lanes::LeafTables tables{tree_.mass_ends().data(), bucket_leaves_.data(),
+                                           tree_.total_mass(), max_depth_, bucket_bits_};
+  const bool avx512 = path == math::VectorPath::kAvx512;
   for (size_t i0 = 0; i0 < n; i0 += kBatch) {
     const size_t m = std::min(kBatch, n - i0);
+    if (path == math::VectorPath::kScalar) {
+      // The reference: one point at a time.
+      for (size_t i = 0; i < m; ++i) {
+        size_t l;
+        LocateInLeaf(a[i0 + i], b[i0 + i], &l, &pa[i], &pb[i]);
+        leaf[i] = static_cast<int64_t>(l);
+      }
+    } else {
+      if (avx512) {
+        mesh_warp_lanes::LeafSharesAvx512(tables, m, a + i0, b + i0, leaf, f, g, across);
+      } else {
+        mesh_warp_lanes::LeafSharesOf(tables, m, a + i0, b + i0, leaf, f, g, across);
+      }
+      if (uniform_density_) {
+        if (avx512) {
+          mesh_warp_lanes::PlaceUniformAvx512(m, f, g, pa, pb);
+        } else {
+          mesh_warp_lanes::PlaceUniformOf(m, f, g, pa, pb);
+        }
+      }
+      for (size_t i = 0; i < m; ++i) {
+        if (across[i] != 0) {  // rare: a node across leaves at the depth cap
+          size_t l;
+          LocateInLeaf(a[i0 + i], b[i0 + i], &l, &pa[i], &pb[i]);
+          leaf[i] = static_cast<int64_t>(l);
+        } else if (!uniform_density_) {
+          PlaceInCell(tree_.LeafCell(static_cast<size_t>(leaf[i])), f[i], g[i], &pa[i], &pb[i]);
+        }
+      }
+    }
+    PathsOf(m, pa, pb, paths, path);
     for (size_t i = 0; i < m; ++i) {
-      size_t leaf;
-      LocateInLeaf(a[i0 + i], b[i0 + i], &leaf, &pa[i], &pb[i]);
-      out[i0 + i].leaf = static_cast<uint32_t>(leaf);
+      out[i0 + i].leaf = static_cast<uint32_t>(leaf[i]);
       out[i0 + i].index = 0;
-    }
-    PathsOf(m, pa, pb, paths, vector_path);
-    for (size_t i = 0; i < m; ++i) out[i0 + i].digits = paths[i];
-  }
-}
-
-namespace {
-
-// MeshCurveTree::PathOf over 8 lanes x kVectors vectors at once, in GCC's
-// vector extensions: the same IEEE operations in the same order as the
-// scalar code (comparisons and selects for its branches and clamps), so the
-// same bits on any instruction set. The vectors are independent chains of
-// kLevels steps that the CPU overlaps.
-typedef double Lanes8 __attribute__((vector_size(64)));
-typedef int64_t Mask8 __attribute__((vector_size(64)));
-typedef uint64_t Bits8 __attribute__((vector_size(64)));
-constexpr int kLanes = 8, kVectors = 4, kBlock = kLanes * kVectors;
-
-__attribute__((always_inline)) inline void PathsOfBlock(const double* pa, const double* pb,
-                                                        uint64_t* paths) {
-  Lanes8 a[kVectors], b[kVectors];
-  Bits8 p[kVectors];
-  for (int v = 0; v < kVectors; ++v) {
-    std::memcpy(&a[v], pa + v * kLanes, sizeof(Lanes8));
-    std::memcpy(&b[v], pb + v * kLanes, sizeof(Lanes8));
-    p[v] = Bits8{};
-  }
-  const Lanes8 zero{}, one = zero + 1.0;
-  for (int level = 0; level < MeshCurveTree::kLevels; ++level) {
-    for (int v = 0; v < kVectors; ++v) {
-      // Child (E, A, M): (a, b) -> (b, 2a); child (A, X, M): (a, b) ->
-      // (2a + b - 1, 2 (1 - a - b)).
-      const Lanes8 s = 2 * a[v] + b[v];
-      const Mask8 first = s < one;
-      const Lanes8 na = first ? b[v] : s - 1;
-      const Lanes8 nb = first ? 2 * a[v] : 2 * (1 - a[v] - b[v]);
-      // std::clamp(na, 0, 1), then std::clamp(nb, 0, 1 - a).
-      a[v] = na < zero ? zero : (one < na ? one : na);
-      const Lanes8 top = 1 - a[v];
-      b[v] = nb < zero ? zero : (top < nb ? top : nb);
-      p[v] = (p[v] << 1) | (Bits8)(first + 1);
+      out[i0 + i].digits = paths[i];
     }
   }
-  for (int v = 0; v < kVectors; ++v) std::memcpy(paths + v * kLanes, &p[v], sizeof(Bits8));
 }
-
-// n <= kBlock points: padded to a block.
-__attribute__((always_inline)) inline void PathsOfPadded(size_t n, const double* pa,
-                                                         const double* pb, uint64_t* paths) {
-  double a[kBlock] = {}, b[kBlock] = {};
-  uint64_t p[kBlock];
-  std::copy(pa, pa + n, a), std::copy(pb, pb + n, b);
-  PathsOfBlock(a, b, p);
-  std::copy(p, p + n, paths);
-}
-
-// The same loop compiled for the baseline (SSE2 pairs) and for AVX-512F.
-void PathsOfBaseline(size_t n, const double* pa, const double* pb, uint64_t* paths) {
-  size_t i = 0;
-  for (; i + kBlock <= n; i += kBlock) PathsOfBlock(pa + i, pb + i, paths + i);
-  if (i < n) PathsOfPadded(n - i, pa + i, pb + i, paths + i);
-}
-
-__attribute__((target("avx512f"))) void PathsOfAvx512(size_t n, const double* pa,
-                                                      const double* pb, uint64_t* paths) {
-  size_t i = 0;
-  for (; i + kBlock <= n; i += kBlock) PathsOfBlock(pa + i, pb + i, paths + i);
-  if (i < n) PathsOfPadded(n - i, pa + i, pb + i, paths + i);
-}
-
-}  // namespace
 
 void MeshWarp::PathsOf(size_t n, const double* pa, const double* pb, uint64_t* paths,
                        math::VectorPath path) {
   if (path == math::VectorPath::kScalar) {
     for (size_t i = 0; i < n; ++i) paths[i] = MeshCurveTree::PathOf(pa[i], pb[i]);
   } else if (path == math::VectorPath::kAvx512) {
-    PathsOfAvx512(n, pa, pb, paths);
+    mesh_warp_lanes::PathsOfAvx512(n, pa, pb, paths);
   } else {
-    PathsOfBaseline(n, pa, pb, paths);
+    mesh_warp_lanes::PathsOfLanes(n, pa, pb, paths);
   }
 }
 

@@ -52,9 +52,13 @@ class MeshWarp {
     LocateMany(1, &a, &b, &at);
     return at;
   }
-  // out[i] = Locate(a[i], b[i]) for i < n, bit for bit; the bisections
-  // below the leaves (PathsOf) run over the batch at once.
-  void LocateMany(size_t n, const double* a, const double* b, CurveAddress* out) const;
+  // out[i] = Locate(a[i], b[i]) for i < n, bit for bit on every vector path
+  // (REQUIRES: math::Runs(path)): the leaf searches, the placement in
+  // uniform cells and the bisections below the leaves (PathsOf) run over the
+  // batch 8 lanes at a time (mesh/mesh_warp_lanes.h); kScalar is the
+  // reference, one point at a time.
+  void LocateMany(size_t n, const double* a, const double* b, CurveAddress* out,
+                  math::VectorPath path = math::BestVectorPath()) const;
 
   // paths[i] = MeshCurveTree::PathOf(pa[i], pb[i]) for i < n, bit for bit,
   // on the vector path `path` (8 lanes of the same IEEE operations; AVX-512F
@@ -66,9 +70,12 @@ class MeshWarp {
   // The leaf holding the image of (a, b) and the point's place in the
   // leaf's frame (E (0, 0), X (1, 0), A (0, 1)).
   void LocateInLeaf(double a, double b, size_t* leaf, double* pa, double* pb) const;
+  // Its first part: the leaf, the share f in [0, 1] of the leaf's mass and
+  // g in [0, 1) across it that PlaceInCell (mesh_warp.cc) turns into the place.
+  void LeafShare(double a, double b, size_t* leaf, double* f, double* g) const;
 
   const MeshCurveTree& tree_;
-  int max_depth_ = 0;  // halvings before a node across leaves is split by mass
+  int max_depth_ = 0;             // halvings before a node across leaves is split by mass
   bool uniform_density_ = false;  // every leaf cell's model is uniform
   // Node j of depth bucket_bits_ meets leaves bucket_leaves_[2j] ..
   // bucket_leaves_[2j + 1]: where the search for a node's leaves starts.

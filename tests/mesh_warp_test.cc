@@ -1,18 +1,28 @@
 // The mesh warp's batches (mesh/mesh_warp.h) give the scalar code's bits:
-// MeshWarp::PathsOf equals MeshCurveTree::PathOf on every vector path this
-// CPU runs, over random points of the leaf frame, its edges and corners.
+// MeshWarp::PathsOf equals MeshCurveTree::PathOf, and MeshWarp::LocateMany
+// its scalar path (one point at a time), on every vector path this CPU runs,
+// over random points, edges, corners and dyadic lines.
 #include "mesh/mesh_warp.h"
 
+#include <algorithm>
 #include <cstdint>
+#include <cstring>
+#include <memory>
 #include <random>
 #include <vector>
 
 #include "core/vector_math.h"
 #include "gtest/gtest.h"
+#include "mesh/icosphere.h"
 #include "mesh/mesh_curve_tree.h"
+#include "mesh/mesh_density.h"
+#include "mesh/mesh_surface.h"
 
 namespace sfc {
 namespace {
+
+constexpr math::VectorPath kPaths[] = {math::VectorPath::kScalar, math::VectorPath::kSse2,
+                                       math::VectorPath::kAvx, math::VectorPath::kAvx512};
 
 TEST(MeshWarp, PathsOfIsPathOfOnEveryVectorPath) {
   std::mt19937_64 rng(36);
@@ -29,8 +39,7 @@ TEST(MeshWarp, PathsOfIsPathOfOnEveryVectorPath) {
   }
   std::vector<uint64_t> expected(pa.size());
   for (size_t i = 0; i < pa.size(); ++i) expected[i] = MeshCurveTree::PathOf(pa[i], pb[i]);
-  for (math::VectorPath path : {math::VectorPath::kScalar, math::VectorPath::kSse2,
-                                math::VectorPath::kAvx, math::VectorPath::kAvx512}) {
+  for (math::VectorPath path : kPaths) {
     if (!math::Runs(path)) continue;
     for (size_t n : {size_t{1}, size_t{31}, pa.size()}) {
       std::vector<uint64_t> got(n);
@@ -39,6 +48,55 @@ TEST(MeshWarp, PathsOfIsPathOfOnEveryVectorPath) {
         ASSERT_EQ(got[i], expected[i]) << math::VectorPathName(path) << " point " << i;
       }
     }
+  }
+}
+
+// Uniform (no cell decoded), a linear density (the scalar placement after the
+// batch's search) and one that is zero on half the sphere (leaves of no mass).
+TEST(MeshWarp, LocateManyIsTheScalarLocateOnEveryVectorPath) {
+  const auto surface = MeshSurface::Create(MakeIcosphere(3), false);
+  const std::shared_ptr<const MeshDensity> densities[] = {
+      UniformMeshDensity(),
+      std::make_shared<FunctionMeshDensity>(
+          [](const MeshPoint& p) { return 1.5 + p.position.x + 0.3 * p.position.z; }, "linear"),
+      std::make_shared<FunctionMeshDensity>(
+          [](const MeshPoint& p) { return std::max(0.0, p.position.z); }, "upper half")};
+  std::mt19937_64 rng(36);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<double> a, b;
+  for (int i = 0; i < 5003; ++i) a.push_back(unit(rng)), b.push_back(unit(rng));
+  // Corners, edges, dyadic lines (where nodes and truncations meet), both
+  // zeros and the clamps' ends.
+  const double below_one = 1.0 - 0x1.0p-53;
+  for (double x : {0.0, -0.0, 0x1.0p-40, 0.25, 0.5, 0.75, below_one, 1.0, -1.0, 2.0}) {
+    for (double y : {0.0, -0.0, 0.5, 0.375, below_one, 1.0}) a.push_back(x), b.push_back(y);
+  }
+  for (const auto& density : densities) {
+    MeshTreeOptions options;
+    options.count = 1 << 16;
+    const auto tree = MeshCurveTree::Build(surface, density, options);
+    ASSERT_TRUE(tree.ok()) << tree.status();
+    const MeshWarp warp(**tree);
+    std::vector<CurveAddress> expected(a.size());
+    warp.LocateMany(a.size(), a.data(), b.data(), expected.data(), math::VectorPath::kScalar);
+    for (math::VectorPath path : kPaths) {
+      if (!math::Runs(path)) continue;
+      for (size_t n : {size_t{1}, size_t{13}, size_t{64}, a.size()}) {
+        std::vector<CurveAddress> got(n);
+        warp.LocateMany(n, a.data(), b.data(), got.data(), path);
+        for (size_t i = 0; i < n; ++i) {
+          ASSERT_EQ(got[i].leaf, expected[i].leaf)
+              << density->spec() << " " << math::VectorPathName(path) << " point " << i;
+          ASSERT_EQ(got[i].digits, expected[i].digits)
+              << density->spec() << " " << math::VectorPathName(path) << " point " << i;
+          ASSERT_EQ(got[i].index, expected[i].index);
+        }
+      }
+    }
+    // Locate is the batch's answer for one point.
+    const CurveAddress one = warp.Locate(a[7], b[7]);
+    EXPECT_EQ(one.leaf, expected[7].leaf);
+    EXPECT_EQ(one.digits, expected[7].digits);
   }
 }
 
