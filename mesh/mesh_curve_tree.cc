@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <thread>
 #include <type_traits>
 
 #include "absl/strings/str_format.h"
 #include "base/status_macros.h"
+#include "base/worker_pool.h"
 #include "mesh/triangle_order.h"
 
 namespace sfc {
@@ -158,18 +158,15 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
   while (tree->box_leaves_ * kRanksPerBox < ranks) tree->box_leaves_ *= 2;
   const Box empty{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
   tree->boxes_.assign(2 * tree->box_leaves_, empty);
-  // Each rank's roles and box, in runs of whole box leaves, on threads.
+  // Each rank's roles and box, in runs of whole box leaves, on the worker pool.
   const size_t parts =
       ranks >= kParallelRanks ? static_cast<size_t>(std::min(options.threads, 8)) : 1;
   const size_t leaves_per_part = (ranks + kRanksPerBox - 1) / kRanksPerBox / parts + 1;
-  std::vector<std::thread> workers;
-  for (size_t part = 1; part < parts; ++part) {
+  WorkerPool::Shared().ParallelFor(static_cast<int>(parts), [&](int part) {
     const size_t a = std::min(ranks, part * leaves_per_part * kRanksPerBox);
     const size_t b = std::min(ranks, (part + 1) * leaves_per_part * kRanksPerBox);
-    workers.emplace_back([&tree, &centroid, a, b] { tree->PlaceRanks(a, b, centroid); });
-  }
-  tree->PlaceRanks(0, std::min(ranks, leaves_per_part * kRanksPerBox), centroid);
-  for (std::thread& worker : workers) worker.join();
+    tree->PlaceRanks(a, b, centroid);
+  });
 
   // Masses.
   tree->rank_first_leaf_.resize(ranks + 1);

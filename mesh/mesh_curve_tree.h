@@ -64,8 +64,10 @@ struct MeshTreeOptions {
   // Bisection levels below a mesh triangle, 0..56. Cells the cap stops are
   // counted in Stats::capped_leaves.
   int max_depth = 40;
-  // Threads for the triangles' order (mesh/triangle_order.h), >= 1: the same
-  // tree for any count.
+  // Parallel parts, >= 1, of the triangles' order (mesh/triangle_order.h:
+  // the top levels' splits, up to the next power of two, at most 64) and of
+  // the ranks' roles and boxes (at most 8), run on the process's worker pool
+  // (base/worker_pool.h); the same tree for any count.
   int threads = 1;
   // RESOURCE_EXHAUSTED past this many leaves (32 bytes each for non-uniform
   // densities, 24 for uniform).

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <thread>
+#include <vector>
+
+#include "base/worker_pool.h"
 
 namespace sfc {
 namespace {
@@ -174,27 +176,56 @@ struct Node {
   Vec3 centre[2];  // of the halves, as the split left them
 };
 
-// Splits the items [begin, end) (`run` = Summarize of them) into node k and
-// below, as Order does; the first halves `spawn` levels down on threads.
-void Split(const Item* items, Index* begin, Index* end, const Summary& run, size_t k, int spawn,
-           Node* nodes) {
-  const size_t n = static_cast<size_t>(end - begin);
-  if (n == 1) return;
-  const Vec3 extent = run.hi - run.lo;
+// A run of items [begin, end) still to split, its Summary and its node.
+struct Run {
+  Index* begin;
+  Index* end;
+  Summary summary;
+  size_t k;
+};
+
+// Splits `run` as Order does into node run.k and its two halves; false for a
+// run of one item (a leaf: no node).
+bool SplitOnce(const Item* items, const Run& run, Node* nodes, Run* first, Run* second) {
+  const size_t n = static_cast<size_t>(run.end - run.begin);
+  if (n == 1) return false;
+  const Vec3 extent = run.summary.hi - run.summary.lo;
   const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
-  const size_t split = SplitByArea(items, begin, end, axis, run.area / 2);
-  Index* middle = begin + split;
-  const Summary first = Summarize(items, begin, middle), second = Summarize(items, middle, end);
-  nodes[k] = {static_cast<uint32_t>(split),
-              {Centre(items, first, begin), Centre(items, second, middle)}};
-  if (spawn > 0) {
-    std::thread worker([&] { Split(items, begin, middle, first, k + 1, spawn - 1, nodes); });
-    Split(items, middle, end, second, k + split, spawn - 1, nodes);
-    worker.join();
-    return;
+  const size_t split = SplitByArea(items, run.begin, run.end, axis, run.summary.area / 2);
+  Index* middle = run.begin + split;
+  *first = {run.begin, middle, Summarize(items, run.begin, middle), run.k + 1};
+  *second = {middle, run.end, Summarize(items, middle, run.end), run.k + split};
+  nodes[run.k] = {static_cast<uint32_t>(split),
+                  {Centre(items, first->summary, run.begin), Centre(items, second->summary, middle)}};
+  return true;
+}
+
+// Splits `run` into node run.k and every node below it.
+void Split(const Item* items, const Run& run, Node* nodes) {
+  Run first, second;
+  if (!SplitOnce(items, run, nodes, &first, &second)) return;
+  Split(items, first, nodes);
+  Split(items, second, nodes);
+}
+
+// The same on the process's worker pool: the top `levels` levels a level at
+// a time, each level's runs in parallel, then the 2^levels runs below.
+void SplitInParallel(const Item* items, const Run& all, int levels, Node* nodes) {
+  std::vector<Run> runs{all};
+  for (int level = 0; level < levels && !runs.empty(); ++level) {
+    std::vector<Run> halves(2 * runs.size());
+    std::vector<char> split(runs.size(), 0);
+    WorkerPool::Shared().ParallelFor(static_cast<int>(runs.size()), [&](int i) {
+      split[i] = SplitOnce(items, runs[i], nodes, &halves[2 * i], &halves[2 * i + 1]);
+    });
+    std::vector<Run> next;
+    for (size_t i = 0; i < runs.size(); ++i) {
+      if (split[i]) next.push_back(halves[2 * i]), next.push_back(halves[2 * i + 1]);
+    }
+    runs.swap(next);
   }
-  Split(items, begin, middle, first, k + 1, 0, nodes);
-  Split(items, middle, end, second, k + split, 0, nodes);
+  WorkerPool::Shared().ParallelFor(static_cast<int>(runs.size()),
+                                   [&](int i) { Split(items, runs[i], nodes); });
 }
 
 // Order's choice of which half goes first, on Split's tree (node k holds
@@ -233,8 +264,8 @@ std::vector<uint32_t> CurveOrderOfTriangles(const std::vector<uint32_t>& triangl
   Index* begin = arrangement.data();
   Index* end = begin + arrangement.size();
   const Summary all = Summarize(items.data(), begin, end);
-  // Threads split the top levels' halves, 2^spawn runs at once; none for a
-  // mesh too small to repay them.
+  // The worker pool splits the top levels' halves, up to 2^spawn runs at
+  // once; none for a mesh too small to repay it.
   int spawn = 0;
   while ((1 << spawn) < threads && spawn < 6) ++spawn;
   // The curve starts at the low corner of the centroids' bounding box.
@@ -243,7 +274,7 @@ std::vector<uint32_t> CurveOrderOfTriangles(const std::vector<uint32_t>& triangl
     return out;
   }
   std::vector<Node> nodes(items.size() - 1);
-  Split(items.data(), begin, end, all, 0, spawn, nodes.data());
+  SplitInParallel(items.data(), {begin, end, all, 0}, spawn, nodes.data());
   Walk(items.data(), begin, end, 0, nodes.data(), all.lo, &out);
   return out;
 }

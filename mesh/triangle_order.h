@@ -27,7 +27,8 @@ namespace sfc {
 // triangle t's; REQUIRES: both cover every index in `triangles`, and the
 // areas are finite and >= 0. Ties are broken by triangle index, so the order
 // is a function of the geometry and the indices alone: the same for any
-// `threads` (>= 1), which split the top levels' halves at once.
+// `threads` (>= 1): up to that many (rounded up to a power of two, at most
+// 64) of the top levels' runs are split at once on the process's worker pool.
 std::vector<uint32_t> CurveOrderOfTriangles(const std::vector<uint32_t>& triangles,
                                             const std::vector<Vec3>& centroid,
                                             const std::vector<double>& area, int threads = 1);
