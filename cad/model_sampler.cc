@@ -36,29 +36,24 @@ class TrimmedDensity final : public Density {
 };
 
 // The paper's tolerance a for the whole model when the options leave it
-// automatic (0): 1% of the diagonal of the box of every face with area, each
-// measured as core measures one surface (a 17 x 17 grid of its unit square).
-// a is a length in model units, and the model is one surface made of faces:
-// 1% of each face's own diagonal split every face, however small or flat, to
+// automatic (0): core's automatic share of the diagonal of the box of every
+// face with area, each measured on core's grid (WidenByGridPoints). a is a
+// length in model units, and the model is one surface made of faces: 1% of
+// each face's own diagonal split every face, however small or flat, to
 // stage 1's base depth (4096 leaves a face: 32 768 of the STEP box's 46 064).
 // 0 when no face gives a finite box; each face's build then resolves its own.
-double ModelTolerance(const Model& model) {
-  constexpr int kGrid = 16;
+// `control.check` is asked between faces (a face without a closed form is
+// evaluated by the CAD kernel).
+absl::StatusOr<double> ModelTolerance(const Model& model, const BuildControl& control) {
   Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
   for (const Face& face : model.faces()) {
+    if (control.check) RETURN_IF_ERROR(control.check());
     if (!(face.area() > 0)) continue;
-    for (int i = 0; i <= kGrid; ++i) {
-      for (int j = 0; j <= kGrid; ++j) {
-        const Vec3 p = face.surface().Point(static_cast<double>(i) / kGrid,
-                                            static_cast<double>(j) / kGrid);
-        if (!IsFinite(p)) continue;  // the face's own build reports it
-        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-      }
-    }
+    double u, v;
+    WidenByGridPoints(face.surface(), &lo, &hi, &u, &v);  // a face's own build reports it
   }
   const double diagonal = Norm(hi - lo);
-  return std::isfinite(diagonal) && diagonal > 0 ? 0.01 * diagonal : 0.0;
+  return std::isfinite(diagonal) && diagonal > 0 ? kAutomaticToleranceShare * diagonal : 0.0;
 }
 
 // A face the core tree cannot sample because it has nothing to sample: no
@@ -76,7 +71,9 @@ absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
     std::shared_ptr<const Model> model, std::shared_ptr<const Density> density,
     const CurveTreeOptions& given, uint64_t count, const BuildControl& control) {
   CurveTreeOptions options = given;
-  if (options.tolerance == 0) options.tolerance = ModelTolerance(*model);
+  if (options.tolerance == 0) {
+    ASSIGN_OR_RETURN(options.tolerance, ModelTolerance(*model, control));
+  }
   auto tree = std::shared_ptr<ModelTree>(new ModelTree());
   tree->model_ = model;
   uint64_t leaves = 0, bytes = 0;  // of the faces' trees so far

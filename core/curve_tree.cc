@@ -730,30 +730,39 @@ absl::StatusOr<CurveTreeOptions> ResolveOptions(const Surface& surface, CurveTre
   if (options.max_leaves == 0) return absl::InvalidArgumentError("max_leaves must be >= 1");
   if (options.depth_cap == 0) options.depth_cap = curve.max_depth();
   if (options.tolerance == 0) {
-    constexpr int kGrid = 16;
     Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-    for (int i = 0; i <= kGrid; ++i) {
-      for (int j = 0; j <= kGrid; ++j) {
-        const double u = static_cast<double>(i) / kGrid, v = static_cast<double>(j) / kGrid;
-        const Vec3 p = surface.Point(u, v);
-        if (!IsFinite(p)) {
-          return SurfaceNotFiniteError(u, v);
-        }
-        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-      }
-    }
+    double u = 0, v = 0;
+    if (!WidenByGridPoints(surface, &lo, &hi, &u, &v)) return SurfaceNotFiniteError(u, v);
     const double diagonal = Norm(hi - lo);
     if (!(diagonal > 0)) {
       return absl::InvalidArgumentError(
           "the surface maps the whole parameter box to one point; it has no area to sample");
     }
-    options.tolerance = 0.01 * diagonal;
+    options.tolerance = kAutomaticToleranceShare * diagonal;
   }
   return options;
 }
 
 }  // namespace
+
+bool WidenByGridPoints(const Surface& surface, Vec3* lo, Vec3* hi, double* u, double* v) {
+  bool finite = true;
+  for (int i = 0; i <= kToleranceGrid; ++i) {
+    for (int j = 0; j <= kToleranceGrid; ++j) {
+      const double s = static_cast<double>(i) / kToleranceGrid;
+      const double t = static_cast<double>(j) / kToleranceGrid;
+      const Vec3 p = surface.Point(s, t);
+      if (!IsFinite(p)) {
+        if (finite) *u = s, *v = t;
+        finite = false;
+        continue;
+      }
+      *lo = {std::min(lo->x, p.x), std::min(lo->y, p.y), std::min(lo->z, p.z)};
+      *hi = {std::max(hi->x, p.x), std::max(hi->y, p.y), std::max(hi->z, p.z)};
+    }
+  }
+  return finite;
+}
 
 int CurveTree::GradeFor(uint64_t count) {
   int g = 0;

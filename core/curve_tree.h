@@ -69,6 +69,16 @@
 
 namespace sfc {
 
+// The automatic tolerance a (CurveTreeOptions::tolerance = 0) is this share
+// of the diagonal of the box of the surface's points on the grid of
+// kToleranceGrid x kToleranceGrid intervals of its unit square. A CAD model
+// takes one for all its faces, from the box of all of theirs.
+inline constexpr double kAutomaticToleranceShare = 0.01;
+inline constexpr int kToleranceGrid = 16;
+// Widens [*lo, *hi] to the surface's finite points on that grid; returns
+// false, with the (u, v) of the first point that is not finite in *u, *v,
+// when one is not (the rest of the grid is still taken).
+bool WidenByGridPoints(const Surface& surface, Vec3* lo, Vec3* hi, double* u, double* v);
 
 // Where the depth cap stopped a split that a test still wanted (paper Sect. 5.3).
 struct DepthCapHit {

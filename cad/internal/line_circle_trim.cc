@@ -54,7 +54,10 @@ std::optional<LineCircleTrim> LineCircleTrim::Extract(const TopoDS_Face& face, d
         const gp_Pnt2d m = curve.Value(0.5 * (first + last));
         Arc arc{circle.Location().X(), circle.Location().Y(), circle.Radius(),
                 s.X(), s.Y(), e.X(), e.Y(), m.X(), m.Y(), false};
-        arc.full = Length(e.X() - s.X(), e.Y() - s.Y()) <= band;
+        // Ends that meet make a whole circle only if the arc turns more than
+        // half way round (its parameter is the angle): a short arc of a large
+        // circle has close ends too.
+        arc.full = Length(e.X() - s.X(), e.Y() - s.Y()) <= band && last - first > M_PI;
         trim.arcs_.push_back(arc);
       } else {
         return std::nullopt;
