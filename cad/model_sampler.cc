@@ -224,7 +224,14 @@ absl::StatusOr<std::unique_ptr<ModelSampleCursor>> ModelSampleCursor::Create(
     const auto& pieces = cursor->tree_->pieces();
     cursor->piece_members_.assign(pieces.size(), {});
     std::vector<double> his(pieces.size());
-    for (size_t p = 0; p < pieces.size(); ++p) his[p] = pieces[p].hi;
+    for (size_t p = 0; p < pieces.size(); ++p) {
+      his[p] = pieces[p].hi;
+      // A net puts its window's share of the points in it, to a few points:
+      // the lists hold 4 bytes a sample, not twice that from growing.
+      const double share = std::max(0.0, pieces[p].hi - pieces[p].lo);
+      cursor->piece_members_[p].reserve(
+          static_cast<size_t>(share * static_cast<double>(sequence.count())) + 64);
+    }
     // Windows [lo, hi) meet end to end, and q_k = 1 is the last piece's
     // (Sequence::InWindow's choice).
     for (uint64_t k = 0; k < sequence.count(); ++k) {

@@ -53,8 +53,10 @@ void PermuteIntoBuckets(CurveAddress* at, size_t n, uint64_t buckets, const Buck
 // of those by the rest while it is in cache, each bucket's few addresses
 // then by key; the second pass split over `parts` threads. The order is
 // that of one sort of the whole (keys are distinct: they hold the index).
-// Beside the addresses it holds a few KB a thread. More leaves than half the
-// addresses (a large mesh, a small set) take one sort.
+// Beside the addresses it holds two tables of 2^fine_bits counts a thread
+// (4 bytes each: about 256 KB a thread at 2^24 samples). More leaves than
+// half the addresses (a large mesh, a small set) take one comparison sort,
+// O(N log N).
 void SortAddresses(std::vector<CurveAddress>* addresses, int parts) {
   std::vector<CurveAddress>& at = *addresses;
   if (at.size() < 2) return;

@@ -79,7 +79,8 @@ class MeshSampler final : public CurveSamples {
   MeshSample AtMass(uint64_t k, double m, size_t l, const MeshCurveTree::Cell& cell) const;
 
   // Every sequence: a two-dimensional one (sobol) through a MeshWarp made
-  // with the sampler (O(1)).
+  // with the sampler (O(leaves) time, at most 8 MB, per request; outside the
+  // stream's memory budget, like the cursor's per-thread scratch).
   absl::Status AcceptsSequence(const Sequence&) const override { return absl::OkStatus(); }
   // The points (a[i], b[i]) of the unit square through the MeshWarp.
   // REQUIRES: a two-dimensional sequence.

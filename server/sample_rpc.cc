@@ -20,7 +20,8 @@ namespace {
 
 // What a stream holds while it runs: the sort of a non-monotone sequence's
 // range (16 bytes a sample; a sobol set sorts its whole count, 16 bytes a
-// sample, core/curve_samples.h CurveAddress), a blue set's relaxation (the
+// sample, core/curve_samples.h CurveAddress, and on a CAD model first lists
+// each face's samples, 4 bytes a sample more), a blue set's relaxation (the
 // whole set), the producer's batch (per sample the index and the columns in
 // float64, the model columns uint32), and the messages of its
 // pipeline, at most pipeline_depth + 2 (queued, being made, being written;
@@ -36,7 +37,8 @@ uint64_t StreamWorkingBytes(const SampleRequest& request, const StreamOptions& s
   const uint64_t blue =
       request.sequence == SequenceKind::kBlue ? kBlueNoiseBytesPerSample * request.count : 0;
   const uint64_t sorted = SequenceIsTwoDimensional(request.sequence) ? request.count : n;
-  const uint64_t sort = SequenceIsMonotone(request.sequence) ? 0 : 16 * sorted;
+  const uint64_t sort_bytes = SequenceIsTwoDimensional(request.sequence) ? 20 : 16;
+  const uint64_t sort = SequenceIsMonotone(request.sequence) ? 0 : sort_bytes * sorted;
   const SampleFields& f = request.fields;
   SampleFields made = f;  // the engine makes u v x y z whatever the wire carries
   made.uv = made.xyz = true;
