@@ -8,10 +8,12 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "core/vector_math.h"
+
 namespace sfc::tree_warp_internal {
 
-// The largest double below 1: a rescaled coordinate stays in [0, 1).
-inline constexpr double kBelowOne = 1.0 - 0x1.0p-53;
+// A rescaled coordinate stays in [0, 1): clamped to math::kBelowOne.
+using math::kBelowOne;
 
 // The Newton steps an inverse CDF takes at most (then its value as it stands).
 inline constexpr int kCdfMaxSteps = 100;

@@ -18,6 +18,9 @@
 
 namespace sfc::math {
 
+// The largest double below 1: where a coordinate of [0, 1) is clamped.
+inline constexpr double kBelowOne = 1.0 - 0x1.0p-53;
+
 // sin(pi x) and cos(pi x), within 3.5 ulp (SLEEF's u35 functions: three
 // times as fast as its 0.506-ulp ones, and a sample's place is a few ulp of
 // its cell at most), exact at multiples of 1/2 (the argument is reduced

@@ -31,6 +31,7 @@
 #include "core/sequence.h"
 #include "core/types/region.h"
 #include "core/types/sample_batch.h"
+#include "core/vector_math.h"
 #include "mesh/mesh_curve_tree.h"
 #include "mesh/mesh_warp.h"
 
@@ -72,7 +73,7 @@ class MeshSampler final : public CurveSamples {
     const double begin = tree_->mass_begin(l);
     const double t = (m - begin) / (tree_->mass_ends()[l] - begin);
     if (!(t >= 0)) return 0;
-    if (!(t < 1)) return 0x1.fffffffffffffp-1;  // the largest double below 1
+    if (!(t < 1)) return math::kBelowOne;
     return t;
   }
   // Sample at mass coordinate m inside leaf l with cell `cell` (= LeafCell(l)).

@@ -21,12 +21,13 @@
 #include <immintrin.h>
 #endif
 
+#include "core/vector_math.h"
 #include "mesh/mesh_curve_tree.h"
 
 namespace sfc::mesh_warp_lanes {
 
-// The largest double below 1: coordinates are clamped to [0, kBelowOne].
-constexpr double kBelowOne = 1.0 - 0x1.0p-53;
+// Coordinates are clamped to [0, kBelowOne].
+using math::kBelowOne;
 
 // What the leaf search reads of a MeshWarp (mesh_warp.h's members).
 struct LeafTables {
@@ -38,7 +39,7 @@ struct LeafTables {
 
 // Bit i of x at bit 2i, for x < 2^32 (a uint64_t or 8 lanes of them).
 template <typename T>
-inline T Spread(T x) {
+__attribute__((always_inline)) inline T Spread(T x) {
   x = (x | x << 16) & 0x0000ffff0000ffffULL;
   x = (x | x << 8) & 0x00ff00ff00ff00ffULL;
   x = (x | x << 4) & 0x0f0f0f0f0f0f0f0fULL;

@@ -196,7 +196,8 @@ bool SplitOnce(const Item* items, const Run& run, Node* nodes, Run* first, Run* 
   *first = {run.begin, middle, Summarize(items, run.begin, middle), run.k + 1};
   *second = {middle, run.end, Summarize(items, middle, run.end), run.k + split};
   nodes[run.k] = {static_cast<uint32_t>(split),
-                  {Centre(items, first->summary, run.begin), Centre(items, second->summary, middle)}};
+                  {Centre(items, first->summary, run.begin),
+                   Centre(items, second->summary, middle)}};
   return true;
 }
 
