@@ -10,18 +10,13 @@ namespace sfc::sequence_internal {
 
 size_t PointsOnAvx512(const uint32_t* ks, uint64_t k0, size_t n, const OwenFlips& table, double* a,
                       double* b) {
-  const SobolSecondBytes& second = SobolSecondTables();
   size_t i = 0;
   for (; i + 8 <= n; i += 8) {
-    U64x8 k, ra, rb;
-    for (int j = 0; j < 8; ++j) {
-      k[j] = ks != nullptr ? ks[i + j] : k0 + i + j;
-      ra[j] = ReverseBits32(static_cast<uint32_t>(k[j]));
-      rb[j] = SobolSecond(second, static_cast<uint32_t>(k[j]));
-    }
+    U64x8 k;
+    for (int j = 0; j < 8; ++j) k[j] = ks != nullptr ? ks[i + j] : k0 + i + j;
     const U64x8 k_mix = CounterMix(k);
-    const F64x8 va = NestedScramble(ra, k_mix, 0, table);
-    const F64x8 vb = NestedScramble(rb, k_mix, 1, table);
+    const F64x8 va = LinearScramble(k, k_mix, 0, table);
+    const F64x8 vb = LinearScramble(k, k_mix, 1, table);
     std::memcpy(a + i, &va, sizeof(va));
     std::memcpy(b + i, &vb, sizeof(vb));
   }

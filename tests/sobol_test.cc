@@ -1,5 +1,5 @@
 // The sobol sequence and its warp through the curve tree (core/tree_warp.h):
-// every 2^m block of the scrambled sequence is a (0,m,2)-net; a set has
+// every 2^m block of the linearly scrambled sequence is a (0,m,2)-net; a set has
 // exactly N samples in curve order, the same bytes for any batch size and
 // thread count, index ranges and shards that concatenate to the whole set,
 // regions that filter it, a prefix that a larger set on the same tree keeps;
@@ -53,6 +53,22 @@ TEST(SobolSequence, EveryAlignedBlockOfTwoToTheMIsANet) {
     ExpectNet(s, 0, 10);
     ExpectNet(s, 1024, 10);  // the second block of 1024
     ExpectNet(s, 0, 12);
+    // Blocks far along, where k's higher bytes take part.
+    const Sequence all(SequenceKind::kSobol, uint64_t{1} << 32, seed);
+    ExpectNet(all, uint64_t{3} << 16, 16);
+    ExpectNet(all, uint64_t{0xb7} << 24, 14);
+    // The scramble is more than a digital shift: a block's points do not sit
+    // at one offset inside their strata, and the top ten digits are not the
+    // radical inverse's xor one mask.
+    const Sequence radical_inverse(SequenceKind::kVanDerCorput, 1024, seed);
+    std::set<uint64_t> offsets, masks;
+    for (uint64_t k = 0; k < 1024; ++k) {
+      offsets.insert(static_cast<uint64_t>(std::ldexp(s.At(k), 20)) & 1023);
+      masks.insert(static_cast<uint64_t>(std::ldexp(s.At(k), 10)) ^
+                   static_cast<uint64_t>(std::ldexp(radical_inverse.At(k), 10)));
+    }
+    EXPECT_GT(offsets.size(), 1u);
+    EXPECT_GT(masks.size(), 1u);
   }
   // Scrambles of other seeds differ.
   const Sequence a(SequenceKind::kSobol, 16, 1), b(SequenceKind::kSobol, 16, 2);
