@@ -19,11 +19,14 @@ namespace {
 // density vanishes at a point the spacing would be infinite).
 constexpr double kMaxSpacingRatio = 8;
 // Candidates are placed in rounds of this many per searching sample. Each
-// round is one batch through the cursor, which enters (and tabulates) the
+// round places them through the cursor, which enters (and tabulates) the
 // leaf of every searching sample again: 16 took 35 % less time than 4 on the
 // sphere at 2*10^5, with the same set (a sample's choice depends on the
 // rounds only through exact ties of crowding between candidates).
 constexpr int kRound = 16;
+// Searching samples are placed and checked in blocks of this many: a block's
+// candidates stay in cache between their placement and their check.
+constexpr size_t kBlock = 256;
 // A candidate whose density differs from the density at its sample's
 // jittered place by more than this factor is not taken.
 constexpr double kDensityJump = 1.25;
@@ -63,15 +66,16 @@ class HashGrid {
     }
     for (size_t b = 0; b < buckets; ++b) start_[b + 1] += start_[b];
     entries_.resize(ids.size());
-    std::vector<uint32_t> fill(start_.begin(), start_.end() - 1);
+    fill_.assign(start_.begin(), start_.end() - 1);
     for (size_t i = 0; i < ids.size(); ++i) {
-      const uint32_t slot = fill[keys_[i]]++;
+      const uint32_t slot = fill_[keys_[i]]++;
       entries_[slot] = {p[ids[i]], r[ids[i]], ids[i]};
       if (slots) (*slots)[ids[i]] = slot;
     }
   }
   void Kill(uint32_t slot) { entries_[slot].id = kDead; }
-
+  // Lists no point (keeping the memory for the next Build).
+  void Clear() { entries_.clear(); }
   int64_t Cell(double x) const { return static_cast<int64_t>(std::floor(x * inv_cell_)); }
   // The cell's Morton code, cut to the table: neighbouring cells share
   // cache lines, and so do the cells of queries made in curve order.
@@ -100,7 +104,7 @@ class HashGrid {
  private:
   double inv_cell_;
   uint64_t mask_ = 0;
-  std::vector<uint32_t> start_, keys_;
+  std::vector<uint32_t> start_, keys_, fill_;
   std::vector<Entry> entries_;
 };
 
@@ -172,7 +176,10 @@ class Relaxation {
   std::vector<uint8_t> in_todo_;  // in the half-sweep's list (constant during it)
   std::vector<double> delta_;     // the density at each sample's jittered place
   std::vector<uint8_t> frozen_;   // keeps its jittered place (FreezeBesideJumps)
-  bool uniform_density_ = true;   // all of delta_ alike: candidates need none
+  std::vector<uint8_t> moves_;    // HalfSweep's
+  std::vector<double> new_q_;
+  std::vector<Vec3> new_p_;
+  bool uniform_density_ = true;  // all of delta_ alike: candidates need none
   HashGrid main_, moved_grid_;
 };
 
@@ -307,9 +314,14 @@ absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
   // them as much as many; the few left later get all C.
   const uint64_t tries = std::min<uint64_t>(
       candidates, static_cast<uint64_t>(options_.first_candidates) << std::min(sweep, 20));
-  std::vector<uint8_t> moves(todo.size(), 0);
-  std::vector<double> new_q(todo.size());
-  std::vector<Vec3> new_p(todo.size());
+  // The half-sweep's outcome for todo[t] (kept between half-sweeps: fresh
+  // memory costs page faults).
+  std::vector<uint8_t>& moves = moves_;
+  std::vector<double>& new_q = new_q_;
+  std::vector<Vec3>& new_p = new_p_;
+  moves.assign(todo.size(), 0);
+  new_q.resize(todo.size());
+  new_p.resize(todo.size());
   RETURN_IF_ERROR(ForParts(todo.size(), [&](int, size_t begin, size_t end) -> absl::Status {
     // The part's samples that are too close, in index order, with the
     // crowding of their best place so far (their own at first).
@@ -339,7 +351,8 @@ absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
         searching.push_back({static_cast<uint32_t>(t), c, q_[k], p_[k]});
       }
     }
-    std::vector<std::pair<double, int>> h(kRound);
+    static_assert(kRound <= 16, "a candidate's j takes 4 bits of its sort key");
+    uint64_t key[kRound];
     std::vector<double> cq;
     std::vector<int> cj;
     std::vector<Vec3> cp;
@@ -348,65 +361,74 @@ absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
     std::vector<HashGrid::Entry> near;
     for (uint64_t j0 = 0; j0 < tries && !searching.empty(); j0 += kRound) {
       const int m = static_cast<int>(std::min<uint64_t>(kRound, tries - j0));
-      // Candidates j0 .. j0 + m - 1 of every searching sample, sorted inside
-      // each sample's stratum so that the batch's q do not decrease.
-      cq.clear(), cj.clear();
-      for (const Search& s : searching) {
-        const uint64_t k = todo[s.t];
-        for (int j = 0; j < m; ++j) {
-          const uint64_t counter = (k * options_.sweeps + sweep) * candidates + j0 + j;
-          h[j] = {CounterUniform(seed_, hash_stream::kBlueCandidate, counter), j};
-        }
-        std::sort(h.begin(), h.begin() + m);
-        for (int j = 0; j < m; ++j) {
-          cq.push_back((static_cast<double>(k) + h[j].first) / static_cast<double>(n_));
-          cj.push_back(h[j].second);
-        }
-      }
-      cp.resize(cq.size());
-      cd.resize(uniform_density_ ? 0 : cq.size());
-      RETURN_IF_ERROR(
-          place_(cq.data(), cq.size(), cp.data(), uniform_density_ ? nullptr : cd.data()));
-      // A sample takes its first candidate, in j order, that clears every
-      // neighbour; failing that, after all C, the least crowded one.
       still.clear();
-      for (size_t s = 0; s < searching.size(); ++s) {
-        Search& search = searching[s];
-        const uint32_t k = todo[search.t];
-        // The neighbours of all m candidates, gathered once from the grids:
-        // a sample's candidates lie in its stratum, so one box holds them.
-        Vec3 lo = cp[s * m], hi = cp[s * m];
-        for (int j = 0; j < m; ++j) {
-          const Vec3& x = cp[s * m + j];
-          if (!IsFinite(x)) return absl::InvalidArgumentError("a candidate is not finite");
-          lo = {std::min(lo.x, x.x), std::min(lo.y, x.y), std::min(lo.z, x.z)};
-          hi = {std::max(hi.x, x.x), std::max(hi.y, x.y), std::max(hi.z, x.z)};
-        }
-        Gather(k, lo, hi, &near);
-        int first = -1;
-        for (int j = 0; j < m; ++j) {
-          const size_t c = s * m + j;
-          if (first >= 0 && cj[c] > cj[s * m + first]) continue;
-          // Across a density step a stratum's sample would drift to the
-          // sparse side, where it is less crowded: it stays where the
-          // density is within kDensityJump of its jittered place's.
-          if (!uniform_density_ &&
-              !(cd[c] * kDensityJump >= delta_[k] && cd[c] <= kDensityJump * delta_[k])) {
-            continue;
+      for (size_t s0 = 0; s0 < searching.size(); s0 += kBlock) {
+        const size_t s1 = std::min(searching.size(), s0 + kBlock);
+        // Candidates j0 .. j0 + m - 1 of the block's searching samples,
+        // sorted inside each sample's stratum so that the batch's q do not
+        // decrease.
+        cq.clear(), cj.clear();
+        for (size_t s = s0; s < s1; ++s) {
+          const uint64_t k = todo[searching[s].t];
+          // Key: UniformOf's 53 bits above j, so that the keys sort as the
+          // pairs (h, j) do.
+          for (int j = 0; j < m; ++j) {
+            const uint64_t counter = (k * options_.sweeps + sweep) * candidates + j0 + j;
+            key[j] = (CounterHash(seed_, hash_stream::kBlueCandidate, counter) >> 11) << 4 | j;
+            for (int t = j; t > 0 && key[t] < key[t - 1]; --t) std::swap(key[t], key[t - 1]);
           }
-          const double crowding = Crowding(k, cp[c], search.best, near);
-          if (crowding >= 1) {
-            first = j;
-          } else if (first < 0 && crowding > search.best) {
-            // Ties go to the first in the batch's (hashed) order.
-            search.best = crowding, search.q = cq[c], search.p = cp[c];
+          for (int t = 0; t < m; ++t) {
+            const double h = static_cast<double>(key[t] >> 4) * 0x1.0p-53;
+            cq.push_back((static_cast<double>(k) + h) / static_cast<double>(n_));
+            cj.push_back(static_cast<int>(key[t] & 15));
           }
         }
-        if (first >= 0) {
-          moves[search.t] = 1, new_q[search.t] = cq[s * m + first];
-          new_p[search.t] = cp[s * m + first];
-        } else {
-          still.push_back(search);
+        cp.resize(cq.size());
+        cd.resize(uniform_density_ ? 0 : cq.size());
+        RETURN_IF_ERROR(
+            place_(cq.data(), cq.size(), cp.data(), uniform_density_ ? nullptr : cd.data()));
+        // A sample takes its first candidate, in j order, that clears every
+        // neighbour; failing that, after all C, the least crowded one.
+        for (size_t s = s0; s < s1; ++s) {
+          Search& search = searching[s];
+          const uint32_t k = todo[search.t];
+          const size_t c0 = (s - s0) * m;
+          // The neighbours of all m candidates, gathered once from the
+          // grids: a sample's candidates lie in its stratum, so one box
+          // holds them.
+          Vec3 lo = cp[c0], hi = cp[c0];
+          for (int j = 0; j < m; ++j) {
+            const Vec3& x = cp[c0 + j];
+            if (!IsFinite(x)) return absl::InvalidArgumentError("a candidate is not finite");
+            lo = {std::min(lo.x, x.x), std::min(lo.y, x.y), std::min(lo.z, x.z)};
+            hi = {std::max(hi.x, x.x), std::max(hi.y, x.y), std::max(hi.z, x.z)};
+          }
+          Gather(k, lo, hi, &near);
+          int first = -1;
+          for (int j = 0; j < m; ++j) {
+            const size_t c = c0 + j;
+            if (first >= 0 && cj[c] > cj[c0 + first]) continue;
+            // Across a density step a stratum's sample would drift to the
+            // sparse side, where it is less crowded: it stays where the
+            // density is within kDensityJump of its jittered place's.
+            if (!uniform_density_ &&
+                !(cd[c] * kDensityJump >= delta_[k] && cd[c] <= kDensityJump * delta_[k])) {
+              continue;
+            }
+            const double crowding = Crowding(k, cp[c], search.best, near);
+            if (crowding >= 1) {
+              first = j;
+            } else if (first < 0 && crowding > search.best) {
+              // Ties go to the first in the batch's (hashed) order.
+              search.best = crowding, search.q = cq[c], search.p = cp[c];
+            }
+          }
+          if (first >= 0) {
+            moves[search.t] = 1, new_q[search.t] = cq[c0 + first];
+            new_p[search.t] = cp[c0 + first];
+          } else {
+            still.push_back(search);
+          }
         }
       }
       std::swap(searching, still);
@@ -489,7 +511,7 @@ absl::StatusOr<BlueNoiseSet> Relaxation::Run(double total_mass) {
       main_.Build(p_, r_, all, &slot);
       for (uint32_t i : moved_since_build) moved_flag[i] = 0;
       moved_since_build.clear();
-      moved_grid_ = HashGrid(cell);
+      moved_grid_.Clear();
     }
     for (uint32_t c = 0; c < 2; ++c) {
       colour.clear();
