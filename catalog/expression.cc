@@ -470,6 +470,11 @@ void ExecuteMany(const std::vector<Instruction>& code, const double* const* vars
     double* top = st[sp + 1];  // a pushed column
     double* a = sp >= 1 ? st[sp - 1] : nullptr;  // a binary operator's columns
     const double* b = sp >= 0 ? st[sp] : nullptr;
+    // A binary operator: a[i] = f(a[i], b[i]), then one column fewer.
+    const auto binary = [&](auto f) {
+      for (size_t i = 0; i < m; ++i) a[i] = f(a[i], b[i]);
+      --sp;
+    };
     switch (in.op) {
       case Op::kConst:
         std::fill(top, top + m, in.a), ++sp;
@@ -494,56 +499,43 @@ void ExecuteMany(const std::vector<Instruction>& code, const double* const* vars
         ++sp;
         break;
       case Op::kAdd:
-        for (size_t i = 0; i < m; ++i) a[i] = a[i] + b[i];
-        --sp;
+        binary([](double x, double y) { return x + y; });
         break;
       case Op::kSub:
-        for (size_t i = 0; i < m; ++i) a[i] = a[i] - b[i];
-        --sp;
+        binary([](double x, double y) { return x - y; });
         break;
       case Op::kMul:
-        for (size_t i = 0; i < m; ++i) a[i] = a[i] * b[i];
-        --sp;
+        binary([](double x, double y) { return x * y; });
         break;
       case Op::kDiv:
-        for (size_t i = 0; i < m; ++i) a[i] = a[i] / b[i];
-        --sp;
+        binary([](double x, double y) { return x / y; });
         break;
       case Op::kPow:
-        for (size_t i = 0; i < m; ++i) a[i] = Pow(a[i], b[i]);
-        --sp;
+        binary([](double x, double y) { return Pow(x, y); });
         break;
       case Op::kLess:
-        for (size_t i = 0; i < m; ++i) a[i] = Lt(a[i], b[i]);
-        --sp;
+        binary([](double x, double y) { return Lt(x, y); });
         break;
       case Op::kGreater:
-        for (size_t i = 0; i < m; ++i) a[i] = Lt(b[i], a[i]);
-        --sp;
+        binary([](double x, double y) { return Lt(y, x); });
         break;
       case Op::kLessEqual:
-        for (size_t i = 0; i < m; ++i) a[i] = Le(a[i], b[i]);
-        --sp;
+        binary([](double x, double y) { return Le(x, y); });
         break;
       case Op::kGreaterEqual:
-        for (size_t i = 0; i < m; ++i) a[i] = Le(b[i], a[i]);
-        --sp;
+        binary([](double x, double y) { return Le(y, x); });
         break;
       case Op::kEqual:
-        for (size_t i = 0; i < m; ++i) a[i] = Eq(a[i], b[i]);
-        --sp;
+        binary([](double x, double y) { return Eq(x, y); });
         break;
       case Op::kNotEqual:
-        for (size_t i = 0; i < m; ++i) a[i] = Ne(a[i], b[i]);
-        --sp;
+        binary([](double x, double y) { return Ne(x, y); });
         break;
       case Op::kAnd:
-        for (size_t i = 0; i < m; ++i) a[i] = And(a[i], b[i]);
-        --sp;
+        binary([](double x, double y) { return And(x, y); });
         break;
       case Op::kOr:
-        for (size_t i = 0; i < m; ++i) a[i] = Or(a[i], b[i]);
-        --sp;
+        binary([](double x, double y) { return Or(x, y); });
         break;
       case Op::kFunc:
         if (in.fn == Fn::kSin || in.fn == Fn::kCos) {
