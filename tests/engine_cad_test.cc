@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "base/status_macros.h"
 #include "cad/fixtures.h"
 #include "cad/load.h"
 #include "cad/model_sampler.h"
@@ -91,10 +92,22 @@ TEST(EngineCad, NoSampleOfTheBoxWithAHoleLeavesItsFace) {
   }
 }
 
+// The STEP box with a hole, loaded.
+absl::StatusOr<std::shared_ptr<const cad::Model>> BoxModel() {
+  ASSIGN_OR_RETURN(const std::string bytes,
+                   fx::SolidBytes(fx::Solid::kBoxWithHole, ModelFormat::kStep));
+  return cad::Load(ModelFormat::kStep, bytes, "box_with_hole.step");
+}
+
+// Its tree for 10^6 samples under the uniform density.
+absl::StatusOr<std::shared_ptr<const cad::ModelTree>> BoxTree() {
+  ASSIGN_OR_RETURN(auto model, BoxModel());
+  return cad::ModelTree::Build(model, std::shared_ptr<const Density>(MakeUniformDensity()), {},
+                               1'000'000);
+}
+
 TEST(EngineCad, FacesGetSamplesInProportionToTheirExactAreas) {
-  auto bytes = fx::SolidBytes(fx::Solid::kBoxWithHole, ModelFormat::kStep);
-  ASSERT_TRUE(bytes.ok());
-  auto model = cad::Load(ModelFormat::kStep, *bytes, "box_with_hole.step");
+  auto model = BoxModel();
   ASSERT_TRUE(model.ok()) << model.status();
   LocalEngine e;
   for (uint64_t n : {1000u, 20000u}) {
@@ -116,12 +129,7 @@ TEST(EngineCad, FacesGetSamplesInProportionToTheirExactAreas) {
 // grid. Followed down to issue 33's rough floor, the box's tree for 10^6
 // samples had 197 588 leaves and took a minute of CAD-kernel classification.
 TEST(EngineCad, TrimsAreFollowedNoFinerThanTheTrimGrid) {
-  auto bytes = fx::SolidBytes(fx::Solid::kBoxWithHole, ModelFormat::kStep);
-  ASSERT_TRUE(bytes.ok());
-  auto model = cad::Load(ModelFormat::kStep, *bytes, "box_with_hole.step");
-  ASSERT_TRUE(model.ok()) << model.status();
-  auto tree = cad::ModelTree::Build(*model, std::shared_ptr<const Density>(MakeUniformDensity()),
-                                    {}, 1'000'000);
+  auto tree = BoxTree();
   ASSERT_TRUE(tree.ok()) << tree.status();
   EXPECT_LT((*tree)->leaf_count(), 100'000u);
 }
@@ -131,12 +139,7 @@ TEST(EngineCad, TrimsAreFollowedNoFinerThanTheTrimGrid) {
 // however small or flat, to stage 1's base depth: 46 064 leaves for the box
 // at 10^6, 4 096 a plane).
 TEST(EngineCad, AModelsFacesShareOneTolerance) {
-  auto bytes = fx::SolidBytes(fx::Solid::kBoxWithHole, ModelFormat::kStep);
-  ASSERT_TRUE(bytes.ok());
-  auto model = cad::Load(ModelFormat::kStep, *bytes, "box_with_hole.step");
-  ASSERT_TRUE(model.ok()) << model.status();
-  auto tree = cad::ModelTree::Build(*model, std::shared_ptr<const Density>(MakeUniformDensity()),
-                                    {}, 1'000'000);
+  auto tree = BoxTree();
   ASSERT_TRUE(tree.ok()) << tree.status();
   const double diagonal = std::sqrt(fx::kBoxX * fx::kBoxX + fx::kBoxY * fx::kBoxY +
                                     fx::kBoxZ * fx::kBoxZ);
@@ -160,9 +163,7 @@ class OnesDensity final : public Density {
 // same trees and windows, bit for bit (a tree built at grade g is the
 // grade-0 tree refined to g).
 TEST(EngineCad, FacesSharesFromExactAreasMatchTheCoarseTrees) {
-  auto bytes = fx::SolidBytes(fx::Solid::kBoxWithHole, ModelFormat::kStep);
-  ASSERT_TRUE(bytes.ok());
-  auto model = cad::Load(ModelFormat::kStep, *bytes, "box_with_hole.step");
+  auto model = BoxModel();
   ASSERT_TRUE(model.ok()) << model.status();
   std::shared_ptr<const Density> uniform = MakeUniformDensity();
   ASSERT_TRUE(uniform->IsUniform());
