@@ -39,7 +39,7 @@ void SobolColumns(int dim, uint32_t v[32]) {
 // lower-triangular matrix is digit i plus the digits j < i where bit 31 - j of
 // the counter hash (seed, kSobol[dim], i) is set; the shift is that hash at
 // counter 32.
-void MakeLinearScrambles(uint64_t seed, OwenFlips* t) {
+void MakeLinearScrambles(uint64_t seed, ScrambleTables* t) {
   for (int dim = 0; dim < 2; ++dim) {
     uint32_t row[32];
     for (int i = 0; i < 32; ++i) {
@@ -72,8 +72,8 @@ void MakeLinearScrambles(uint64_t seed, OwenFlips* t) {
 
 }  // namespace
 
-std::shared_ptr<const OwenFlips> Sequence::MakeOwenFlips(SequenceKind kind, uint64_t seed) {
-  auto t = std::make_shared<OwenFlips>();
+std::shared_ptr<const ScrambleTables> Sequence::MakeScrambles(SequenceKind kind, uint64_t seed) {
+  auto t = std::make_shared<ScrambleTables>();
   if (kind == SequenceKind::kSobol) {
     MakeLinearScrambles(seed, t.get());
     return t;
@@ -119,15 +119,15 @@ double Sequence::Raw(uint64_t k) const {
       return (*table_)[k];
     case SequenceKind::kProgressive:
       return NestedScramble<uint64_t>(ReverseBits32(static_cast<uint32_t>(k)), CounterMix(k), 0,
-                                      *flips_);
+                                      *scrambles_);
     case SequenceKind::kSobol:
-      return LinearScramble<uint64_t>(k, CounterMix(k), 0, *flips_);
+      return LinearScramble<uint64_t>(k, CounterMix(k), 0, *scrambles_);
   }
   return 0;
 }
 
 double Sequence::Second(uint64_t k) const {
-  return LinearScramble<uint64_t>(k, CounterMix(k), 1, *flips_);
+  return LinearScramble<uint64_t>(k, CounterMix(k), 1, *scrambles_);
 }
 
 void Sequence::PointsMany(const uint32_t* ks, uint64_t k0, size_t n, double* a, double* b,
@@ -135,13 +135,13 @@ void Sequence::PointsMany(const uint32_t* ks, uint64_t k0, size_t n, double* a, 
   assert(kind_ == SequenceKind::kSobol);
   // Eight lanes where 64-bit lanes are cheap; the scalar code elsewhere.
   const size_t done = path == math::VectorPath::kAvx512
-                          ? sequence_internal::PointsOnAvx512(ks, k0, n, *flips_, a, b)
+                          ? sequence_internal::PointsOnAvx512(ks, k0, n, *scrambles_, a, b)
                           : 0;
   for (size_t i = done; i < n; ++i) {
     const uint64_t k = ks != nullptr ? ks[i] : k0 + i;
     const uint64_t k_mix = CounterMix(k);
-    a[i] = LinearScramble<uint64_t>(k, k_mix, 0, *flips_);
-    b[i] = LinearScramble<uint64_t>(k, k_mix, 1, *flips_);
+    a[i] = LinearScramble<uint64_t>(k, k_mix, 0, *scrambles_);
+    b[i] = LinearScramble<uint64_t>(k, k_mix, 1, *scrambles_);
   }
   if (windowed_) {
     for (size_t i = 0; i < n; ++i) a[i] = (a[i] - lo_) / (hi_ - lo_);

@@ -22,7 +22,7 @@ namespace sfc {
 
 // The nested scrambles of sobol and progressive, computed once per sequence
 // (core/sequence_internal.h).
-struct OwenFlips;
+struct ScrambleTables;
 
 class Sequence {
  public:
@@ -31,7 +31,7 @@ class Sequence {
   Sequence(SequenceKind kind, uint64_t count, uint64_t seed)
       : kind_(kind), count_(count), seed_(seed) {
     if (kind == SequenceKind::kSobol || kind == SequenceKind::kProgressive) {
-      flips_ = MakeOwenFlips(kind, seed);
+      scrambles_ = MakeScrambles(kind, seed);
     }
   }
 
@@ -96,7 +96,7 @@ class Sequence {
 
  private:
   double Raw(uint64_t k) const;  // q_k
-  static std::shared_ptr<const OwenFlips> MakeOwenFlips(SequenceKind kind, uint64_t seed);
+  static std::shared_ptr<const ScrambleTables> MakeScrambles(SequenceKind kind, uint64_t seed);
 
   SequenceKind kind_;
   uint64_t count_;
@@ -105,7 +105,7 @@ class Sequence {
   bool windowed_ = false;
   double lo_ = 0, hi_ = 1;
   // The scrambles of sobol and progressive: shared by copies and windows.
-  std::shared_ptr<const OwenFlips> flips_;
+  std::shared_ptr<const ScrambleTables> scrambles_;
 };
 
 // The first k in [0, count) for which reached(k) holds, for a predicate that

@@ -8,8 +8,8 @@
 
 namespace sfc::sequence_internal {
 
-size_t PointsOnAvx512(const uint32_t* ks, uint64_t k0, size_t n, const OwenFlips& table, double* a,
-                      double* b) {
+size_t PointsOnAvx512(const uint32_t* ks, uint64_t k0, size_t n, const ScrambleTables& table,
+                      double* a, double* b) {
   size_t i = 0;
   for (; i + 8 <= n; i += 8) {
     U64x8 k;

@@ -36,7 +36,7 @@ inline constexpr int kBlockLevels = 4;
 // table's levels. sobol (linear, coordinates 0 and 1): linear[dim][b][x] is
 // the scrambled generator matrix times byte b of k being x, and shift[dim]
 // the digital shift (LinearScramble).
-struct OwenFlips {
+struct ScrambleTables {
   uint64_t key[2];       // the keys of the flips below the table (BlockHash)
   uint64_t tail_key[2];  // the keys of the bits below 2^-32
   uint32_t top[1][1 << sequence_internal::kTableLevels];
@@ -70,7 +70,7 @@ __attribute__((always_inline)) inline U BlockHash(uint64_t key, U prefix, int i)
 // The table's flips for the top levels of r (< 2^32), and the conversion of
 // a value below 2^53 to double (exact), for one value or for eight lanes.
 template <typename U>
-__attribute__((always_inline)) inline U TopFlips(const OwenFlips& table, int dim, U r) {
+__attribute__((always_inline)) inline U TopFlips(const ScrambleTables& table, int dim, U r) {
   if constexpr (std::is_integral_v<U>) {
     return table.top[dim][r >> (32 - kTableLevels)];
   } else {
@@ -93,7 +93,8 @@ __attribute__((always_inline)) inline auto ToDouble(U x) {
 // (UniformOf(KeyedHash(tail_key[dim], CounterMix(k))), base/counter_hash.h:
 // k's CounterMix is shared by the coordinates).
 template <typename U>
-__attribute__((always_inline)) inline auto ToUnit(U r, U k_mix, int dim, const OwenFlips& table) {
+__attribute__((always_inline)) inline auto ToUnit(U r, U k_mix, int dim,
+                                                  const ScrambleTables& table) {
   const auto tail = ToDouble(KeyedHash(table.tail_key[dim], k_mix) >> 11) * 0x1.0p-53;
   return (ToDouble(r) + tail) * 0x1.0p-32;
 }
@@ -108,7 +109,7 @@ __attribute__((always_inline)) inline auto ToUnit(U r, U k_mix, int dim, const O
 // (< 2^32), or eight lanes of them.
 template <typename U>
 __attribute__((always_inline)) inline auto NestedScramble(U r, U k_mix, int dim,
-                                                          const OwenFlips& table) {
+                                                          const ScrambleTables& table) {
   // The flips of all 32 levels as one mask, then one xor.
   U flips = TopFlips(table, dim, r);
   for (int root = kTableLevels; root < 32; root += kBlockLevels) {
@@ -136,7 +137,7 @@ __attribute__((always_inline)) inline auto NestedScramble(U r, U k_mix, int dim,
 // lanes of them.
 template <typename U>
 __attribute__((always_inline)) inline auto LinearScramble(U k, U k_mix, int dim,
-                                                          const OwenFlips& table) {
+                                                          const ScrambleTables& table) {
   const auto& t = table.linear[dim];
   U r;
   if constexpr (std::is_integral_v<U>) {
@@ -154,8 +155,8 @@ __attribute__((always_inline)) inline auto LinearScramble(U k, U k_mix, int dim,
 // (core/sequence_avx512.cc): a[i] and b[i] as Sequence::PointsMany gives
 // them. Returns how many it took (a multiple of eight); the caller computes
 // the rest.
-size_t PointsOnAvx512(const uint32_t* ks, uint64_t k0, size_t n, const OwenFlips& table, double* a,
-                      double* b);
+size_t PointsOnAvx512(const uint32_t* ks, uint64_t k0, size_t n, const ScrambleTables& table,
+                      double* a, double* b);
 
 }  // namespace sequence_internal
 }  // namespace sfc
