@@ -9,6 +9,11 @@
 # arguments that must not change the bytes (batch sizes), and every line of
 # kVectorPaths runs again under each narrower vector path the CPU has
 # (SFCSAMPLER_VECTOR_PATH: scalar, sse2, avx) and must give the same hash.
+# Every line also runs with glibc's CPU dispatch narrowed to a CPU without
+# AVX, AVX2, FMA or AVX-512 (GLIBC_TUNABLES; our own dispatch reads the CPU
+# itself and keeps its path): libm's FMA variants of sin, exp, pow and the
+# like round differently, so a hash that moves here reads the C library
+# somewhere the sampler promises machine-independent bytes.
 #
 # A changed hash means the same request now gives other samples: that needs
 # a new algorithm version (request/sample_request.h), not a new pin.
@@ -27,6 +32,7 @@ hash_of() {  # ARGS...: the SHA-256 of the NPY the CLI writes
   sha256sum < "$tmp/out.npy" | cut -c1-64
 }
 failures=0 checked=0
+narrow_glibc=glibc.cpu.hwcaps=-AVX512F,-AVX2,-FMA,-FMA4,-AVX
 while read -r expected name rest; do
   [[ -z "$expected" || "$expected" == \#* ]] && continue
   eval "args=($rest)"  # the file's own quoting; MODELS is the fixtures' folder
@@ -41,6 +47,9 @@ while read -r expected name rest; do
     echo "FAIL: $name ($rest): $got, pinned $expected" >&2
     failures=$((failures + 1))
   fi
+  got=$(GLIBC_TUNABLES=$narrow_glibc hash_of "${args[@]}")
+  checked=$((checked + 1))
+  [[ "$got" == "$expected" ]] || { echo "FAIL: $name under $narrow_glibc: $got" >&2; failures=$((failures + 1)); }
   if [[ "$name" == *@paths ]]; then
     for path in scalar sse2 avx; do
       got=$(SFCSAMPLER_VECTOR_PATH=$path hash_of "${args[@]}")
