@@ -64,6 +64,46 @@ constexpr int kLanes = 8;
 // are independent chains of kLevels steps that the CPU overlaps.
 constexpr int kVectors = 4, kBlock = kLanes * kVectors;
 
+// One level of PathsOfBlock for each vector. kFirst: the scalar code's
+// clamps in full. After a level (a, b) lies in the frame's triangle as the
+// clamps leave it: a in [0, 1], b in [0, fl(1 - a)]. From there, in IEEE
+// arithmetic (round to nearest, no FMA), two of the four clamps can never
+// act, so the later levels skip them:
+// - child (E, A, M), fl(2a + b) < 1: then 2a + b < 1 exactly, so the new a
+//   = b is in [0, 1], and the new b = 2a (exact) < 1 - b, so 2a <= fl(1 -
+//   b): its upper clamp holds too;
+// - child (A, X, M): 2a + b <= 2 exactly (b <= fl(1 - a), which is 1 - a
+//   for a >= 1/2 and at most 1 otherwise), so s = fl(2a + b) is in [1, 2]
+//   and the new a = s - 1 (exact) in [0, 1]; the new b = 2 fl(fl(1 - a) -
+//   b) >= 0. Only its upper clamp, fl(1 - new a), can act.
+// The comparisons that choose the children see the same values either way,
+// so the paths are the scalar code's (tests/mesh_warp_test.cc checks them).
+template <bool kFirst>
+__attribute__((always_inline)) inline void PathLevel(Lanes8* a, Lanes8* b, Bits8* p) {
+  const Lanes8 zero{}, one = zero + 1.0;
+  for (int v = 0; v < kVectors; ++v) {
+    // Child (E, A, M): (a, b) -> (b, 2a); child (A, X, M): (a, b) ->
+    // (2a + b - 1, 2 (1 - a - b)).
+    const Lanes8 twice = 2 * a[v];
+    const Lanes8 s = twice + b[v];
+    const Ints8 first = s < one;
+    const Lanes8 na = first ? b[v] : s - 1;
+    const Lanes8 nb = first ? twice : 2 * (1 - a[v] - b[v]);
+    if (kFirst) {
+      // std::clamp(na, 0, 1), then std::clamp(nb, 0, 1 - a).
+      a[v] = na < zero ? zero : (one < na ? one : na);
+      const Lanes8 top = 1 - a[v];
+      b[v] = nb < zero ? zero : (top < nb ? top : nb);
+    } else {
+      a[v] = na;
+      const Lanes8 top = 1 - na;
+      b[v] = top < nb ? top : nb;
+    }
+    p[v] = p[v] << 1;
+    p[v] = first ? p[v] : p[v] | 1;
+  }
+}
+
 __attribute__((always_inline)) inline void PathsOfBlock(const double* pa, const double* pb,
                                                         uint64_t* paths) {
   Lanes8 a[kVectors], b[kVectors];
@@ -73,22 +113,8 @@ __attribute__((always_inline)) inline void PathsOfBlock(const double* pa, const 
     std::memcpy(&b[v], pb + v * kLanes, sizeof(Lanes8));
     p[v] = Bits8{};
   }
-  const Lanes8 zero{}, one = zero + 1.0;
-  for (int level = 0; level < MeshCurveTree::kLevels; ++level) {
-    for (int v = 0; v < kVectors; ++v) {
-      // Child (E, A, M): (a, b) -> (b, 2a); child (A, X, M): (a, b) ->
-      // (2a + b - 1, 2 (1 - a - b)).
-      const Lanes8 s = 2 * a[v] + b[v];
-      const Ints8 first = s < one;
-      const Lanes8 na = first ? b[v] : s - 1;
-      const Lanes8 nb = first ? 2 * a[v] : 2 * (1 - a[v] - b[v]);
-      // std::clamp(na, 0, 1), then std::clamp(nb, 0, 1 - a).
-      a[v] = na < zero ? zero : (one < na ? one : na);
-      const Lanes8 top = 1 - a[v];
-      b[v] = nb < zero ? zero : (top < nb ? top : nb);
-      p[v] = (p[v] << 1) | (Bits8)(first + 1);
-    }
-  }
+  PathLevel<true>(a, b, p);
+  for (int level = 1; level < MeshCurveTree::kLevels; ++level) PathLevel<false>(a, b, p);
   for (int v = 0; v < kVectors; ++v) std::memcpy(paths + v * kLanes, &p[v], sizeof(Bits8));
 }
 
