@@ -99,6 +99,9 @@ class CurveSamples {
   // kind's warp (WarpMany, a batch at a time), by which the cursor sorts the
   // whole set and the filler places it. A pure function of each k.
   void AddressesOf(const uint32_t* ks, uint64_t k0, size_t n, CurveAddress* out) const;
+  // Two-dimensional sequences: every address's leaf is below this (the
+  // cursor's sort buckets by it).
+  virtual uint32_t AddressLeafBound() const = 0;
   // OK when the kind can place `sequence`'s samples; INVALID_ARGUMENT with
   // the reason otherwise (a kind without a warp for two-dimensional ones).
   virtual absl::Status AcceptsSequence(const Sequence& sequence) const;

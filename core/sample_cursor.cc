@@ -22,13 +22,17 @@ SampleFields ColumnsOf(const CurveSamples& samples, SampleFields fields) {
 // Permutes at[0, n) in place so that the addresses of each bucket come
 // together, buckets in increasing order (McIlroy, Bostic and McIlroy's
 // American flag sort, 1993): bucket(a) in [0, buckets). `end` (buckets
-// entries) returns where each bucket ends.
+// entries) returns where each bucket ends; when `counted`, it comes in
+// holding each bucket's count.
 template <typename Bucket>
 void PermuteIntoBuckets(CurveAddress* at, size_t n, uint64_t buckets, const Bucket& bucket,
-                        std::vector<uint32_t>* end) {
-  end->assign(buckets, 0);
+                        std::vector<uint32_t>* end, bool counted = false) {
+  constexpr size_t kAhead = 8;  // addresses: two cache lines
+  if (!counted) {
+    end->assign(buckets, 0);
+    for (size_t j = 0; j < n; ++j) ++(*end)[bucket(at[j])];
+  }
   std::vector<uint32_t> next(buckets);  // each bucket's first place not yet filled
-  for (size_t j = 0; j < n; ++j) ++(*end)[bucket(at[j])];
   uint32_t running = 0;
   for (uint64_t c = 0; c < buckets; ++c) {
     next[c] = running, running += (*end)[c], (*end)[c] = running;
@@ -39,6 +43,9 @@ void PermuteIntoBuckets(CurveAddress* at, size_t n, uint64_t buckets, const Buck
       // c's own comes back to it.
       CurveAddress carried = at[next[c]];
       for (uint64_t b = bucket(carried); b != c; b = bucket(carried)) {
+        // Each swap's place depends on the address carried there: a chain of
+        // loads, each bucket's next place fetched ahead so that it hits cache.
+        __builtin_prefetch(at + next[b] + kAhead, 1);
         std::swap(carried, at[next[b]++]);
       }
       at[next[c]++] = carried;
@@ -46,56 +53,137 @@ void PermuteIntoBuckets(CurveAddress* at, size_t n, uint64_t buckets, const Buck
   }
 }
 
-// Sorts addresses into curve order (by CurveAddress::Key), in place: by
-// buckets of the leaf and the digits' top bits (as many as make about four
-// addresses a bucket), permuted in two passes, first by the top 8 bits of
-// the bucket (so the first pass writes to 256 places at a time), then each
-// of those by the rest while it is in cache, each bucket's few addresses
-// then by key; the second pass split over `parts` threads. The order is
-// that of one sort of the whole (keys are distinct: they hold the index).
-// Beside the addresses it holds two tables of 2^fine_bits counts a thread
-// (4 bytes each: about 256 KB a thread at 2^24 samples). More leaves than
-// half the addresses (a large mesh, a small set) take one comparison sort,
-// O(N log N).
-void SortAddresses(std::vector<CurveAddress>* addresses, int parts) {
+// Copies at[0, n) to out[0, n) with the addresses of each bucket together,
+// buckets in increasing order, each in its order in `at`: bucket(a) in [0,
+// buckets). `end` (buckets entries) returns where each bucket ends. Unlike
+// PermuteIntoBuckets, no store waits on a load: for addresses in cache.
+template <typename Bucket>
+void DistributeIntoBuckets(const CurveAddress* at, size_t n, uint64_t buckets, const Bucket& bucket,
+                           CurveAddress* out, std::vector<uint32_t>* end) {
+  end->assign(buckets, 0);
+  for (size_t j = 0; j < n; ++j) ++(*end)[bucket(at[j])];
+  uint32_t running = 0;
+  for (uint64_t c = 0; c < buckets; ++c) {
+    const uint32_t count = (*end)[c];
+    (*end)[c] = running;  // its first place, until the copy below moves it on
+    running += count;
+  }
+  for (size_t j = 0; j < n; ++j) out[(*end)[bucket(at[j])]++] = at[j];
+}
+
+// Sorts a bucket's few addresses, all of one leaf, into curve order: by
+// insertion, on digits then index (CurveAddress::Key's order within a leaf).
+void SortWithinLeaf(CurveAddress* first, CurveAddress* last) {
+  for (CurveAddress* i = first + 1; i < last; ++i) {
+    const CurveAddress moved = *i;
+    CurveAddress* j = i;
+    for (; j > first; --j) {
+      const CurveAddress& before = j[-1];
+      if (before.digits < moved.digits ||
+          (before.digits == moved.digits && before.index < moved.index)) {
+        break;
+      }
+      *j = before;
+    }
+    *j = moved;
+  }
+}
+
+// The buckets by which SortAddresses sorts n addresses whose leaves are
+// below `leaves`: the leaf and the digits' top `bits` (as many as make about
+// two addresses a bucket), in two passes, first by the top 8 bits of the
+// bucket (the coarse bucket, below 256), then each coarse bucket by the rest
+// (the fine bucket, below 2^fine_bits). `compare`: more leaves than half the
+// addresses (a large mesh, a small set), or too many addresses for 32-bit
+// counts, take one comparison sort instead, O(N log N).
+struct AddressBuckets {
+  AddressBuckets(uint32_t leaves, size_t n) {
+    compare = n < 2 || leaves > n / 2 + 1024 || n >= (uint64_t{1} << 32);
+    if (compare) return;
+    while (bits < 20 && (uint64_t{leaves} << (bits + 1)) <= n / 2) ++bits;
+    const uint64_t buckets = uint64_t{leaves} << bits;
+    while ((buckets - 1) >> fine_bits >= 256) ++fine_bits;
+    coarse = ((buckets - 1) >> fine_bits) + 1;
+  }
+  // Digits are below 2^52 (CurveAddress::Key); bits above are ignored.
+  uint64_t Of(const CurveAddress& a) const {
+    return (uint64_t{a.leaf} << bits) | ((a.digits & kDigits) >> (52 - bits));
+  }
+  uint64_t CoarseOf(const CurveAddress& a) const { return Of(a) >> fine_bits; }
+  // Writes a's coarse bucket into its digits' unused top 8 bits (the first
+  // pass's bucket, no shifts by variable counts in its chain of loads) and
+  // returns it; SortAddresses clears them.
+  uint64_t Stamp(CurveAddress* a) const {
+    const uint64_t c = CoarseOf(*a);
+    a->digits |= c << kStampShift;
+    return c;
+  }
+
+  static constexpr uint64_t kDigits = (uint64_t{1} << 52) - 1;
+  static constexpr int kStampShift = 56;
+  bool compare = false;
+  int bits = 0, fine_bits = 0;
+  uint64_t coarse = 0;
+};
+
+// Sorts addresses into curve order (by CurveAddress::Key), in place, by
+// `buckets`, each stamped with its coarse bucket (AddressBuckets::Stamp)
+// unless buckets.compare; coarse_count[c] holds how many lie in coarse
+// bucket c. The first pass permutes them in place into their coarse buckets
+// (so it writes to at most 256 places at a time, each fetched ahead); the
+// second, split over `parts` threads, takes each coarse bucket while it is in
+// cache into its fine buckets, and each fine bucket's few addresses by key.
+// The order is that of one sort of the whole (keys are distinct: they hold
+// the index). Beside the addresses it holds two tables of 2^fine_bits counts
+// a thread (4 bytes each: about 256 KB a thread at 2^24 samples) and a copy
+// of one coarse bucket (at most 1 MB a thread).
+void SortAddresses(std::vector<CurveAddress>* addresses, const AddressBuckets& buckets,
+                   std::vector<uint32_t> coarse_count, int parts) {
+  // The second pass's copy of a coarse bucket, at most 1 MB a thread.
+  constexpr size_t kScratchAddresses = size_t{1} << 16;
   std::vector<CurveAddress>& at = *addresses;
-  if (at.size() < 2) return;
-  uint32_t leaves = 0;
-  for (const CurveAddress& a : at) leaves = std::max(leaves, a.leaf + 1);
-  if (leaves > at.size() / 2 + 1024 || at.size() >= (uint64_t{1} << 32)) {
+  if (buckets.compare) {
     std::sort(at.begin(), at.end());
     return;
   }
-  // Digits are below 2^52 (CurveAddress::Key): the top `bits` of them.
-  int bits = 0;
-  while (bits < 20 && (uint64_t{leaves} << (bits + 1)) <= at.size() / 4) ++bits;
-  auto bucket_of = [bits](const CurveAddress& a) {
-    return (uint64_t{a.leaf} << bits) | (a.digits >> (52 - bits));
-  };
-  const uint64_t buckets = uint64_t{leaves} << bits;
-  int fine_bits = 0;  // buckets >> fine_bits <= 256
-  while ((buckets - 1) >> fine_bits >= 256) ++fine_bits;
-  const uint64_t coarse = ((buckets - 1) >> fine_bits) + 1;
-  std::vector<uint32_t> coarse_end;
-  PermuteIntoBuckets(at.data(), at.size(), coarse,
-                     [&](const CurveAddress& a) { return bucket_of(a) >> fine_bits; },
-                     &coarse_end);
+  const int fine_bits = buckets.fine_bits;
+  const uint64_t coarse = buckets.coarse;
+  std::vector<uint32_t> coarse_end = std::move(coarse_count);
+  PermuteIntoBuckets(
+      at.data(), at.size(), coarse,
+      [](const CurveAddress& a) { return a.digits >> AddressBuckets::kStampShift; }, &coarse_end,
+      /*counted=*/true);
   // Coarse buckets to parts of about equal counts.
   WorkerPool::Shared().ParallelFor(parts, [&](int i) {
     const uint64_t from = at.size() * i / parts, to = at.size() * (i + 1) / parts;
     std::vector<uint32_t> end;
+    std::vector<CurveAddress> scratch;
     for (uint64_t c = 0; c < coarse; ++c) {
       const uint64_t begin = c == 0 ? 0 : coarse_end[c - 1];
       // Each coarse bucket with addresses is the part's where it begins.
       if (begin < from || begin >= to || coarse_end[c] == begin) continue;
       CurveAddress* first = at.data() + begin;
+      const size_t n = coarse_end[c] - begin;
+      for (size_t j = 0; j < n; ++j) first[j].digits &= AddressBuckets::kDigits;
       const uint64_t base = c << fine_bits;
-      PermuteIntoBuckets(first, coarse_end[c] - begin, uint64_t{1} << fine_bits,
-                         [&](const CurveAddress& a) { return bucket_of(a) - base; }, &end);
+      auto fine_bucket = [&](const CurveAddress& a) { return buckets.Of(a) - base; };
+      // A coarse bucket of cache size is copied into buckets and back (no
+      // chain of loads); a larger one (a leaf with most of the mass) is
+      // permuted in place.
+      CurveAddress* sorted = first;
+      if (n <= kScratchAddresses) {
+        scratch.resize(std::max(scratch.size(), n));
+        DistributeIntoBuckets(first, n, uint64_t{1} << fine_bits, fine_bucket, scratch.data(),
+                              &end);
+        sorted = scratch.data();
+      } else {
+        PermuteIntoBuckets(first, n, uint64_t{1} << fine_bits, fine_bucket, &end);
+      }
       for (size_t f = 0; f < end.size(); ++f) {
         const uint32_t b = f == 0 ? 0 : end[f - 1];
-        if (end[f] - b > 1) std::sort(first + b, first + end[f]);
+        if (end[f] - b > 1) SortWithinLeaf(sorted + b, sorted + end[f]);
       }
+      if (sorted != first) std::copy(sorted, sorted + n, first);
     }
   });
 }
@@ -150,13 +238,28 @@ absl::Status SampleCursor::Plan(uint64_t begin, uint64_t end,
     }
     const uint32_t* ks = sequence.windowed() ? in_window->data() : nullptr;
     const uint64_t m = sequence.windowed() ? in_window->size() : count;
-    addresses_.resize(m);
+    ResizeColumn(&addresses_, m);
     const int parts = m >= 8192 ? threads_ : 1;
+    // Each part stamps and counts its addresses' coarse buckets while they
+    // are in cache.
+    const AddressBuckets buckets(samples.AddressLeafBound(), m);
+    std::vector<std::vector<uint32_t>> counts(parts);
     WorkerPool::Shared().ParallelFor(parts, [&](int i) {
       const uint64_t j0 = m * i / parts, j1 = m * (i + 1) / parts;
-      samples.AddressesOf(ks != nullptr ? ks + j0 : nullptr, j0, j1 - j0, addresses_.data() + j0);
+      constexpr uint64_t kPiece = 4096;
+      if (!buckets.compare) counts[i].assign(buckets.coarse, 0);
+      for (uint64_t p = j0; p < j1; p += kPiece) {
+        const uint64_t n = std::min(kPiece, j1 - p);
+        samples.AddressesOf(ks != nullptr ? ks + p : nullptr, p, n, addresses_.data() + p);
+        if (buckets.compare) continue;
+        for (uint64_t j = p; j < p + n; ++j) ++counts[i][buckets.Stamp(&addresses_[j])];
+      }
     });
-    SortAddresses(&addresses_, parts);
+    std::vector<uint32_t> coarse_count(buckets.coarse, 0);
+    for (const std::vector<uint32_t>& part : counts) {
+      for (uint64_t c = 0; c < part.size(); ++c) coarse_count[c] += part[c];
+    }
+    SortAddresses(&addresses_, buckets, std::move(coarse_count), parts);
     const uint64_t kept = addresses_.size();
     addresses_.erase(addresses_.begin() + std::min(end, kept), addresses_.end());
     addresses_.erase(addresses_.begin(), addresses_.begin() + std::min(begin, kept));

@@ -46,6 +46,8 @@ class Sampler final : public CurveSamples {
   void WarpMany(size_t n, const double* a, const double* b, CurveAddress* out) const override;
   // The warp of a two-dimensional sequence; null for the others.
   const TreeWarp* warp() const { return warp_.get(); }
+  // The tree's leaf count.
+  uint32_t AddressLeafBound() const override { return static_cast<uint32_t>(tree_->leaf_count()); }
 
   // Every region kind: a parameter rectangle or a 3D box.
   absl::Status AcceptsRegion(const Region&) const override { return absl::OkStatus(); }

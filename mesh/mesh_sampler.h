@@ -87,6 +87,8 @@ class MeshSampler final : public CurveSamples {
   // REQUIRES: a two-dimensional sequence.
   void WarpMany(size_t n, const double* a, const double* b, CurveAddress* out) const override;
   const MeshWarp* warp() const { return warp_.get(); }
+  // The tree's leaf count.
+  uint32_t AddressLeafBound() const override { return static_cast<uint32_t>(tree_->leaf_count()); }
 
   // INVALID_ARGUMENT for a parameter rectangle: a mesh has no parameter
   // square (use a 3D box).

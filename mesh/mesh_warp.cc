@@ -245,7 +245,7 @@ void MeshWarp::LocateMany(size_t n, const double* a, const double* b, CurveAddre
   uint64_t paths[kBatch];
   const mesh_warp_lanes::LeafTables tables{tree_.mass_ends().data(), bucket_leaves_.data(),
                                            tree_.total_mass(), max_depth_, bucket_bits_};
-  const bool avx512 = path == math::VectorPath::kAvx512;
+  using math::VectorPath;
   for (size_t i0 = 0; i0 < n; i0 += kBatch) {
     const size_t m = std::min(kBatch, n - i0);
     if (path == math::VectorPath::kScalar) {
@@ -256,14 +256,18 @@ void MeshWarp::LocateMany(size_t n, const double* a, const double* b, CurveAddre
         leaf[i] = static_cast<int64_t>(l);
       }
     } else {
-      if (avx512) {
+      if (path == VectorPath::kAvx512) {
         mesh_warp_lanes::LeafSharesAvx512(tables, m, a + i0, b + i0, leaf, f, g, across);
+      } else if (path == VectorPath::kAvx) {
+        mesh_warp_lanes::LeafSharesAvx(tables, m, a + i0, b + i0, leaf, f, g, across);
       } else {
         mesh_warp_lanes::LeafSharesOf(tables, m, a + i0, b + i0, leaf, f, g, across);
       }
       if (uniform_density_) {
-        if (avx512) {
+        if (path == VectorPath::kAvx512) {
           mesh_warp_lanes::PlaceUniformAvx512(m, f, g, pa, pb);
+        } else if (path == VectorPath::kAvx) {
+          mesh_warp_lanes::PlaceUniformAvx(m, f, g, pa, pb);
         } else {
           mesh_warp_lanes::PlaceUniformOf(m, f, g, pa, pb);
         }
@@ -293,6 +297,8 @@ void MeshWarp::PathsOf(size_t n, const double* pa, const double* pb, uint64_t* p
     for (size_t i = 0; i < n; ++i) paths[i] = MeshCurveTree::PathOf(pa[i], pb[i]);
   } else if (path == math::VectorPath::kAvx512) {
     mesh_warp_lanes::PathsOfAvx512(n, pa, pb, paths);
+  } else if (path == math::VectorPath::kAvx) {
+    mesh_warp_lanes::PathsOfAvx(n, pa, pb, paths);
   } else {
     mesh_warp_lanes::PathsOfLanes(n, pa, pb, paths);
   }

@@ -55,13 +55,13 @@ class MeshWarp {
   // out[i] = Locate(a[i], b[i]) for i < n, bit for bit on every vector path
   // (REQUIRES: math::Runs(path)): the leaf searches, the placement in
   // uniform cells and the bisections below the leaves (PathsOf) run over the
-  // batch 8 lanes at a time (mesh/mesh_warp_lanes.h); kScalar is the
-  // reference, one point at a time.
+  // batch 8 lanes at a time (2 on the baseline's SSE2;
+  // mesh/mesh_warp_lanes.h); kScalar is the reference, one point at a time.
   void LocateMany(size_t n, const double* a, const double* b, CurveAddress* out,
                   math::VectorPath path = math::BestVectorPath()) const;
 
   // paths[i] = MeshCurveTree::PathOf(pa[i], pb[i]) for i < n, bit for bit,
-  // on the vector path `path` (8 lanes of the same IEEE operations; AVX-512F
+  // on the vector path `path` (lanes of the same IEEE operations; AVX-512F
   // or the baseline's). REQUIRES: math::Runs(path).
   static void PathsOf(size_t n, const double* pa, const double* pb, uint64_t* paths,
                       math::VectorPath path = math::BestVectorPath());

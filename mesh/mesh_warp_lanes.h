@@ -1,11 +1,12 @@
-// The mesh warp's batch loops (mesh/mesh_warp.h), 8 lanes at a time in GCC's
+// The mesh warp's batch loops (mesh/mesh_warp.h), kLanes at a time in GCC's
 // vector extensions: each lane does the scalar code's IEEE operations in its
 // order (comparisons and selects for its branches and clamps; the build has
 // -ffp-contract=off), so every instruction set gives the scalar code's bits.
-// mesh_warp.cc builds them for the baseline (SSE2), mesh_warp_avx512.cc for
-// AVX-512F; MeshWarp dispatches on math::BestVectorPath(). Internal linkage
-// (an anonymous namespace) on purpose: each of the two files keeps its own
-// copy, compiled for its instruction set, which the linker never merges.
+// mesh_warp.cc builds them for the baseline (SSE2), mesh_warp_avx.cc for AVX
+// and mesh_warp_avx512.cc for AVX-512F; MeshWarp dispatches on
+// math::BestVectorPath(). Internal linkage (an anonymous namespace) on
+// purpose: each of the three files keeps its own copy, compiled for its
+// instruction set, which the linker never merges.
 //
 // Thread-safety: pure functions.
 #ifndef SFCSAMPLER_MESH_MESH_WARP_LANES_H_
@@ -37,7 +38,7 @@ struct LeafTables {
   int max_depth, bucket_bits;
 };
 
-// Bit i of x at bit 2i, for x < 2^32 (a uint64_t or 8 lanes of them).
+// Bit i of x at bit 2i, for x < 2^32 (a uint64_t or a vector of them).
 template <typename T>
 __attribute__((always_inline)) inline T Spread(T x) {
   x = (x | x << 16) & 0x0000ffff0000ffffULL;
@@ -52,44 +53,85 @@ void PathsOfAvx512(size_t n, const double* pa, const double* pb, uint64_t* paths
 void LeafSharesAvx512(const LeafTables& tables, size_t n, const double* a, const double* b,
                       int64_t* leaf, double* f, double* g, int64_t* across);
 void PlaceUniformAvx512(size_t n, const double* f, const double* g, double* pa, double* pb);
+// The AVX builds (mesh_warp_avx.cc).
+void PathsOfAvx(size_t n, const double* pa, const double* pb, uint64_t* paths);
+void LeafSharesAvx(const LeafTables& tables, size_t n, const double* a, const double* b,
+                   int64_t* leaf, double* f, double* g, int64_t* across);
+void PlaceUniformAvx(size_t n, const double* f, const double* g, double* pa, double* pb);
 
 namespace {
 
-typedef double Lanes8 __attribute__((vector_size(64)));
-typedef int64_t Ints8 __attribute__((vector_size(64)));
-typedef uint64_t Bits8 __attribute__((vector_size(64)));
+// As many lanes as the build's registers hold: 8 with AVX-512F, 4 with AVX,
+// 2 in the baseline's SSE2 (wider generic vectors there would be split into
+// many registers, spilled and partly done a lane at a time: three times
+// slower).
+#if defined(__AVX512F__)
 constexpr int kLanes = 8;
+#elif defined(__AVX__)
+constexpr int kLanes = 4;
+#else
+constexpr int kLanes = 2;
+#endif
+typedef double Doubles __attribute__((vector_size(8 * kLanes)));
+typedef int64_t Ints __attribute__((vector_size(8 * kLanes)));
+typedef uint64_t Words __attribute__((vector_size(8 * kLanes)));
 
-// MeshCurveTree::PathOf over 8 lanes x kVectors vectors at once. The vectors
+// MeshCurveTree::PathOf over kLanes x kVectors lanes at once. The vectors
 // are independent chains of kLevels steps that the CPU overlaps.
 constexpr int kVectors = 4, kBlock = kLanes * kVectors;
 
-__attribute__((always_inline)) inline void PathsOfBlock(const double* pa, const double* pb,
-                                                        uint64_t* paths) {
-  Lanes8 a[kVectors], b[kVectors];
-  Bits8 p[kVectors];
+// One level of PathsOfBlock for each vector. kFirst: the scalar code's
+// clamps in full. After a level (a, b) lies in the frame's triangle as the
+// clamps leave it: a in [0, 1], b in [0, fl(1 - a)]. From there, in IEEE
+// arithmetic (round to nearest, no FMA), two of the four clamps can never
+// act, so the later levels skip them:
+// - child (E, A, M), fl(2a + b) < 1: then 2a + b < 1 exactly, so the new a
+//   = b is in [0, 1], and the new b = 2a (exact) < 1 - b, so 2a <= fl(1 -
+//   b): its upper clamp holds too;
+// - child (A, X, M): 2a + b <= 2 exactly (b <= fl(1 - a), which is 1 - a
+//   for a >= 1/2 and at most 1 otherwise), so s = fl(2a + b) is in [1, 2]
+//   and the new a = s - 1 (exact) in [0, 1]; the new b = 2 fl(fl(1 - a) -
+//   b) >= 0. Only its upper clamp, fl(1 - new a), can act.
+// The comparisons that choose the children see the same values either way,
+// so the paths are the scalar code's (tests/mesh_warp_test.cc checks them).
+template <bool kFirst>
+__attribute__((always_inline)) inline void PathLevel(Doubles* a, Doubles* b, Words* p) {
+  const Doubles zero{}, one = zero + 1.0;
   for (int v = 0; v < kVectors; ++v) {
-    std::memcpy(&a[v], pa + v * kLanes, sizeof(Lanes8));
-    std::memcpy(&b[v], pb + v * kLanes, sizeof(Lanes8));
-    p[v] = Bits8{};
-  }
-  const Lanes8 zero{}, one = zero + 1.0;
-  for (int level = 0; level < MeshCurveTree::kLevels; ++level) {
-    for (int v = 0; v < kVectors; ++v) {
-      // Child (E, A, M): (a, b) -> (b, 2a); child (A, X, M): (a, b) ->
-      // (2a + b - 1, 2 (1 - a - b)).
-      const Lanes8 s = 2 * a[v] + b[v];
-      const Ints8 first = s < one;
-      const Lanes8 na = first ? b[v] : s - 1;
-      const Lanes8 nb = first ? 2 * a[v] : 2 * (1 - a[v] - b[v]);
+    // Child (E, A, M): (a, b) -> (b, 2a); child (A, X, M): (a, b) ->
+    // (2a + b - 1, 2 (1 - a - b)).
+    const Doubles twice = 2 * a[v];
+    const Doubles s = twice + b[v];
+    const Ints first = s < one;
+    const Doubles na = first ? b[v] : s - 1;
+    const Doubles nb = first ? twice : 2 * (1 - a[v] - b[v]);
+    if (kFirst) {
       // std::clamp(na, 0, 1), then std::clamp(nb, 0, 1 - a).
       a[v] = na < zero ? zero : (one < na ? one : na);
-      const Lanes8 top = 1 - a[v];
+      const Doubles top = 1 - a[v];
       b[v] = nb < zero ? zero : (top < nb ? top : nb);
-      p[v] = (p[v] << 1) | (Bits8)(first + 1);
+    } else {
+      a[v] = na;
+      const Doubles top = 1 - na;
+      b[v] = top < nb ? top : nb;
     }
+    p[v] = p[v] << 1;
+    p[v] = first ? p[v] : p[v] | 1;
   }
-  for (int v = 0; v < kVectors; ++v) std::memcpy(paths + v * kLanes, &p[v], sizeof(Bits8));
+}
+
+__attribute__((always_inline)) inline void PathsOfBlock(const double* pa, const double* pb,
+                                                        uint64_t* paths) {
+  Doubles a[kVectors], b[kVectors];
+  Words p[kVectors];
+  for (int v = 0; v < kVectors; ++v) {
+    std::memcpy(&a[v], pa + v * kLanes, sizeof(Doubles));
+    std::memcpy(&b[v], pb + v * kLanes, sizeof(Doubles));
+    p[v] = Words{};
+  }
+  PathLevel<true>(a, b, p);
+  for (int level = 1; level < MeshCurveTree::kLevels; ++level) PathLevel<false>(a, b, p);
+  for (int v = 0; v < kVectors; ++v) std::memcpy(paths + v * kLanes, &p[v], sizeof(Words));
 }
 
 // MeshWarp::PathsOf's batch: blocks, and the tail padded to a block.
@@ -106,7 +148,7 @@ __attribute__((always_inline)) inline void PathsOfLanes(size_t n, const double* 
   }
 }
 
-__attribute__((always_inline)) inline bool Any(Ints8 mask) {
+__attribute__((always_inline)) inline bool Any(Ints mask) {
 #ifdef __AVX512F__
   return _mm512_test_epi64_mask((__m512i)mask, (__m512i)mask) != 0;
 #else
@@ -117,41 +159,41 @@ __attribute__((always_inline)) inline bool Any(Ints8 mask) {
 }
 // p[index[k]] in each lane: one gather instruction where the build has
 // AVX-512F.
-__attribute__((always_inline)) inline Lanes8 Gather(const double* p, Ints8 index) {
+__attribute__((always_inline)) inline Doubles Gather(const double* p, Ints index) {
 #ifdef __AVX512F__
-  return (Lanes8)_mm512_mask_i64gather_pd(_mm512_setzero_pd(), 0xff, (__m512i)index, p, 8);
+  return (Doubles)_mm512_mask_i64gather_pd(_mm512_setzero_pd(), 0xff, (__m512i)index, p, 8);
 #else
-  Lanes8 r;
+  Doubles r;
   for (int k = 0; k < kLanes; ++k) r[k] = p[index[k]];
   return r;
 #endif
 }
-__attribute__((always_inline)) inline Ints8 Gather(const uint32_t* p, Ints8 index) {
+__attribute__((always_inline)) inline Ints Gather(const uint32_t* p, Ints index) {
 #ifdef __AVX512F__
   const __m256i r = _mm512_mask_i64gather_epi32(_mm256_setzero_si256(), 0xff, (__m512i)index, p, 4);
   typedef uint32_t Words8 __attribute__((vector_size(32)));
-  return __builtin_convertvector((Words8)r, Ints8);
+  return __builtin_convertvector((Words8)r, Ints);
 #else
-  Ints8 r;
+  Ints r;
   for (int k = 0; k < kLanes; ++k) r[k] = p[index[k]];
   return r;
 #endif
 }
 // x exactly, for 0 <= x < 2^52: x in the mantissa of 2^52, less 2^52.
-__attribute__((always_inline)) inline Lanes8 ExactDouble(Ints8 x) {
-  return (Lanes8)(x | 0x4330000000000000LL) - 0x1.0p52;
+__attribute__((always_inline)) inline Doubles ExactDouble(Ints x) {
+  return (Doubles)(x | 0x4330000000000000LL) - 0x1.0p52;
 }
 // floor(x) as an integer, exactly, for 0 <= x < 2^51 (-0 included): x + 2^52
 // rounds x to an integer in the mantissa, one less where that went up. Vector
 // operations of AVX-512F alone (its conversions to 64-bit integers are
 // AVX-512DQ's), and static_cast's truncation for these x.
-__attribute__((always_inline)) inline Ints8 FloorOf(Lanes8 x) {
-  const Lanes8 big = x + 0x1.0p52;
-  const Ints8 up = big - 0x1.0p52 > x;
-  return ((Ints8)big - 0x4330000000000000LL) + up;  // up is -1 where true
+__attribute__((always_inline)) inline Ints FloorOf(Doubles x) {
+  const Doubles big = x + 0x1.0p52;
+  const Ints up = big - 0x1.0p52 > x;
+  return ((Ints)big - 0x4330000000000000LL) + up;  // up is -1 where true
 }
 // 2^k for |k| <= 1022 (the scalar Pow2's exponent field).
-__attribute__((always_inline)) inline Lanes8 Pow2(Ints8 k) { return (Lanes8)((k + 1023) << 52); }
+__attribute__((always_inline)) inline Doubles Pow2(Ints k) { return (Doubles)((k + 1023) << 52); }
 
 // LeafShareBlock's vectors: independent chains of dependent gathers, which
 // the CPU overlaps.
@@ -162,26 +204,26 @@ constexpr int kShareVectors = 4, kShareBlock = kLanes * kShareVectors;
 // vectors: std::upper_bound's and std::lower_bound's answer (mesh_warp.cc's
 // FirstAbove, FirstAtOrAbove), into base.
 template <bool kAtOrAbove>
-__attribute__((always_inline)) inline void FirstNotBefore(const double* e, Ints8* base, Ints8* len,
-                                                          const Lanes8* x) {
-  const Ints8 none{};
+__attribute__((always_inline)) inline void FirstNotBefore(const double* e, Ints* base, Ints* len,
+                                                          const Doubles* x) {
+  const Ints none{};
   for (;;) {
-    Ints8 half[kShareVectors], step[kShareVectors], any{};
+    Ints half[kShareVectors], step[kShareVectors], any{};
     for (int v = 0; v < kShareVectors; ++v) {
       half[v] = len[v] >> 1, step[v] = half[v] > none;
       any |= step[v];
     }
     if (!Any(any)) break;
     for (int v = 0; v < kShareVectors; ++v) {
-      const Lanes8 probe = Gather(e, step[v] ? base[v] + half[v] - 1 : base[v]);
-      const Ints8 before = kAtOrAbove ? probe < x[v] : probe <= x[v];
+      const Doubles probe = Gather(e, step[v] ? base[v] + half[v] - 1 : base[v]);
+      const Ints before = kAtOrAbove ? probe < x[v] : probe <= x[v];
       base[v] = (step[v] & before) ? base[v] + half[v] : base[v];
       len[v] -= half[v];
     }
   }
   for (int v = 0; v < kShareVectors; ++v) {
-    const Lanes8 probe = Gather(e, base[v]);
-    const Ints8 before = kAtOrAbove ? probe < x[v] : probe <= x[v];
+    const Doubles probe = Gather(e, base[v]);
+    const Ints before = kAtOrAbove ? probe < x[v] : probe <= x[v];
     base[v] = ((len[v] > none) & before) ? base[v] + 1 : base[v];
   }
 }
@@ -195,34 +237,34 @@ __attribute__((always_inline)) inline void LeafShareBlock(const LeafTables& t, c
                                                           double* f_out, double* g_out,
                                                           int64_t* across_out) {
   constexpr int V = kShareVectors;
-  const Lanes8 zero{}, below = zero + kBelowOne, one = zero + 1.0;
-  const Ints8 izero{};
+  const Doubles zero{}, below = zero + kBelowOne, one = zero + 1.0;
+  const Ints izero{};
   const int64_t max_depth = t.max_depth;
   const int64_t bits_a = (max_depth + 1) / 2, bits_b = max_depth / 2;
-  const Lanes8 cap_scale = Pow2(izero - max_depth);
-  Lanes8 c0[V], c1[V], x_lo[V], x_hi[V];
-  Bits8 cap_node[V];
-  Ints8 from[V], lo[V], hi[V], len_lo[V], len_hi[V];
+  const Doubles cap_scale = Pow2(izero - max_depth);
+  Doubles c0[V], c1[V], x_lo[V], x_hi[V];
+  Words cap_node[V];
+  Ints from[V], lo[V], hi[V], len_lo[V], len_hi[V];
   for (int v = 0; v < V; ++v) {
-    std::memcpy(&c0[v], a_in + v * kLanes, sizeof(Lanes8));
-    std::memcpy(&c1[v], b_in + v * kLanes, sizeof(Lanes8));
+    std::memcpy(&c0[v], a_in + v * kLanes, sizeof(Doubles));
+    std::memcpy(&c1[v], b_in + v * kLanes, sizeof(Doubles));
     c0[v] = c0[v] < zero ? zero : (below < c0[v] ? below : c0[v]);
     c1[v] = c1[v] < zero ? zero : (below < c1[v] ? below : c1[v]);
-    const Bits8 top_a = Spread((Bits8)FloorOf(c0[v] * Pow2(izero + bits_a)));
-    const Bits8 top_b = Spread((Bits8)FloorOf(c1[v] * Pow2(izero + bits_b)));
+    const Words top_a = Spread((Words)FloorOf(c0[v] * Pow2(izero + bits_a)));
+    const Words top_b = Spread((Words)FloorOf(c1[v] * Pow2(izero + bits_b)));
     cap_node[v] = max_depth % 2 == 0 ? top_a << 1 | top_b : top_a | top_b << 1;
-    const Ints8 bucket = (Ints8)(cap_node[v] >> (max_depth - t.bucket_bits));
+    const Ints bucket = (Ints)(cap_node[v] >> (max_depth - t.bucket_bits));
     from[v] = Gather(t.bucket_leaves, 2 * bucket);
     len_lo[v] = Gather(t.bucket_leaves, 2 * bucket + 1) + 1 - from[v];
     len_hi[v] = len_lo[v], lo[v] = from[v], hi[v] = from[v];
-    x_lo[v] = ExactDouble((Ints8)cap_node[v]) * cap_scale * t.total;
-    x_hi[v] = ExactDouble((Ints8)cap_node[v] + 1) * cap_scale * t.total;
+    x_lo[v] = ExactDouble((Ints)cap_node[v]) * cap_scale * t.total;
+    x_hi[v] = ExactDouble((Ints)cap_node[v] + 1) * cap_scale * t.total;
   }
   FirstNotBefore<false>(t.ends, lo, len_lo, x_lo);
   FirstNotBefore<true>(t.ends, hi, len_hi, x_hi);
   // The bisection for the first depth whose node holds mass of leaf lo alone.
-  Lanes8 lo_begin[V], lo_end[V];
-  Ints8 across[V], depth[V], shallow[V];
+  Doubles lo_begin[V], lo_end[V];
+  Ints across[V], depth[V], shallow[V];
   for (int v = 0; v < V; ++v) {
     across[v] = lo[v] != hi[v];
     lo[v] = across[v] ? from[v] : lo[v];  // the scalar code takes these lanes: any valid leaf
@@ -231,15 +273,15 @@ __attribute__((always_inline)) inline void LeafShareBlock(const LeafTables& t, c
     depth[v] = izero + max_depth, shallow[v] = across[v] ? depth[v] : izero;
   }
   for (;;) {
-    Ints8 active[V], any{};
+    Ints active[V], any{};
     for (int v = 0; v < V; ++v) active[v] = shallow[v] < depth[v], any |= active[v];
     if (!Any(any)) break;
     for (int v = 0; v < V; ++v) {
-      const Ints8 mid = (shallow[v] + depth[v]) >> 1;
-      const Ints8 node = (Ints8)(cap_node[v] >> (Bits8)(max_depth - mid));
-      const Lanes8 scale = Pow2(-mid);
-      const Ints8 inside = (ExactDouble(node) * scale * t.total >= lo_begin[v]) &
-                           (ExactDouble(node + 1) * scale * t.total <= lo_end[v]);
+      const Ints mid = (shallow[v] + depth[v]) >> 1;
+      const Ints node = (Ints)(cap_node[v] >> (Words)(max_depth - mid));
+      const Doubles scale = Pow2(-mid);
+      const Ints inside = (ExactDouble(node) * scale * t.total >= lo_begin[v]) &
+                          (ExactDouble(node + 1) * scale * t.total <= lo_end[v]);
       depth[v] = (active[v] & inside) ? mid : depth[v];
       shallow[v] = (active[v] & ~inside) ? mid + 1 : shallow[v];
     }
@@ -247,25 +289,25 @@ __attribute__((always_inline)) inline void LeafShareBlock(const LeafTables& t, c
   for (int v = 0; v < V; ++v) {
     // What is left of each coordinate below the node's bits (+ 0 makes the
     // -0 of -0 - 0 the scalar's +0).
-    const Lanes8 scaled_a = c0[v] * Pow2((depth[v] + 1) >> 1);
-    const Lanes8 scaled_b = c1[v] * Pow2(depth[v] >> 1);
-    const Lanes8 rest_a = (scaled_a - ExactDouble(FloorOf(scaled_a))) + 0.0;
-    const Lanes8 rest_b = (scaled_b - ExactDouble(FloorOf(scaled_b))) + 0.0;
-    const Ints8 axis = (depth[v] & 1) != izero;
-    const Lanes8 w = Pow2(-depth[v]);
-    const Lanes8 t0 = ExactDouble((Ints8)(cap_node[v] >> (Bits8)(max_depth - depth[v]))) * w;
-    const Lanes8 leaf_begin = lo_begin[v], leaf_mass = lo_end[v] - lo_begin[v];
-    const Ints8 has_mass = leaf_mass > zero;
-    const Lanes8 r0 = (t0 * t.total - leaf_begin) / leaf_mass;
-    const Lanes8 r1 = ((t0 + w) * t.total - leaf_begin) / leaf_mass;
-    const Lanes8 f0 = has_mass ? (r0 < zero ? zero : (one < r0 ? one : r0)) : zero;
-    const Lanes8 f1 = has_mass ? (r1 < zero ? zero : (one < r1 ? one : r1)) : one;
-    const Lanes8 along = axis ? rest_b : rest_a, across_leaf = axis ? rest_a : rest_b;
-    const Lanes8 f = f0 + along * (f1 - f0);
-    std::memcpy(leaf_out + v * kLanes, &lo[v], sizeof(Ints8));
+    const Doubles scaled_a = c0[v] * Pow2((depth[v] + 1) >> 1);
+    const Doubles scaled_b = c1[v] * Pow2(depth[v] >> 1);
+    const Doubles rest_a = (scaled_a - ExactDouble(FloorOf(scaled_a))) + 0.0;
+    const Doubles rest_b = (scaled_b - ExactDouble(FloorOf(scaled_b))) + 0.0;
+    const Ints axis = (depth[v] & 1) != izero;
+    const Doubles w = Pow2(-depth[v]);
+    const Doubles t0 = ExactDouble((Ints)(cap_node[v] >> (Words)(max_depth - depth[v]))) * w;
+    const Doubles leaf_begin = lo_begin[v], leaf_mass = lo_end[v] - lo_begin[v];
+    const Ints has_mass = leaf_mass > zero;
+    const Doubles r0 = (t0 * t.total - leaf_begin) / leaf_mass;
+    const Doubles r1 = ((t0 + w) * t.total - leaf_begin) / leaf_mass;
+    const Doubles f0 = has_mass ? (r0 < zero ? zero : (one < r0 ? one : r0)) : zero;
+    const Doubles f1 = has_mass ? (r1 < zero ? zero : (one < r1 ? one : r1)) : one;
+    const Doubles along = axis ? rest_b : rest_a, across_leaf = axis ? rest_a : rest_b;
+    const Doubles f = f0 + along * (f1 - f0);
+    std::memcpy(leaf_out + v * kLanes, &lo[v], sizeof(Ints));
     std::memcpy(f_out + v * kLanes, &f, sizeof f);
     std::memcpy(g_out + v * kLanes, &across_leaf, sizeof across_leaf);
-    std::memcpy(across_out + v * kLanes, &across[v], sizeof(Ints8));
+    std::memcpy(across_out + v * kLanes, &across[v], sizeof(Ints));
   }
 }
 
@@ -290,23 +332,23 @@ __attribute__((always_inline)) inline void LeafSharesOf(const LeafTables& tables
 
 // The correctly rounded square root in each lane (one vsqrtpd where the
 // build has -fno-math-errno and the vector width).
-__attribute__((always_inline)) inline Lanes8 Sqrt(Lanes8 x) {
+__attribute__((always_inline)) inline Doubles Sqrt(Doubles x) {
   for (int k = 0; k < kLanes; ++k) x[k] = std::sqrt(x[k]);
   return x;
 }
 
-// mesh_warp.cc's PlaceInCell for a uniform cell (split 0.5), 8 points.
+// mesh_warp.cc's PlaceInCell for a uniform cell (split 0.5), kLanes points.
 __attribute__((always_inline)) inline void PlaceUniformVector(const double* f_in,
                                                               const double* g_in, double* pa,
                                                               double* pb) {
-  Lanes8 f, b;
+  Doubles f, b;
   std::memcpy(&f, f_in, sizeof f);
   std::memcpy(&b, g_in, sizeof b);
-  const Lanes8 zero{}, split = zero + 0.5;
-  const Ints8 first = f < split;
-  const Lanes8 s = Sqrt(first ? f / split : (1 - f) / (1 - split));
-  const Lanes8 ox = first ? zero : zero + 1.0;
-  const Lanes8 a_out = ox + s * ((1 - b) * (0.5 - ox) + b * (0.0 - ox)), b_out = s * b;
+  const Doubles zero{}, split = zero + 0.5;
+  const Ints first = f < split;
+  const Doubles s = Sqrt(first ? f / split : (1 - f) / (1 - split));
+  const Doubles ox = first ? zero : zero + 1.0;
+  const Doubles a_out = ox + s * ((1 - b) * (0.5 - ox) + b * (0.0 - ox)), b_out = s * b;
   std::memcpy(pa, &a_out, sizeof a_out);
   std::memcpy(pb, &b_out, sizeof b_out);
 }

@@ -493,5 +493,43 @@ TEST(MeshSampler, SobolSetsKeepTheMassSplit) {
   EXPECT_NEAR(count, right / total * n, 16);
 }
 
+// The cursor's bucket sort (core/sample_cursor.cc) puts a set in the order
+// of one comparison sort of its addresses (CurveAddress::Key), with a
+// density and without, on an icosphere beside one triangle of most of the
+// mass, whose samples overflow the sort's per-thread copy of a coarse bucket
+// (2^16 addresses) and are permuted in place instead; for 1 and 2 threads.
+TEST(MeshSampler, SobolSetsComeInTheOrderOfOneComparisonSort) {
+  TriangleMesh mesh = MakeIcosphere(3);
+  const uint32_t v = static_cast<uint32_t>(mesh.positions.size());
+  mesh.positions.insert(mesh.positions.end(), {{10, 0, 0}, {90, 0, 0}, {10, 80, 0}});
+  mesh.triangles.push_back({v, v + 1, v + 2});
+  ASSERT_TRUE(FinalizeMesh(&mesh).ok());
+  for (const Vec3& p : mesh.positions) mesh.weights.push_back(1.5 + std::sin(p.x + p.y));
+  const auto surface = MeshSurface::Create(std::move(mesh), false);
+  const uint64_t n = 200'000;
+  for (bool weighted : {false, true}) {
+    const auto sampler =
+        MakeSampler(surface, weighted ? VertexWeightMeshDensity() : UniformMeshDensity(), n, 3,
+                    SequenceKind::kSobol);
+    std::vector<CurveAddress> expected(n);
+    sampler->AddressesOf(nullptr, 0, n, expected.data());
+    std::sort(expected.begin(), expected.end());
+    for (int threads : {1, 2}) {
+      auto cursor = SampleCursor::Create(sampler, 0, n, {}, {}, threads);
+      ASSERT_TRUE(cursor.ok()) << cursor.status();
+      SampleBatch batch;
+      while (true) {
+        auto got = (*cursor)->Next(65536, &batch);
+        ASSERT_TRUE(got.ok()) << got.status();
+        if (*got == 0) break;
+      }
+      ASSERT_EQ(batch.size(), n);
+      for (uint64_t i = 0; i < n; ++i) {
+        ASSERT_EQ(batch.index[i], expected[i].index) << "weighted " << weighted << " at " << i;
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace sfc

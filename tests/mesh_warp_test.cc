@@ -5,6 +5,7 @@
 #include "mesh/mesh_warp.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <memory>
@@ -36,6 +37,21 @@ TEST(MeshWarp, PathsOfIsPathOfOnEveryVectorPath) {
   // Corners, edges and the halving lines, where the branches meet.
   for (double a : {0.0, 0.25, 0.5, 1.0}) {
     for (double b : {0.0, 0.5, 1.0 - a}) pa.push_back(a), pb.push_back(b);
+  }
+  // Points a rounding off the triangle's edges and the line 2a + b = 1 (the
+  // first level's clamps act; the later levels skip two of them, which must
+  // never have acted), points of every scale down to 2^-60, and points
+  // outside the triangle and the square, both zeros among them.
+  for (int i = 0; i < 4000; ++i) {
+    const double a = unit(rng), scale = std::ldexp(1.0, -static_cast<int>(rng() % 61));
+    const int ulps = static_cast<int>(rng() % 7) - 3;
+    double b = i % 2 == 0 ? 1 - a : 1 - 2 * a;
+    for (int k = 0; k < std::abs(ulps); ++k) b = std::nextafter(b, ulps > 0 ? 2.0 : -2.0);
+    pa.push_back(a * scale), pb.push_back(i % 3 == 0 ? b : b * scale);
+    pa.push_back(unit(rng) * scale), pb.push_back(unit(rng) * scale);
+  }
+  for (double a : {-0.0, -0.25, 1.0 + 0x1.0p-52, 1.5, 0x1.0p-1074}) {
+    for (double b : {-0.0, -0.5, 0.0, 1.0, 1.25, 0x1.0p-1074}) pa.push_back(a), pb.push_back(b);
   }
   std::vector<uint64_t> expected(pa.size());
   for (size_t i = 0; i < pa.size(); ++i) expected[i] = MeshCurveTree::PathOf(pa[i], pb[i]);
