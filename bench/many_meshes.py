@@ -12,9 +12,14 @@ Every side samples every mesh with --count uniform points and keeps the points:
                   .sample_points_uniformly(count), then numpy.asarray(points)
                   (python3-open3d 0.16, Debian; one thread)
   ours, loop      for V, F: Sampler.sample(mesh=(V, F), count=count) (one thread)
-  ours, many      sfcsampler.sample_many(meshes, count=count, workers=W): the
-                  same calls on W threads of this process (the GIL is released
-                  in C++); every column (index, u, v, x, y, z: 480 KB a mesh)
+  ours, many      sfcsampler.sample_many(meshes, count=count, workers=W): on W
+                  threads of this process, each mesh one C++ call with the GIL
+                  released (its canonical PLY, hash, seed and samples:
+                  Engine.sample_mesh_arrays); every column (index, u, v, x, y,
+                  z: 480 KB a mesh)
+  --python-path   adds the same two through sample_many's per-mesh Python path
+                  (the canonical PLY in NumPy, then hold and sample, as before
+                  the one C++ call), for a before/after in one run
   ours, many,     the same with columns=("x", "y", "z"): the points only, as
   points only     Open3D keeps (240 KB a mesh); the other columns' memory goes
                   to the next mesh at once instead of being faulted in afresh
@@ -75,6 +80,18 @@ def ours_many(meshes, count, workers, columns=None):
     return [r.samples for r in results]
 
 
+def python_path(fn):
+    """fn run with sample_many's per-mesh Python path instead of Engine.sample_mesh_arrays."""
+    def run():
+        make = sfcsampler.many.MeshArrays.make
+        sfcsampler.many.MeshArrays.make = classmethod(lambda cls, *args: None)
+        try:
+            return fn()
+        finally:
+            sfcsampler.many.MeshArrays.make = make
+    return run
+
+
 def timed(fn):
     start = time.perf_counter()
     out = fn()
@@ -118,6 +135,8 @@ def main():
     p.add_argument("--rounds", type=int, default=3)
     p.add_argument("--workers", type=int, default=2, help="threads of sample_many")
     p.add_argument("--no-dask", action="store_true")
+    p.add_argument("--python-path", action="store_true",
+                   help="also sample_many through its per-mesh Python path (before/after)")
     args = p.parse_args()
     import open3d as o3d  # python3-open3d (tools/setup-debian.sh)
 
@@ -140,6 +159,12 @@ def main():
         f"ours, sample_many ({args.workers} threads), points only": lambda: ours_many(
             meshes, args.count, args.workers, columns=("x", "y", "z")),
     }
+    if args.python_path:
+        w = args.workers
+        sides[f"ours, sample_many ({w} threads), Python path"] = python_path(
+            lambda: ours_many(meshes, args.count, w))
+        sides[f"ours, sample_many ({w} threads), points only, Python path"] = python_path(
+            lambda: ours_many(meshes, args.count, w, columns=("x", "y", "z")))
     times = {k: [] for k in sides}
     cpu = {k: [] for k in sides}
     for r in range(args.rounds):

@@ -156,11 +156,11 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
   tree->rank_roles_.resize(ranks);
   tree->box_leaves_ = 1;
   while (tree->box_leaves_ * kRanksPerBox < ranks) tree->box_leaves_ *= 2;
-  const Box empty{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
-  tree->boxes_.assign(2 * tree->box_leaves_, empty);
-  // Each rank's roles and box, in runs of whole box leaves, on the worker pool.
+  // Each rank's roles, in runs of whole box leaves, on the worker pool (the
+  // boxes later, in the same parts).
   const size_t parts =
       ranks >= kParallelRanks ? static_cast<size_t>(std::min(options.threads, 8)) : 1;
+  tree->box_parts_ = parts;
   const size_t leaves_per_part = (ranks + kRanksPerBox - 1) / kRanksPerBox / parts + 1;
   WorkerPool::Shared().ParallelFor(static_cast<int>(parts), [&](int part) {
     const size_t a = std::min(ranks, part * leaves_per_part * kRanksPerBox);
@@ -248,12 +248,11 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
     }
   }
   stats.leaves = tree->mass_ends_.size();
-  tree->FinishBoxes();
   stats.bytes = tree->rank_triangle_.size() * 4 + tree->rank_roles_.size() +
                 tree->rank_first_leaf_.size() * 4 + tree->leaf_rank_.size() * 4 +
                 tree->leaf_path_.size() * 8 + tree->leaf_depth_.size() +
                 tree->leaf_density_.size() * 24 + tree->mass_ends_.size() * 8 +
-                tree->boxes_.size() * sizeof(Box);
+                2 * tree->box_leaves_ * sizeof(Box);  // the boxes, once built
   return std::shared_ptr<const MeshCurveTree>(std::move(tree));
 }
 
@@ -563,14 +562,24 @@ void MeshCurveTree::PlaceRanks(size_t begin, size_t end, const std::vector<Vec3>
     }
     const int entry = p_is_entry ? p : q, exit = p_is_entry ? q : p;
     rank_roles_[r] = static_cast<uint8_t>(entry * 3 + exit);
-    Box& b = boxes_[box_leaves_ + r / kRanksPerBox];
-    const Box t = TriangleBox(r);
-    b.lo = {std::min(b.lo.x, t.lo.x), std::min(b.lo.y, t.lo.y), std::min(b.lo.z, t.lo.z)};
-    b.hi = {std::max(b.hi.x, t.hi.x), std::max(b.hi.y, t.hi.y), std::max(b.hi.z, t.hi.z)};
   }
 }
 
-void MeshCurveTree::FinishBoxes() {
+void MeshCurveTree::BuildBoxes() const {
+  const Box empty{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
+  boxes_.assign(2 * box_leaves_, empty);
+  const size_t ranks = rank_triangle_.size();
+  const size_t leaves_per_part = (ranks + kRanksPerBox - 1) / kRanksPerBox / box_parts_ + 1;
+  WorkerPool::Shared().ParallelFor(static_cast<int>(box_parts_), [&](int part) {
+    const size_t a = std::min(ranks, part * leaves_per_part * kRanksPerBox);
+    const size_t e = std::min(ranks, (part + 1) * leaves_per_part * kRanksPerBox);
+    for (size_t r = a; r < e; ++r) {
+      Box& b = boxes_[box_leaves_ + r / kRanksPerBox];
+      const Box t = TriangleBox(r);
+      b.lo = {std::min(b.lo.x, t.lo.x), std::min(b.lo.y, t.lo.y), std::min(b.lo.z, t.lo.z)};
+      b.hi = {std::max(b.hi.x, t.hi.x), std::max(b.hi.y, t.hi.y), std::max(b.hi.z, t.hi.z)};
+    }
+  });
   for (size_t i = box_leaves_ - 1; i >= 1; --i) {
     const Box &a = boxes_[2 * i], &b = boxes_[2 * i + 1];
     boxes_[i] = {{std::min(a.lo.x, b.lo.x), std::min(a.lo.y, b.lo.y), std::min(a.lo.z, b.lo.z)},
@@ -580,6 +589,7 @@ void MeshCurveTree::FinishBoxes() {
 
 void MeshCurveTree::RanksMeetingBox(const Vec3& lo, const Vec3& hi,
                                     std::vector<std::pair<size_t, size_t>>* runs) const {
+  std::call_once(boxes_once_, [this] { BuildBoxes(); });
   CollectRuns(1, 0, box_leaves_ * kRanksPerBox, lo, hi, runs);
 }
 

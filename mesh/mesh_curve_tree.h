@@ -36,13 +36,15 @@
 // T leaves for every N, and a small triangle is never split before a large
 // one of the same density.
 //
-// Thread-safety: immutable after Build(); thread-safe.
+// Thread-safety: thread-safe; immutable after Build() but for the bounding
+// boxes of RanksMeetingBox, which its first call builds (once, for all).
 #ifndef SFCSAMPLER_MESH_MESH_CURVE_TREE_H_
 #define SFCSAMPLER_MESH_MESH_CURVE_TREE_H_
 
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <utility>
 #include <vector>
 
@@ -128,6 +130,8 @@ class MeshCurveTree {
   // Appends to `runs` the maximal rank ranges [a, b), in curve order, whose
   // triangles' bounding boxes (of their vertices: exact for flat triangles)
   // may meet the closed box [lo, hi]. Triangles outside are skipped whole.
+  // The first call builds the boxes (requests without a region, most of them,
+  // never pay for them).
   void RanksMeetingBox(const Vec3& lo, const Vec3& hi,
                        std::vector<std::pair<size_t, size_t>>* runs) const;
 
@@ -165,11 +169,12 @@ class MeshCurveTree {
   };
   MeshCurveTree() = default;
   Box TriangleBox(size_t rank) const;  // of its vertices
-  // Ranks [begin, end): their entry and exit corners (rank_roles_) and their
-  // boxes' leaves (boxes_, allocated; end a multiple of kRanksPerBox or the
-  // last rank). Disjoint ranges may run at once.
+  // Ranks [begin, end): their entry and exit corners (rank_roles_). Disjoint
+  // ranges may run at once.
   void PlaceRanks(size_t begin, size_t end, const std::vector<Vec3>& centroid);
-  void FinishBoxes();  // boxes_'s inner nodes, from its leaves
+  // boxes_: its leaves (box_parts_ parts of whole leaves at once), then its
+  // inner nodes. Run once, by RanksMeetingBox.
+  void BuildBoxes() const;
   void CollectRuns(size_t node, size_t node_lo, size_t node_hi, const Vec3& lo, const Vec3& hi,
                    std::vector<std::pair<size_t, size_t>>* runs) const;
 
@@ -186,9 +191,12 @@ class MeshCurveTree {
   std::vector<std::array<double, 3>> leaf_density_;  // empty for uniform density
   std::vector<double> mass_ends_;
   // Bounding boxes over runs of ranks: a complete binary tree, node 1 the
-  // root, whose leaves hold kRanksPerBox ranks each.
-  std::vector<Box> boxes_;
+  // root, whose leaves hold kRanksPerBox ranks each; built by the first
+  // RanksMeetingBox.
+  mutable std::once_flag boxes_once_;
+  mutable std::vector<Box> boxes_;
   size_t box_leaves_ = 0;
+  size_t box_parts_ = 1;
   Stats stats_;
 };
 

@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "absl/strings/ascii.h"
+#include "absl/strings/escaping.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/strip.h"
@@ -61,6 +62,18 @@ std::string Sha256Hex(std::string_view bytes) {
   hex.reserve(2 * SHA256_DIGEST_LENGTH);
   for (unsigned char c : digest) absl::StrAppendFormat(&hex, "%02x", c);
   return hex;
+}
+
+uint64_t ModelSeed(uint64_t base_seed, std::string_view sha256_hex) {
+  std::string message("sfcsampler.model-seed", 21);
+  message.push_back('\0');
+  for (int i = 0; i < 8; ++i) message.push_back(static_cast<char>((base_seed >> (8 * i)) & 0xff));
+  message += absl::HexStringToBytes(absl::string_view(sha256_hex.data(), sha256_hex.size()));
+  unsigned char digest[SHA256_DIGEST_LENGTH];
+  SHA256(reinterpret_cast<const unsigned char*>(message.data()), message.size(), digest);
+  uint64_t seed = 0;
+  for (int i = 0; i < 8; ++i) seed = (seed << 8) | digest[i];
+  return seed & ((uint64_t{1} << 63) - 1);
 }
 
 std::string ModelRoutingKey(ModelFormat format, std::string_view sha256) {

@@ -29,6 +29,14 @@ std::string ModelFormatList();
 // SHA-256 of `bytes` as 64 lowercase hex digits.
 std::string Sha256Hex(std::string_view bytes);
 
+// The seed of a model with content hash `sha256_hex` (64 hex digits) in a
+// many-model run under `base_seed` (`sfcsampler sample-many`, Python's
+// sample_many): the first 8 bytes, big-endian, of
+// SHA-256("sfcsampler.model-seed\0" + base_seed as 8 bytes little-endian + the
+// hash's 32 bytes), top bit cleared. python/sfcsampler/many.py's model_seed()
+// computes the same.
+uint64_t ModelSeed(uint64_t base_seed, std::string_view sha256_hex);
+
 // The x-surface-key (the consistent-hash proxy's routing key, docker/) of
 // every request about one model: FindModel, UploadModel, and the Sample and
 // Prepare that name it, so all of them reach the replica that stores it.

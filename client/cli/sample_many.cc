@@ -260,20 +260,6 @@ int Usage(const std::string& message) {
 
 }  // namespace
 
-uint64_t ModelSeed(uint64_t base_seed, const std::string& sha256_hex) {
-  std::string message("sfcsampler.model-seed", 21);
-  message.push_back('\0');
-  for (int i = 0; i < 8; ++i) message.push_back(static_cast<char>((base_seed >> (8 * i)) & 0xff));
-  message += absl::HexStringToBytes(sha256_hex);
-  const std::string digest = Sha256Hex(message);
-  uint64_t seed = 0;
-  for (int i = 0; i < 16; ++i) {
-    const char c = digest[i];
-    seed = (seed << 4) | static_cast<uint64_t>(c <= '9' ? c - '0' : c - 'a' + 10);
-  }
-  return seed & ((uint64_t{1} << 63) - 1);
-}
-
 Command AddSampleManyCommand(CLI::App& app) {
   auto flags = std::make_shared<SampleManyFlags>();
   SampleManyFlags* f = flags.get();

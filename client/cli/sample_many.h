@@ -9,7 +9,8 @@
 // the format's (kept when two models share a stem, as part.step and part.iges),
 // so a dataset's tree (ShapeNet's <synset>/<id>/models/model_normalized.obj) is
 // mirrored. Each model's seed comes from
-// the base --seed and the model's content hash (ModelSeed), so a model's
+// the base --seed and the model's content hash (ModelSeed in
+// request/model_spec.h), so a model's
 // output does not depend on the order of the inputs or on --jobs, and equals
 // `sfcsampler sample --surface FORMAT:FILE --seed <its seed>` on it alone
 // (--face applies to the CAD models and --triangle to the meshes). A
@@ -55,12 +56,6 @@ struct SampleManyFlags {
 // Runs it; returns the exit status. AddSampleManyCommand (commands.h) adds
 // the subcommand and its flags.
 int RunSampleMany(const SampleManyFlags& flags);
-
-// The seed of a model with content hash `sha256_hex` (64 hex digits) under
-// `base_seed`: the first 8 bytes, big-endian, of SHA-256("sfcsampler.model-seed\0"
-// + base_seed as 8 bytes little-endian + the hash's 32 bytes), top bit cleared.
-// python/sfcsampler/many.py computes the same.
-uint64_t ModelSeed(uint64_t base_seed, const std::string& sha256_hex);
 
 }  // namespace sfc
 

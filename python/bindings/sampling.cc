@@ -16,14 +16,18 @@
 #include "core/vector_math.h"
 #include "engine/sampling_engine.h"
 #include "kinds/registered_kinds.h"
+#include "pybind11/numpy.h"
 #include "python/bindings/batch_columns.h"
 #include "python/bindings/buffer_pool.h"
 #include "python/bindings/errors.h"
 #include "python/bindings/memory_models.h"
+#include "python/bindings/mesh_arrays.h"
 #include "python/bindings/recent_tree_source.h"
 #include "python/bindings/register.h"
 #include "python/bindings/request.h"
 #include "python/bindings/tree_summary_dict.h"
+#include "request/model_spec.h"
+#include "request/request_flags.h"
 #include "request/stream_options.h"
 #include "request/tree_count.h"
 
@@ -32,6 +36,29 @@ namespace py = pybind11;
 namespace sfc::python {
 
 namespace {
+
+// Fills `filled` with up to `max_samples` more of `job`'s samples, of which
+// `produced` came before; narrows them to float32 when asked. Returns how
+// many it gave. Needs no GIL.
+uint64_t Fill(SamplingJob& job, const SampleFields& fields, bool region, bool float32,
+              uint64_t produced, uint64_t max_samples, BufferPool* pool, BatchColumns* filled) {
+  SampleBatch& batch = filled->batch;
+  // Reserve what a plain range will produce, so filling never reallocates.
+  const uint64_t left = job.end - job.begin - std::min(job.end - job.begin, produced);
+  const size_t reserve =
+      static_cast<size_t>(std::min(max_samples, region ? uint64_t{1} << 16 : left));
+  TakeColumns(fields, reserve, *pool, &batch);
+  uint64_t got = 0;
+  while (got < max_samples) {
+    // A region may drop samples, so ask for what is still wanted.
+    auto n = job.cursor->Next(static_cast<size_t>(max_samples - got), &batch);
+    ThrowIfError(n.status());
+    if (*n == 0) break;
+    got += *n;
+  }
+  if (float32) Narrow(filled, pool);
+  return got;
+}
 
 class PyJob {
  public:
@@ -51,27 +78,13 @@ class PyJob {
       throw StatusException(absl::InvalidArgumentError("max_samples must be >= 1"));
     }
     BatchColumns filled;
-    SampleBatch& batch = filled.batch;
     {
       py::gil_scoped_release release;
       std::lock_guard<std::mutex> lock(mu_);
-      // Reserve what a plain range will produce, so filling never reallocates.
-      const uint64_t left = job_.end - job_.begin - std::min(job_.end - job_.begin, produced_);
-      const size_t reserve =
-          static_cast<size_t>(std::min(max_samples, region_ ? uint64_t{1} << 16 : left));
-      TakeColumns(fields_, reserve, *pool_, &batch);
-      uint64_t got = 0;
-      while (got < max_samples) {
-        // A region may drop samples, so ask for what is still wanted.
-        auto n = job_.cursor->Next(static_cast<size_t>(max_samples - got), &batch);
-        ThrowIfError(n.status());
-        if (*n == 0) break;
-        got += *n;
-      }
-      produced_ += got;
-      if (float32_) Narrow(&filled, pool_.get());
+      produced_ +=
+          Fill(job_, fields_, region_, float32_, produced_, max_samples, pool_.get(), &filled);
     }
-    if (batch.size() == 0) return py::none();
+    if (filled.batch.size() == 0) return py::none();
     return ColumnsDict(std::move(filled), fields_, pool_);
   }
 
@@ -131,6 +144,77 @@ class PyEngine {
     ThrowIfError(job.status());
     return std::make_unique<PyJob>(*std::move(job), r.request, *parsed == ColumnPrecision::kFloat32,
                                    pool_);
+  }
+
+  // sample_mesh_arrays(): see its docstring below.
+  py::object SampleMeshArrays(const py::array& vertices, const py::array& faces, const PyRequest& r,
+                              uint64_t base_seed, const std::string& precision,
+                              const std::string& name) {
+    auto float64 = [](const py::array& a) {
+      return a.dtype().kind() == 'f' && a.itemsize() == 8 && a.dtype().byteorder() != '>';
+    };
+    auto int32_or_64 = [](const py::array& a) {
+      return a.dtype().kind() == 'i' && (a.itemsize() == 4 || a.itemsize() == 8) &&
+             a.dtype().byteorder() != '>';
+    };
+    auto rows_of_three = [](const py::array& a) {
+      return a.ndim() == 2 && a.shape(1) == 3 && (a.flags() & py::array::c_style) != 0;
+    };
+    if (!float64(vertices) || !int32_or_64(faces) || !rows_of_three(vertices) ||
+        !rows_of_three(faces)) {
+      return py::none();
+    }
+    const absl::StatusOr<ColumnPrecision> parsed = ParseColumnPrecision(precision);
+    ThrowIfError(parsed.status());
+    const bool float32 = *parsed == ColumnPrecision::kFloat32;
+    const auto* v = static_cast<const double*>(vertices.data());
+    const void* f = faces.data();
+    const auto vertex_count = static_cast<size_t>(vertices.shape(0));
+    const auto face_count = static_cast<size_t>(faces.shape(0));
+    const bool wide = faces.itemsize() == 8;
+    std::string sha256;
+    uint64_t seed = 0;
+    absl::StatusOr<SamplingJob> job;
+    SampleRequest request;
+    BatchColumns filled;
+    {
+      // The arrays stay alive (the caller holds them) and are only read.
+      py::gil_scoped_release release;
+      std::string ply;
+      if (!CanonicalPly(v, vertex_count, f, wide, face_count, &ply)) {
+        ply.clear();
+      } else {
+        const std::string spec = models_.Hold(ModelFormat::kPly, std::move(ply), name);
+        struct Release {
+          MemoryModelSource& models;
+          const std::string& spec;
+          ~Release() { models.Release(spec); }
+        } release_hold{models_, spec};
+        sha256 = spec.substr(spec.rfind('=') + 1);
+        seed = ModelSeed(base_seed, sha256);
+        RequestFlags flags = r.flags;
+        flags.surface = spec;
+        flags.seed = seed;
+        absl::StatusOr<SampleRequest> parsed_request = ToSampleRequest(flags);
+        if (!parsed_request.ok()) {
+          job = parsed_request.status();
+        } else {
+          request = *std::move(parsed_request);
+          job = engine_.Start(request);
+          if (job.ok()) {
+            Fill(*job, request.fields, request.region.kind != Region::Kind::kAll, float32, 0,
+                 uint64_t{1} << 62, pool_.get(), &filled);
+          }
+        }
+      }
+    }
+    if (sha256.empty()) return py::none();  // a check failed: canonical_ply() names it
+    ThrowIfError(job.status());
+    py::object columns = filled.batch.size() == 0
+                             ? py::object(py::dict())
+                             : py::object(ColumnsDict(std::move(filled), request.fields, pool_));
+    return py::make_tuple(sha256, seed, columns, TreeSummaryDict(SummarizeTree(job->tree)),
+                          job->begin, job->end);
   }
 
   py::dict Prepare(const PyRequest& r) {
@@ -233,6 +317,16 @@ output_pool_bytes: buffers of freed result arrays (1 MiB or more each) kept, in
            "requests name it by until release_model(spec). Holds are counted.")
       .def("release_model", &PyEngine::ReleaseModel, py::arg("spec"),
            "Ends one hold_model() of `spec`; the bytes go when the last hold ends.")
+      .def("sample_mesh_arrays", &PyEngine::SampleMeshArrays, py::arg("vertices"), py::arg("faces"),
+           py::arg("request"), py::kw_only(), py::arg("base_seed"),
+           py::arg("precision") = "float64", py::arg("name") = "",
+           "One mesh of a many-model run, all of it with the GIL released: the canonical PLY "
+           "of (vertices, faces) (float64 and int32/int64 C-contiguous (n, 3) arrays; "
+           "meshes.canonical_ply's bytes), its SHA-256, its seed model_seed(base_seed, sha256), "
+           "and every sample of `request` (a Request on any surface and seed, which the mesh "
+           "and its seed replace). Returns (sha256, seed, columns, tree, begin, end), exactly "
+           "what holding the PLY and sampling it gives; None when the arrays are of another "
+           "kind or fail a check of canonical_ply(), which then names the error.")
       .def("prepare", &PyEngine::Prepare, py::arg("request"),
            "Builds (or reuses) the request's tree, sized for tree_count (or count), and returns "
            "its summary.");

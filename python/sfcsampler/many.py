@@ -27,8 +27,10 @@ import time
 import numpy as np
 
 from sfcsampler import _core, meshes
+from sfcsampler._request import make_request
 from sfcsampler.errors import Error
-from sfcsampler.samples import column_names
+from sfcsampler.samples import (Samples, column_dtype, column_names, kept_columns, select,
+                                warn_depth_cap)
 
 # File extensions of the model formats (lower case, with the dot) and their formats, the
 # CLI's table (request/model_files.h).
@@ -231,12 +233,74 @@ def columns_list(request):
         request["columns"] = column_names(request["columns"])
 
 
-def sample_one(model, request, base_seed, sampler=None, out_path=None, keep=True, client=None):
+class MeshArrays:
+    """sample_one()'s path for a mesh given as (vertices, faces) NumPy arrays, in this
+    process: one C++ call makes its canonical PLY, hashes it, derives its seed and samples it
+    with the GIL released (Engine.sample_mesh_arrays), the same bytes as holding
+    mesh_ply(mesh) and sampling it. Made once per run; None from make() when the request
+    cannot take it (sample_one's other path then reports what is wrong)."""
+
+    def __init__(self, sampler, request, base_seed):
+        self.engine, self.base_seed = sampler._engine, base_seed
+        rest = dict(request)
+        self.precision = rest.pop("precision", "float64")
+        columns = rest.pop("columns", None)
+        rest["face"], rest["triangle"] = False, bool(rest.get("triangle"))
+        if columns is not None:
+            columns = [c for c in columns if c != "face"]
+            if not columns:
+                raise ValueError("no column")
+        self.kept = kept_columns(columns, rest)
+        column_dtype(self.precision)
+        # Any mesh and seed: each call replaces them.
+        self.request = make_request(dict(rest, surface="ply:sha256=" + "0" * 64, seed=0))
+
+    @classmethod
+    def make(cls, sampler, request, base_seed):
+        try:
+            return cls(sampler, request, base_seed)
+        except (Error, TypeError, ValueError):
+            return None
+
+    def sample(self, model):
+        """(sha256, seed, Samples) of the Model, or None when it is not (vertices, faces)
+        arrays this path takes as they are or fails a check of canonical_ply()."""
+        mesh = model.mesh
+        if (model.path is not None or model.weights is not None or type(mesh) not in (tuple, list)
+                or len(mesh) != 2 or type(mesh[0]) is not np.ndarray
+                or type(mesh[1]) is not np.ndarray):
+            return None
+        out = self.engine.sample_mesh_arrays(mesh[0], mesh[1], self.request,
+                                             base_seed=self.base_seed, precision=self.precision,
+                                             name=model.name)
+        if out is None:
+            return None
+        sha256, seed, columns, tree, begin, end = out
+        warn_depth_cap(tree, stacklevel=4)
+        return sha256, seed, Samples(select(columns, self.kept), tree, begin, end, seed,
+                                     _core.ALGORITHM_VERSION, column_dtype(self.precision),
+                                     self.kept)
+
+
+def sample_one(model, request, base_seed, sampler=None, out_path=None, keep=True, client=None,
+               mesh_arrays=None):
     """Samples one Model with its derived seed; never raises for the model's own errors
-    (they go into Result.error). `client` samples on a server instead of `sampler`."""
+    (they go into Result.error). `client` samples on a server instead of `sampler`;
+    `mesh_arrays` (a MeshArrays) takes meshes given as arrays in this process."""
     start = time.perf_counter()
     result = Result(model.name)
     try:
+        fast = None
+        if mesh_arrays is not None:
+            try:
+                fast = mesh_arrays.sample(model)
+            except Error:
+                fast = None  # the other path reports it, with the model's hash and seed
+        if fast is not None:
+            result.sha256, result.seed, samples = fast
+            _finish(result, samples, out_path, keep)
+            result.seconds = time.perf_counter() - start
+            return result
         fmt, data = model.load()
         request = dict(request)
         mesh = fmt in ("obj", "ply")  # the model columns apply to the models that have them
@@ -263,17 +327,22 @@ def sample_one(model, request, base_seed, sampler=None, out_path=None, keep=True
                 result.sha256 = spec.rsplit("sha256=", 1)[1]
                 result.seed = model_seed(base_seed, result.sha256)
                 samples = sampler.sample(surface=spec, seed=result.seed, **request)
-        result.count = len(samples)
-        if out_path is not None:
-            result.path = out_path
-            os.makedirs(os.path.dirname(out_path) or ".", exist_ok=True)
-            write_npy(result.path, samples)
-        if keep:
-            result.samples = samples
+        _finish(result, samples, out_path, keep)
     except (Error, OSError, ValueError, TypeError, MemoryError) as e:
         result.error = str(e)
     result.seconds = time.perf_counter() - start
     return result
+
+
+def _finish(result, samples, out_path, keep):
+    """Counts, writes (out_path) and keeps (keep) one model's samples."""
+    result.count = len(samples)
+    if out_path is not None:
+        result.path = out_path
+        os.makedirs(os.path.dirname(out_path) or ".", exist_ok=True)
+        write_npy(result.path, samples)
+    if keep:
+        result.samples = samples
 
 
 def npy_bytes(samples):
@@ -372,13 +441,15 @@ def sample_many(models, *, seed=1, out_dir=None, keep=None, workers=0, progress=
     sampler = None if client is not None else Sampler(
         max_trees=0, threads=1 if workers > 1 else 0, model_check_program=model_check_program,
         model_parse_seconds=model_parse_seconds, parsed_model_bytes=0, parse_threads=0)
+    mesh_arrays = None if sampler is None else MeshArrays.make(sampler, request, seed)
     bar = _Bar(len(items), progress)
     results = Results([None] * len(items))
 
     def run(k):
         # On a worker thread: this thread waits for all at once, not woken per model
         # (a wake-up per model costs GIL hand-overs the workers would wait for).
-        results[k] = sample_one(items[k], request, seed, sampler, paths[k], keep, client)
+        results[k] = sample_one(items[k], request, seed, sampler, paths[k], keep, client,
+                                mesh_arrays)
         bar.step(results[k])
 
     try:

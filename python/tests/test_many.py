@@ -237,6 +237,45 @@ def test_python_meshes_in_memory_and_progress(capsys):
         sfcsampler.sample_many(meshes, surface="sphere")
 
 
+def test_python_meshes_as_arrays_are_bit_for_bit_single_calls():
+    # Arrays take sample_many's C++ path (Engine.sample_mesh_arrays: the PLY, its hash, the seed
+    # and the samples in one call); every mesh must still be exactly sample(mesh=...) with its
+    # derived seed, for every kind of input and any worker count: int64 and int32 faces (the
+    # C++ path), float32 vertices, Fortran order and a list (the other path), a bad mesh.
+    base = [torus_mesh(9 + k, 7, wobble=0.1, seed=k) for k in range(4)]
+    meshes = {"i64": base[0], "i32": (base[1][0], base[1][1].astype(np.int32)),
+              "f32": (base[2][0].astype(np.float32), base[2][1]),
+              "fortran": (np.asfortranarray(base[3][0]), base[3][1]),
+              "list": [base[0][0] * 2, base[0][1]],
+              "bad": (base[1][0], base[1][1] + 1000)}
+    request = dict(count=1500, seed=7, normals=True, triangle=True, density_column=True,
+                   curve_position=True)
+    alone = {}
+    for name, mesh in meshes.items():
+        if name == "bad":
+            continue
+        seed = many.model_seed(7, hashlib.sha256(sfcsampler.meshes.mesh_ply(mesh)).hexdigest())
+        alone[name] = (seed, {p: sfcsampler.sample(mesh=mesh, precision=p,
+                                                   **dict(request, seed=seed))
+                              for p in ("float64", "float32")})
+    for workers in (1, 2, 3):
+        for precision in ("float64", "float32"):
+            results = sfcsampler.sample_many(meshes, workers=workers, precision=precision,
+                                             **request)
+            assert [r.name for r in results.failed] == ["bad"]
+            assert "vertex indices must lie in" in results.failed[0].error
+            for r in results:
+                if r.ok:
+                    assert r.seed == alone[r.name][0] and r.count == 1500
+                    same_samples(r.samples, alone[r.name][1][precision])
+    # columns=: only those, the same bytes.
+    points = sfcsampler.sample_many(meshes, workers=2, columns=("x", "y", "z"), **request)
+    for r in points:
+        if r.ok:
+            assert r.samples.index is None and r.samples.normals is None
+            assert np.array_equal(r.samples.points, alone[r.name][1]["float64"].points)
+
+
 def test_python_sample_many_keeps_and_writes_only_the_named_columns(folder, tmp_path):
     names = [folder / "torus.ply", folder / "sphere.step"]
     full = sfcsampler.sample_many(names, count=2000, seed=5, triangle=True)
