@@ -1,6 +1,7 @@
 #include "core/sampler.h"
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <optional>
 
@@ -10,6 +11,35 @@
 
 namespace sfc {
 namespace {
+
+// Whether the jet's derivatives up to `order` are finite.
+bool DerivativesFinite(const SurfaceJet& jet, int order) {
+  return IsFinite(jet.fu) && IsFinite(jet.fv) &&
+         (order < 2 || (IsFinite(jet.fuu) && IsFinite(jet.fuv) && IsFinite(jet.fvv)));
+}
+
+// The jet whose normal and curvatures a sample at (u, v) reports: the jet
+// there, or, where a derivative is infinite or NaN but the point is finite
+// (a singular line of the parameterisation, such as the superellipsoid's
+// |cos|^e at cos = 0, where 0 x inf meets in fu x fv), the first finite jet
+// 2^(k - 53) from (u, v) towards the unit square's centre in both
+// parameters, k = 0, 1, .., 40: the limit the normal and curvatures take at
+// the line, to the parameter's rounding. The sample keeps its own point.
+// Non-finite when none is (the surface is singular on a patch, not a line).
+SurfaceJet ReportedJet(const Surface& surface, double u, double v, int order) {
+  const SurfaceJet jet = surface.Jet(u, v, order);
+  if (DerivativesFinite(jet, order) || !IsFinite(jet.p)) return jet;
+  for (int k = 0; k <= 40; ++k) {
+    const double step = std::ldexp(1.0, k - 53);
+    const double nu = u < 0.5 ? u + step : u - step, nv = v < 0.5 ? v + step : v - step;
+    SurfaceJet near = surface.Jet(nu, nv, order);
+    if (DerivativesFinite(near, order)) {
+      near.p = jet.p;
+      return near;
+    }
+  }
+  return jet;
+}
 
 // Places samples in their leaves (core/leaf_walk.h) and evaluates the surface
 // there: points alone in one call for the batch, or jets for normals and
@@ -66,7 +96,7 @@ absl::Status SurfaceFiller::Evaluate(size_t n, const SampleRows& out) {
   const int jet_order = fields_.density && density.NeedsCurvature() ? 2 : 1;
   for (size_t i = 0; i < n; ++i) {
     const double u = out.u[i], v = out.v[i];
-    const SurfaceJet jet = surface.Jet(u, v, jet_order);
+    const SurfaceJet jet = ReportedJet(surface, u, v, jet_order);
     if (!IsFinite(jet.p)) return not_finite(i);
     out.x[i] = jet.p.x, out.y[i] = jet.p.y, out.z[i] = jet.p.z;
     const SurfaceGeometry geo = GeometryOf(jet);

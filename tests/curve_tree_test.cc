@@ -14,6 +14,8 @@
 namespace sfc {
 namespace {
 
+using testing::Collect;
+using testing::MakeSampler;
 using testing::MakeSetup;
 
 // Marks every leaf's cell on the finest grid the tree uses; each grid cell
@@ -213,6 +215,28 @@ TEST(CurveTree, ASurfaceWithZeroAreaIsReportedAsSuch) {
   ASSERT_TRUE(zero.ok());
   const auto t2 = CurveTree::Build(*plane, *zero->density, {}, 3);
   EXPECT_NE(t2.status().message().find("density integrates"), std::string::npos) << t2.status();
+}
+
+// A constant density is a uniform one at any scale the masses resolve; one
+// whose masses would be subnormal (every sample once fell on one point) is
+// refused with what to do, not sampled.
+TEST(CurveTree, ADensityTooSmallToResolveIsRefusedAndSmallOnesAreUniform) {
+  auto plane = MakePlane();
+  for (const char* tiny : {"expr:1e-308", "expr:1e-295"}) {
+    const auto density = MakeDensity(tiny);
+    ASSERT_TRUE(density.ok()) << density.status();
+    const auto tree = CurveTree::Build(*plane, *density->density, {}, 10);
+    ASSERT_EQ(tree.status().code(), absl::StatusCode::kInvalidArgument) << tiny;
+    EXPECT_NE(tree.status().message().find("scale it up"), std::string::npos) << tree.status();
+  }
+  // 1e-280 still resolves: samples spread over the square as for a constant.
+  const uint64_t n = 4096;
+  const auto s = MakeSetup("plane", "expr:1e-280", n);
+  const SampleBatch b = Collect(MakeSampler(s, SequenceKind::kJittered, n, 1), 0, n);
+  ASSERT_EQ(b.size(), n);
+  int quadrant[4] = {};
+  for (size_t i = 0; i < n; ++i) ++quadrant[(b.u[i] < 0.5) + 2 * (b.v[i] < 0.5)];
+  for (int q : quadrant) EXPECT_NEAR(q, n / 4.0, 2.0);  // one sample a stratum: exact to 2
 }
 
 TEST(CurveTree, SingularLinesAreLocatedAndTheTreeStaysSmall) {
