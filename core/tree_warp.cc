@@ -129,6 +129,10 @@ void InvertCdfs(size_t n, const uint8_t* lanes, const double (*p)[3], const doub
     tree_warp_internal::InvertCdfsAvx512(n, lanes, p, share, out);
     return;
   }
+  if (tree_warp_internal::RunsAvx2(path)) {
+    tree_warp_internal::InvertCdfsAvx2(n, lanes, p, share, out);
+    return;
+  }
   CdfInversion inversion[64];
   uint8_t active[64];
   size_t count = 0;
@@ -322,11 +326,14 @@ void TreeWarp::LocateMany(size_t n, const double* a_in, const double* b_in, Curv
       state[i] = Curve::kRootState;
     }
     if (grid_ == 2) {
-      const size_t vectored =
-          path == math::VectorPath::kAvx512
-              ? tree_warp_internal::DescendGrid2Avx512(m, a, b, ref, state, splits_.data(),
-                                                       children_.data(), state_at_.data())
-              : 0;
+      size_t vectored = 0;
+      if (path == math::VectorPath::kAvx512) {
+        vectored = tree_warp_internal::DescendGrid2Avx512(m, a, b, ref, state, splits_.data(),
+                                                          children_.data(), state_at_.data());
+      } else if (tree_warp_internal::RunsAvx2(path)) {
+        vectored = tree_warp_internal::DescendGrid2Avx2(m, a, b, ref, state, splits_.data(),
+                                                        children_.data(), state_at_.data());
+      }
       Descend<2>(m - vectored, a + vectored, b + vectored, ref + vectored, state + vectored);
     } else {
       Descend<3>(m, a, b, ref, state);
@@ -470,6 +477,11 @@ void TreeWarp::DigitsInLeaf(size_t m, const double* x, const double* y, const ui
   const int chunks = levels / chunk_levels_, head = levels % chunk_levels_;
   if (grid_ == 2 && path == math::VectorPath::kAvx512) {
     const size_t vectored = tree_warp_internal::DigitsGrid2Avx512(
+        m, x, y, state, cells, top, chunks, head, child_at_.data(), state_at_.data(),
+        encode_.data(), digits);
+    x += vectored, y += vectored, state += vectored, digits += vectored, m -= vectored;
+  } else if (grid_ == 2 && tree_warp_internal::RunsAvx2(path)) {
+    const size_t vectored = tree_warp_internal::DigitsGrid2Avx2(
         m, x, y, state, cells, top, chunks, head, child_at_.data(), state_at_.data(),
         encode_.data(), digits);
     x += vectored, y += vectored, state += vectored, digits += vectored, m -= vectored;

@@ -55,14 +55,15 @@ class MeshWarp {
   // out[i] = Locate(a[i], b[i]) for i < n, bit for bit on every vector path
   // (REQUIRES: math::Runs(path)): the leaf searches, the placement in
   // uniform cells and the bisections below the leaves (PathsOf) run over the
-  // batch 8 lanes at a time (2 on the baseline's SSE2;
-  // mesh/mesh_warp_lanes.h); kScalar is the reference, one point at a time.
+  // batch 8 lanes at a time on AVX-512F, 4 on AVX (AVX2's integer lanes and
+  // gathers where the CPU has them), 2 on the baseline's SSE2
+  // (mesh/mesh_warp_lanes.h); kScalar is the reference, one point at a time.
   void LocateMany(size_t n, const double* a, const double* b, CurveAddress* out,
                   math::VectorPath path = math::BestVectorPath()) const;
 
   // paths[i] = MeshCurveTree::PathOf(pa[i], pb[i]) for i < n, bit for bit,
-  // on the vector path `path` (lanes of the same IEEE operations; AVX-512F
-  // or the baseline's). REQUIRES: math::Runs(path).
+  // on the vector path `path` (lanes of the same IEEE operations; AVX-512F,
+  // AVX2, AVX or the baseline's). REQUIRES: math::Runs(path).
   static void PathsOf(size_t n, const double* pa, const double* pb, uint64_t* paths,
                       math::VectorPath path = math::BestVectorPath());
 

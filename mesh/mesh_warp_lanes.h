@@ -2,9 +2,10 @@
 // vector extensions: each lane does the scalar code's IEEE operations in its
 // order (comparisons and selects for its branches and clamps; the build has
 // -ffp-contract=off), so every instruction set gives the scalar code's bits.
-// mesh_warp.cc builds them for the baseline (SSE2), mesh_warp_avx.cc for AVX
-// and mesh_warp_avx512.cc for AVX-512F; MeshWarp dispatches on
-// math::BestVectorPath(). Internal linkage (an anonymous namespace) on
+// mesh_warp.cc builds them for the baseline (SSE2), mesh_warp_avx.cc for AVX,
+// mesh_warp_avx2.cc for AVX2 (the kAvx path of a CPU with AVX2: 256-bit
+// integer lanes and gathers) and mesh_warp_avx512.cc for AVX-512F; MeshWarp
+// dispatches on math::BestVectorPath(). Internal linkage (an anonymous namespace) on
 // purpose: each of the three files keeps its own copy, compiled for its
 // instruction set, which the linker never merges.
 //
@@ -18,7 +19,7 @@
 #include <cstdint>
 #include <cstring>
 
-#ifdef __AVX512F__
+#if defined(__AVX512F__) || defined(__AVX2__)
 #include <immintrin.h>
 #endif
 
@@ -53,6 +54,11 @@ void PathsOfAvx512(size_t n, const double* pa, const double* pb, uint64_t* paths
 void LeafSharesAvx512(const LeafTables& tables, size_t n, const double* a, const double* b,
                       int64_t* leaf, double* f, double* g, int64_t* across);
 void PlaceUniformAvx512(size_t n, const double* f, const double* g, double* pa, double* pb);
+// The AVX2 builds (mesh_warp_avx2.cc).
+void PathsOfAvx2(size_t n, const double* pa, const double* pb, uint64_t* paths);
+void LeafSharesAvx2(const LeafTables& tables, size_t n, const double* a, const double* b,
+                    int64_t* leaf, double* f, double* g, int64_t* across);
+void PlaceUniformAvx2(size_t n, const double* f, const double* g, double* pa, double* pb);
 // The AVX builds (mesh_warp_avx.cc).
 void PathsOfAvx(size_t n, const double* pa, const double* pb, uint64_t* paths);
 void LeafSharesAvx(const LeafTables& tables, size_t n, const double* a, const double* b,
@@ -151,6 +157,8 @@ __attribute__((always_inline)) inline void PathsOfLanes(size_t n, const double* 
 __attribute__((always_inline)) inline bool Any(Ints mask) {
 #ifdef __AVX512F__
   return _mm512_test_epi64_mask((__m512i)mask, (__m512i)mask) != 0;
+#elif defined(__AVX2__)
+  return !_mm256_testz_si256((__m256i)mask, (__m256i)mask);
 #else
   int64_t any = 0;
   for (int k = 0; k < kLanes; ++k) any |= mask[k];
@@ -158,10 +166,12 @@ __attribute__((always_inline)) inline bool Any(Ints mask) {
 #endif
 }
 // p[index[k]] in each lane: one gather instruction where the build has
-// AVX-512F.
+// AVX-512F or AVX2.
 __attribute__((always_inline)) inline Doubles Gather(const double* p, Ints index) {
 #ifdef __AVX512F__
   return (Doubles)_mm512_mask_i64gather_pd(_mm512_setzero_pd(), 0xff, (__m512i)index, p, 8);
+#elif defined(__AVX2__)
+  return (Doubles)_mm256_i64gather_pd(p, (__m256i)index, 8);
 #else
   Doubles r;
   for (int k = 0; k < kLanes; ++k) r[k] = p[index[k]];
@@ -173,6 +183,9 @@ __attribute__((always_inline)) inline Ints Gather(const uint32_t* p, Ints index)
   const __m256i r = _mm512_mask_i64gather_epi32(_mm256_setzero_si256(), 0xff, (__m512i)index, p, 4);
   typedef uint32_t Words8 __attribute__((vector_size(32)));
   return __builtin_convertvector((Words8)r, Ints);
+#elif defined(__AVX2__)
+  const __m128i r = _mm256_i64gather_epi32(reinterpret_cast<const int*>(p), (__m256i)index, 4);
+  return (Ints)_mm256_cvtepu32_epi64(r);
 #else
   Ints r;
   for (int k = 0; k < kLanes; ++k) r[k] = p[index[k]];

@@ -274,12 +274,11 @@ TEST(TreeWarp, MapsTheUnitSquareOntoTheLeavesByMass) {
   EXPECT_LT(worst, 1.0);
 }
 
-// The batch descent's vector path gives the scalar path's addresses, bit for
-// bit, on a Hilbert tree with a density (leaves at several depths, so lanes
-// reach their leaves in different rounds), at random points, the square's
-// edges and its dyadic lines, in batches whose size is not a multiple of 8.
-TEST(TreeWarp, LocateManyGivesTheSameAddressesOnEveryVectorPath) {
-  const auto s = MakeSetup("monkey_saddle", "gaussian:floor=0.05", 1 << 14);
+// LocateMany on every vector path this CPU runs against its scalar path, bit
+// for bit, at random points, the square's edges and its dyadic lines, in
+// batches whose size is not a multiple of 4 or 8 (the vectors' tails).
+void LocateManyMatchesScalar(const char* surface, const char* density) {
+  const auto s = MakeSetup(surface, density, 1 << 14);
   const TreeWarp warp(*s.tree);
   std::mt19937_64 rng(36);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -293,12 +292,28 @@ TEST(TreeWarp, LocateManyGivesTheSameAddressesOnEveryVectorPath) {
   for (math::VectorPath path :
        {math::VectorPath::kSse2, math::VectorPath::kAvx, math::VectorPath::kAvx512}) {
     if (!math::Runs(path)) continue;
-    std::vector<CurveAddress> got(a.size());
-    warp.LocateMany(a.size(), a.data(), b.data(), got.data(), path);
-    for (size_t i = 0; i < a.size(); ++i) {
-      ASSERT_EQ(got[i].leaf, expected[i].leaf) << math::VectorPathName(path) << " point " << i;
-      ASSERT_EQ(got[i].digits, expected[i].digits) << math::VectorPathName(path) << " point " << i;
+    for (size_t n : {size_t{1}, size_t{7}, size_t{13}, size_t{64}, size_t{70}, a.size()}) {
+      std::vector<CurveAddress> got(n);
+      warp.LocateMany(n, a.data(), b.data(), got.data(), path);
+      for (size_t i = 0; i < n; ++i) {
+        ASSERT_EQ(got[i].leaf, expected[i].leaf) << math::VectorPathName(path) << " point " << i;
+        ASSERT_EQ(got[i].digits, expected[i].digits)
+            << math::VectorPathName(path) << " point " << i;
+      }
     }
+  }
+}
+
+// The batch descent's vector paths give the scalar path's addresses: on a
+// Hilbert tree with a density (leaves at several depths, so lanes reach
+// their leaves in different rounds) and on the uniform sphere (quadratic
+// leaves throughout: the inverse CDFs' vector code). kAvx on a CPU with AVX2
+// runs core/tree_warp_avx2.cc, kAvx512 core/tree_warp_avx512.cc.
+TEST(TreeWarp, LocateManyGivesTheSameAddressesOnEveryVectorPath) {
+  for (const auto& [surface, density] :
+       {std::pair{"monkey_saddle", "gaussian:floor=0.05"}, std::pair{"sphere", "uniform"}}) {
+    SCOPED_TRACE(surface);
+    LocateManyMatchesScalar(surface, density);
   }
 }
 
