@@ -307,7 +307,9 @@ void LeafWalk::Continue(size_t n) {
     }
     if (curve_position_ != nullptr) {
       const double pos = at.pos + fraction_[i] * at.span;
-      curve_position_[i] = (leaf_start_ + pos * leaf_span_) / static_cast<double>(curve_.Span(0));
+      // Below 1 as the column promises: the last leaf's end can round up to it.
+      curve_position_[i] = std::min(
+          (leaf_start_ + pos * leaf_span_) / static_cast<double>(curve_.Span(0)), math::kBelowOne);
     }
   }
   if (!warped_) return;

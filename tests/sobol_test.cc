@@ -152,6 +152,23 @@ TEST(SobolSampler, ExactCountEveryIndexOnceInCurveOrder) {
   for (size_t i = 1; i < n; ++i) ASSERT_LE(all.curve_position[i - 1], all.curve_position[i]) << i;
 }
 
+// Curve positions lie in [0, 1), as the column promises, also where the
+// last leaf's end rounds up (superellipsoid e = 0.1: 3 of 20 000 were 1).
+TEST(SobolSampler, CurvePositionsStayBelowOne) {
+  const uint64_t n = 20000;
+  const auto s = MakeSetup("superellipsoid:e=0.1", "uniform", n);
+  SampleFields fields;
+  fields.curve_position = true;
+  for (SequenceKind kind : {SequenceKind::kSobol, SequenceKind::kJittered}) {
+    const SampleBatch all = Collect(MakeSampler(s, kind, n, 1), 0, n, {}, fields);
+    ASSERT_EQ(all.size(), n);
+    for (size_t i = 0; i < n; ++i) {
+      ASSERT_GE(all.curve_position[i], 0.0) << i;
+      ASSERT_LT(all.curve_position[i], 1.0) << i;
+    }
+  }
+}
+
 TEST(SobolSampler, SameBytesForAnyBatchSizeAndThreadCount) {
   const uint64_t n = 20000;
   const auto s = MakeSetup("eight", "gaussian:floor=0.1", n);
