@@ -677,6 +677,62 @@ TEST(Server, TheServerDeadlineEndsLongStreams) {
   ExpectStatus(result.status(), absl::StatusCode::kDeadlineExceeded, "resume after the last index");
 }
 
+// A blue request whose relaxation would take many seconds (about 7 s a
+// million samples on one core), on a tree built beforehand so that only the
+// relaxation runs when the request comes.
+SampleRequest LongBlueRelaxation() {
+  SampleRequest r = Request("sphere", 1'000'000, 3);
+  r.sequence = SequenceKind::kBlue;
+  return r;
+}
+void WarmTreeOf(SamplerClient& client, const SampleRequest& request) {
+  SampleRequest warm = request;
+  warm.sequence = SequenceKind::kJittered;
+  warm.begin = 0, warm.end = 1;
+  ASSERT_TRUE(Fetch(client, warm).ok());
+}
+uint64_t StreamMemoryReserved(SamplerClient& client) {
+  auto stats = client.GetCacheStats();
+  EXPECT_TRUE(stats.ok()) << stats.status();
+  return stats.ok() ? stats->stream_memory_reserved() : ~uint64_t{0};
+}
+
+TEST(Server, TheServerDeadlineStopsABlueRelaxationAndFreesItsMemory) {
+  ServerOptions options = LoopbackOptions();
+  options.request_deadline_seconds = 0.5;
+  ClientOptions co;
+  co.max_resumes = 0;
+  Running r = StartServer(options, co);
+  WarmTreeOf(*r.client, LongBlueRelaxation());
+  const auto start = std::chrono::steady_clock::now();
+  ExpectStatus(Fetch(*r.client, LongBlueRelaxation()).status(),
+               absl::StatusCode::kDeadlineExceeded, "blue-noise set relaxed");
+  // Promptly: a generous bound, far below the relaxation's own time.
+  EXPECT_LT(std::chrono::steady_clock::now() - start, milliseconds(5000));
+  EXPECT_EQ(StreamMemoryReserved(*r.client), 0u);
+  EXPECT_EQ(r.server->service().active_streams(), 0u);
+}
+
+TEST(Server, AClientThatGivesUpStopsABlueRelaxationAndFreesItsMemory) {
+  ClientOptions co;
+  co.max_resumes = 0;
+  Running r = StartServer(LoopbackOptions(), co);
+  WarmTreeOf(*r.client, LongBlueRelaxation());
+  ClientOptions ic = co;
+  ic.target = "127.0.0.1:" + std::to_string(r.server->port());
+  ic.deadline_seconds = 0.5;
+  auto impatient = *SamplerClient::Connect(ic);
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(Fetch(*impatient, LongBlueRelaxation()).status().code(),
+            absl::StatusCode::kDeadlineExceeded);
+  // The server sees the client gone, stops the relaxation and frees its slot
+  // and its reservation, long before the relaxation would have ended.
+  EXPECT_TRUE(Within(5, [&] {
+    return r.server->service().active_streams() == 0 && StreamMemoryReserved(*r.client) == 0;
+  }));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, milliseconds(5500));
+}
+
 // With any pipeline depth (0: none): the producer stops at the full queue,
 // the RPC thread's blocked write is what the watchdog cuts.
 TEST(Server, AReaderThatStopsReadingIsCutAndFreesItsSlot) {
