@@ -6,6 +6,7 @@
 #include <chrono>
 #include <fstream>
 #include <functional>
+#include <string>
 #include <thread>
 
 #include "client/sampler_client.h"
@@ -454,6 +455,41 @@ TEST(Server, ShutdownStopsARunningBuild) {
   EXPECT_LT(std::chrono::steady_clock::now() - start, milliseconds(3000));
   waiting.join();
   EXPECT_EQ(status.code(), absl::StatusCode::kUnavailable) << status;
+}
+
+// The batch size a refusal names is accepted when asked for, whether the
+// tree was cold at the refusal and warm at the ask: at every remainder of the
+// message size by the bytes a sample takes (12 here), so the header's few
+// bytes of cache state would cross a boundary at some of them.
+TEST(Server, TheLargestBatchSizeARefusalNamesIsAccepted) {
+  for (int extra = 0; extra < 12; ++extra) {
+    ServerOptions options = LoopbackOptions();
+    options.max_message_bytes = 65536 + extra;
+    ClientOptions co;
+    co.max_resumes = 0;
+    co.stream.batch_size = 1 << 20;
+    co.stream.precision = ColumnPrecision::kFloat32;
+    Running r = StartServer(options, co);
+    SampleRequest request = LongStream(3'000'000);
+    request.fields.uv = false;
+    const absl::Status refused = Fetch(*r.client, request).status();  // on a cold tree
+    ExpectStatus(refused, absl::StatusCode::kInvalidArgument, "ask for at most ");
+    const std::string m(refused.message());
+    const std::string ask = "ask for at most ";
+    const uint32_t hinted = static_cast<uint32_t>(std::stoul(m.substr(m.find(ask) + ask.size())));
+    ClientOptions asks = co;
+    asks.stream.batch_size = hinted;
+    asks.target = "127.0.0.1:" + std::to_string(r.server->port());
+    auto client = *SamplerClient::Connect(asks);
+    size_t first = 0;
+    const auto result = client->Sample(request, [&](const StreamInfo&, const SampleBatch& b) {
+      first = b.size();
+      return absl::CancelledError("one batch is enough");
+    });
+    EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled)
+        << "extra " << extra << ": " << result.status();
+    EXPECT_EQ(first, hinted) << "extra " << extra;
+  }
 }
 
 TEST(Server, AStockClientReceivesEveryColumnWithinItsDefaultMessageLimit) {
