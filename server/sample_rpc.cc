@@ -207,6 +207,7 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
                             "stream was cut after %d samples; read faster or resume after the last "
                             "index received",
                             options_.write_timeout_seconds, *sent));
+      case StreamWatchdog::Reason::kReadTimeout:  // a Sample stream reads nothing
       case StreamWatchdog::Reason::kNone:
         break;
     }
