@@ -382,6 +382,20 @@ TEST(Server, ABuildNobodyWaitsForAnyMoreStopsAndFreesItsSlot) {
   EXPECT_EQ(s.builds_failed, 0u);  // a stopped build is not remembered as a failure
 }
 
+TEST(Server, TheServersRequestDeadlineStopsABuildNobodyElseWaitsFor) {
+  ServerOptions options = HeavyOptions();
+  options.request_deadline_seconds = 0.5;
+  ClientOptions co;
+  co.max_resumes = 0;
+  Running r = StartServer(options, co);
+  const auto start = std::chrono::steady_clock::now();
+  ExpectStatus(Fetch(*r.client, HeavyBuild()).status(), absl::StatusCode::kDeadlineExceeded,
+               "request deadline of 0.5 s");
+  EXPECT_LT(std::chrono::steady_clock::now() - start, milliseconds(3000));
+  EXPECT_TRUE(Within(5, [&] { return r.server->cache().stats().builds_running == 0; }));
+  EXPECT_EQ(r.server->cache().stats().builds_stopped, 1u);
+}
+
 TEST(Server, AWaiterLeavesAtItsOwnDeadlineWhileTheBuildGoesOnForOthers) {
   Running r = StartServer(HeavyOptions());
   absl::Status patient_status;
