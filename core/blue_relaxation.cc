@@ -34,6 +34,10 @@ constexpr double kDensityJump = 1.25;
 // densities differ by more than kDensityJump both keep their jittered places
 // (Relaxation::FreezeBesideJumps).
 constexpr double kJumpReach = 2;
+// The O(N) passes ask options.check every this many samples (a few
+// milliseconds of work: placing a sample through a cursor takes about a
+// microsecond, a neighbour query less).
+constexpr size_t kCheckEvery = 4096;
 
 // Points in a grid of cubic cells of side `cell`, hashed by Morton code: a
 // bucket array of cell lists in CSR form, each entry a copy of its point and radius (so a
@@ -152,6 +156,8 @@ class Relaxation {
   // stratum, so a strip beside a step holds its share as in the jittered
   // set; its neighbours relax around it.
   absl::Status FreezeBesideJumps();
+  // options_.check's answer (OK when it is empty).
+  absl::Status Check() const { return options_.check ? options_.check() : absl::OkStatus(); }
   bool Conflicts(uint32_t i, const Vec3& x) const {
     return AnyNear(i, x, [](uint32_t, double) { return true; });
   }
@@ -236,6 +242,7 @@ absl::Status Relaxation::FreezeBesideJumps() {
   std::vector<std::vector<uint32_t>> found(threads_);
   RETURN_IF_ERROR(ForParts(n_, [&](int part, size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) {
+      if ((i - begin) % kCheckEvery == 0) RETURN_IF_ERROR(Check());
       const double reach = kJumpReach * r_[i] / options_.rho;
       const Vec3 x = p_[i];
       bool jump = false;
@@ -333,6 +340,7 @@ absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
     };
     std::vector<Search> searching;
     for (size_t t = begin; t < end; ++t) {
+      if ((t - begin) % kCheckEvery == 0) RETURN_IF_ERROR(Check());
       const uint32_t k = todo[t];
       // Two samples of the colour that are too close would both move, each
       // away from where the other was, and may meet again: only the one of
@@ -363,6 +371,7 @@ absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
       const int m = static_cast<int>(std::min<uint64_t>(kRound, tries - j0));
       still.clear();
       for (size_t s0 = 0; s0 < searching.size(); s0 += kBlock) {
+        RETURN_IF_ERROR(Check());
         const size_t s1 = std::min(searching.size(), s0 + kBlock);
         // Candidates j0 .. j0 + m - 1 of the block's searching samples,
         // sorted inside each sample's stratum so that the batch's q do not
@@ -465,8 +474,13 @@ absl::StatusOr<BlueNoiseSet> Relaxation::Run(double total_mass) {
   p_.resize(n_);
   std::vector<double>& delta = delta_;
   delta.resize(n_);
-  RETURN_IF_ERROR(ForParts(n_, [&](int, size_t begin, size_t end) {
-    return place_(q_.data() + begin, end - begin, p_.data() + begin, delta.data() + begin);
+  RETURN_IF_ERROR(ForParts(n_, [&](int, size_t begin, size_t end) -> absl::Status {
+    for (size_t b = begin; b < end; b += kCheckEvery) {
+      RETURN_IF_ERROR(Check());
+      const size_t e = std::min(end, b + kCheckEvery);
+      RETURN_IF_ERROR(place_(q_.data() + b, e - b, p_.data() + b, delta.data() + b));
+    }
+    return absl::OkStatus();
   }));
   uniform_density_ =
       std::all_of(delta.begin(), delta.end(), [&](double x) { return x == delta[0]; });
@@ -519,6 +533,7 @@ absl::StatusOr<BlueNoiseSet> Relaxation::Run(double total_mass) {
         if (suspect_[i] && !frozen_[i]) colour.push_back(i);
       }
       if (colour.empty()) continue;
+      RETURN_IF_ERROR(Check());
       moved.clear();
       for (uint32_t i : colour) in_todo_[i] = 1;
       RETURN_IF_ERROR(HalfSweep(sweep, colour, &moved));

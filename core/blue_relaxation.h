@@ -64,6 +64,14 @@ struct BlueNoiseOptions {
   // first_candidates 2^s), each >= 1.
   int first_candidates = 8;
   int candidates = 64;
+  // Asked whether the caller still wants the set (client gone, deadline
+  // passed): before every half-sweep and every block of candidates, and
+  // every few thousand samples of the O(N) passes, so at most some tens of
+  // milliseconds of work pass between two asks. A non-OK status stops the
+  // relaxation, which returns it (and frees its memory). Called from several
+  // threads at once when threads > 1. Empty: never stop. It does not change
+  // the set.
+  std::function<absl::Status()> check;
 };
 
 // Places mass coordinates: q[i], i < n, non-decreasing in [0, 1], to their
@@ -79,8 +87,8 @@ struct BlueNoiseSet {
 
 // The blue-noise set of `count` samples of `seed` on a curve of total mass
 // `total_mass` (S_M), placed by `place`. A pure function of its arguments
-// (not of `threads`). Errors: place's; INVALID_ARGUMENT for options out of
-// range or a non-finite point or density.
+// (not of `threads`). Errors: place's; options.check's; INVALID_ARGUMENT for
+// options out of range or a non-finite point or density.
 absl::StatusOr<BlueNoiseSet> RelaxBlueNoise(uint64_t count, uint64_t seed, double total_mass,
                                             const MassPlacer& place, int threads = 1,
                                             const BlueNoiseOptions& options = {});

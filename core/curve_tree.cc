@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -28,12 +29,40 @@ void RecordHit(const DepthCapHit& hit, std::vector<DepthCapHit>* worst) {
   if (worst->size() > PrecisionReport::kMaxReported) worst->pop_back();
 }
 
-absl::Status LeafBudgetError(uint64_t max_leaves) {
-  return absl::ResourceExhaustedError(absl::StrFormat(
+// When the budget allows at least this many leaves a sample, the count is not
+// what fills it: the surface's or density's detail is (a leaf of the error
+// test carries down to kRoughFloor of a sample only where its model misses).
+constexpr double kLeavesPerSampleNotCount = 16;
+
+// The leaf budget's error for a tree of `grade` (-1: stage 1, where the count
+// plays no part yet), saying what to change.
+absl::Status LeafBudgetError(uint64_t max_leaves, int grade) {
+  const std::string budget = absl::StrFormat(
       "the curve tree needs more than %d leaves (the max_leaves budget, %d bytes at %d bytes a "
-      "leaf); ask for fewer samples, raise the tolerance or rho, lower the depth cap, or raise the "
-      "budget",
-      max_leaves, max_leaves * CurveTree::kBytesPerLeaf, CurveTree::kBytesPerLeaf));
+      "leaf)",
+      max_leaves, max_leaves * CurveTree::kBytesPerLeaf, CurveTree::kBytesPerLeaf);
+  if (grade < 0) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        budget,
+        " to follow the surface's shape alone, whatever the count: its detail is finer than the "
+        "tolerance over the budget; raise the tolerance, lower the depth cap, smooth or simplify "
+        "the surface, or raise the budget"));
+  }
+  const double samples = std::ldexp(1.0, grade);
+  if (static_cast<double>(max_leaves) >= kLeavesPerSampleNotCount * samples) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        budget,
+        absl::StrFormat(
+            ", %.3g leaves a sample for the 2^%d samples it is graded for, so the count is not "
+            "what needs them: the surface or density has more detail than the budget resolves (a "
+            "steep, rough or fast-oscillating term, or a singularity); smooth or simplify the "
+            "spec, raise the tolerance or rho, lower the depth cap, or raise the budget",
+            static_cast<double>(max_leaves) / samples, grade)));
+  }
+  return absl::ResourceExhaustedError(absl::StrCat(
+      budget,
+      "; ask for fewer samples, raise the tolerance or rho, lower the depth cap, or raise the "
+      "budget"));
 }
 
 double TriangleArea(const Vec3& a, const Vec3& b, const Vec3& c) {
@@ -152,6 +181,7 @@ class CurveTree::Builder {
   void StartStage2(double base, int grade, size_t expected_leaves) {
     base_ = base;
     grade_ = grade;
+    stage2_ = true;
     starts_.clear();
     masses_.clear();
     models_.clear();
@@ -647,7 +677,7 @@ class CurveTree::Builder {
   absl::Status BudgetError() const {
     // Say where the tree was growing deepest: usually a singularity.
     return absl::ResourceExhaustedError(absl::StrCat(
-        LeafBudgetError(options_.max_leaves).message(),
+        LeafBudgetError(options_.max_leaves, stage2_ ? grade_ : -1).message(),
         absl::StrFormat(". The deepest split so far is at depth %d near (u,v) = (%.9g, %.9g)%s",
                         deepest_, deepest_u_, deepest_v_,
                         deepest_ >= 20 ? "; the surface may be singular there" : "")));
@@ -702,6 +732,7 @@ class CurveTree::Builder {
   const int order_;
   double base_ = 1;
   int grade_ = 0;
+  bool stage2_ = false;  // past stage 1: the count shapes the tree
   int deepest_ = 0;
   double deepest_u_ = 0.5, deepest_v_ = 0.5;
   std::vector<uint64_t> stage1_starts_;

@@ -9,7 +9,8 @@
 namespace sfc {
 
 absl::StatusOr<Sequence> BlueSequence(const TreeLookup& lookup, const CursorOpener& open,
-                                      uint64_t count, uint64_t seed, int threads) {
+                                      uint64_t count, uint64_t seed, int threads,
+                                      const BuildControl& caller) {
   // Mass coordinates are placed as a sequence of their own: in-leaf placement
   // depends on the mass coordinate and the tree only, never on the count, so
   // a candidate lands where the same q of the final sequence does.
@@ -37,8 +38,10 @@ absl::StatusOr<Sequence> BlueSequence(const TreeLookup& lookup, const CursorOpen
     }
     return absl::OkStatus();
   };
+  BlueNoiseOptions options;
+  options.check = caller.check;
   ASSIGN_OR_RETURN(const BlueNoiseSet set,
-                   RelaxBlueNoise(count, seed, lookup.any->total_mass(), place, threads));
+                   RelaxBlueNoise(count, seed, lookup.any->total_mass(), place, threads, options));
   return Sequence::FromTable(set.q, seed);
 }
 

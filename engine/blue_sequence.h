@@ -20,9 +20,12 @@ namespace sfc {
 // The kBlue sequence of `count` samples of `seed` on the tree `lookup`, whose
 // kind opens cursors with `open`; computed whole with `threads` threads (the
 // bytes do not depend on them). Errors: the cursor's (INVALID_ARGUMENT when
-// the surface or density is not usable at a sample).
+// the surface or density is not usable at a sample); caller.check's non-OK
+// status (client gone, deadline), which it asks at least every few tens of
+// milliseconds of the relaxation (BlueNoiseOptions::check).
 absl::StatusOr<Sequence> BlueSequence(const TreeLookup& lookup, const CursorOpener& open,
-                                      uint64_t count, uint64_t seed, int threads);
+                                      uint64_t count, uint64_t seed, int threads,
+                                      const BuildControl& caller = {});
 
 }  // namespace sfc
 

@@ -200,7 +200,7 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
   if (request.sequence == SequenceKind::kBlue) {
     // The whole set, whatever part of it the request covers.
     ASSIGN_OR_RETURN(sequence, BlueSequence(job.tree.lookup, job.tree.open_cursor, request.count,
-                                            request.seed, limits_.generation_threads));
+                                            request.seed, limits_.generation_threads, caller));
   } else {
     sequence = Sequence(request.sequence, request.count, request.seed);
   }

@@ -65,7 +65,8 @@ class SamplingEngine {
                                        const BuildControl& caller = {}) const;
 
   // Validates `request` and opens its cursor. Errors as Prepare, plus
-  // INVALID_ARGUMENT for a bad range, shard, region or tree_count.
+  // INVALID_ARGUMENT for a bad range, shard, region or tree_count. A blue
+  // set's relaxation asks `caller.check` too, and stops with its status.
   absl::StatusOr<SamplingJob> Start(const SampleRequest& request,
                                     const BuildControl& caller = {}) const;
 

@@ -22,10 +22,19 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
   std::optional<ModelFormat> format;
   // The bytes count against the model budget as they arrive.
   ModelStore::Upload upload = models_->StartUpload();
+  // An uploader that stops sending is cut after upload_idle_timeout_seconds:
+  // a blocked Read has no timeout of its own.
+  const auto watch = upload_watchdog_.Start(context);
+  const auto read = [&](v1::ModelChunk* chunk) {
+    watch->BeginRead();
+    const bool got = reader->Read(chunk);
+    watch->EndRead();
+    return got;
+  };
   if (status.ok()) {
     v1::ModelChunk chunk;
     bool first = true;
-    while (status.ok() && reader->Read(&chunk)) {
+    while (status.ok() && read(&chunk)) {
       if (first) {
         // The name is the client's: escaped and clipped before any message
         // or log line shows it, and never stored (the model is shared).
@@ -52,7 +61,18 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
                               absl::StrFormat("upload \"%s\": %s", name, appended.message()));
       }
     }
-    if (status.ok() && first) {
+    if (watch->reason() == StreamWatchdog::Reason::kReadTimeout) {
+      // The client sees CANCELLED (the cut stream cannot carry a status); the
+      // log says why.
+      status = grpc::Status(
+          grpc::StatusCode::DEADLINE_EXCEEDED,
+          absl::StrFormat("upload \"%s\": the client sent nothing for %g s (the server's "
+                          "upload_idle_timeout) after %d bytes, so the upload was cut; send the "
+                          "model without pauses",
+                          name, options_.upload_idle_timeout_seconds, upload.size()));
+    } else if (status.ok() && context->IsCancelled()) {
+      status = grpc::Status(grpc::StatusCode::CANCELLED, "the client cancelled the upload");
+    } else if (status.ok() && first) {
       status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, "the upload carried no model");
     }
   }

@@ -25,11 +25,13 @@ ModelStore::Upload::Upload(Upload&& other) noexcept
       whole_(std::move(other.whole_)),
       expected_(other.expected_),
       size_(other.size_),
-      held_(other.held_) {
+      held_(other.held_),
+      whole_held_(other.whole_held_) {
   other.chunks_.clear();
   other.whole_.clear();
   other.size_ = 0;
   other.held_ = 0;
+  other.whole_held_ = 0;
 }
 
 ModelStore::Upload::~Upload() {
@@ -41,10 +43,29 @@ absl::Status ModelStore::Upload::Expect(uint64_t total_bytes) {
     store_->CountRejected();
     return TooLarge(total_bytes, store_->max_model_bytes_, store_->budget_bytes_);
   }
-  if (absl::Status held = store_->Hold(total_bytes); !held.ok()) return held;
-  held_ += total_bytes;
+  // Nothing is counted yet: a client that declares a large size and sends
+  // nothing holds nothing of the budget.
   expected_ = total_bytes;
-  whole_.reserve(total_bytes);
+  return absl::OkStatus();
+}
+
+absl::Status ModelStore::Upload::Grow(uint64_t needed) {
+  if (needed <= whole_held_) return absl::OkStatus();
+  // Geometric growth, capped at the declared size: the copies cost O(size)
+  // in all, and the last buffer is exactly the model's.
+  const uint64_t capacity =
+      std::min<uint64_t>(*expected_, std::max<uint64_t>(needed, 2 * whole_held_));
+  // The new buffer is counted before it exists, the old one until it is gone.
+  if (absl::Status held = store_->Hold(capacity); !held.ok()) return held;
+  held_ += capacity;
+  std::string bigger;
+  bigger.reserve(capacity);
+  bigger += whole_;
+  whole_.swap(bigger);
+  bigger = std::string();
+  store_->Release(whole_held_);
+  held_ -= whole_held_;
+  whole_held_ = capacity;
   return absl::OkStatus();
 }
 
@@ -54,7 +75,8 @@ absl::Status ModelStore::Upload::Append(std::string chunk) {
       return absl::InvalidArgumentError(absl::StrFormat(
           "the upload sent more than the %d bytes it declared (total_bytes)", *expected_));
     }
-    whole_ += chunk;  // counted by Expect
+    if (absl::Status grown = Grow(size_ + chunk.size()); !grown.ok()) return grown;
+    whole_ += chunk;  // counted by Grow
     size_ += chunk.size();
     return absl::OkStatus();
   }

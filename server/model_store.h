@@ -49,10 +49,12 @@ class ModelStore final : public ModelSource {
     Upload(const Upload&) = delete;
     ~Upload();  // gives back what it holds
 
-    // Declares the model's size before the first chunk: the whole size is
-    // counted and allocated now, and no join is needed at the end.
-    // RESOURCE_EXHAUSTED as Append; the upload must then send exactly this
-    // many bytes (INVALID_ARGUMENT otherwise).
+    // Declares the model's size before the first chunk: the bytes are then
+    // gathered in one buffer that grows as they arrive (to at most this
+    // size, counted as it grows), and no join is needed at the end.
+    // RESOURCE_EXHAUSTED when the size is past max_model_bytes or the
+    // budget; the upload must then send exactly this many bytes
+    // (INVALID_ARGUMENT otherwise).
     absl::Status Expect(uint64_t total_bytes);
     // Appends the next chunk. RESOURCE_EXHAUSTED when the model would pass
     // max_model_bytes or the budget, or when other uploads hold so much of
@@ -67,13 +69,17 @@ class ModelStore final : public ModelSource {
     // The bytes as one string of exactly their size. While it is built the
     // chunks and the string are both counted.
     absl::StatusOr<std::string> Join();
+    // With Expect: makes whole_ hold at least `needed` bytes, counting its
+    // new buffer first; RESOURCE_EXHAUSTED as Append.
+    absl::Status Grow(uint64_t needed);
 
     ModelStore* store_;
     std::vector<std::string> chunks_;  // exact sizes: no growth by doubling
-    std::string whole_;                // with Expect: reserved at its full size
+    std::string whole_;                // with Expect: grown as bytes arrive
     std::optional<uint64_t> expected_;  // with Expect: the declared size
     uint64_t size_ = 0;
     uint64_t held_ = 0;  // counted against the store's budget now
+    uint64_t whole_held_ = 0;  // of held_, whole_'s buffer
   };
 
   ModelStore(uint64_t budget_bytes, uint64_t max_model_bytes);

@@ -17,9 +17,9 @@ BuildControl RequestControl(const grpc::ServerContext* context, Clock::time_poin
     }
     if (Clock::now() > deadline) {
       return absl::DeadlineExceededError(absl::StrFormat(
-          "the tree was still being built when the server's request deadline of %g s passed; "
-          "retry later (the build goes on while other requests wait for it) or ask for fewer "
-          "samples",
+          "the request was still being prepared (its tree built or its blue-noise set relaxed) "
+          "when the server's request deadline of %g s passed; retry later (a tree build goes on "
+          "while other requests wait for it) or ask for fewer samples",
           deadline_seconds));
     }
     return absl::OkStatus();

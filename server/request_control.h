@@ -15,7 +15,8 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point start);
 
-// A request's own check while its tree is built or waited for: the client
+// A request's own check while its tree is built or waited for, or its blue
+// set relaxed (it may be asked from several threads at once): the client
 // is gone (CANCELLED), or the server's request deadline has passed
 // (DEADLINE_EXCEEDED, saying what to do).
 BuildControl RequestControl(const grpc::ServerContext* context, Clock::time_point deadline,

@@ -1,4 +1,5 @@
 #include <chrono>
+#include <cstdint>
 
 #include "absl/strings/str_format.h"
 #include "base/echo.h"
@@ -53,6 +54,18 @@ uint64_t StreamWorkingBytes(const SampleRequest& request, const StreamOptions& s
                               messages * (8 + width * wire_columns + 4 * index_columns);
   const uint64_t batch = stream.batch_size != 0 ? stream.batch_size : kDefaultBatchSize;
   return sort + blue + per_sample * std::min(n, batch);
+}
+
+// The bytes the stream header takes in the first message, at most, over what
+// may differ between two asks of the same request: whether the tree was
+// cached or refined, and the batch_size echoed. So the largest batch size it
+// lets MaxSamplesPerMessage name is accepted when the client asks for it.
+size_t HeaderBytesBound(const v1::StreamHeader& header) {
+  v1::StreamHeader largest = header;
+  largest.mutable_tree()->set_cache_hit(true);
+  largest.mutable_tree()->set_refined(true);
+  largest.mutable_request()->set_batch_size(UINT32_MAX);
+  return largest.ByteSizeLong();
 }
 
 }  // namespace
@@ -152,14 +165,16 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
   // Every message, the first with its header too, fits max_message_bytes.
   const bool indices_listed =
       request.region.kind != Region::Kind::kAll || !SequenceIsMonotone(request.sequence);
+  // One computation both refuses a batch_size and names the largest accepted.
+  const size_t header_bytes = HeaderBytesBound(header);
   const uint32_t fits = MaxSamplesPerMessage(request.fields, stream.precision, indices_listed,
-                                             header.ByteSizeLong(), options_.max_message_bytes);
+                                             header_bytes, options_.max_message_bytes);
   if (fits == 0) {
     return grpc::Status(
         grpc::StatusCode::INVALID_ARGUMENT,
         absl::StrFormat("the stream header alone is %d bytes, more than the server's "
                         "max_message_bytes of %d; use shorter specs",
-                        header.ByteSizeLong(), options_.max_message_bytes));
+                        header_bytes, options_.max_message_bytes));
   }
   if (stream.batch_size > fits) {
     return grpc::Status(
@@ -192,6 +207,7 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
                             "stream was cut after %d samples; read faster or resume after the last "
                             "index received",
                             options_.write_timeout_seconds, *sent));
+      case StreamWatchdog::Reason::kReadTimeout:  // a Sample stream reads nothing
       case StreamWatchdog::Reason::kNone:
         break;
     }

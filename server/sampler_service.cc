@@ -23,6 +23,7 @@ SamplerService::SamplerService(const ServerOptions& options, TreeCache* cache, M
                          ? nullptr
                          : std::make_unique<const TokenAuthenticator>(options.token)),
       watchdog_(options.write_timeout_seconds),
+      upload_watchdog_(options.upload_idle_timeout_seconds),
       stream_memory_(options.stream_memory_bytes) {
   // An evicted upload's parses go with it (their requests hold what they use).
   models_->SetEvictionListener(

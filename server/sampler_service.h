@@ -12,7 +12,8 @@
 // so a slow reader holds at most depth + 2 messages in the server, and a
 // cancelled or disconnected client makes the next Write fail at once, which
 // ends the stream and frees its cursor and tree. A reader
-// that stops reading is cut after the write timeout (StreamWatchdog). Every
+// that stops reading is cut after the write timeout (StreamWatchdog), and an
+// upload that stops sending after the upload idle timeout. Every
 // message stays within max_message_bytes: the batch size follows from the
 // requested columns.
 //
@@ -92,7 +93,8 @@ class SamplerService final : public ::sfcsampler::v1::Sampler::Service {
   const SamplingEngine engine_;
   // Set when the service itself checks the token (plaintext ports).
   const std::unique_ptr<const TokenAuthenticator> authenticator_;
-  StreamWatchdog watchdog_;
+  StreamWatchdog watchdog_;         // Sample streams' writes
+  StreamWatchdog upload_watchdog_;  // UploadModel streams' reads
   StreamMemory stream_memory_;
 
   std::atomic<uint32_t> active_streams_{0};

@@ -61,6 +61,9 @@ struct ServerOptions {
   // A stream whose write waits this long for a reader that does not read is
   // cut and its slot freed.
   double write_timeout_seconds = 30;
+  // An upload that sends no chunk for this long is cut (so an idle client
+  // holds its stream and the model budget it reserved no longer than that).
+  double upload_idle_timeout_seconds = 30;
   double shutdown_grace_seconds = 10;          // SIGTERM: in-flight streams get this long
 
   // Security: TLS when both files are set; clients must then present a

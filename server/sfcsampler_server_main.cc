@@ -168,6 +168,10 @@ int main(int argc, char** argv) {
                  "seconds a stream may wait for a client that reads nothing before it is cut")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  app.add_option("--upload-idle-timeout", o.upload_idle_timeout_seconds,
+                 "seconds an UploadModel stream may send nothing before it is cut")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--generation-threads", o.limits.generation_threads,
                  "threads that fill one stream's batches (same samples, same order)")
       ->capture_default_str()

@@ -4,8 +4,8 @@
 
 namespace sfc {
 
-StreamWatchdog::StreamWatchdog(double write_timeout_seconds, std::chrono::milliseconds period)
-    : write_timeout_seconds_(write_timeout_seconds), period_(period) {
+StreamWatchdog::StreamWatchdog(double timeout_seconds, std::chrono::milliseconds period)
+    : timeout_seconds_(timeout_seconds), period_(period) {
   thread_ = std::thread([this] { Loop(); });
 }
 
@@ -29,16 +29,16 @@ StreamWatchdog::Watch::~Watch() {
   owner_->watches_.erase(this);
 }
 
-void StreamWatchdog::Watch::BeginWrite() {
+void StreamWatchdog::Watch::Begin(Reason due) {
   absl::MutexLock lock(&owner_->mu_);
-  writing_ = true;
-  write_started_ = Clock::now();
+  waiting_ = due;
+  wait_started_ = Clock::now();
 }
 
-void StreamWatchdog::Watch::EndWrite() {
-  absl::MutexLock lock(&owner_->mu_);
-  writing_ = false;
-}
+void StreamWatchdog::Watch::BeginWrite() { Begin(Reason::kWriteTimeout); }
+void StreamWatchdog::Watch::EndWrite() { Begin(Reason::kNone); }
+void StreamWatchdog::Watch::BeginRead() { Begin(Reason::kReadTimeout); }
+void StreamWatchdog::Watch::EndRead() { Begin(Reason::kNone); }
 
 StreamWatchdog::Reason StreamWatchdog::Watch::reason() const {
   absl::MutexLock lock(&owner_->mu_);
@@ -47,16 +47,18 @@ StreamWatchdog::Reason StreamWatchdog::Watch::reason() const {
 
 void StreamWatchdog::Loop() {
   const auto timeout = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(write_timeout_seconds_));
+      std::chrono::duration<double>(timeout_seconds_));
   absl::MutexLock lock(&mu_);
   while (!stopping_) {
     mu_.AwaitWithTimeout(absl::Condition(&stopping_), absl::FromChrono(period_));
     const auto now = Clock::now();
     for (Watch* w : watches_) {
-      if (w->reason_ != Reason::kNone || !w->writing_ || now - w->write_started_ <= timeout)
+      if (w->reason_ != Reason::kNone || w->waiting_ == Reason::kNone ||
+          now - w->wait_started_ <= timeout) {
         continue;
-      w->reason_ = Reason::kWriteTimeout;
-      // Thread-safe; the stream's blocked Write returns false.
+      }
+      w->reason_ = w->waiting_;
+      // Thread-safe; the stream's blocked Write or Read returns false.
       w->context_->TryCancel();
     }
   }

@@ -2,6 +2,7 @@
 // samples apart by the hexagonal spacing's share asked for (plane, sphere),
 // the density's mass split kept, the same bytes for any thread count, and
 // shards, ranges and regions equal to the whole run's samples.
+#include <atomic>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -159,6 +160,43 @@ TEST(BlueSequence, ShardsRangesAndRegionsAreTheWholeRun) {
   box.region.kind = Region::Kind::kBox;
   box.region.lo = {0, 0, -1}, box.region.hi = {2, 2, 1};
   testing::ExpectSameSamples(DrawAll(e.engine, box), testing::Filter(whole, box.region));
+}
+
+TEST(BlueSequence, TheCallersCheckIsAskedOftenAndStopsTheRelaxation) {
+  const uint64_t n = 5000;
+  const MassPlacer square = [](const double* q, size_t m, Vec3* p, double* density) {
+    for (size_t i = 0; i < m; ++i) {
+      const double t = q[i] * 100, row = std::floor(t);
+      p[i] = {t - row, row / 100, 0};
+      if (density) density[i] = 1;
+    }
+    return absl::OkStatus();
+  };
+  const auto plain = RelaxBlueNoise(n, 9, 1.0, square, 2);
+  ASSERT_TRUE(plain.ok()) << plain.status();
+  // A check that lets it finish: asked many times, the set unchanged.
+  std::atomic<int> asked{0};
+  BlueNoiseOptions options;
+  options.check = [&] {
+    ++asked;
+    return absl::OkStatus();
+  };
+  const auto checked = RelaxBlueNoise(n, 9, 1.0, square, 2, options);
+  ASSERT_TRUE(checked.ok()) << checked.status();
+  EXPECT_EQ(*checked->q, *plain->q);
+  // Once per half-sweep that has samples to move and per block of them.
+  EXPECT_GE(asked.load(), 10);
+  // A check that says stop, from its k-th ask on: the relaxation returns its
+  // status, whenever that comes (in the first placement, a sweep, ...).
+  for (const int k : {1, asked.load() / 2, asked.load()}) {
+    std::atomic<int> count{0};
+    options.check = [&] {
+      return ++count >= k ? absl::DeadlineExceededError("past the deadline") : absl::OkStatus();
+    };
+    const auto stopped = RelaxBlueNoise(n, 9, 1.0, square, 2, options);
+    EXPECT_EQ(stopped.status().code(), absl::StatusCode::kDeadlineExceeded) << k;
+    EXPECT_EQ(stopped.status().message(), "past the deadline") << k;
+  }
 }
 
 TEST(BlueSequence, TooLargeACountIsInvalidArgument) {

@@ -64,6 +64,19 @@ TEST(Engine, ASingularityExhaustsTheLeafBudgetAndIsLocated) {
               0.01);
 }
 
+// The leaf budget's error says what fills it: a short request on a surface
+// of fine detail is not told to ask for fewer samples; a large one is.
+TEST(Engine, ALeafBudgetErrorSaysWhetherTheCountOrTheDetailFillsIt) {
+  EngineLimits limits;
+  limits.max_tree_leaves = 8192;
+  const std::string ripples = "expr:x=u;y=v;z=0.1*abs(sin(3000*u))";
+  const absl::Status detail = StartWith(ripples, "uniform", 100, limits).status();
+  ExpectError(detail, absl::StatusCode::kResourceExhausted, "the count is not what needs them");
+  EXPECT_EQ(detail.message().find("fewer samples"), std::string::npos) << detail;
+  ExpectError(StartWith("torus", "uniform", 100'000'000, limits).status(),
+              absl::StatusCode::kResourceExhausted, "ask for fewer samples");
+}
+
 TEST(Engine, NegativeDensityIsInvalidArgument) {
   ExpectError(RunToEnd("plane", "expr:u-0.5", 100), absl::StatusCode::kInvalidArgument, ">= 0");
 }

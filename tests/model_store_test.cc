@@ -139,12 +139,15 @@ TEST(ModelStore, UploadsBeingReceivedCountAgainstTheBudget) {
   EXPECT_EQ(store.Put(ModelFormat::kPly, std::move(undeclared), "c.ply").status().code(),
             absl::StatusCode::kResourceExhausted);
   EXPECT_EQ(store.stats().upload_bytes, 0u);
-  // Declared up front, the same upload is counted once and fits.
+  // Declared up front, the same upload is counted as its bytes arrive (its
+  // buffer's old and new copy for the moment it grows) and fits.
   ModelStore::Upload third = store.StartUpload();
   ASSERT_TRUE(third.Expect(200).ok());
+  EXPECT_EQ(store.stats().upload_bytes, 0u);
+  ASSERT_TRUE(third.Append(std::string(100, 'c')).ok());
+  EXPECT_EQ(store.stats().upload_bytes, 100u);
+  ASSERT_TRUE(third.Append(std::string(100, 'c')).ok());
   EXPECT_EQ(store.stats().upload_bytes, 200u);
-  ASSERT_TRUE(third.Append(std::string(100, 'c')).ok());
-  ASSERT_TRUE(third.Append(std::string(100, 'c')).ok());
   auto kept = store.Put(ModelFormat::kPly, std::move(third), "c.ply");
   ASSERT_TRUE(kept.ok()) << kept.status();
   EXPECT_EQ(kept->sha256, Sha256Hex(std::string(200, 'c')));
@@ -152,6 +155,29 @@ TEST(ModelStore, UploadsBeingReceivedCountAgainstTheBudget) {
   EXPECT_EQ(kept->bytes->capacity(), 200u);
   EXPECT_EQ(store.stats().upload_bytes, 0u);
   EXPECT_EQ(store.stats().bytes, 200u);
+}
+
+// A declared size is not a claim on the budget: uploads that declare much and
+// send little hold what they sent, and others still fit. The one that cannot
+// grow when its bytes come is turned away, saying what to do.
+TEST(ModelStore, ADeclaredSizeIsCountedAsItsBytesArrive) {
+  ModelStore store(/*budget_bytes=*/1000, /*max_model_bytes=*/1000);
+  std::vector<ModelStore::Upload> idle;
+  for (int i = 0; i < 4; ++i) {
+    idle.push_back(store.StartUpload());
+    ASSERT_TRUE(idle.back().Expect(1000).ok()) << i;
+    ASSERT_TRUE(idle.back().Append("v 0 0 0\n").ok()) << i;
+  }
+  EXPECT_EQ(store.stats().upload_bytes, 4u * 8);
+  auto small = store.Put(ModelFormat::kObj, std::string(100, 's'), "small.obj");
+  ASSERT_TRUE(small.ok()) << small.status();
+  // One of them sends on; another cannot then grow past the budget.
+  ASSERT_TRUE(idle[0].Append(std::string(600, 'a')).ok());
+  const absl::Status refused = idle[1].Append(std::string(600, 'b'));
+  EXPECT_EQ(refused.code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_THAT(std::string(refused.message()), ::testing::HasSubstr("retry"));
+  idle.clear();
+  EXPECT_EQ(store.stats().upload_bytes, 0u);
 }
 
 // An upload past max_model_bytes is refused at the chunk that passes it, or

@@ -18,6 +18,7 @@
 #include "cad/fixtures.h"
 #include "client/sampler_client.h"
 #include "engine/model_source.h"
+#include "grpcpp/create_channel.h"
 #include "gtest/gtest.h"
 #include "proto/convert.h"
 #include "request/model_spec.h"
@@ -50,6 +51,61 @@ ServerOptions ModelServerOptions() {
 }
 
 constexpr char kSquareObj[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
+
+// Uploads that declare the largest model and then send nothing hold only
+// the bytes they sent, so another client's upload goes through; and they are
+// cut after the idle timeout, freeing their streams.
+TEST(ServerModels, IdleUploadsThatDeclareMuchHoldLittleAndAreCut) {
+  ServerOptions options = LoopbackOptions();
+  options.upload_idle_timeout_seconds = 1;
+  Running r = StartServer(options);
+  auto channel = grpc::CreateChannel("127.0.0.1:" + std::to_string(r.server->port()),
+                                     grpc::InsecureChannelCredentials());
+  auto stub = v1::Sampler::NewStub(channel);
+  struct Idle {
+    grpc::ClientContext context;
+    v1::ModelInfo info;
+    std::unique_ptr<grpc::ClientWriter<v1::ModelChunk>> writer;
+  };
+  std::vector<std::unique_ptr<Idle>> idle;
+  for (int i = 0; i < 4; ++i) {
+    idle.push_back(std::make_unique<Idle>());
+    Idle& u = *idle.back();
+    // Bounds the test should the server never cut them.
+    u.context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+    u.writer = stub->UploadModel(&u.context, &u.info);
+    v1::ModelChunk chunk;
+    chunk.set_format("obj");
+    chunk.set_total_bytes(r.server->models().max_model_bytes());
+    chunk.set_data("v 0 0 0\n");
+    ASSERT_TRUE(u.writer->Write(chunk)) << i;
+  }
+  // Every idle upload's chunk has arrived.
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (r.server->models().stats().upload_bytes < 4 * 8 &&
+         std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  EXPECT_EQ(r.server->models().stats().upload_bytes, 4u * 8);
+  auto info = r.client->UploadModel("obj", "square.obj", kSquareObj);
+  ASSERT_TRUE(info.ok()) << info.status();
+  // Then the idle ones are cut (the client sees CANCELLED; the server's log
+  // says why), well before a generous bound, and hold nothing.
+  const auto start = std::chrono::steady_clock::now();
+  for (auto& u : idle) {
+    const grpc::Status status = u->writer->Finish();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::CANCELLED) << status.error_message();
+  }
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
+  // Their handlers give the bytes back as they return, just after the cut.
+  const auto freed_by = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  while (r.server->models().stats().upload_bytes != 0 &&
+         std::chrono::steady_clock::now() < freed_by) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  EXPECT_EQ(r.server->models().stats().upload_bytes, 0u);
+  EXPECT_EQ(r.server->models().stats().models, 1u);  // no partial model was stored
+}
 
 // A 100 000-digit index: the real INVALID_ARGUMENT arrives (not the
 // client's RESOURCE_EXHAUSTED about header size), under 1 KB, the token

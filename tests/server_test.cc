@@ -6,6 +6,7 @@
 #include <chrono>
 #include <fstream>
 #include <functional>
+#include <string>
 #include <thread>
 
 #include "client/sampler_client.h"
@@ -381,6 +382,20 @@ TEST(Server, ABuildNobodyWaitsForAnyMoreStopsAndFreesItsSlot) {
   EXPECT_EQ(s.builds_failed, 0u);  // a stopped build is not remembered as a failure
 }
 
+TEST(Server, TheServersRequestDeadlineStopsABuildNobodyElseWaitsFor) {
+  ServerOptions options = HeavyOptions();
+  options.request_deadline_seconds = 0.5;
+  ClientOptions co;
+  co.max_resumes = 0;
+  Running r = StartServer(options, co);
+  const auto start = std::chrono::steady_clock::now();
+  ExpectStatus(Fetch(*r.client, HeavyBuild()).status(), absl::StatusCode::kDeadlineExceeded,
+               "request deadline of 0.5 s");
+  EXPECT_LT(std::chrono::steady_clock::now() - start, milliseconds(3000));
+  EXPECT_TRUE(Within(5, [&] { return r.server->cache().stats().builds_running == 0; }));
+  EXPECT_EQ(r.server->cache().stats().builds_stopped, 1u);
+}
+
 TEST(Server, AWaiterLeavesAtItsOwnDeadlineWhileTheBuildGoesOnForOthers) {
   Running r = StartServer(HeavyOptions());
   absl::Status patient_status;
@@ -454,6 +469,41 @@ TEST(Server, ShutdownStopsARunningBuild) {
   EXPECT_LT(std::chrono::steady_clock::now() - start, milliseconds(3000));
   waiting.join();
   EXPECT_EQ(status.code(), absl::StatusCode::kUnavailable) << status;
+}
+
+// The batch size a refusal names is accepted when asked for, whether the
+// tree was cold at the refusal and warm at the ask: at every remainder of the
+// message size by the bytes a sample takes (12 here), so the header's few
+// bytes of cache state would cross a boundary at some of them.
+TEST(Server, TheLargestBatchSizeARefusalNamesIsAccepted) {
+  for (int extra = 0; extra < 12; ++extra) {
+    ServerOptions options = LoopbackOptions();
+    options.max_message_bytes = 65536 + extra;
+    ClientOptions co;
+    co.max_resumes = 0;
+    co.stream.batch_size = 1 << 20;
+    co.stream.precision = ColumnPrecision::kFloat32;
+    Running r = StartServer(options, co);
+    SampleRequest request = LongStream(3'000'000);
+    request.fields.uv = false;
+    const absl::Status refused = Fetch(*r.client, request).status();  // on a cold tree
+    ExpectStatus(refused, absl::StatusCode::kInvalidArgument, "ask for at most ");
+    const std::string m(refused.message());
+    const std::string ask = "ask for at most ";
+    const uint32_t hinted = static_cast<uint32_t>(std::stoul(m.substr(m.find(ask) + ask.size())));
+    ClientOptions asks = co;
+    asks.stream.batch_size = hinted;
+    asks.target = "127.0.0.1:" + std::to_string(r.server->port());
+    auto client = *SamplerClient::Connect(asks);
+    size_t first = 0;
+    const auto result = client->Sample(request, [&](const StreamInfo&, const SampleBatch& b) {
+      first = b.size();
+      return absl::CancelledError("one batch is enough");
+    });
+    EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled)
+        << "extra " << extra << ": " << result.status();
+    EXPECT_EQ(first, hinted) << "extra " << extra;
+  }
 }
 
 TEST(Server, AStockClientReceivesEveryColumnWithinItsDefaultMessageLimit) {
@@ -675,6 +725,62 @@ TEST(Server, TheServerDeadlineEndsLongStreams) {
     return absl::OkStatus();
   });
   ExpectStatus(result.status(), absl::StatusCode::kDeadlineExceeded, "resume after the last index");
+}
+
+// A blue request whose relaxation would take many seconds (about 7 s a
+// million samples on one core), on a tree built beforehand so that only the
+// relaxation runs when the request comes.
+SampleRequest LongBlueRelaxation() {
+  SampleRequest r = Request("sphere", 1'000'000, 3);
+  r.sequence = SequenceKind::kBlue;
+  return r;
+}
+void WarmTreeOf(SamplerClient& client, const SampleRequest& request) {
+  SampleRequest warm = request;
+  warm.sequence = SequenceKind::kJittered;
+  warm.begin = 0, warm.end = 1;
+  ASSERT_TRUE(Fetch(client, warm).ok());
+}
+uint64_t StreamMemoryReserved(SamplerClient& client) {
+  auto stats = client.GetCacheStats();
+  EXPECT_TRUE(stats.ok()) << stats.status();
+  return stats.ok() ? stats->stream_memory_reserved() : ~uint64_t{0};
+}
+
+TEST(Server, TheServerDeadlineStopsABlueRelaxationAndFreesItsMemory) {
+  ServerOptions options = LoopbackOptions();
+  options.request_deadline_seconds = 0.5;
+  ClientOptions co;
+  co.max_resumes = 0;
+  Running r = StartServer(options, co);
+  WarmTreeOf(*r.client, LongBlueRelaxation());
+  const auto start = std::chrono::steady_clock::now();
+  ExpectStatus(Fetch(*r.client, LongBlueRelaxation()).status(),
+               absl::StatusCode::kDeadlineExceeded, "blue-noise set relaxed");
+  // Promptly: a generous bound, far below the relaxation's own time.
+  EXPECT_LT(std::chrono::steady_clock::now() - start, milliseconds(5000));
+  EXPECT_EQ(StreamMemoryReserved(*r.client), 0u);
+  EXPECT_EQ(r.server->service().active_streams(), 0u);
+}
+
+TEST(Server, AClientThatGivesUpStopsABlueRelaxationAndFreesItsMemory) {
+  ClientOptions co;
+  co.max_resumes = 0;
+  Running r = StartServer(LoopbackOptions(), co);
+  WarmTreeOf(*r.client, LongBlueRelaxation());
+  ClientOptions ic = co;
+  ic.target = "127.0.0.1:" + std::to_string(r.server->port());
+  ic.deadline_seconds = 0.5;
+  auto impatient = *SamplerClient::Connect(ic);
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(Fetch(*impatient, LongBlueRelaxation()).status().code(),
+            absl::StatusCode::kDeadlineExceeded);
+  // The server sees the client gone, stops the relaxation and frees its slot
+  // and its reservation, long before the relaxation would have ended.
+  EXPECT_TRUE(Within(5, [&] {
+    return r.server->service().active_streams() == 0 && StreamMemoryReserved(*r.client) == 0;
+  }));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, milliseconds(5500));
 }
 
 // With any pipeline depth (0: none): the producer stops at the full queue,
