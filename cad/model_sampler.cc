@@ -336,7 +336,7 @@ absl::StatusOr<size_t> ModelSampleCursor::Next(size_t max, SampleBatch* batch) {
       for (size_t i = at; i < at + n; ++i) KeepInTrim(piece, i, batch);
       if (fields_.curve_position) {
         for (size_t i = at; i < at + n; ++i) {
-          batch->curve_position[i] = (piece_ + batch->curve_position[i]) / pieces;
+          batch->curve_position[i] = CurvePosition(piece_ + batch->curve_position[i], pieces);
         }
       }
       if (fields_.face) batch->face.insert(batch->face.end(), n, static_cast<uint32_t>(piece.face));

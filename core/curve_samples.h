@@ -13,6 +13,7 @@
 #ifndef SFCSAMPLER_CORE_CURVE_SAMPLES_H_
 #define SFCSAMPLER_CORE_CURVE_SAMPLES_H_
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -20,10 +21,19 @@
 
 #include "absl/status/status.h"
 #include "core/sequence.h"
+#include "core/vector_math.h"
 #include "core/types/region.h"
 #include "core/types/sample_batch.h"
 
 namespace sfc {
+
+// The curve_position column's value at `along` of `total` units of the curve
+// (the tree's curve indices, a mesh's triangle ranks, a model's pieces):
+// along / total, kept in [0, 1) as the column promises (the quotient rounds
+// up to 1 when along is within rounding of total).
+inline double CurvePosition(double along, double total) {
+  return std::min(along / total, math::kBelowOne);
+}
 
 // A batch's columns from one row on; null for the columns not asked for.
 struct SampleRows {
@@ -100,7 +110,8 @@ class CurveSamples {
   // whole set and the filler places it. A pure function of each k.
   void AddressesOf(const uint32_t* ks, uint64_t k0, size_t n, CurveAddress* out) const;
   // Two-dimensional sequences: every address's leaf is below this (the
-  // cursor's sort buckets by it).
+  // cursor's sort buckets by it; a bound too small would lose the order, so
+  // every address WarpMany gives must hold it).
   virtual uint32_t AddressLeafBound() const = 0;
   // OK when the kind can place `sequence`'s samples; INVALID_ARGUMENT with
   // the reason otherwise (a kind without a warp for two-dimensional ones).

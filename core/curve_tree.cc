@@ -15,10 +15,8 @@ namespace {
 constexpr int kNeverFails = 63;
 // Fixed-point scale of the running masses: S_base is 2^56 units.
 constexpr int kMassBits = 56;
-// The least total mass a tree takes: its unit, 2^-kMassBits of it, is a
-// normal double (below, masses lose their bits; at 1e-308 every sample fell
-// on one point).
-constexpr double kSmallestMass = 0x1p-1022 * static_cast<double>(uint64_t{1} << kMassBits);
+static_assert(CurveTree::kSmallestMass == 0x1p-1022 * static_cast<double>(uint64_t{1} << kMassBits),
+              "the mass unit of the least total mass is the least normal double");
 
 void RecordHit(const DepthCapHit& hit, std::vector<DepthCapHit>* worst) {
   auto ratio = [](const DepthCapHit& h) { return h.limit > 0 ? h.measured / h.limit : INFINITY; };
@@ -833,11 +831,11 @@ absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Build(const Surface&
         "the density, or add a floor)",
         base));
   }
-  if (base < kSmallestMass) {
+  if (base < CurveTree::kSmallestMass) {
     return absl::InvalidArgumentError(absl::StrFormat(
-        "the density integrates to %g over the surface, too small to resolve (below 2^-966, "
-        "where its masses' unit leaves the normal doubles); scale it up: only its ratios matter",
-        base));
+        "the density integrates to %g over the surface, too small to resolve (below %g, where "
+        "its masses' unit leaves the normal doubles); scale it up: only its ratios matter",
+        base, CurveTree::kSmallestMass));
   }
   tree->base_mass_ = base;
   tree->mass_unit_ = std::ldexp(base, -kMassBits);

@@ -167,6 +167,11 @@ class CurveTree {
   // (docs/ALGORITHM.md, "Features inside a leaf").
   static constexpr double kRoughShare = 0.01;
   static constexpr double kRoughFloor = 1.0 / 2048;
+  // The least total mass a density may have over a surface, a mesh or a
+  // model, 2^-966: below it the tree's mass unit (2^-56 of the total) and
+  // a mesh's small leaves' masses leave the normal doubles, and samples
+  // coincide (docs/ALGORITHM.md, "Tiny densities").
+  static constexpr double kSmallestMass = 0x1p-966;
   // The edge probe (EdgeError): a gap of kEdgeJump of the largest node value
   // between m and the model at a corner or edge midpoint counts, over a band
   // of kEdgeBand of the cell.

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/area_estimator.h"
+#include "core/curve_samples.h"
 #include "core/slope_batch.h"
 #include "core/vector_math.h"
 
@@ -307,9 +308,8 @@ void LeafWalk::Continue(size_t n) {
     }
     if (curve_position_ != nullptr) {
       const double pos = at.pos + fraction_[i] * at.span;
-      // Below 1 as the column promises: the last leaf's end can round up to it.
-      curve_position_[i] = std::min(
-          (leaf_start_ + pos * leaf_span_) / static_cast<double>(curve_.Span(0)), math::kBelowOne);
+      curve_position_[i] =
+          CurvePosition(leaf_start_ + pos * leaf_span_, static_cast<double>(curve_.Span(0)));
     }
   }
   if (!warped_) return;

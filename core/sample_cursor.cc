@@ -1,6 +1,7 @@
 #include "core/sample_cursor.h"
 
 #include <algorithm>
+#include <cassert>
 #include <utility>
 
 #include "absl/strings/str_format.h"
@@ -113,8 +114,11 @@ struct AddressBuckets {
   // Writes a's coarse bucket into its digits' unused top 8 bits (the first
   // pass's bucket, no shifts by variable counts in its chain of loads) and
   // returns it; SortAddresses clears them.
+  // REQUIRES: a.leaf < the bound the buckets were sized for
+  // (CurveSamples::AddressLeafBound), so c < coarse <= 256 fits the 8 bits.
   uint64_t Stamp(CurveAddress* a) const {
     const uint64_t c = CoarseOf(*a);
+    assert(c < coarse && coarse <= 256);
     a->digits |= c << kStampShift;
     return c;
   }

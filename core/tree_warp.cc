@@ -8,7 +8,6 @@
 
 #include "core/leaf_model.h"
 #include "core/tree_warp_internal.h"
-#include "core/vector_math.h"
 
 namespace sfc {
 namespace {
@@ -421,8 +420,7 @@ void TreeWarp::PlaceMany(size_t n, const CurveAddress* at, double* u, double* v,
       const double start = static_cast<double>(tree_.leaf_start(l));
       const double span = static_cast<double>(tree_.leaf_end(l) - tree_.leaf_start(l));
       const double fraction = static_cast<double>(digits[i]) / digit_span;
-      // Below 1 as the column promises: the last leaf's end can round up to it.
-      curve_position[i0 + i] = std::min((start + fraction * span) / curve_span, math::kBelowOne);
+      curve_position[i0 + i] = CurvePosition(start + fraction * span, curve_span);
     }
   }
 }

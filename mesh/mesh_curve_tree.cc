@@ -7,6 +7,7 @@
 #include "absl/strings/str_format.h"
 #include "base/status_macros.h"
 #include "base/worker_pool.h"
+#include "core/curve_tree.h"
 #include "mesh/triangle_order.h"
 
 namespace sfc {
@@ -211,6 +212,12 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
       return absl::FailedPreconditionError(absl::StrFormat(
           "the density '%s' is zero on the whole of mesh '%s': there is nothing to sample",
           density->spec(), mesh.name));
+    }
+    if (total0 < CurveTree::kSmallestMass) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "the density '%s' integrates to %g over mesh '%s', too small to resolve (below %g); "
+          "scale it up: only its ratios matter",
+          density->spec(), total0, mesh.name, CurveTree::kSmallestMass));
     }
     TriangleBuilder builder(*surface, *density, options.tolerance, total0,
                             std::ldexp(1.0, stats.grade), options.max_depth);

@@ -137,7 +137,7 @@ absl::Status MeshFiller::WriteColumns(size_t n, const MeshCurveTree::Cell* const
       out.density[i] = d;
     }
     if (fields_.curve_position) {
-      out.curve_position[i] = (cells[i]->rank + area_positions[i]) / triangles;
+      out.curve_position[i] = CurvePosition(cells[i]->rank + area_positions[i], triangles);
     }
   }
   return absl::OkStatus();

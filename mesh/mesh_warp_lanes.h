@@ -6,8 +6,9 @@
 // mesh_warp_avx2.cc for AVX2 (the kAvx path of a CPU with AVX2: 256-bit
 // integer lanes and gathers) and mesh_warp_avx512.cc for AVX-512F; MeshWarp
 // dispatches on math::BestVectorPath(). Internal linkage (an anonymous namespace) on
-// purpose: each of the three files keeps its own copy, compiled for its
-// instruction set, which the linker never merges.
+// purpose: each of the four files keeps its own copy, compiled for its
+// instruction set, which the linker never merges (nm shows none of the wider
+// builds' objects exporting a weak symbol the baseline could pick up).
 //
 // Thread-safety: pure functions.
 #ifndef SFCSAMPLER_MESH_MESH_WARP_LANES_H_
@@ -197,9 +198,9 @@ __attribute__((always_inline)) inline Doubles ExactDouble(Ints x) {
   return (Doubles)(x | 0x4330000000000000LL) - 0x1.0p52;
 }
 // floor(x) as an integer, exactly, for 0 <= x < 2^51 (-0 included): x + 2^52
-// rounds x to an integer in the mantissa, one less where that went up. Vector
-// operations of AVX-512F alone (its conversions to 64-bit integers are
-// AVX-512DQ's), and static_cast's truncation for these x.
+// rounds x to an integer in the mantissa, one less where that went up: plain
+// vector operations on every build (conversions to 64-bit integers would need
+// AVX-512DQ), and static_cast's truncation for these x.
 __attribute__((always_inline)) inline Ints FloorOf(Doubles x) {
   const Doubles big = x + 0x1.0p52;
   const Ints up = big - 0x1.0p52 > x;

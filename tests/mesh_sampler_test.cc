@@ -370,6 +370,14 @@ TEST(MeshCurveTree, BadDensitiesAreErrors) {
             absl::StatusCode::kInvalidArgument);
   EXPECT_EQ(MeshCurveTree::Build(Icosphere(2), GaussianCurvatureMeshDensity(0), {}).status().code(),
             absl::StatusCode::kInvalidArgument);
+  // Too small to resolve (its leaves' masses subnormal, samples coinciding):
+  // refused with what to do; a small one that resolves is built.
+  auto tiny = std::make_shared<FunctionMeshDensity>([](const MeshPoint&) { return 1e-320; }, "t");
+  const auto r2 = MeshCurveTree::Build(Icosphere(2), tiny, {});
+  EXPECT_EQ(r2.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(r2.status().message().find("scale it up"), std::string::npos) << r2.status();
+  auto small = std::make_shared<FunctionMeshDensity>([](const MeshPoint&) { return 1e-280; }, "s");
+  EXPECT_TRUE(MeshCurveTree::Build(Icosphere(2), small, {}).ok());
 }
 
 // The sobol sequence warped onto a mesh (mesh/mesh_warp.h): exact N, every

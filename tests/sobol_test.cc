@@ -169,6 +169,20 @@ TEST(SobolSampler, CurvePositionsStayBelowOne) {
   }
 }
 
+// Every kind's position is CurvePosition's: the last part's end, within
+// rounding of the whole, stays below 1 (a mesh of 3 triangles at 2 + (1 -
+// 2^-53) of 3 rounded to 1).
+TEST(CurvePosition, StaysBelowOneWhereTheQuotientRoundsUp) {
+  for (double total = 1; total <= 4096; ++total) {
+    // The last part's rank plus a place just below its end: the sum itself
+    // rounds to total from 2 parts on.
+    const double at = CurvePosition((total - 1) + math::kBelowOne, total);
+    ASSERT_LT(at, 1.0) << total;
+    ASSERT_GT(at, 1.0 - 0x1p-40) << total;
+    ASSERT_EQ(CurvePosition(total / 2, total), 0.5);
+  }
+}
+
 TEST(SobolSampler, SameBytesForAnyBatchSizeAndThreadCount) {
   const uint64_t n = 20000;
   const auto s = MakeSetup("eight", "gaussian:floor=0.1", n);

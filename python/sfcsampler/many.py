@@ -10,7 +10,7 @@ which worker sampled it or on how many workers there were:
            SHA-256("sfcsampler.model-seed\\0" + base seed as 8 bytes little-endian
                    + the 32 bytes of the model's SHA-256), top bit cleared
 
-(model_seed(); the CLI computes the same, client/cli/sample_many.cc). A
+(model_seed(); C++ computes the same, request/model_spec.h ModelSeed). A
 model's result is then exactly sfcsampler.sample(surface="FORMAT:FILE",
 seed=model_seed(base, sha256), ...) on it alone.
 """
