@@ -20,7 +20,8 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
   grpc::Status status = Admit(*context);
   std::string name, raw_name;  // escaped for messages; as sent, for the log's own escape
   std::optional<ModelFormat> format;
-  // The bytes count against the model budget as they arrive.
+  // The bytes count against the model budget as they arrive (a declared size
+  // at the first chunk).
   ModelStore::Upload upload = models_->StartUpload();
   // An uploader that stops sending is cut after upload_idle_timeout_seconds:
   // a blocked Read has no timeout of its own.

@@ -25,13 +25,11 @@ ModelStore::Upload::Upload(Upload&& other) noexcept
       whole_(std::move(other.whole_)),
       expected_(other.expected_),
       size_(other.size_),
-      held_(other.held_),
-      whole_held_(other.whole_held_) {
+      held_(other.held_) {
   other.chunks_.clear();
   other.whole_.clear();
   other.size_ = 0;
   other.held_ = 0;
-  other.whole_held_ = 0;
 }
 
 ModelStore::Upload::~Upload() {
@@ -43,29 +41,9 @@ absl::Status ModelStore::Upload::Expect(uint64_t total_bytes) {
     store_->CountRejected();
     return TooLarge(total_bytes, store_->max_model_bytes_, store_->budget_bytes_);
   }
-  // Nothing is counted yet: a client that declares a large size and sends
-  // nothing holds nothing of the budget.
+  // Nothing is counted until the first chunk (Append): a client that opens
+  // an upload and sends nothing holds nothing of the budget.
   expected_ = total_bytes;
-  return absl::OkStatus();
-}
-
-absl::Status ModelStore::Upload::Grow(uint64_t needed) {
-  if (needed <= whole_held_) return absl::OkStatus();
-  // Geometric growth, capped at the declared size: the copies cost O(size)
-  // in all, and the last buffer is exactly the model's.
-  const uint64_t capacity =
-      std::min<uint64_t>(*expected_, std::max<uint64_t>(needed, 2 * whole_held_));
-  // The new buffer is counted before it exists, the old one until it is gone.
-  if (absl::Status held = store_->Hold(capacity); !held.ok()) return held;
-  held_ += capacity;
-  std::string bigger;
-  bigger.reserve(capacity);
-  bigger += whole_;
-  whole_.swap(bigger);
-  bigger = std::string();
-  store_->Release(whole_held_);
-  held_ -= whole_held_;
-  whole_held_ = capacity;
   return absl::OkStatus();
 }
 
@@ -75,8 +53,15 @@ absl::Status ModelStore::Upload::Append(std::string chunk) {
       return absl::InvalidArgumentError(absl::StrFormat(
           "the upload sent more than the %d bytes it declared (total_bytes)", *expected_));
     }
-    if (absl::Status grown = Grow(size_ + chunk.size()); !grown.ok()) return grown;
-    whole_ += chunk;  // counted by Grow
+    if (held_ < *expected_) {
+      // The first chunk holds and allocates the declared size once: the
+      // buffer never grows, so nothing is counted twice. An uploader that
+      // then stops sending keeps it until the idle cut (the service's).
+      if (absl::Status held = store_->Hold(*expected_); !held.ok()) return held;
+      held_ = *expected_;
+      whole_.reserve(*expected_);
+    }
+    whole_ += chunk;  // counted by the hold above
     size_ += chunk.size();
     return absl::OkStatus();
   }

@@ -6,8 +6,9 @@
 // Bounded: one model may hold at most max_model_bytes (larger uploads are
 // RESOURCE_EXHAUSTED and stop being read at that point), and all models
 // together budget_bytes, past which the least recently used are evicted.
-// Uploads being received count against the same budget as they arrive
-// (Upload), so the bytes in flight plus the stored ones never pass it. A
+// Uploads being received count against the same budget as they arrive, or
+// at their first chunk at the size they declare (Upload), so the bytes in
+// flight plus the stored ones never pass it. A
 // request naming an evicted model gets NOT_FOUND that says to upload it again;
 // a tree or stream that uses a model keeps its bytes alive.
 //
@@ -49,16 +50,16 @@ class ModelStore final : public ModelSource {
     Upload(const Upload&) = delete;
     ~Upload();  // gives back what it holds
 
-    // Declares the model's size before the first chunk: the bytes are then
-    // gathered in one buffer that grows as they arrive (to at most this
-    // size, counted as it grows), and no join is needed at the end.
-    // RESOURCE_EXHAUSTED when the size is past max_model_bytes or the
-    // budget; the upload must then send exactly this many bytes
-    // (INVALID_ARGUMENT otherwise).
+    // Declares the model's size before the first chunk. Nothing is counted
+    // yet; the first Append counts and allocates the whole size once, and no
+    // join is needed at the end. RESOURCE_EXHAUSTED when the size is past
+    // max_model_bytes or the budget; the upload must then send exactly this
+    // many bytes (INVALID_ARGUMENT otherwise).
     absl::Status Expect(uint64_t total_bytes);
-    // Appends the next chunk. RESOURCE_EXHAUSTED when the model would pass
-    // max_model_bytes or the budget, or when other uploads hold so much of
-    // the budget that this chunk does not fit (stored models are evicted
+    // Appends the next chunk (with Expect, the first one holds the declared
+    // size). RESOURCE_EXHAUSTED when the model would pass max_model_bytes or
+    // the budget, or when other uploads hold so much of the budget that this
+    // chunk (or the declared size) does not fit (stored models are evicted
     // first); the upload then holds nothing more.
     absl::Status Append(std::string chunk);
     uint64_t size() const { return size_; }
@@ -69,17 +70,13 @@ class ModelStore final : public ModelSource {
     // The bytes as one string of exactly their size. While it is built the
     // chunks and the string are both counted.
     absl::StatusOr<std::string> Join();
-    // With Expect: makes whole_ hold at least `needed` bytes, counting its
-    // new buffer first; RESOURCE_EXHAUSTED as Append.
-    absl::Status Grow(uint64_t needed);
 
     ModelStore* store_;
     std::vector<std::string> chunks_;  // exact sizes: no growth by doubling
-    std::string whole_;                // with Expect: grown as bytes arrive
+    std::string whole_;                // with Expect: allocated at its full size
     std::optional<uint64_t> expected_;  // with Expect: the declared size
     uint64_t size_ = 0;
     uint64_t held_ = 0;  // counted against the store's budget now
-    uint64_t whole_held_ = 0;  // of held_, whole_'s buffer
   };
 
   ModelStore(uint64_t budget_bytes, uint64_t max_model_bytes);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 #include <thread>
@@ -56,14 +57,26 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> Credentials(const Serve
   return credentials;
 }
 
+// A timeout must be finite and > 0: 0 or less would cut every stream at
+// once, NaN or infinity never.
+absl::Status ValidateTimeout(const char* flag, double seconds) {
+  if (std::isfinite(seconds) && seconds > 0) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      absl::StrFormat("%s must be a finite number of seconds > 0, got %g", flag, seconds));
+}
+
 absl::Status Validate(const ServerOptions& o) {
   if (o.max_message_bytes < (64u << 10)) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "--max-message-bytes must be at least 65536 (a header and a batch must fit), got %d",
         o.max_message_bytes));
   }
-  if (!(o.write_timeout_seconds > 0)) {
-    return absl::InvalidArgumentError("--write-timeout must be > 0 seconds");
+  if (absl::Status s = ValidateTimeout("--write-timeout", o.write_timeout_seconds); !s.ok()) {
+    return s;
+  }
+  if (absl::Status s = ValidateTimeout("--upload-idle-timeout", o.upload_idle_timeout_seconds);
+      !s.ok()) {
+    return s;
   }
   if (o.max_concurrent_builds < 1 || o.max_queued_builds < 0 || !(o.failure_ttl_seconds >= 0)) {
     return absl::InvalidArgumentError(

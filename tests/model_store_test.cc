@@ -139,13 +139,13 @@ TEST(ModelStore, UploadsBeingReceivedCountAgainstTheBudget) {
   EXPECT_EQ(store.Put(ModelFormat::kPly, std::move(undeclared), "c.ply").status().code(),
             absl::StatusCode::kResourceExhausted);
   EXPECT_EQ(store.stats().upload_bytes, 0u);
-  // Declared up front, the same upload is counted as its bytes arrive (its
-  // buffer's old and new copy for the moment it grows) and fits.
+  // Declared up front, the same upload is counted once, at its first chunk,
+  // and fits.
   ModelStore::Upload third = store.StartUpload();
   ASSERT_TRUE(third.Expect(200).ok());
   EXPECT_EQ(store.stats().upload_bytes, 0u);
   ASSERT_TRUE(third.Append(std::string(100, 'c')).ok());
-  EXPECT_EQ(store.stats().upload_bytes, 100u);
+  EXPECT_EQ(store.stats().upload_bytes, 200u);
   ASSERT_TRUE(third.Append(std::string(100, 'c')).ok());
   EXPECT_EQ(store.stats().upload_bytes, 200u);
   auto kept = store.Put(ModelFormat::kPly, std::move(third), "c.ply");
@@ -157,26 +157,47 @@ TEST(ModelStore, UploadsBeingReceivedCountAgainstTheBudget) {
   EXPECT_EQ(store.stats().bytes, 200u);
 }
 
-// A declared size is not a claim on the budget: uploads that declare much and
-// send little hold what they sent, and others still fit. The one that cannot
-// grow when its bytes come is turned away, saying what to do.
-TEST(ModelStore, ADeclaredSizeIsCountedAsItsBytesArrive) {
-  ModelStore store(/*budget_bytes=*/1000, /*max_model_bytes=*/1000);
-  std::vector<ModelStore::Upload> idle;
-  for (int i = 0; i < 4; ++i) {
-    idle.push_back(store.StartUpload());
-    ASSERT_TRUE(idle.back().Expect(1000).ok()) << i;
-    ASSERT_TRUE(idle.back().Append("v 0 0 0\n").ok()) << i;
-  }
-  EXPECT_EQ(store.stats().upload_bytes, 4u * 8);
-  auto small = store.Put(ModelFormat::kObj, std::string(100, 's'), "small.obj");
-  ASSERT_TRUE(small.ok()) << small.status();
-  // One of them sends on; another cannot then grow past the budget.
-  ASSERT_TRUE(idle[0].Append(std::string(600, 'a')).ok());
-  const absl::Status refused = idle[1].Append(std::string(600, 'b'));
+// A declared size is held once, from the first chunk, never twice: a model
+// of 250 bytes fits a budget of 300 beside a stored one of 50, which stays.
+// An upload that has declared its size but sent no chunk holds nothing; one
+// whose declared size does not fit beside the others is turned away at its
+// first chunk, saying what to do.
+TEST(ModelStore, ADeclaredSizeIsHeldOnceFromTheFirstChunk) {
+  ModelStore store(/*budget_bytes=*/300, /*max_model_bytes=*/300);
+  auto stored = store.Put(ModelFormat::kObj, std::string(50, 's'), "s.obj");
+  ASSERT_TRUE(stored.ok()) << stored.status();
+  ModelStore::Upload upload = store.StartUpload();
+  ASSERT_TRUE(upload.Expect(250).ok());
+  EXPECT_EQ(store.stats().upload_bytes, 0u);
+  ASSERT_TRUE(upload.Append(std::string(150, 'a')).ok());
+  EXPECT_EQ(store.stats().upload_bytes, 250u);
+  ASSERT_TRUE(upload.Append(std::string(100, 'a')).ok());
+  EXPECT_EQ(store.stats().upload_bytes, 250u);
+  auto kept = store.Put(ModelFormat::kObj, std::move(upload), "a.obj");
+  ASSERT_TRUE(kept.ok()) << kept.status();
+  EXPECT_EQ(*kept->bytes, std::string(250, 'a'));
+  EXPECT_EQ(kept->bytes->capacity(), 250u);
+  EXPECT_EQ(store.stats().upload_bytes, 0u);
+  EXPECT_EQ(store.stats().bytes, 300u);
+  EXPECT_EQ(store.stats().evictions, 0u);
+  EXPECT_TRUE(store.Resolve(**ParseModelSpec(stored->Spec())).ok());
+
+  ModelStore::Upload declared = store.StartUpload();
+  ASSERT_TRUE(declared.Expect(200).ok());
+  ModelStore::Upload silent = store.StartUpload();
+  ASSERT_TRUE(silent.Expect(200).ok());
+  EXPECT_EQ(store.stats().upload_bytes, 0u);
+  EXPECT_EQ(store.stats().evictions, 0u);
+  ASSERT_TRUE(declared.Append("v 0 0 0\n").ok());
+  EXPECT_EQ(store.stats().upload_bytes, 200u);
+  // 200 + 200 held would pass 300 whatever is evicted.
+  const absl::Status refused = silent.Append("v 0 0 0\n");
   EXPECT_EQ(refused.code(), absl::StatusCode::kResourceExhausted);
   EXPECT_THAT(std::string(refused.message()), ::testing::HasSubstr("retry"));
-  idle.clear();
+  EXPECT_EQ(store.stats().upload_bytes, 200u);
+  {
+    ModelStore::Upload gone = std::move(declared);  // a client that leaves gives it back
+  }
   EXPECT_EQ(store.stats().upload_bytes, 0u);
 }
 

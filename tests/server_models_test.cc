@@ -52,12 +52,16 @@ ServerOptions ModelServerOptions() {
 
 constexpr char kSquareObj[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
 
-// Uploads that declare the largest model and then send nothing hold only
-// the bytes they sent, so another client's upload goes through; and they are
-// cut after the idle timeout, freeing their streams.
-TEST(ServerModels, IdleUploadsThatDeclareMuchHoldLittleAndAreCut) {
+// An upload that declared its size holds that size from its first chunk;
+// one that has sent nothing holds nothing. Idle uploads keep what they hold
+// only until the idle cut: while four hold the budget another client is told
+// to retry, and after they are cut (the client sees CANCELLED, the server's
+// log says why) its upload goes through and no partial model is stored.
+TEST(ServerModels, IdleUploadsHoldTheirDeclaredSizeOnlyUntilCut) {
   ServerOptions options = LoopbackOptions();
-  options.upload_idle_timeout_seconds = 1;
+  options.max_model_bytes = 1000;
+  options.model_bytes = 4 * 1000 + 40;  // the 48-byte square does not fit beside them
+  options.upload_idle_timeout_seconds = 3;
   Running r = StartServer(options);
   auto channel = grpc::CreateChannel("127.0.0.1:" + std::to_string(r.server->port()),
                                      grpc::InsecureChannelCredentials());
@@ -68,35 +72,37 @@ TEST(ServerModels, IdleUploadsThatDeclareMuchHoldLittleAndAreCut) {
     std::unique_ptr<grpc::ClientWriter<v1::ModelChunk>> writer;
   };
   std::vector<std::unique_ptr<Idle>> idle;
-  for (int i = 0; i < 4; ++i) {
+  for (int i = 0; i < 5; ++i) {
     idle.push_back(std::make_unique<Idle>());
     Idle& u = *idle.back();
     // Bounds the test should the server never cut them.
-    u.context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+    u.context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
     u.writer = stub->UploadModel(&u.context, &u.info);
+    if (i == 4) break;  // the fifth sends nothing at all
     v1::ModelChunk chunk;
     chunk.set_format("obj");
-    chunk.set_total_bytes(r.server->models().max_model_bytes());
+    chunk.set_total_bytes(1000);
     chunk.set_data("v 0 0 0\n");
     ASSERT_TRUE(u.writer->Write(chunk)) << i;
   }
-  // Every idle upload's chunk has arrived.
+  // Every idle upload's first chunk has arrived.
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-  while (r.server->models().stats().upload_bytes < 4 * 8 &&
+  while (r.server->models().stats().upload_bytes < 4 * 1000 &&
          std::chrono::steady_clock::now() < until) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  EXPECT_EQ(r.server->models().stats().upload_bytes, 4u * 8);
-  auto info = r.client->UploadModel("obj", "square.obj", kSquareObj);
-  ASSERT_TRUE(info.ok()) << info.status();
-  // Then the idle ones are cut (the client sees CANCELLED; the server's log
-  // says why), well before a generous bound, and hold nothing.
+  EXPECT_EQ(r.server->models().stats().upload_bytes, 4u * 1000);
+  auto refused = r.client->UploadModel("obj", "square.obj", kSquareObj);
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kResourceExhausted) << refused.status();
+  EXPECT_NE(std::string(refused.status().message()).find("retry"), std::string::npos)
+      << refused.status();
+  // Then the idle ones are cut, well before a generous bound.
   const auto start = std::chrono::steady_clock::now();
   for (auto& u : idle) {
     const grpc::Status status = u->writer->Finish();
     EXPECT_EQ(status.error_code(), grpc::StatusCode::CANCELLED) << status.error_message();
   }
-  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(15));
   // Their handlers give the bytes back as they return, just after the cut.
   const auto freed_by = std::chrono::steady_clock::now() + std::chrono::seconds(2);
   while (r.server->models().stats().upload_bytes != 0 &&
@@ -104,7 +110,10 @@ TEST(ServerModels, IdleUploadsThatDeclareMuchHoldLittleAndAreCut) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   EXPECT_EQ(r.server->models().stats().upload_bytes, 0u);
-  EXPECT_EQ(r.server->models().stats().models, 1u);  // no partial model was stored
+  EXPECT_EQ(r.server->models().stats().models, 0u);  // no partial model was stored
+  auto info = r.client->UploadModel("obj", "square.obj", kSquareObj);
+  ASSERT_TRUE(info.ok()) << info.status();
+  EXPECT_EQ(r.server->models().stats().models, 1u);
 }
 
 // A 100 000-digit index: the real INVALID_ARGUMENT arrives (not the

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <string>
 #include <thread>
 
@@ -781,6 +782,32 @@ TEST(Server, AClientThatGivesUpStopsABlueRelaxationAndFreesItsMemory) {
     return r.server->service().active_streams() == 0 && StreamMemoryReserved(*r.client) == 0;
   }));
   EXPECT_LT(std::chrono::steady_clock::now() - start, milliseconds(5500));
+}
+
+// A timeout of 0 or less would cut every stream at once, NaN or infinity
+// never: the server refuses to start, naming the flag. Valid ones are
+// reported by GetCacheStats.
+TEST(Server, TimeoutsMustBeFiniteAndPositive) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (double bad : {0.0, -1.0, nan, inf}) {
+    ServerOptions write = LoopbackOptions();
+    write.write_timeout_seconds = bad;
+    ExpectStatus(SamplerServer::Start(write).status(), absl::StatusCode::kInvalidArgument,
+                 "--write-timeout must be a finite number of seconds > 0");
+    ServerOptions upload = LoopbackOptions();
+    upload.upload_idle_timeout_seconds = bad;
+    ExpectStatus(SamplerServer::Start(upload).status(), absl::StatusCode::kInvalidArgument,
+                 "--upload-idle-timeout must be a finite number of seconds > 0");
+  }
+  ServerOptions options = LoopbackOptions();
+  options.write_timeout_seconds = 7.5;
+  options.upload_idle_timeout_seconds = 0.25;
+  Running r = StartServer(options);
+  auto stats = r.client->GetCacheStats();
+  ASSERT_TRUE(stats.ok()) << stats.status();
+  EXPECT_EQ(stats->write_timeout_seconds(), 7.5);
+  EXPECT_EQ(stats->upload_idle_timeout_seconds(), 0.25);
 }
 
 // With any pipeline depth (0: none): the producer stops at the full queue,
