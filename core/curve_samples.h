@@ -21,9 +21,9 @@
 
 #include "absl/status/status.h"
 #include "core/sequence.h"
-#include "core/vector_math.h"
 #include "core/types/region.h"
 #include "core/types/sample_batch.h"
+#include "core/vector_math.h"
 
 namespace sfc {
 
