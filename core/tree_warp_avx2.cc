@@ -61,21 +61,21 @@ size_t DescendGrid2Avx2(size_t m, double* a, double* b, int32_t* ref, uint8_t* s
       // each column's rows' (TreeWarp::splits_, grid 2).
       const __m256i node =
           _mm256_add_epi64(_mm256_slli_epi64(vref[v], 3), _mm256_slli_epi64(vref[v], 2));
-      const __m256d column_bound = _mm256_mask_i64gather_pd(zero, splits, node, active_d, 8);
-      const __m256d right = _mm256_cmp_pd(va[v], column_bound, _CMP_GE_OQ);
-      const __m256i dx = _mm256_and_si256(AsLanes(right), one);
-      const __m256d column_inverse = _mm256_mask_i64gather_pd(
-          zero, splits, _mm256_add_epi64(node, _mm256_add_epi64(dx, two)), active_d, 8);
-      const __m256d na = ClampBelowOne(
-          _mm256_mul_pd(_mm256_sub_pd(va[v], _mm256_and_pd(right, column_bound)), column_inverse));
+      // One split, the column's (x at `at`) or the row's: the side x falls
+      // on (d, 0 or 1) and x rescaled to it.
+      auto pick = [&](__m256d x, __m256i at, __m256i* d) {
+        const __m256d bound = _mm256_mask_i64gather_pd(zero, splits, at, active_d, 8);
+        const __m256d beyond = _mm256_cmp_pd(x, bound, _CMP_GE_OQ);
+        *d = _mm256_and_si256(AsLanes(beyond), one);
+        const __m256d inverse = _mm256_mask_i64gather_pd(
+            zero, splits, _mm256_add_epi64(at, _mm256_add_epi64(*d, two)), active_d, 8);
+        return ClampBelowOne(
+            _mm256_mul_pd(_mm256_sub_pd(x, _mm256_and_pd(beyond, bound)), inverse));
+      };
+      __m256i dx, dy;
+      const __m256d na = pick(va[v], node, &dx);
       const __m256i rows = _mm256_add_epi64(node, _mm256_add_epi64(_mm256_slli_epi64(dx, 2), four));
-      const __m256d row_bound = _mm256_mask_i64gather_pd(zero, splits, rows, active_d, 8);
-      const __m256d up = _mm256_cmp_pd(vb[v], row_bound, _CMP_GE_OQ);
-      const __m256i dy = _mm256_and_si256(AsLanes(up), one);
-      const __m256d row_inverse = _mm256_mask_i64gather_pd(
-          zero, splits, _mm256_add_epi64(rows, _mm256_add_epi64(dy, two)), active_d, 8);
-      const __m256d nb = ClampBelowOne(
-          _mm256_mul_pd(_mm256_sub_pd(vb[v], _mm256_and_pd(up, row_bound)), row_inverse));
+      const __m256d nb = pick(vb[v], rows, &dy);
       const __m256i at = _mm256_add_epi64(_mm256_slli_epi64(dy, 1), dx);
       // The 32-bit look-ups' mask: each 64-bit lane's low half.
       const __m128i active32 = _mm256_castsi256_si128(
