@@ -31,6 +31,7 @@ inline constexpr uint64_t kSobol[2] = {5, 6};           // the sobol coordinates
 inline constexpr uint64_t kSobolTail[2] = {7, 8};       // and their bits below 2^-32
 inline constexpr uint64_t kBlueCandidate = 0x626c7565;  // "blue" in ASCII
 inline constexpr uint64_t kBluePriority = 0x626c7566;
+inline constexpr uint64_t kBlueOrder = 0x626c7567;  // the order a sample tries its candidates in
 }  // namespace hash_stream
 
 // The key of the stream `stream` of `seed`.

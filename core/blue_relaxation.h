@@ -8,8 +8,9 @@
 //
 // Method. Start from the jittered q_k. In Jacobi sweeps by colour (even k,
 // then odd k), every sample of the colour that is too close to a neighbour
-// tries candidates h = hash(seed, sweep, k, j), j = 0, 1, ... in its stratum
-// and takes the first whose point clears every other sample; if none of them
+// tries m candidates stratified over its stratum, h_j = (j + hash(seed,
+// sweep, k, j)) / m, in a hashed order, and takes the first whose point
+// clears every other sample; if none of them
 // does, the least crowded one, when it is less crowded than its place
 // (candidates where the density differs from the density at the sample's
 // jittered place by more than 1.25x are not taken: across a density step a
