@@ -32,6 +32,7 @@ grpc::Status SamplerService::GetCacheStats(grpc::ServerContext* context,
     response->set_max_message_bytes(options_.max_message_bytes);
     response->set_write_timeout_seconds(options_.write_timeout_seconds);
     response->set_upload_idle_timeout_seconds(options_.upload_idle_timeout_seconds);
+    response->set_upload_min_bytes_per_second(options_.upload_min_bytes_per_second);
     response->set_stream_memory_bytes(stream_memory_.budget_bytes());
     response->set_stream_memory_reserved(stream_memory_.reserved_bytes());
     response->set_stream_memory_waits(stream_memory_.waits());

@@ -60,6 +60,17 @@ grpc::Status SamplerService::UploadModel(grpc::ServerContext* context,
       if (absl::Status appended = upload.Append(std::move(*chunk.mutable_data())); !appended.ok()) {
         status = grpc::Status(static_cast<grpc::StatusCode>(appended.code()),
                               absl::StrFormat("upload \"%s\": %s", name, appended.message()));
+      } else if (const double seconds = SecondsSince(start);
+                 options_.upload_min_bytes_per_second *
+                     (seconds - options_.upload_idle_timeout_seconds) >
+                 static_cast<double>(upload.size())) {
+        status = grpc::Status(
+            grpc::StatusCode::DEADLINE_EXCEEDED,
+            absl::StrFormat("upload \"%s\": %d bytes in %.1f s is slower than the server's "
+                            "upload_min_rate of %g bytes a second (counted after the first %g "
+                            "s), so the upload was cut; send the model faster",
+                            name, upload.size(), seconds, options_.upload_min_bytes_per_second,
+                            options_.upload_idle_timeout_seconds));
       }
     }
     if (watch->reason() == StreamWatchdog::Reason::kReadTimeout) {

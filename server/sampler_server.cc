@@ -78,6 +78,11 @@ absl::Status Validate(const ServerOptions& o) {
       !s.ok()) {
     return s;
   }
+  if (!(std::isfinite(o.upload_min_bytes_per_second) && o.upload_min_bytes_per_second > 0)) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("--upload-min-rate must be a finite number of bytes a second > 0, got %g",
+                        o.upload_min_bytes_per_second));
+  }
   if (o.max_concurrent_builds < 1 || o.max_queued_builds < 0 || !(o.failure_ttl_seconds >= 0)) {
     return absl::InvalidArgumentError(
         "--max-concurrent-builds must be >= 1, --max-queued-builds and --failure-ttl >= 0");

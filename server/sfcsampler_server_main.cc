@@ -172,6 +172,11 @@ int main(int argc, char** argv) {
                  "seconds an UploadModel stream may send nothing before it is cut")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  app.add_option("--upload-min-rate", o.upload_min_bytes_per_second,
+                 "bytes a second an UploadModel stream must average once it is "
+                 "--upload-idle-timeout seconds old, or it is cut")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--generation-threads", o.limits.generation_threads,
                  "threads that fill one stream's batches (same samples, same order)")
       ->capture_default_str()

@@ -116,6 +116,64 @@ TEST(ServerModels, IdleUploadsHoldTheirDeclaredSizeOnlyUntilCut) {
   EXPECT_EQ(r.server->models().stats().models, 1u);
 }
 
+// A client that sends a few bytes just before every idle cut keeps its
+// declared size only until it falls below the minimum rate: it gets
+// DEADLINE_EXCEEDED saying so, and the budget it held comes back. A client
+// that sends at the rate is not cut.
+TEST(ServerModels, ATricklingUploadIsCutAtTheMinimumRate) {
+  ServerOptions options = LoopbackOptions();
+  options.max_model_bytes = 100000;
+  options.upload_idle_timeout_seconds = 0.6;
+  options.upload_min_bytes_per_second = 2000;
+  Running r = StartServer(options);
+  auto channel = grpc::CreateChannel("127.0.0.1:" + std::to_string(r.server->port()),
+                                     grpc::InsecureChannelCredentials());
+  auto stub = v1::Sampler::NewStub(channel);
+  const auto upload = [&](int bytes_a_chunk) {
+    grpc::ClientContext context;
+    // Bounds the test should the server never cut it.
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+    v1::ModelInfo info;
+    auto writer = stub->UploadModel(&context, &info);
+    const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    std::string rest = obj + std::string(3000 - obj.size(), '\n');  // a valid OBJ of 3 000 bytes
+    v1::ModelChunk chunk;
+    chunk.set_format("obj");
+    chunk.set_total_bytes(rest.size());
+    // A chunk every 0.25 s: each gap well inside the idle timeout.
+    for (bool first = true; !rest.empty(); first = false) {
+      if (!first) std::this_thread::sleep_for(std::chrono::milliseconds(250));
+      const size_t n = std::min<size_t>(bytes_a_chunk, rest.size());
+      chunk.set_data(rest.substr(0, n));
+      rest.erase(0, n);
+      if (!writer->Write(chunk)) break;
+      chunk.clear_format();
+      chunk.clear_total_bytes();
+    }
+    writer->WritesDone();
+    return writer->Finish();
+  };
+  // 8 bytes every 0.25 s: 32 bytes a second.
+  const auto start = std::chrono::steady_clock::now();
+  const grpc::Status slow = upload(8);
+  EXPECT_EQ(slow.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED) << slow.error_message();
+  EXPECT_NE(slow.error_message().find("upload_min_rate"), std::string::npos)
+      << slow.error_message();
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
+  const auto freed_by = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  while (r.server->models().stats().upload_bytes != 0 &&
+         std::chrono::steady_clock::now() < freed_by) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  EXPECT_EQ(r.server->models().stats().upload_bytes, 0u);
+  EXPECT_EQ(r.server->models().stats().models, 0u);
+  // 500 bytes every 0.25 s, twice the minimum rate, for longer than the
+  // idle timeout: stored.
+  const grpc::Status fast = upload(500);
+  EXPECT_TRUE(fast.ok()) << fast.error_message();
+  EXPECT_EQ(r.server->models().stats().models, 1u);
+}
+
 // A 100 000-digit index: the real INVALID_ARGUMENT arrives (not the
 // client's RESOURCE_EXHAUSTED about header size), under 1 KB, the token
 // clipped.

@@ -799,15 +799,21 @@ TEST(Server, TimeoutsMustBeFiniteAndPositive) {
     upload.upload_idle_timeout_seconds = bad;
     ExpectStatus(SamplerServer::Start(upload).status(), absl::StatusCode::kInvalidArgument,
                  "--upload-idle-timeout must be a finite number of seconds > 0");
+    ServerOptions rate = LoopbackOptions();
+    rate.upload_min_bytes_per_second = bad;
+    ExpectStatus(SamplerServer::Start(rate).status(), absl::StatusCode::kInvalidArgument,
+                 "--upload-min-rate must be a finite number of bytes a second > 0");
   }
   ServerOptions options = LoopbackOptions();
   options.write_timeout_seconds = 7.5;
   options.upload_idle_timeout_seconds = 0.25;
+  options.upload_min_bytes_per_second = 1234.5;
   Running r = StartServer(options);
   auto stats = r.client->GetCacheStats();
   ASSERT_TRUE(stats.ok()) << stats.status();
   EXPECT_EQ(stats->write_timeout_seconds(), 7.5);
   EXPECT_EQ(stats->upload_idle_timeout_seconds(), 0.25);
+  EXPECT_EQ(stats->upload_min_bytes_per_second(), 1234.5);
 }
 
 // With any pipeline depth (0: none): the producer stops at the full queue,
