@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Sobol's CPU against jittered's (issue 36's "within 2x"), alternating rounds in one run.
 
-For each surface and vector path (the default, then `SFCSAMPLER_VECTOR_PATH=avx`, what an AVX2
+For each surface and vector path (the default, then `SFCSAMPLER_VECTOR_PATH=avx2`, what an AVX2
 machine runs), the in-process CLI writes 10^6 samples as NPY to /dev/null, sobol then jittered,
 --rounds times; CPU is user + sys of each child process. Prints medians and ranges.
 
@@ -37,10 +37,10 @@ def main():
     print("| surface | path | sobol CPU, median (range) | jittered CPU | sobol / jittered |")
     print("|---|---|---:|---:|---:|")
     for surface in args.surfaces:
-        for path in ("default", "avx"):
+        for path in ("default", "avx2"):
             env = dict(os.environ)
-            if path == "avx":
-                env["SFCSAMPLER_VECTOR_PATH"] = "avx"
+            if path != "default":
+                env["SFCSAMPLER_VECTOR_PATH"] = path
             times = {"sobol": [], "jittered": []}
             for _ in range(args.rounds):
                 for sequence in times:

@@ -27,7 +27,7 @@ noisy machine's load hits both sides alike):
 11. Two threads against one (core_benchmark's BM_SampleFromBuiltTreeThreads).
 12. sample_many of 1 000 small meshes against a loop over Open3D
     (bench/many_meshes.py).
---quick runs rows 1-3 and 8-11 only. The CPU's vector path (SSE2/AVX/AVX-512) is
+--quick runs rows 1-3 and 8-11 only. The CPU's vector path (SSE2/AVX/AVX2/AVX-512F) is
 printed first; the bytes never depend on it.
 """
 

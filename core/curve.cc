@@ -174,11 +174,10 @@ Curve::Curve(const Definition& def)
 void Curve::DescendMany(const uint64_t* digits, int levels, size_t n, uint64_t* states, uint64_t* x,
                         uint64_t* y) const {
   if (bit_parallel_ && levels <= 32) {
-    static const bool avx2 = __builtin_cpu_supports("avx2");
     const math::VectorPath path = math::BestVectorPath();
     if (path == math::VectorPath::kAvx512) {
       hilbert_batch::DescendAvx512(batch_masks_, digits, levels, n, states, x, y);
-    } else if (path == math::VectorPath::kAvx && avx2) {
+    } else if (path == math::VectorPath::kAvx2) {
       hilbert_batch::DescendAvx2(batch_masks_, digits, levels, n, states, x, y);
     } else {
       hilbert_batch::Descend(batch_masks_, digits, levels, n, states, x, y);

@@ -93,8 +93,8 @@ class Curve {
   // Descend for n digit strings of `levels` levels each: states[i] is the
   // start orientation of string i on entry and its end orientation on return.
   // The Hilbert curve's strings are decoded as a batch, vectorised where the
-  // vector path of core/vector_math.h is AVX-512F, or AVX on a CPU with AVX2,
-  // with Descend's bits.
+  // vector path of core/vector_math.h is AVX-512F or AVX2, with Descend's
+  // bits.
   void DescendMany(const uint64_t* digits, int levels, size_t n, uint64_t* states, uint64_t* x,
                    uint64_t* y) const;
 

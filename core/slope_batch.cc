@@ -6,7 +6,7 @@ namespace sfc::slope_batch {
 
 void FollowSlopes(double* c, const double* p, const double* q, size_t n, bool exact_inverse,
                   double cells, double inverse) {
-  static const math::VectorPath path = math::BestVectorPath();
+  static const math::VectorPath path = math::WithoutAvx2(math::BestVectorPath());
   if (path == math::VectorPath::kAvx512) {
     return FollowSlopesAvx512(c, p, q, n, exact_inverse, cells, inverse);
   }

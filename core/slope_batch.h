@@ -3,7 +3,8 @@
 // (+ - * / sqrt and comparisons; the build has -ffp-contract=off), so every
 // instruction set gives the scalar code's bits. slope_batch_avx.cc and
 // slope_batch_avx512.cc build it for AVX and AVX-512F; FollowSlopes
-// dispatches on math::BestVectorPath().
+// dispatches on math::BestVectorPath() (its AVX build on the AVX2 path:
+// math::WithoutAvx2).
 #ifndef SFCSAMPLER_CORE_SLOPE_BATCH_H_
 #define SFCSAMPLER_CORE_SLOPE_BATCH_H_
 

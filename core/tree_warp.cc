@@ -129,7 +129,7 @@ void InvertCdfs(size_t n, const uint8_t* lanes, const double (*p)[3], const doub
     tree_warp_internal::InvertCdfsAvx512(n, lanes, p, share, out);
     return;
   }
-  if (tree_warp_internal::RunsAvx2(path)) {
+  if (path == math::VectorPath::kAvx2) {
     tree_warp_internal::InvertCdfsAvx2(n, lanes, p, share, out);
     return;
   }
@@ -330,7 +330,7 @@ void TreeWarp::LocateMany(size_t n, const double* a_in, const double* b_in, Curv
       if (path == math::VectorPath::kAvx512) {
         vectored = tree_warp_internal::DescendGrid2Avx512(m, a, b, ref, state, splits_.data(),
                                                           children_.data(), state_at_.data());
-      } else if (tree_warp_internal::RunsAvx2(path)) {
+      } else if (path == math::VectorPath::kAvx2) {
         vectored = tree_warp_internal::DescendGrid2Avx2(m, a, b, ref, state, splits_.data(),
                                                         children_.data(), state_at_.data());
       }
@@ -480,7 +480,7 @@ void TreeWarp::DigitsInLeaf(size_t m, const double* x, const double* y, const ui
         m, x, y, state, cells, top, chunks, head, child_at_.data(), state_at_.data(),
         encode_.data(), digits);
     x += vectored, y += vectored, state += vectored, digits += vectored, m -= vectored;
-  } else if (grid_ == 2 && tree_warp_internal::RunsAvx2(path)) {
+  } else if (grid_ == 2 && path == math::VectorPath::kAvx2) {
     const size_t vectored = tree_warp_internal::DigitsGrid2Avx2(
         m, x, y, state, cells, top, chunks, head, child_at_.data(), state_at_.data(),
         encode_.data(), digits);

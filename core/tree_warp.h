@@ -62,7 +62,7 @@ class TreeWarp {
   // the tree a level at a time together, so their chains of dependent loads
   // overlap instead of following one another.
   // On the AVX-512F vector path (`path`, for tests) a Hilbert tree's points
-  // descend eight lanes to a vector, on the AVX path of a CPU with AVX2 four
+  // descend eight lanes to a vector, on the AVX2 path four
   // (the leaves' digits and inverse CDFs likewise), with the same bits.
   void LocateMany(size_t n, const double* a, const double* b, CurveAddress* out,
                   math::VectorPath path = math::BestVectorPath()) const;

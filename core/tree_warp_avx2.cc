@@ -2,7 +2,7 @@
 // of TreeWarp (core/tree_warp_internal.h), four lanes to a vector, each lane
 // the scalar code's IEEE operations and integer look-ups in
 // core/tree_warp.cc, so their bits are the scalar path's. Run only on the
-// kAvx vector path of a CPU with AVX2 (tree_warp_internal::RunsAvx2).
+// kAvx2 vector path.
 #include <immintrin.h>
 
 #include <algorithm>

@@ -1,8 +1,8 @@
 // The vector paths of TreeWarp (core/tree_warp.h): AVX-512F, built apart with
 // -mavx512f in core/tree_warp_avx512.cc, which TreeWarp calls only on the
 // kAvx512 vector path (math::BestVectorPath()); AVX2, built with -mavx2 in
-// core/tree_warp_avx2.cc, called only on the kAvx path of a CPU with AVX2
-// (RunsAvx2). Each gives the bits of the scalar code in core/tree_warp.cc.
+// core/tree_warp_avx2.cc, called only on the kAvx2 path. Each gives the bits
+// of the scalar code in core/tree_warp.cc (which the other paths run).
 // Not for use outside TreeWarp.
 #ifndef SFCSAMPLER_CORE_TREE_WARP_INTERNAL_H_
 #define SFCSAMPLER_CORE_TREE_WARP_INTERNAL_H_
@@ -48,13 +48,6 @@ size_t DigitsGrid2Avx2(size_t m, const double* x, const double* y, const uint8_t
                        const int32_t* state_at, const uint64_t* encode, uint64_t* digits);
 void InvertCdfsAvx2(size_t n, const uint8_t* lanes, const double (*p)[3], const double* share,
                     double* out);
-
-// Whether `path` takes the AVX2 functions: the kAvx path on a CPU with AVX2
-// (what such a CPU runs unless it has AVX-512F).
-inline bool RunsAvx2(math::VectorPath path) {
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  return path == math::VectorPath::kAvx && avx2;
-}
 
 }  // namespace sfc::tree_warp_internal
 

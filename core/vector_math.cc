@@ -9,23 +9,24 @@ namespace sfc::math {
 namespace {
 
 VectorPath Widest() {
-  __builtin_cpu_init();
-  if (__builtin_cpu_supports("avx512f")) return VectorPath::kAvx512;
-  if (__builtin_cpu_supports("avx")) return VectorPath::kAvx;
-  return VectorPath::kSse2;  // every x86-64 CPU
-}
-
-// The widest path, or a narrower one named by SFCSAMPLER_VECTOR_PATH (for
-// checking that every path gives the same bytes end to end).
-VectorPath Detect() {
-  const VectorPath widest = Widest();
-  const char* name = std::getenv("SFCSAMPLER_VECTOR_PATH");
-  if (name == nullptr) return widest;
-  for (VectorPath path : {VectorPath::kScalar, VectorPath::kSse2, VectorPath::kAvx}) {
-    if (VectorPathName(path) == name && static_cast<int>(path) <= static_cast<int>(widest))
-      return path;
+  VectorPath widest = VectorPath::kScalar;
+  for (VectorPath path : kVectorPaths) {
+    if (Runs(path)) widest = path;
   }
   return widest;
+}
+
+// The widest path, or another one this CPU runs named by
+// SFCSAMPLER_VECTOR_PATH (for checking that every path gives the same bytes
+// end to end).
+VectorPath Detect() {
+  const char* name = std::getenv("SFCSAMPLER_VECTOR_PATH");
+  if (name != nullptr) {
+    for (VectorPath path : kVectorPaths) {
+      if (VectorPathName(path) == name && Runs(path)) return path;
+    }
+  }
+  return Widest();
 }
 
 // Whole vectors of `width` by `body`(x, n, s, c); a tail of two or more
@@ -74,6 +75,18 @@ void CbrtSse2(const double* x, size_t n, double* out) {
     _mm_storeu_pd(out + i, Sleef_cinz_cbrtd2_u35sse2(_mm_loadu_pd(x + i)));
 }
 
+// A batch function on `path`: its scalar reference `scalar`(), or its SSE2,
+// AVX or AVX-512F loop by Batched; kAvx2 runs the AVX loop (WithoutAvx2).
+template <typename Scalar, typename Body, typename One>
+void OnPath(VectorPath path, const double* x, size_t n, double* s, double* c, Scalar scalar,
+            Body sse2, Body avx, Body avx512, One one) {
+  const VectorPath built = WithoutAvx2(path);
+  if (built == VectorPath::kScalar) return scalar();
+  if (built == VectorPath::kSse2) return Batched(x, n, s, c, 2, sse2, one);
+  if (built == VectorPath::kAvx) return Batched(x, n, s, c, 4, avx, one);
+  Batched(x, n, s, c, 8, avx512, one);
+}
+
 }  // namespace
 
 // One value through lane 0 of the SSE2 functions: ~20% faster than SLEEF's
@@ -118,33 +131,37 @@ std::string_view VectorPathName(VectorPath path) {
     case VectorPath::kScalar: return "scalar";
     case VectorPath::kSse2: return "sse2";
     case VectorPath::kAvx: return "avx";
+    case VectorPath::kAvx2: return "avx2";
     case VectorPath::kAvx512: return "avx512f";
   }
   return "?";
 }
 
 bool Runs(VectorPath path) {
-  static const VectorPath widest = Widest();
-  return static_cast<int>(path) <= static_cast<int>(widest);
+  __builtin_cpu_init();
+  switch (path) {
+    case VectorPath::kScalar:
+    case VectorPath::kSse2: return true;  // every x86-64 CPU
+    case VectorPath::kAvx: return __builtin_cpu_supports("avx");
+    case VectorPath::kAvx2: return __builtin_cpu_supports("avx2");
+    case VectorPath::kAvx512: return __builtin_cpu_supports("avx512f");
+  }
+  return false;
 }
 
 void SinCosPiOn(VectorPath path, const double* x, size_t n, double* s, double* c) {
+  auto scalar = [&] {  // SLEEF's portable C: the reference
+    for (size_t i = 0; i < n; ++i) {
+      const Sleef_double_2 r = Sleef_cinz_sincospid1_u35purec(x[i]);
+      s[i] = r.x, c[i] = r.y;
+    }
+  };
   auto one = [](double x, double* s, double* c) {
     const SinCos r = SinCosPi(x);
     *s = r.sin, *c = r.cos;
   };
-  switch (path) {
-    case VectorPath::kScalar:  // SLEEF's portable C: the reference
-      for (size_t i = 0; i < n; ++i) {
-        const Sleef_double_2 r = Sleef_cinz_sincospid1_u35purec(x[i]);
-        s[i] = r.x, c[i] = r.y;
-      }
-      return;
-    case VectorPath::kSse2: return Batched(x, n, s, c, 2, SinCosPiSse2, one);
-    case VectorPath::kAvx: return Batched(x, n, s, c, 4, vector_math_internal::SinCosPiAvx, one);
-    case VectorPath::kAvx512:
-      return Batched(x, n, s, c, 8, vector_math_internal::SinCosPiAvx512, one);
-  }
+  OnPath(path, x, n, s, c, scalar, SinCosPiSse2, vector_math_internal::SinCosPiAvx,
+         vector_math_internal::SinCosPiAvx512, one);
 }
 
 void SinCosPi(const double* x, size_t n, double* s, double* c) {
@@ -152,22 +169,18 @@ void SinCosPi(const double* x, size_t n, double* s, double* c) {
 }
 
 void SinCosOfOn(VectorPath path, const double* x, size_t n, double* s, double* c) {
+  auto scalar = [&] {
+    for (size_t i = 0; i < n; ++i) {
+      const Sleef_double_2 r = Sleef_cinz_sincosd1_u10purec(x[i]);
+      s[i] = r.x, c[i] = r.y;
+    }
+  };
   auto one = [](double x, double* s, double* c) {
     const SinCos r = SinCosOf(x);
     *s = r.sin, *c = r.cos;
   };
-  switch (path) {
-    case VectorPath::kScalar:
-      for (size_t i = 0; i < n; ++i) {
-        const Sleef_double_2 r = Sleef_cinz_sincosd1_u10purec(x[i]);
-        s[i] = r.x, c[i] = r.y;
-      }
-      return;
-    case VectorPath::kSse2: return Batched(x, n, s, c, 2, SinCosOfSse2, one);
-    case VectorPath::kAvx: return Batched(x, n, s, c, 4, vector_math_internal::SinCosOfAvx, one);
-    case VectorPath::kAvx512:
-      return Batched(x, n, s, c, 8, vector_math_internal::SinCosOfAvx512, one);
-  }
+  OnPath(path, x, n, s, c, scalar, SinCosOfSse2, vector_math_internal::SinCosOfAvx,
+         vector_math_internal::SinCosOfAvx512, one);
 }
 
 void SinCosOf(const double* x, size_t n, double* s, double* c) {
@@ -175,20 +188,15 @@ void SinCosOf(const double* x, size_t n, double* s, double* c) {
 }
 
 void PowOn(VectorPath path, const double* x, double y, size_t n, double* out) {
+  auto scalar = [&] {
+    for (size_t i = 0; i < n; ++i) out[i] = Sleef_cinz_powd1_u10purec(x[i], y);
+  };
   auto one = [y](double x, double* r, double*) { *r = Pow(x, y); };
   auto with = [y](void (*body)(const double*, double, size_t, double*)) {
     return [y, body](const double* x, size_t n, double* r, double*) { body(x, y, n, r); };
   };
-  switch (path) {
-    case VectorPath::kScalar:
-      for (size_t i = 0; i < n; ++i) out[i] = Sleef_cinz_powd1_u10purec(x[i], y);
-      return;
-    case VectorPath::kSse2: return Batched(x, n, out, nullptr, 2, with(PowSse2), one);
-    case VectorPath::kAvx:
-      return Batched(x, n, out, nullptr, 4, with(vector_math_internal::PowAvx), one);
-    case VectorPath::kAvx512:
-      return Batched(x, n, out, nullptr, 8, with(vector_math_internal::PowAvx512), one);
-  }
+  OnPath(path, x, n, out, nullptr, scalar, with(PowSse2), with(vector_math_internal::PowAvx),
+         with(vector_math_internal::PowAvx512), one);
 }
 
 void Pow(const double* x, double y, size_t n, double* out) {
@@ -196,20 +204,15 @@ void Pow(const double* x, double y, size_t n, double* out) {
 }
 
 void CbrtOn(VectorPath path, const double* x, size_t n, double* out) {
+  auto scalar = [&] {
+    for (size_t i = 0; i < n; ++i) out[i] = Sleef_cinz_cbrtd1_u35purec(x[i]);
+  };
   auto one = [](double x, double* r, double*) { *r = Cbrt(x); };
   auto with = [](void (*body)(const double*, size_t, double*)) {
     return [body](const double* x, size_t n, double* r, double*) { body(x, n, r); };
   };
-  switch (path) {
-    case VectorPath::kScalar:
-      for (size_t i = 0; i < n; ++i) out[i] = Sleef_cinz_cbrtd1_u35purec(x[i]);
-      return;
-    case VectorPath::kSse2: return Batched(x, n, out, nullptr, 2, with(CbrtSse2), one);
-    case VectorPath::kAvx:
-      return Batched(x, n, out, nullptr, 4, with(vector_math_internal::CbrtAvx), one);
-    case VectorPath::kAvx512:
-      return Batched(x, n, out, nullptr, 8, with(vector_math_internal::CbrtAvx512), one);
-  }
+  OnPath(path, x, n, out, nullptr, scalar, with(CbrtSse2), with(vector_math_internal::CbrtAvx),
+         with(vector_math_internal::CbrtAvx512), one);
 }
 
 void Cbrt(const double* x, size_t n, double* out) { CbrtOn(BestVectorPath(), x, n, out); }

@@ -4,7 +4,7 @@
 // sin, cos and pow on machines that have FMA) nor the vector width.
 //
 // Each batch function is dispatched once per process to the widest vector
-// path the CPU offers (SSE2, AVX, AVX-512F). Every path, and the scalar
+// path the CPU offers (SSE2, AVX, AVX2, AVX-512F). Every path, and the scalar
 // reference each batch function has, returns the same bits: SLEEF makes the
 // cinz functions alike across instruction sets, and tests/vector_math_test.cc
 // checks it bit for bit on the paths this machine has.
@@ -62,15 +62,31 @@ double Asinh(double x);
 double Acosh(double x);
 double Atanh(double x);
 
-// The vector paths, for tests and benchmarks.
-enum class VectorPath { kScalar, kSse2, kAvx, kAvx512 };
-// The path the batch functions use: the widest this CPU runs, or a narrower
-// one (scalar, sse2, avx) named by the environment variable
-// SFCSAMPLER_VECTOR_PATH, read once.
+// The vector paths, for tests and benchmarks, narrowest first. kAvx2 is kAvx
+// and AVX2's 256-bit integer lanes and gathers: the loops that use them have
+// builds of their own for it (core/curve_avx2.cc, core/tree_warp_avx2.cc,
+// mesh/mesh_warp_avx2.cc), and kAvx runs the plain AVX builds (what an
+// AVX-only CPU runs) on any CPU.
+enum class VectorPath { kScalar, kSse2, kAvx, kAvx2, kAvx512 };
+// Every path, narrowest first: the lists that tests and dispatch walk.
+inline constexpr VectorPath kVectorPaths[] = {VectorPath::kScalar, VectorPath::kSse2,
+                                              VectorPath::kAvx, VectorPath::kAvx2,
+                                              VectorPath::kAvx512};
+// The path the batch functions use: the widest this CPU runs, or another one
+// it runs (scalar, sse2, avx, avx2, avx512f) named by the environment
+// variable SFCSAMPLER_VECTOR_PATH, read once.
 VectorPath BestVectorPath();
+// "scalar", "sse2", "avx", "avx2" or "avx512f".
 std::string_view VectorPathName(VectorPath path);
-// Whether this CPU runs `path`.
+// Whether this CPU runs `path` (its instruction set, by CPUID).
 bool Runs(VectorPath path);
+// The path whose build a function with no build of its own for AVX2 runs
+// (the elementary functions here, core/slope_batch.h): kAvx for kAvx2 (their
+// floating-point loops have nothing to gain from AVX2), `path` otherwise.
+// The one place that maps kAvx2 onto kAvx.
+constexpr VectorPath WithoutAvx2(VectorPath path) {
+  return path == VectorPath::kAvx2 ? VectorPath::kAvx : path;
+}
 // SinCosPi over a batch on one given path. REQUIRES: Runs(path).
 void SinCosPiOn(VectorPath path, const double* x, size_t n, double* s, double* c);
 // SinCosOf, Pow and Cbrt over a batch on one given path. REQUIRES: Runs(path).

@@ -14,13 +14,6 @@ namespace {
 using mesh_warp_lanes::kBelowOne;
 using mesh_warp_lanes::Spread;
 
-// Whether `path` takes the AVX2 builds of the batch loops: the kAvx path on a
-// CPU with AVX2 (what such a CPU runs unless it has AVX-512F).
-bool RunsAvx2(math::VectorPath path) {
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  return path == math::VectorPath::kAvx && avx2;
-}
-
 // Halvings past the depth at which nodes hold one leaf's mass on average
 // before a node that still straddles leaves is split by mass: the straddling
 // nodes' share of the error falls as 2^-kExtraDepth of the leaf level's.
@@ -253,7 +246,6 @@ void MeshWarp::LocateMany(size_t n, const double* a, const double* b, CurveAddre
   const mesh_warp_lanes::LeafTables tables{tree_.mass_ends().data(), bucket_leaves_.data(),
                                            tree_.total_mass(), max_depth_, bucket_bits_};
   using math::VectorPath;
-  const bool avx2 = RunsAvx2(path);
   for (size_t i0 = 0; i0 < n; i0 += kBatch) {
     const size_t m = std::min(kBatch, n - i0);
     if (path == math::VectorPath::kScalar) {
@@ -266,7 +258,7 @@ void MeshWarp::LocateMany(size_t n, const double* a, const double* b, CurveAddre
     } else {
       if (path == VectorPath::kAvx512) {
         mesh_warp_lanes::LeafSharesAvx512(tables, m, a + i0, b + i0, leaf, f, g, across);
-      } else if (avx2) {
+      } else if (path == VectorPath::kAvx2) {
         mesh_warp_lanes::LeafSharesAvx2(tables, m, a + i0, b + i0, leaf, f, g, across);
       } else if (path == VectorPath::kAvx) {
         mesh_warp_lanes::LeafSharesAvx(tables, m, a + i0, b + i0, leaf, f, g, across);
@@ -276,7 +268,7 @@ void MeshWarp::LocateMany(size_t n, const double* a, const double* b, CurveAddre
       if (uniform_density_) {
         if (path == VectorPath::kAvx512) {
           mesh_warp_lanes::PlaceUniformAvx512(m, f, g, pa, pb);
-        } else if (avx2) {
+        } else if (path == VectorPath::kAvx2) {
           mesh_warp_lanes::PlaceUniformAvx2(m, f, g, pa, pb);
         } else if (path == VectorPath::kAvx) {
           mesh_warp_lanes::PlaceUniformAvx(m, f, g, pa, pb);
@@ -309,7 +301,7 @@ void MeshWarp::PathsOf(size_t n, const double* pa, const double* pb, uint64_t* p
     for (size_t i = 0; i < n; ++i) paths[i] = MeshCurveTree::PathOf(pa[i], pb[i]);
   } else if (path == math::VectorPath::kAvx512) {
     mesh_warp_lanes::PathsOfAvx512(n, pa, pb, paths);
-  } else if (RunsAvx2(path)) {
+  } else if (path == math::VectorPath::kAvx2) {
     mesh_warp_lanes::PathsOfAvx2(n, pa, pb, paths);
   } else if (path == math::VectorPath::kAvx) {
     mesh_warp_lanes::PathsOfAvx(n, pa, pb, paths);

@@ -55,8 +55,8 @@ class MeshWarp {
   // out[i] = Locate(a[i], b[i]) for i < n, bit for bit on every vector path
   // (REQUIRES: math::Runs(path)): the leaf searches, the placement in
   // uniform cells and the bisections below the leaves (PathsOf) run over the
-  // batch 8 lanes at a time on AVX-512F, 4 on AVX (AVX2's integer lanes and
-  // gathers where the CPU has them), 2 on the baseline's SSE2
+  // batch 8 lanes at a time on AVX-512F, 4 on AVX2 (integer lanes and
+  // gathers) and on AVX, 2 on the baseline's SSE2
   // (mesh/mesh_warp_lanes.h); kScalar is the reference, one point at a time.
   void LocateMany(size_t n, const double* a, const double* b, CurveAddress* out,
                   math::VectorPath path = math::BestVectorPath()) const;

@@ -3,9 +3,9 @@
 // order (comparisons and selects for its branches and clamps; the build has
 // -ffp-contract=off), so every instruction set gives the scalar code's bits.
 // mesh_warp.cc builds them for the baseline (SSE2), mesh_warp_avx.cc for AVX,
-// mesh_warp_avx2.cc for AVX2 (the kAvx path of a CPU with AVX2: 256-bit
-// integer lanes and gathers) and mesh_warp_avx512.cc for AVX-512F; MeshWarp
-// dispatches on math::BestVectorPath(). Internal linkage (an anonymous namespace) on
+// mesh_warp_avx2.cc for AVX2 (the kAvx2 path: 256-bit integer lanes and
+// gathers) and mesh_warp_avx512.cc for AVX-512F; MeshWarp dispatches on
+// math::BestVectorPath(). Internal linkage (an anonymous namespace) on
 // purpose: each of the four files keeps its own copy, compiled for its
 // instruction set, which the linker never merges (nm shows none of the wider
 // builds' objects exporting a weak symbol the baseline could pick up).

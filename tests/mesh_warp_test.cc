@@ -10,7 +10,6 @@
 #include <cstring>
 #include <memory>
 #include <random>
-#include <tuple>
 #include <vector>
 
 #include "core/vector_math.h"
@@ -19,13 +18,9 @@
 #include "mesh/mesh_curve_tree.h"
 #include "mesh/mesh_density.h"
 #include "mesh/mesh_surface.h"
-#include "mesh/mesh_warp_lanes.h"
 
 namespace sfc {
 namespace {
-
-constexpr math::VectorPath kPaths[] = {math::VectorPath::kScalar, math::VectorPath::kSse2,
-                                       math::VectorPath::kAvx, math::VectorPath::kAvx512};
 
 TEST(MeshWarp, PathsOfIsPathOfOnEveryVectorPath) {
   std::mt19937_64 rng(36);
@@ -57,7 +52,7 @@ TEST(MeshWarp, PathsOfIsPathOfOnEveryVectorPath) {
   }
   std::vector<uint64_t> expected(pa.size());
   for (size_t i = 0; i < pa.size(); ++i) expected[i] = MeshCurveTree::PathOf(pa[i], pb[i]);
-  for (math::VectorPath path : kPaths) {
+  for (math::VectorPath path : math::kVectorPaths) {
     if (!math::Runs(path)) continue;
     for (size_t n : {size_t{1}, size_t{31}, pa.size()}) {
       std::vector<uint64_t> got(n);
@@ -65,21 +60,6 @@ TEST(MeshWarp, PathsOfIsPathOfOnEveryVectorPath) {
       for (size_t i = 0; i < n; ++i) {
         ASSERT_EQ(got[i], expected[i]) << math::VectorPathName(path) << " point " << i;
       }
-    }
-  }
-  // The AVX and AVX2 builds one by one (the kAvx path runs the AVX2 build on
-  // a CPU with AVX2, so the AVX build is checked here directly).
-  using Build = void (*)(size_t, const double*, const double*, uint64_t*);
-  for (const auto& [name, build, runs] :
-       {std::tuple<const char*, Build, bool>{"avx", mesh_warp_lanes::PathsOfAvx,
-                                             __builtin_cpu_supports("avx")},
-        std::tuple<const char*, Build, bool>{"avx2", mesh_warp_lanes::PathsOfAvx2,
-                                             __builtin_cpu_supports("avx2")}}) {
-    if (!runs) continue;
-    for (size_t n : {size_t{1}, size_t{31}, pa.size()}) {
-      std::vector<uint64_t> got(n);
-      build(n, pa.data(), pb.data(), got.data());
-      for (size_t i = 0; i < n; ++i) ASSERT_EQ(got[i], expected[i]) << name << " point " << i;
     }
   }
 }
@@ -112,7 +92,7 @@ TEST(MeshWarp, LocateManyIsTheScalarLocateOnEveryVectorPath) {
     const MeshWarp warp(**tree);
     std::vector<CurveAddress> expected(a.size());
     warp.LocateMany(a.size(), a.data(), b.data(), expected.data(), math::VectorPath::kScalar);
-    for (math::VectorPath path : kPaths) {
+    for (math::VectorPath path : math::kVectorPaths) {
       if (!math::Runs(path)) continue;
       for (size_t n : {size_t{1}, size_t{13}, size_t{64}, a.size()}) {
         std::vector<CurveAddress> got(n);

@@ -8,7 +8,8 @@
 # surfaces, a CAD model and a mesh. Lines may repeat a hash with other
 # arguments that must not change the bytes (batch sizes), and every line of
 # kVectorPaths runs again under each narrower vector path the CPU has
-# (SFCSAMPLER_VECTOR_PATH: scalar, sse2, avx) and must give the same hash.
+# (SFCSAMPLER_VECTOR_PATH: scalar, sse2, avx, avx2; one the CPU lacks runs
+# the widest) and must give the same hash.
 # Every line also runs with glibc's CPU dispatch narrowed to a CPU without
 # AVX, AVX2, FMA or AVX-512 (GLIBC_TUNABLES; our own dispatch reads the CPU
 # itself and keeps its path): libm's FMA variants of sin, exp, pow and the
@@ -51,7 +52,7 @@ while read -r expected name rest; do
   checked=$((checked + 1))
   [[ "$got" == "$expected" ]] || { echo "FAIL: $name under $narrow_glibc: $got" >&2; failures=$((failures + 1)); }
   if [[ "$name" == *@paths ]]; then
-    for path in scalar sse2 avx; do
+    for path in scalar sse2 avx avx2; do
       got=$(SFCSAMPLER_VECTOR_PATH=$path hash_of "${args[@]}")
       checked=$((checked + 1))
       [[ "$got" == "$expected" ]] || { echo "FAIL: $name on the $path path: $got" >&2; failures=$((failures + 1)); }

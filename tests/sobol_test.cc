@@ -123,8 +123,7 @@ TEST(SobolSequence, PointsManyIsAtAndSecondOnEveryVectorPath) {
   const Sequence window = whole.Window(0.25, 0.625);
   std::vector<uint32_t> ks;
   for (uint64_t k = 0; k < 1003; ++k) ks.push_back(static_cast<uint32_t>(k * 2654435761u));
-  for (math::VectorPath path : {math::VectorPath::kScalar, math::VectorPath::kSse2,
-                                math::VectorPath::kAvx, math::VectorPath::kAvx512}) {
+  for (math::VectorPath path : math::kVectorPaths) {
     if (!math::Runs(path)) continue;
     for (const Sequence* s : {&whole, &window}) {
       for (bool listed : {false, true}) {
@@ -320,8 +319,7 @@ void LocateManyMatchesScalar(const char* surface, const char* density) {
   }
   std::vector<CurveAddress> expected(a.size());
   warp.LocateMany(a.size(), a.data(), b.data(), expected.data(), math::VectorPath::kScalar);
-  for (math::VectorPath path :
-       {math::VectorPath::kSse2, math::VectorPath::kAvx, math::VectorPath::kAvx512}) {
+  for (math::VectorPath path : math::kVectorPaths) {
     if (!math::Runs(path)) continue;
     for (size_t n : {size_t{1}, size_t{7}, size_t{13}, size_t{64}, size_t{70}, a.size()}) {
       std::vector<CurveAddress> got(n);
@@ -338,8 +336,8 @@ void LocateManyMatchesScalar(const char* surface, const char* density) {
 // The batch descent's vector paths give the scalar path's addresses: on a
 // Hilbert tree with a density (leaves at several depths, so lanes reach
 // their leaves in different rounds) and on the uniform sphere (quadratic
-// leaves throughout: the inverse CDFs' vector code). kAvx on a CPU with AVX2
-// runs core/tree_warp_avx2.cc, kAvx512 core/tree_warp_avx512.cc.
+// leaves throughout: the inverse CDFs' vector code). kAvx2 runs
+// core/tree_warp_avx2.cc, kAvx512 core/tree_warp_avx512.cc.
 TEST(TreeWarp, LocateManyGivesTheSameAddressesOnEveryVectorPath) {
   for (const auto& [surface, density] :
        {std::pair{"monkey_saddle", "gaussian:floor=0.05"}, std::pair{"sphere", "uniform"}}) {

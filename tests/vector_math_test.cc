@@ -6,8 +6,11 @@
 
 #include <cfloat>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <random>
+#include <set>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -36,13 +39,36 @@ bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 // vector code set different sign bits; a sample there is rejected anyway).
 bool SameValue(double a, double b) { return SameBits(a, b) || (std::isnan(a) && std::isnan(b)); }
 
+// Each path is its own instruction set, by CPUID; the default is the widest
+// this CPU runs; kAvx2 takes the AVX builds where a function has no AVX2 one.
+TEST(VectorMath, PathsAreTheCpusInstructionSets) {
+  EXPECT_TRUE(Runs(VectorPath::kScalar) && Runs(VectorPath::kSse2));
+  EXPECT_EQ(Runs(VectorPath::kAvx), __builtin_cpu_supports("avx") != 0);
+  EXPECT_EQ(Runs(VectorPath::kAvx2), __builtin_cpu_supports("avx2") != 0);
+  EXPECT_EQ(Runs(VectorPath::kAvx512), __builtin_cpu_supports("avx512f") != 0);
+  ASSERT_TRUE(Runs(BestVectorPath()));
+  if (std::getenv("SFCSAMPLER_VECTOR_PATH") == nullptr) {
+    for (VectorPath path : kVectorPaths) {
+      if (static_cast<int>(path) > static_cast<int>(BestVectorPath())) {
+        EXPECT_FALSE(Runs(path)) << VectorPathName(path);
+      }
+    }
+  }
+  std::set<std::string_view> names;
+  for (VectorPath path : kVectorPaths) {
+    names.insert(VectorPathName(path));
+    EXPECT_EQ(WithoutAvx2(path), path == VectorPath::kAvx2 ? VectorPath::kAvx : path);
+  }
+  EXPECT_EQ(names, (std::set<std::string_view>{"scalar", "sse2", "avx", "avx2", "avx512f"}));
+}
+
 TEST(VectorMath, EveryPathGivesTheScalarBits) {
   const std::vector<double> x = Arguments();
   std::vector<double> s0(x.size()), c0(x.size());
   SinCosPiOn(VectorPath::kScalar, x.data(), x.size(), s0.data(), c0.data());
   int paths = 0;
-  for (VectorPath path : {VectorPath::kSse2, VectorPath::kAvx, VectorPath::kAvx512}) {
-    if (!Runs(path)) continue;
+  for (VectorPath path : kVectorPaths) {
+    if (path == VectorPath::kScalar || !Runs(path)) continue;
     ++paths;
     for (size_t offset : {0, 1, 3}) {  // unaligned starts and every tail length
       std::vector<double> s(x.size() - offset), c(x.size() - offset);
@@ -68,7 +94,7 @@ TEST(VectorMath, EveryPathGivesTheScalarBits) {
 // start, on every path gives the scalar bits.
 TEST(VectorMath, EveryShortBatchGivesTheScalarBits) {
   const std::vector<double> x = Arguments();
-  for (VectorPath path : {VectorPath::kSse2, VectorPath::kAvx, VectorPath::kAvx512}) {
+  for (VectorPath path : kVectorPaths) {
     if (!Runs(path)) continue;
     for (size_t start = 0; start + 17 < 2000; start += 17) {
       for (size_t n = 1; n <= 17; ++n) {
@@ -103,8 +129,7 @@ TEST(VectorMath, SinCosOfAndPowBatchesGiveTheScalarBits) {
   x.push_back(0);
   x.push_back(INFINITY);
   for (double y : {1.0 / 3, 0.1, 2.5, -2.0 / 3}) {
-    for (VectorPath path :
-         {VectorPath::kScalar, VectorPath::kSse2, VectorPath::kAvx, VectorPath::kAvx512}) {
+    for (VectorPath path : kVectorPaths) {
       if (!Runs(path)) continue;
       for (size_t start : {0, 1, 3}) {
         for (size_t n : {x.size() - start, size_t{1}, size_t{2}, size_t{7}, size_t{13}}) {
@@ -138,8 +163,7 @@ TEST(VectorMath, CbrtBatchesGiveTheScalarBitsAndCubeRoots) {
   x.push_back(0);
   x.push_back(-0.0);
   x.push_back(INFINITY);
-  for (VectorPath path :
-       {VectorPath::kScalar, VectorPath::kSse2, VectorPath::kAvx, VectorPath::kAvx512}) {
+  for (VectorPath path : kVectorPaths) {
     if (!Runs(path)) continue;
     for (size_t start : {0, 1, 3}) {
       for (size_t n : {x.size() - start, size_t{1}, size_t{2}, size_t{7}, size_t{13}}) {
