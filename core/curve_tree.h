@@ -121,6 +121,9 @@ struct PrecisionReport {
   double error_samples = 0;
   // ... and summed over the leaves the tests still wanted to split.
   double unresolved_error_samples = 0;
+  // The hidden-mass bound summed over the leaves, as a share of the total
+  // mass (0 for densities that do not bound themselves).
+  double hidden_share = 0;
   std::vector<DepthCapHit> worst;     // at most kMaxReported, largest measured/limit first
   // At most kMaxReported singular leaves (piecewise or warped), the smallest first.
   std::vector<DepthCapHit> singular;
@@ -177,6 +180,23 @@ class CurveTree {
   // of kEdgeBand of the cell.
   static constexpr double kEdgeJump = 0.05;
   static constexpr double kEdgeBand = 1.0 / 16;
+  // The hidden-mass certificate (docs/ALGORITHM.md, "Features narrower than
+  // the probes"), for densities that bound themselves (Density::Bounds). A
+  // part of a leaf may hide mass where the density's interval upper bound
+  // there exceeds kHiddenFactor times the largest density the leaf's Gauss
+  // nodes saw; the leaf's hidden-mass bound is the sum of those parts'
+  // bounds times their share of the leaf's area.
+  static constexpr double kHiddenFactor = 8;
+  // Stage 1 splits a leaf while its bound exceeds kStage1HiddenShare of the
+  // stage's mass, within kStage1HiddenLeaves leaves added; stage 2 examines
+  // and splits one while its bound is worth kHiddenFloor samples (the rough
+  // floor: a hidden feature is followed as far as a seen one).
+  static constexpr double kStage1HiddenShare = 1.0 / 8192;
+  static constexpr uint64_t kStage1HiddenLeaves = uint64_t{1} << 17;
+  static constexpr double kHiddenFloor = kRoughFloor;
+  // A tree whose leaves' bounds sum to more than kHiddenShare of its mass is
+  // refused (INVALID_ARGUMENT, saying where).
+  static constexpr double kHiddenShare = 1.0 / 1024;
 
   const Curve& curve() const { return *curve_; }
   // The options with tolerance and depth cap resolved to the values used.
@@ -256,6 +276,9 @@ class CurveTree {
   PodArray<uint64_t> starts_;
   PodArray<uint64_t> mass_end_;  // fixed point, units of mass_unit_
   double mass_unit_ = 0;            // base_mass_ / 2^56
+  // The leaves' hidden-mass bounds summed in the same units (saturating), so
+  // a refined tree's sum is a fresh build's to the bit.
+  uint64_t hidden_units_ = 0;
   PodArray<LeafModel> models_;
   PodArray<float> errors_;
   PodArray<uint8_t> info_;  // fail grade | kPiecewiseBit | kRoughParentBit
