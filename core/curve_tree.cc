@@ -340,13 +340,16 @@ class CurveTree::Builder {
           w.u0, w.u0 + w.size, w.v0, w.v0 + w.size, w.depth, hidden_box_[0], hidden_box_[1],
           hidden_box_[2], hidden_box_[3]);
     }
+    const std::string amount = share >= 1
+                                   ? absl::StrFormat("%.3g times the mass it measured", share)
+                                   : absl::StrFormat("%.3g%% of the mass it measured", 100 * share);
     return absl::InvalidArgumentError(absl::StrFormat(
         "the density has features narrower than the curve tree can see: its interval bounds "
-        "allow up to %.3g%% of its mass (more than %.3g%%) in parts of leaves where it may "
-        "exceed %g times every value the leaves' probes saw%s; the samples would miss that "
-        "mass. Widen or smooth the narrow features (or give them a floor within %g times their "
-        "peak), ask for more samples, or raise the depth cap (%d) if the tree reached it",
-        100 * share, 100 * CurveTree::kHiddenShare, CurveTree::kHiddenFactor, where,
+        "allow up to %s (more than %.3g%%) in parts of leaves where it may exceed %g times "
+        "every value the leaves' probes saw%s; the samples would miss that mass. Widen or "
+        "smooth the narrow features (or give them a floor within %g times their peak), ask for "
+        "more samples, or raise the depth cap (%d) if the tree reached it",
+        amount, 100 * CurveTree::kHiddenShare, CurveTree::kHiddenFactor, where,
         CurveTree::kHiddenFactor, options_.depth_cap));
   }
 

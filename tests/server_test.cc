@@ -340,7 +340,6 @@ TEST(Server, ACancelledStreamIsFreedAtOnce) {
   EXPECT_LT(r.server->metrics().samples_streamed(), 1'000'000.0);
 }
 
-
 // A request whose tree takes a minute to build unless stopped: a pole the
 // tree refines towards until the leaf budget of HeavyOptions().
 SampleRequest HeavyBuild(const std::string& pole_at = "0.3") {
@@ -440,6 +439,17 @@ TEST(Server, BuildsBeyondTheQueueAreTurnedAwayAndNamedTheLimit) {
   ASSERT_TRUE(stats.ok());
   EXPECT_EQ(stats->max_concurrent_builds(), 1u);
   EXPECT_EQ(stats->max_queued_builds(), 0u);
+}
+
+TEST(Server, ADensityWithFeaturesTheTreeCannotSeeIsRefusedAsAnInvalidArgument) {
+  // A strip 1e-4 wide between the Gauss nodes of every cell down to the depth
+  // cap (docs/ALGORITHM.md, "Features narrower than the probes").
+  Running r = StartServer(LoopbackOptions());
+  SampleRequest request = Request("plane", 100000);
+  request.tree.density = "expr:0.001+1000*(u>0.30014142135623731)*(u<0.30024142135623731)";
+  request.tree.options.depth_cap = 10;
+  ExpectStatus(Fetch(*r.client, request).status(), absl::StatusCode::kInvalidArgument,
+               "narrower than the curve tree can see");
 }
 
 TEST(Server, AFailedBuildIsRememberedAndNotRepeated) {
@@ -756,8 +766,8 @@ TEST(Server, TheServerDeadlineStopsABlueRelaxationAndFreesItsMemory) {
   Running r = StartServer(options, co);
   WarmTreeOf(*r.client, LongBlueRelaxation());
   const auto start = std::chrono::steady_clock::now();
-  ExpectStatus(Fetch(*r.client, LongBlueRelaxation()).status(),
-               absl::StatusCode::kDeadlineExceeded, "blue-noise set relaxed");
+  ExpectStatus(Fetch(*r.client, LongBlueRelaxation()).status(), absl::StatusCode::kDeadlineExceeded,
+               "blue-noise set relaxed");
   // Promptly: a generous bound, far below the relaxation's own time.
   EXPECT_LT(std::chrono::steady_clock::now() - start, milliseconds(5000));
   EXPECT_EQ(StreamMemoryReserved(*r.client), 0u);
