@@ -159,8 +159,9 @@ class ExpressionSurface final : public Surface {
 
   std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override {
     // The same operations as Point's u0_ + u * du_, on intervals.
-    const Interval uv[2] = {Interval::Point(u0_) + Interval::Of(u0, u1) * Interval::Point(du_),
-                            Interval::Point(v0_) + Interval::Of(v0, v1) * Interval::Point(dv_)};
+    const Interval uv[2] = {
+        Interval::Point(u0_) + Interval::Of(u0, u1) * Interval::Point(du_),
+        Interval::Point(v0_) + Interval::Of(v0, v1) * Interval::Point(dv_)};
     return BoxOf(x_->Evaluate(uv), y_->Evaluate(uv), z_->Evaluate(uv));
   }
 
@@ -234,10 +235,8 @@ const std::vector<CatalogEntry>& SurfaceCatalog() {
        "torus of major radius R and tube radius r",
        {{"R", "1", "major radius, > 0"}, {"r", "0.4", "tube radius, > 0"}}},
       {"monkey_saddle", "f = (s, t, s^3 - 3 s t^2), (s,t) in [-1,1]^2", "the monkey saddle", {}},
-      {"eight",
-       "f = (cos a sin 2b, sin a sin 2b, sin b), a in [0,2pi], b in [-pi/2,pi/2]",
-       "the eight surface",
-       {}},
+      {"eight", "f = (cos a sin 2b, sin a sin 2b, sin b), a in [0,2pi], b in [-pi/2,pi/2]",
+       "the eight surface", {}},
       {"whitney", "f = (s t, s, t^2), (s,t) in [-1,1]^2", "the Whitney umbrella", {}},
       {"superellipsoid",
        "f = (c(a)^e c(b)^e, c(a)^e s(b)^e, s(a)^e), signed powers, a in [-pi/2,pi/2], b in "
@@ -245,8 +244,7 @@ const std::vector<CatalogEntry>& SurfaceCatalog() {
        "superellipsoid (paper Sect. 5.3); reparam=1 applies the power law "
        "angle = (pi/2) s^3/(s^3+(1-s)^3) on each quarter turn",
        {{"e", "1/3", "exponent, > 0"}, {"reparam", "0", "1 = power-law reparameterisation"}}},
-      {"expr",
-       "f = (x(u,v), y(u,v), z(u,v)), (u,v) in [u0,u1] x [v0,v1]",
+      {"expr", "f = (x(u,v), y(u,v), z(u,v)), (u,v) in [u0,u1] x [v0,v1]",
        "user-defined by muparser expressions in u and v",
        {{"x", "", "expression in u, v"},
         {"y", "", "expression in u, v"},
@@ -262,16 +260,11 @@ const std::vector<CatalogEntry>& SurfaceCatalog() {
 const std::vector<CatalogEntry>& DensityCatalog() {
   static const auto* const kEntries = new std::vector<CatalogEntry>{
       {"uniform", "delta = 1", "uniform with respect to surface area", {}},
-      {"gaussian",
-       "delta = max(|K|, floor)",
-       "proportional to |Gaussian curvature|",
+      {"gaussian", "delta = max(|K|, floor)", "proportional to |Gaussian curvature|",
        {{"floor", "0", "lower bound, >= 0, keeps flat regions sampled"}}},
-      {"mean",
-       "delta = max(|H|, floor)",
-       "proportional to |mean curvature|",
+      {"mean", "delta = max(|H|, floor)", "proportional to |mean curvature|",
        {{"floor", "0", "lower bound, >= 0"}}},
-      {"expr",
-       "delta = f(u, v, x, y, z)",
+      {"expr", "delta = f(u, v, x, y, z)",
        "user-defined muparser expression; (u,v) are unit-square parameters, (x,y,z) the point; "
        "written as expr:EXPRESSION",
        {}},

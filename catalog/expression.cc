@@ -49,13 +49,13 @@ enum class Fn : uint8_t {
 };
 
 enum class Op : uint8_t {
-  kConst,      // push a
-  kVar,        // push x = vars[arg]
-  kVarMulAdd,  // push x * a + b (muparser's cmVARMUL)
-  kVarSquare,  // push x * x
-  kVarCube,    // push (x * x) * x
-  kVarFourth,  // push ((x * x) * x) * x
-  kAdd,        // binary operators pop b, then a, and push a op b
+  kConst,       // push a
+  kVar,         // push x = vars[arg]
+  kVarMulAdd,   // push x * a + b (muparser's cmVARMUL)
+  kVarSquare,   // push x * x
+  kVarCube,     // push (x * x) * x
+  kVarFourth,   // push ((x * x) * x) * x
+  kAdd,         // binary operators pop b, then a, and push a op b
   kSub,
   kMul,
   kDiv,
@@ -89,19 +89,19 @@ struct Builtin {
 };
 
 constexpr Builtin kBuiltins[] = {
-    {"sin", Op::kFunc, Fn::kSin, 1},     {"cos", Op::kFunc, Fn::kCos, 1},
-    {"tan", Op::kFunc, Fn::kTan, 1},     {"asin", Op::kFunc, Fn::kAsin, 1},
-    {"acos", Op::kFunc, Fn::kAcos, 1},   {"atan", Op::kFunc, Fn::kAtan, 1},
-    {"atan2", Op::kAtan2, Fn::kNone, 2}, {"sinh", Op::kFunc, Fn::kSinh, 1},
-    {"cosh", Op::kFunc, Fn::kCosh, 1},   {"tanh", Op::kFunc, Fn::kTanh, 1},
-    {"asinh", Op::kFunc, Fn::kAsinh, 1}, {"acosh", Op::kFunc, Fn::kAcosh, 1},
-    {"atanh", Op::kFunc, Fn::kAtanh, 1}, {"log2", Op::kFunc, Fn::kLog2, 1},
-    {"log10", Op::kFunc, Fn::kLog10, 1}, {"log", Op::kFunc, Fn::kLog, 1},
-    {"ln", Op::kFunc, Fn::kLog, 1},      {"exp", Op::kFunc, Fn::kExp, 1},
-    {"sqrt", Op::kFunc, Fn::kSqrt, 1},   {"sign", Op::kFunc, Fn::kSign, 1},
-    {"rint", Op::kFunc, Fn::kRint, 1},   {"abs", Op::kFunc, Fn::kAbs, 1},
-    {"sum", Op::kSum, Fn::kNone, -1},    {"avg", Op::kAvg, Fn::kNone, -1},
-    {"min", Op::kMin, Fn::kNone, -1},    {"max", Op::kMax, Fn::kNone, -1},
+    {"sin", Op::kFunc, Fn::kSin, 1},       {"cos", Op::kFunc, Fn::kCos, 1},
+    {"tan", Op::kFunc, Fn::kTan, 1},       {"asin", Op::kFunc, Fn::kAsin, 1},
+    {"acos", Op::kFunc, Fn::kAcos, 1},     {"atan", Op::kFunc, Fn::kAtan, 1},
+    {"atan2", Op::kAtan2, Fn::kNone, 2},   {"sinh", Op::kFunc, Fn::kSinh, 1},
+    {"cosh", Op::kFunc, Fn::kCosh, 1},     {"tanh", Op::kFunc, Fn::kTanh, 1},
+    {"asinh", Op::kFunc, Fn::kAsinh, 1},   {"acosh", Op::kFunc, Fn::kAcosh, 1},
+    {"atanh", Op::kFunc, Fn::kAtanh, 1},   {"log2", Op::kFunc, Fn::kLog2, 1},
+    {"log10", Op::kFunc, Fn::kLog10, 1},   {"log", Op::kFunc, Fn::kLog, 1},
+    {"ln", Op::kFunc, Fn::kLog, 1},        {"exp", Op::kFunc, Fn::kExp, 1},
+    {"sqrt", Op::kFunc, Fn::kSqrt, 1},     {"sign", Op::kFunc, Fn::kSign, 1},
+    {"rint", Op::kFunc, Fn::kRint, 1},     {"abs", Op::kFunc, Fn::kAbs, 1},
+    {"sum", Op::kSum, Fn::kNone, -1},      {"avg", Op::kAvg, Fn::kNone, -1},
+    {"min", Op::kMin, Fn::kNone, -1},      {"max", Op::kMax, Fn::kNone, -1},
 };
 
 // ---- Plain-double semantics; the dual numbers' values use the same calls.
@@ -467,7 +467,7 @@ void ExecuteMany(const std::vector<Instruction>& code, const double* const* vars
   int sp = -1;
   double s[kBatch], c[kBatch], args[kMaxStack];
   for (const Instruction& in : code) {
-    double* top = st[sp + 1];                    // a pushed column
+    double* top = st[sp + 1];  // a pushed column
     double* a = sp >= 1 ? st[sp - 1] : nullptr;  // a binary operator's columns
     const double* b = sp >= 0 ? st[sp] : nullptr;
     // A binary operator: a[i] = f(a[i], b[i]), then one column fewer.
@@ -784,9 +784,9 @@ absl::StatusOr<std::unique_ptr<Expression>> Expression::Compile(
     parser.SetExpr(text);
     parser.Eval();  // parses now, so syntax errors surface here
     if (parser.GetNumResults() != 1) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("%s: \"%s\" has %d comma-separated results; give a single expression",
-                          what, text, parser.GetNumResults()));
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "%s: \"%s\" has %d comma-separated results; give a single expression", what, text,
+          parser.GetNumResults()));
     }
   } catch (const mu::Parser::exception_type& e) {
     return ParserError(what, text, e);

@@ -124,7 +124,7 @@ struct PrecisionReport {
   // The hidden-mass bound summed over the leaves, as a share of the total
   // mass (0 for densities that do not bound themselves).
   double hidden_share = 0;
-  std::vector<DepthCapHit> worst;  // at most kMaxReported, largest measured/limit first
+  std::vector<DepthCapHit> worst;     // at most kMaxReported, largest measured/limit first
   // At most kMaxReported singular leaves (piecewise or warped), the smallest first.
   std::vector<DepthCapHit> singular;
   static constexpr int kMaxReported = 8;
@@ -145,7 +145,8 @@ class CurveTree {
   // fail the finer mass test are evaluated. REQUIRES: the surface and density
   // this tree was built from; grade >= this->grade().
   absl::StatusOr<std::shared_ptr<const CurveTree>> Refined(const Surface& surface,
-                                                           const Density& density, int grade,
+                                                           const Density& density,
+                                                           int grade,
                                                            const BuildControl& control = {}) const;
 
   // The smallest grade fine enough for `count` samples: ceil(log2(count)).
@@ -252,8 +253,8 @@ class CurveTree {
            models_.capacity() * sizeof(LeafModel) + errors_.capacity() * sizeof(float) +
            info_.capacity();
   }
-  static constexpr size_t kBytesPerLeaf =
-      sizeof(uint64_t) + sizeof(uint64_t) + sizeof(LeafModel) + sizeof(float) + sizeof(uint8_t);
+  static constexpr size_t kBytesPerLeaf = sizeof(uint64_t) + sizeof(uint64_t) + sizeof(LeafModel) +
+                                          sizeof(float) + sizeof(uint8_t);
 
  private:
   class Builder;
@@ -274,7 +275,7 @@ class CurveTree {
   // PodArray, not std::vector: growing them moves no bytes (base/pod_array.h).
   PodArray<uint64_t> starts_;
   PodArray<uint64_t> mass_end_;  // fixed point, units of mass_unit_
-  double mass_unit_ = 0;         // base_mass_ / 2^56
+  double mass_unit_ = 0;            // base_mass_ / 2^56
   // The leaves' hidden-mass bounds summed in the same units (saturating), so
   // a refined tree's sum is a fresh build's to the bit.
   uint64_t hidden_units_ = 0;

@@ -340,6 +340,7 @@ TEST(Server, ACancelledStreamIsFreedAtOnce) {
   EXPECT_LT(r.server->metrics().samples_streamed(), 1'000'000.0);
 }
 
+
 // A request whose tree takes a minute to build unless stopped: a pole the
 // tree refines towards until the leaf budget of HeavyOptions().
 SampleRequest HeavyBuild(const std::string& pole_at = "0.3") {
@@ -766,8 +767,8 @@ TEST(Server, TheServerDeadlineStopsABlueRelaxationAndFreesItsMemory) {
   Running r = StartServer(options, co);
   WarmTreeOf(*r.client, LongBlueRelaxation());
   const auto start = std::chrono::steady_clock::now();
-  ExpectStatus(Fetch(*r.client, LongBlueRelaxation()).status(), absl::StatusCode::kDeadlineExceeded,
-               "blue-noise set relaxed");
+  ExpectStatus(Fetch(*r.client, LongBlueRelaxation()).status(),
+               absl::StatusCode::kDeadlineExceeded, "blue-noise set relaxed");
   // Promptly: a generous bound, far below the relaxation's own time.
   EXPECT_LT(std::chrono::steady_clock::now() - start, milliseconds(5000));
   EXPECT_EQ(StreamMemoryReserved(*r.client), 0u);
