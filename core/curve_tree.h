@@ -6,8 +6,10 @@
 //  1. The paper's geometric test down to a base depth (6 for Hilbert, 4 for
 //     the 3x3 curves): a cell is split while the largest distance from
 //     f(centre) to f at its 4 corners and 4 edge midpoints exceeds the
-//     tolerance a (AssessSubdivision). S_base is the total mass of these
-//     leaves (fixed, so decisions never depend on later refinement).
+//     tolerance a (AssessSubdivision). For a density that bounds itself
+//     (Density::Bounds) a leaf that may hide mass no probe saw is then split
+//     (kStage1HiddenShare). S_base is the total mass of these leaves (fixed,
+//     so decisions never depend on later refinement).
 //  2. Graded refinement: a tree of grade g serves up to N = 2^g samples. With
 //     mu = mass / S_base a leaf's share, a leaf splits (below the cap r) when
 //      - its model error e, the sum over its children of |its model's
@@ -15,7 +17,8 @@
 //        large:  e / S_base * N > rho * kErrorShare * N^(1/4) * mu, while it
 //        carries at least max(kMinSamples, kErrorFloor * N^(1/2)) samples; or
 //      - it fails the paper's flatness test while it carries at least
-//        max(kMinSamples, kFlatnessFloor * N^(1/2)) samples.
+//        max(kMinSamples, kFlatnessFloor * N^(1/2)) samples; or
+//      - its hidden-mass bound (kHiddenFactor) is worth kHiddenFloor samples.
 //     The error allowance is proportional to the leaf's share of the mass, so
 //     the error summed over any run of examined leaves stays below rho *
 //     kErrorShare * N^(1/4) samples: a fraction of the jittered set's own
@@ -133,8 +136,9 @@ struct PrecisionReport {
 class CurveTree {
  public:
   // Builds the tree of `grade` (0 <= grade <= 62). Errors: INVALID_ARGUMENT
-  // for bad options, a surface that is not finite, a negative density or a
-  // density that integrates to zero; RESOURCE_EXHAUSTED past max_leaves.
+  // for bad options, a surface that is not finite, a negative density, a
+  // density that integrates to zero, or leaves that may hide more than
+  // kHiddenShare of the mass; RESOURCE_EXHAUSTED past max_leaves.
   static absl::StatusOr<std::shared_ptr<const CurveTree>> Build(const Surface& surface,
                                                                 const Density& density,
                                                                 const CurveTreeOptions& options,
