@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <type_traits>
 
 #include "absl/strings/str_cat.h"
@@ -190,14 +191,34 @@ class ExpressionSurface final : public Surface {
 // delta(u, v, x, y, z) with (u, v) the unit-square parameters.
 class ExpressionDensity final : public Density {
  public:
-  explicit ExpressionDensity(std::unique_ptr<Expression> f) : f_(std::move(f)) {}
+  explicit ExpressionDensity(std::unique_ptr<Expression> f)
+      : f_(std::move(f)), uses_point_(f_->Uses(2) || f_->Uses(3) || f_->Uses(4)) {}
   double Value(const SurfacePoint& p) const override {
     const double values[5] = {p.u, p.v, p.p.x, p.p.y, p.p.z};
     return f_->Evaluate(values);
   }
+  bool Bounds() const override { return true; }
+  // The interval program over the rectangle and, where the expression reads
+  // x, y or z, the surface's proven box of the patch (Surface::Bound; the
+  // whole line where the surface cannot bound itself).
+  double UpperBound(const Surface& surface, double u0, double u1, double v0,
+                    double v1) const override {
+    Interval values[5] = {Interval::Of(u0, u1), Interval::Of(v0, v1), Interval::NaN(),
+                          Interval::NaN(), Interval::NaN()};
+    if (uses_point_) {
+      if (const std::optional<Box3> box = surface.Bound(u0, u1, v0, v1)) {
+        values[2] = Interval::Of(box->lo.x, box->hi.x);
+        values[3] = Interval::Of(box->lo.y, box->hi.y);
+        values[4] = Interval::Of(box->lo.z, box->hi.z);
+      }
+    }
+    const Interval r = f_->Evaluate(values);
+    return r.maybe_nan || !(r.hi < INFINITY) ? INFINITY : r.hi;
+  }
 
  private:
   const std::unique_ptr<Expression> f_;
+  const bool uses_point_;  // reads x, y or z
 };
 
 }  // namespace

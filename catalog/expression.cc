@@ -824,6 +824,15 @@ absl::StatusOr<std::unique_ptr<Expression>> Expression::Compile(
 
 size_t Expression::program_size() const { return code_.size(); }
 
+bool Expression::Uses(size_t i) const {
+  for (const Instruction& in : code_) {
+    const bool reads = in.op == Op::kVar || in.op == Op::kVarMulAdd || in.op == Op::kVarSquare ||
+                       in.op == Op::kVarCube || in.op == Op::kVarFourth;
+    if (reads && in.arg == static_cast<int32_t>(i)) return true;
+  }
+  return false;
+}
+
 double Expression::Evaluate(const double* values) const { return Run(code_, values); }
 Dual1 Expression::Evaluate(const Dual1* values) const { return Run(code_, values); }
 Dual2 Expression::Evaluate(const Dual2* values) const { return Run(code_, values); }

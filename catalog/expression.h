@@ -95,6 +95,8 @@ class Expression {
   void EvaluateMany(const double* const* columns, size_t variables, size_t n, double* out) const;
 
   const std::string& text() const { return text_; }
+  // Whether the program reads variables[i] (after muparser's constant folding).
+  bool Uses(size_t i) const;
   // Number of instructions of the compiled program (for tests and tracing).
   size_t program_size() const;
 

@@ -104,6 +104,21 @@ int RoughGrade(double mass, double base) {
   return kNeverFails;
 }
 
+// The smallest grade at which a leaf's hidden-mass bound is worth
+// kHiddenFloor samples (docs/ALGORITHM.md, "Features narrower than the
+// probes").
+int HiddenGrade(double hidden, double base) {
+  if (!(hidden > 0)) return kNeverFails;
+  double n = 1;  // 2^g, exactly
+  for (int g = 0; g <= 62; ++g, n *= 2) {
+    if (hidden / base * n >= CurveTree::kHiddenFloor) return g;
+  }
+  return kNeverFails;
+}
+
+// a + b, sticking at UINT64_MAX.
+uint64_t SaturatingAdd(uint64_t a, uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
+
 // The smallest grade in [0, 62] at which the leaf fails, kNeverFails if none.
 // Both conditions are monotone in g, so a binary search finds it.
 int FailGrade(double error, double mass, double base, double rho) {
@@ -170,10 +185,82 @@ class CurveTree::Builder {
   // `rough_parent`: the cell's parent failed the rough test (stage-1 leaves:
   // true, as stage 1 tests no mass; a refined leaf: as recorded,
   // leaf_rough_parent).
+  // `replaces_leaf`: the cell is a leaf of the tree being refined, whose
+  // hidden-mass bound (in the sum it starts from) it takes out.
   absl::Status RefineCell(int depth, uint64_t start, uint64_t x, uint64_t y, int state,
-                          bool rough_parent) {
+                          bool rough_parent, bool replaces_leaf = false) {
     ASSIGN_OR_RETURN(const CellEval eval, Evaluate(depth, x, y));
+    if (replaces_leaf && density_.Bounds()) {
+      const double h = 1.0 / curve_.PowG(depth);
+      const uint64_t old = ToFixed(HiddenMass(eval, x * h, y * h, h));
+      // A saturated sum stays so (it is refused either way).
+      if (hidden_units_ != UINT64_MAX) hidden_units_ -= std::min(old, hidden_units_);
+    }
     return Refine(depth, start, x, y, state, eval, rough_parent);
+  }
+
+  // The hidden-mass sum of the tree being refined (set before RefineCell).
+  void set_hidden_units(uint64_t units) { hidden_units_ = units; }
+
+  // Stage 1's certified refinement (docs/ALGORITHM.md, "Features narrower
+  // than the probes"): while a stage-1 leaf's hidden-mass bound exceeds
+  // kStage1HiddenShare of the stage's mass, it is replaced by its children,
+  // in rounds (each round's threshold from the mass of the round before), so
+  // that a feature no probe saw counts in S_base. At most
+  // kStage1HiddenLeaves leaves are added; what is left is stage 2's and the
+  // final check's. Nothing changes for densities that do not bound
+  // themselves or leaves that hide nothing.
+  absl::Status RefineHiddenStage1() {
+    if (!density_.Bounds()) return absl::OkStatus();
+    const uint64_t budget = std::min<uint64_t>(
+        options_.max_leaves, stage1_starts_.size() + CurveTree::kStage1HiddenLeaves);
+    bool changed = false;
+    for (;;) {
+      double mass = 0;
+      for (const double m : stage1_masses_) mass += m;
+      const double limit = CurveTree::kStage1HiddenShare * mass;
+      std::vector<uint64_t> starts;
+      std::vector<double> masses, hidden;
+      starts.reserve(stage1_starts_.size());
+      bool split = false;
+      const size_t n = stage1_starts_.size();
+      for (size_t l = 0; l < n; ++l) {
+        const uint64_t end = l + 1 < n ? stage1_starts_[l + 1] : curve_.Span(0);
+        const CurveTree::Cell cell = CellOfRange(curve_, stage1_starts_[l], end);
+        const bool room = starts.size() + curve_.arity() + (n - l - 1) <= budget;
+        if (!(stage1_hidden_[l] > limit) || cell.depth >= options_.depth_cap ||
+            cell.depth >= curve_.max_depth() || !room) {
+          starts.push_back(stage1_starts_[l]);
+          masses.push_back(stage1_masses_[l]);
+          hidden.push_back(stage1_hidden_[l]);
+          continue;
+        }
+        split = true;
+        const int depth = cell.depth + 1;
+        const uint64_t span = curve_.Span(depth);
+        const int g = curve_.grid();
+        const double h = 1.0 / curve_.PowG(depth);
+        for (int c = 0; c < curve_.arity(); ++c) {
+          const Curve::Child& ch = curve_.ChildOf(cell.state, c);
+          const uint64_t x = cell.x * g + ch.dx, y = cell.y * g + ch.dy;
+          NoteDepth(depth, (x + 0.5) * h, (y + 0.5) * h);
+          ASSIGN_OR_RETURN(const CellEval eval, Evaluate(depth, x, y));
+          starts.push_back(stage1_starts_[l] + c * span);
+          masses.push_back(eval.mass);
+          hidden.push_back(HiddenMass(eval, x * h, y * h, h));
+        }
+      }
+      if (!split) break;
+      changed = true;
+      stage1_starts_ = std::move(starts);
+      stage1_masses_ = std::move(masses);
+      stage1_hidden_ = std::move(hidden);
+    }
+    if (changed) {
+      stage1_mass_ = 0;
+      for (const double m : stage1_masses_) stage1_mass_ += m;
+    }
+    return absl::OkStatus();
   }
 
   void StartStage2(double base, int grade, size_t expected_leaves) {
@@ -232,9 +319,38 @@ class CurveTree::Builder {
           "the density integrates to 0 over the surface; it must be positive somewhere (check "
           "the density, or add a floor)");
     }
+    tree->hidden_units_ = hidden_units_;
     tree->ComputeDepthRange();
     tree->ComputeReport();
+    const double share = static_cast<double>(hidden_units_) / static_cast<double>(sum);
+    tree->precision_.hidden_share = share;
+    if (share > CurveTree::kHiddenShare) return HiddenError(share);
     return absl::OkStatus();
+  }
+
+  // The leaves may hide too much mass (docs/ALGORITHM.md, "Features narrower
+  // than the probes"): says how much, where, and what to change.
+  absl::Status HiddenError(double share) const {
+    const CurveTree::Cell& w = worst_hidden_cell_;
+    std::string where;
+    if (worst_hidden_ > 0) {
+      where = absl::StrFormat(
+          ", the most in the cell u in [%.9g, %.9g], v in [%.9g, %.9g] (depth %d), and all in u "
+          "in [%.9g, %.9g], v in [%.9g, %.9g]",
+          w.u0, w.u0 + w.size, w.v0, w.v0 + w.size, w.depth, hidden_box_[0], hidden_box_[1],
+          hidden_box_[2], hidden_box_[3]);
+    }
+    const std::string amount = share >= 1
+                                   ? absl::StrFormat("%.3g times the mass it measured", share)
+                                   : absl::StrFormat("%.3g%% of the mass it measured", 100 * share);
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the density has features narrower than the curve tree can see: its interval bounds "
+        "allow up to %s (more than %.3g%%) in parts of leaves where it may exceed %g times "
+        "every value the leaves' probes saw%s; the samples would miss that mass. Widen or "
+        "smooth the narrow features (or give them a floor within %g times their peak), ask for "
+        "more samples, or raise the depth cap (%d) if the tree reached it",
+        amount, 100 * CurveTree::kHiddenShare, CurveTree::kHiddenFactor, where,
+        CurveTree::kHiddenFactor, options_.depth_cap));
   }
 
   const PrecisionReport& report() const { return report_; }
@@ -274,6 +390,10 @@ class CurveTree::Builder {
     const bool singular = eval.piecewise;
     stage1_starts_.push_back(start);
     stage1_mass_ += eval.mass;
+    if (density_.Bounds()) {
+      stage1_masses_.push_back(eval.mass);
+      stage1_hidden_.push_back(HiddenMass(eval, u0, v0, h));
+    }
     stage1_area_ += singular ? INFINITY : eval.area;
     return absl::OkStatus();
   }
@@ -564,6 +684,68 @@ class CurveTree::Builder {
     return worst * kEdgeBand * h * h;
   }
 
+  // The leaf's hidden-mass bound (docs/ALGORITHM.md, "Features narrower
+  // than the probes"): what the cell's mass may exceed its estimate by in the
+  // parts where the density's interval upper bound (Density::UpperBound)
+  // exceeds kHiddenFactor times the largest density its Gauss nodes saw,
+  // each part counted at its bound times its share of the cell's area (the
+  // quadrature's). A part the density cannot bound, and a cell whose area
+  // element is singular, count 0.
+  double HiddenMass(const CellEval& eval, double u0, double v0, double h) const {
+    if (!density_.Bounds() || eval.piecewise || eval.singular || !std::isfinite(eval.area) ||
+        !(eval.area > 0)) {
+      return 0;
+    }
+    double seen = 0;
+    for (const double d : eval.delta) {
+      if (d > seen) seen = d;  // NaN (a singular node) is skipped
+    }
+    const double limit = kHiddenFactor * seen;
+    const double u1 = std::min(1.0, u0 + h), v1 = std::min(1.0, v0 + h);
+    const double bound = density_.UpperBound(surface_, u0, u1, v0, v1);
+    if (!(bound > limit) || !std::isfinite(bound)) return 0;
+    int budget = kHiddenEvaluations;
+    return BoundAbove(u0, u1, v0, v1, bound, 0, limit, &budget) / ((u1 - u0) * (v1 - v0)) *
+           eval.area;
+  }
+
+  // The hidden parts are narrowed down by halving: each step bounds both
+  // halves along u and both along v and keeps the cut whose parts above the
+  // limit hold less, so a line along an axis is closed in on at 4 bounds a
+  // level; at most kHiddenLevels levels and kHiddenEvaluations bounds a leaf.
+  static constexpr int kHiddenLevels = 12;
+  static constexpr int kHiddenEvaluations = 64;
+
+  // The sum of UpperBound times parameter area over the parts of [u0, u1] x
+  // [v0, v1] whose bound exceeds `limit`, given its own `bound` (> limit).
+  double BoundAbove(double u0, double u1, double v0, double v1, double bound, int level,
+                    double limit, int* budget) const {
+    const double whole = bound * (u1 - u0) * (v1 - v0);
+    if (level == kHiddenLevels || *budget < 4) return whole;
+    *budget -= 4;
+    const double um = u0 + (u1 - u0) / 2, vm = v0 + (v1 - v0) / 2;
+    const double b[4] = {density_.UpperBound(surface_, u0, um, v0, v1),
+                         density_.UpperBound(surface_, um, u1, v0, v1),
+                         density_.UpperBound(surface_, u0, u1, v0, vm),
+                         density_.UpperBound(surface_, u0, u1, vm, v1)};
+    const auto above = [&](double x) { return x > limit && std::isfinite(x); };
+    const auto part = [&](double x) { return above(x) ? x * (u1 - u0) * (v1 - v0) / 2 : 0.0; };
+    const bool along_u = part(b[0]) + part(b[1]) <= part(b[2]) + part(b[3]);
+    double sum = 0;
+    for (int side = 0; side < 2; ++side) {
+      const double x = along_u ? b[side] : b[2 + side];
+      if (!above(x)) continue;
+      if (along_u) {
+        sum += BoundAbove(side == 0 ? u0 : um, side == 0 ? um : u1, v0, v1, x, level + 1, limit,
+                          budget);
+      } else {
+        sum += BoundAbove(u0, u1, side == 0 ? v0 : vm, side == 0 ? vm : v1, x, level + 1, limit,
+                          budget);
+      }
+    }
+    return std::min(whole, sum);
+  }
+
   // The parent model's integral over child (cx, cy) of its g x g grid.
   double ModelOverChild(const CellEval& eval, int cx, int cy, double h) const {
     const int g = curve_.grid();
@@ -587,10 +769,25 @@ class CurveTree::Builder {
     // Steps are followed only in cells larger than the density asks.
     const bool follow_steps = h > density_.StepResolution();
     if (rough_parent && follow_steps) fail = std::min(fail, RoughGrade(eval.mass, base_));
+    // The hidden-mass bound, found where the cell would otherwise stay a
+    // leaf: a leaf whose bound is worth kHiddenFloor samples is examined and
+    // split (docs/ALGORITHM.md, "Features narrower than the probes").
+    double hidden = -1;
+    int hidden_grade = kNeverFails;
+    const auto find_hidden = [&] {
+      if (hidden >= 0) return;
+      hidden = HiddenMass(eval, x * h, y * h, h);
+      hidden_grade = HiddenGrade(hidden, base_);
+    };
+    bool examine = fail <= grade_;
+    if (!examine && depth < options_.depth_cap && density_.Bounds()) {
+      find_hidden();
+      examine = hidden_grade <= grade_;
+    }
     double error = 0;
     bool rough = false;
     CellEval children[9];
-    if (fail <= grade_ && depth < curve_.max_depth()) {
+    if (examine && depth < curve_.max_depth()) {
       for (int c = 0; c < curve_.arity(); ++c) {
         const Curve::Child& ch = curve_.ChildOf(state, c);
         ASSIGN_OR_RETURN(children[c], Evaluate(depth + 1, x * g + ch.dx, y * g + ch.dy));
@@ -621,6 +818,10 @@ class CurveTree::Builder {
       }
       fail = std::min(fail, flat);
     }
+    if (density_.Bounds() && !(fail <= grade_ && depth < options_.depth_cap)) find_hidden();
+    // At the depth cap nothing can split the leaf, and a refinement never
+    // examines it again.
+    if (depth < options_.depth_cap) fail = std::min(fail, hidden_grade);
     if (fail <= grade_ && depth < options_.depth_cap) {
       NoteDepth(depth + 1, (x + 0.5) * h, (y + 0.5) * h);
       const uint64_t span = curve_.Span(depth + 1);
@@ -643,7 +844,21 @@ class CurveTree::Builder {
     errors_.push_back(static_cast<float>(error));
     info_.push_back(static_cast<uint8_t>(fail | (eval.piecewise ? kPiecewiseBit : 0) |
                                          (rough_parent ? kRoughParentBit : 0)));
+    if (hidden > 0) NoteHidden(hidden, depth, x, y, h);
     return absl::OkStatus();
+  }
+
+  // Adds a leaf's hidden-mass bound to the sum and the places reported.
+  void NoteHidden(double hidden, int depth, uint64_t x, uint64_t y, double h) {
+    hidden_units_ = SaturatingAdd(hidden_units_, ToFixed(hidden));
+    if (hidden > worst_hidden_) {
+      worst_hidden_ = hidden;
+      worst_hidden_cell_ = {x * h, y * h, h, depth, 0, x, y};
+    }
+    hidden_box_[0] = std::min(hidden_box_[0], x * h);
+    hidden_box_[1] = std::max(hidden_box_[1], x * h + h);
+    hidden_box_[2] = std::min(hidden_box_[2], y * h);
+    hidden_box_[3] = std::max(hidden_box_[3], y * h + h);
   }
 
   uint64_t ToFixed(double mass) const {
@@ -735,6 +950,15 @@ class CurveTree::Builder {
   double deepest_u_ = 0.5, deepest_v_ = 0.5;
   std::vector<uint64_t> stage1_starts_;
   double stage1_mass_ = 0;
+  // Per stage-1 leaf, for densities that bound themselves: mass and
+  // hidden-mass bound.
+  std::vector<double> stage1_masses_, stage1_hidden_;
+  // Stage 2: the leaves' hidden-mass bounds in mass units (saturating), the
+  // largest one's cell and the box of the cells of those that hide any.
+  uint64_t hidden_units_ = 0;
+  double worst_hidden_ = 0;
+  CurveTree::Cell worst_hidden_cell_{};
+  double hidden_box_[4] = {INFINITY, -INFINITY, INFINITY, -INFINITY};  // u0, u1, v0, v1
   double stage1_area_ = 0;
   PodArray<uint64_t> starts_;
   PodArray<uint64_t> masses_;  // per leaf, fixed point
@@ -819,6 +1043,7 @@ absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Build(const Surface&
   tree->grade_ = grade;
   Builder builder(surface, density, tree->options_, control);
   RETURN_IF_ERROR(builder.BuildGeometric());
+  RETURN_IF_ERROR(builder.RefineHiddenStage1());
   const double base = builder.stage1_mass();
   if (!(builder.stage1_area() > 0)) {
     return absl::InvalidArgumentError(
@@ -867,11 +1092,12 @@ absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Refined(
   Builder builder(surface, density, tree->options_, control);
   builder.set_report(precision_);  // keeps the flatness hits of leaves at the cap
   builder.StartStage2(base_mass_, grade, leaf_count() + leaf_count() / 4);
+  builder.set_hidden_units(hidden_units_);
   for (size_t l = 0; l < leaf_count(); ++l) {
     const Cell cell = LeafCell(l);
     if (leaf_fail_grade(l) <= grade && cell.depth < options_.depth_cap) {
       RETURN_IF_ERROR(builder.RefineCell(cell.depth, starts_[l], cell.x, cell.y, cell.state,
-                                         leaf_rough_parent(l)));
+                                         leaf_rough_parent(l), true));
     } else {
       RETURN_IF_ERROR(builder.CopyLeaf(*this, l));
     }

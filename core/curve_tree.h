@@ -6,8 +6,10 @@
 //  1. The paper's geometric test down to a base depth (6 for Hilbert, 4 for
 //     the 3x3 curves): a cell is split while the largest distance from
 //     f(centre) to f at its 4 corners and 4 edge midpoints exceeds the
-//     tolerance a (AssessSubdivision). S_base is the total mass of these
-//     leaves (fixed, so decisions never depend on later refinement).
+//     tolerance a (AssessSubdivision). For a density that bounds itself
+//     (Density::Bounds) a leaf that may hide mass no probe saw is then split
+//     (kStage1HiddenShare). S_base is the total mass of these leaves (fixed,
+//     so decisions never depend on later refinement).
 //  2. Graded refinement: a tree of grade g serves up to N = 2^g samples. With
 //     mu = mass / S_base a leaf's share, a leaf splits (below the cap r) when
 //      - its model error e, the sum over its children of |its model's
@@ -15,7 +17,8 @@
 //        large:  e / S_base * N > rho * kErrorShare * N^(1/4) * mu, while it
 //        carries at least max(kMinSamples, kErrorFloor * N^(1/2)) samples; or
 //      - it fails the paper's flatness test while it carries at least
-//        max(kMinSamples, kFlatnessFloor * N^(1/2)) samples.
+//        max(kMinSamples, kFlatnessFloor * N^(1/2)) samples; or
+//      - its hidden-mass bound (kHiddenFactor) is worth kHiddenFloor samples.
 //     The error allowance is proportional to the leaf's share of the mass, so
 //     the error summed over any run of examined leaves stays below rho *
 //     kErrorShare * N^(1/4) samples: a fraction of the jittered set's own
@@ -121,6 +124,9 @@ struct PrecisionReport {
   double error_samples = 0;
   // ... and summed over the leaves the tests still wanted to split.
   double unresolved_error_samples = 0;
+  // The hidden-mass bound summed over the leaves, as a share of the total
+  // mass (0 for densities that do not bound themselves).
+  double hidden_share = 0;
   std::vector<DepthCapHit> worst;     // at most kMaxReported, largest measured/limit first
   // At most kMaxReported singular leaves (piecewise or warped), the smallest first.
   std::vector<DepthCapHit> singular;
@@ -130,8 +136,9 @@ struct PrecisionReport {
 class CurveTree {
  public:
   // Builds the tree of `grade` (0 <= grade <= 62). Errors: INVALID_ARGUMENT
-  // for bad options, a surface that is not finite, a negative density or a
-  // density that integrates to zero; RESOURCE_EXHAUSTED past max_leaves.
+  // for bad options, a surface that is not finite, a negative density, a
+  // density that integrates to zero, or leaves that may hide more than
+  // kHiddenShare of the mass; RESOURCE_EXHAUSTED past max_leaves.
   static absl::StatusOr<std::shared_ptr<const CurveTree>> Build(const Surface& surface,
                                                                 const Density& density,
                                                                 const CurveTreeOptions& options,
@@ -177,6 +184,23 @@ class CurveTree {
   // of kEdgeBand of the cell.
   static constexpr double kEdgeJump = 0.05;
   static constexpr double kEdgeBand = 1.0 / 16;
+  // The hidden-mass certificate (docs/ALGORITHM.md, "Features narrower than
+  // the probes"), for densities that bound themselves (Density::Bounds). A
+  // part of a leaf may hide mass where the density's interval upper bound
+  // there exceeds kHiddenFactor times the largest density the leaf's Gauss
+  // nodes saw; the leaf's hidden-mass bound is the sum of those parts'
+  // bounds times their share of the leaf's area.
+  static constexpr double kHiddenFactor = 8;
+  // Stage 1 splits a leaf while its bound exceeds kStage1HiddenShare of the
+  // stage's mass, within kStage1HiddenLeaves leaves added; stage 2 examines
+  // and splits one while its bound is worth kHiddenFloor samples (the rough
+  // floor: a hidden feature is followed as far as a seen one).
+  static constexpr double kStage1HiddenShare = 1.0 / 8192;
+  static constexpr uint64_t kStage1HiddenLeaves = uint64_t{1} << 17;
+  static constexpr double kHiddenFloor = kRoughFloor;
+  // A tree whose leaves' bounds sum to more than kHiddenShare of its mass is
+  // refused (INVALID_ARGUMENT, saying where).
+  static constexpr double kHiddenShare = 1.0 / 1024;
 
   const Curve& curve() const { return *curve_; }
   // The options with tolerance and depth cap resolved to the values used.
@@ -256,6 +280,9 @@ class CurveTree {
   PodArray<uint64_t> starts_;
   PodArray<uint64_t> mass_end_;  // fixed point, units of mass_unit_
   double mass_unit_ = 0;            // base_mass_ / 2^56
+  // The leaves' hidden-mass bounds summed in the same units (saturating), so
+  // a refined tree's sum is a fresh build's to the bit.
+  uint64_t hidden_units_ = 0;
   PodArray<LeafModel> models_;
   PodArray<float> errors_;
   PodArray<uint8_t> info_;  // fail grade | kPiecewiseBit | kRoughParentBit

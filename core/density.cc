@@ -38,6 +38,10 @@ class MeanCurvature final : public Density {
 
 }  // namespace
 
+double Density::UpperBound(const Surface&, double, double, double, double) const {
+  return INFINITY;
+}
+
 std::unique_ptr<Density> MakeUniformDensity() { return std::make_unique<Uniform>(); }
 std::unique_ptr<Density> MakeGaussianCurvatureDensity(double floor) {
   return std::make_unique<GaussianCurvature>(floor);

@@ -11,6 +11,8 @@
 
 namespace sfc {
 
+class Surface;
+
 // What a density may depend on at one surface point.
 struct SurfacePoint {
   double u = 0, v = 0;            // unit-square parameters
@@ -38,6 +40,19 @@ class Density {
   // mass is its area: CAD models then share samples among their faces by
   // their exact trimmed areas, with no coarse tree to estimate them.
   virtual bool IsUniform() const { return false; }
+  // Whether UpperBound can be finite: the tree then checks that no feature
+  // narrower than its probes hides mass in a leaf (docs/ALGORITHM.md,
+  // "Features narrower than the probes"). False (the default, and every
+  // built-in density: the uniform one hides nothing, the curvature ones
+  // cannot bound themselves) skips that check.
+  virtual bool Bounds() const { return false; }
+  // An upper bound of delta over the patch of the parameter rectangle
+  // [u0,u1] x [v0,v1] of `surface`, proven by interval arithmetic
+  // (core/interval.h) for the values Value computes there; +infinity where
+  // the density cannot bound itself (the default). REQUIRES: 0 <= u0 <= u1
+  // <= 1, 0 <= v0 <= v1 <= 1.
+  virtual double UpperBound(const Surface& surface, double u0, double u1, double v0,
+                            double v1) const;
 };
 
 // delta = 1.

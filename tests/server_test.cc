@@ -442,6 +442,17 @@ TEST(Server, BuildsBeyondTheQueueAreTurnedAwayAndNamedTheLimit) {
   EXPECT_EQ(stats->max_queued_builds(), 0u);
 }
 
+TEST(Server, ADensityWithFeaturesTheTreeCannotSeeIsRefusedAsAnInvalidArgument) {
+  // A strip 1e-4 wide between the Gauss nodes of every cell down to the depth
+  // cap (docs/ALGORITHM.md, "Features narrower than the probes").
+  Running r = StartServer(LoopbackOptions());
+  SampleRequest request = Request("plane", 100000);
+  request.tree.density = "expr:0.001+1000*(u>0.30014142135623731)*(u<0.30024142135623731)";
+  request.tree.options.depth_cap = 10;
+  ExpectStatus(Fetch(*r.client, request).status(), absl::StatusCode::kInvalidArgument,
+               "narrower than the curve tree can see");
+}
+
 TEST(Server, AFailedBuildIsRememberedAndNotRepeated) {
   ServerOptions options = LoopbackOptions();
   options.limits.max_tree_leaves = 1000;
