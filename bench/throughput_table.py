@@ -15,7 +15,7 @@ noisy machine's load hits both sides alike):
  4. float32 stream over loopback against a raw bytes stream of the same size,
     and 5. a cache hit against a cold request (eight, curvature density,
     10^6): both from bench/stream_benchmark, whose process has the server's
-    malloc settings (both sides' buffers reuse resident pages; before stop 45
+    malloc settings (both sides' buffers reuse resident pages; before branch stream-speed
     it had glibc's defaults, under which the raw bytes ran about half as fast).
  6. STEP box with a fillet and a hole, 10^6 cold, against the built-in
     sphere (bench/model_benchmark).
