@@ -5,7 +5,14 @@
 // also timed in process (generation alone, the server's thread count) and
 // through a bench-only service that streams the wire path without
 // generating (one batch generated first, encoded into every message).
-//   stream_benchmark [samples]   (default 10^7)
+//   stream_benchmark [samples] [float32|float64] [--repeat=K [--raw]] [--glibc-malloc]
+// samples defaults to 10^7; a precision runs that precision's stream rows
+// only (no cache hits, no concurrent clients), for old-against-new rounds.
+// --repeat=K instead streams that precision's pipelined raw-columns request
+// (or with --raw the raw bytes) K times after one warm call, printing each
+// time, for `perf stat` of that path alone. The process runs with the
+// server's malloc settings (server/memory_trimmer.h SetServerMallocOptions),
+// or glibc's defaults with --glibc-malloc (how this benchmark ran before).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -21,6 +28,7 @@
 #include "grpcpp/server_builder.h"
 #include "kinds/registered_kinds.h"
 #include "proto/convert.h"
+#include "server/memory_trimmer.h"
 #include "server/sampler_server.h"
 
 namespace sfc {
@@ -165,7 +173,20 @@ double GenerationSeconds(const SampleRequest& request, int threads, uint32_t bat
   return Since(start);
 }
 
-int Run(uint64_t n) {
+struct Args {
+  uint64_t n = 10'000'000;
+  std::string only;  // "float32", "float64" or empty (every row)
+  int repeat = 0;
+  bool raw = false;
+  bool glibc_malloc = false;
+};
+
+int Run(const Args& args) {
+  const uint64_t n = args.n;
+  const std::string& only = args.only;
+  // The server's process as sfcsampler-server runs it (its clients here
+  // share the process and these settings).
+  if (!args.glibc_malloc) SetServerMallocOptions();
   ServerOptions options;
   options.address = "127.0.0.1:0";
   options.health_address = "";
@@ -200,12 +221,31 @@ int Run(uint64_t n) {
                {"sphere", &sphere, ColumnPrecision::kFloat64}};
   for (const Case& c : cases) {
     const ColumnPrecision precision = c.precision;
+    if (!only.empty() && only != (precision == ColumnPrecision::kFloat32 ? "float32" : "float64"))
+      continue;
     const SampleRequest& request = *c.request;
     const std::string label = std::string(c.surface) +
                               (precision == ColumnPrecision::kFloat32 ? ", float32" : ", float64");
     const char* name = label.c_str();
     const size_t value_bytes = precision == ColumnPrecision::kFloat32 ? 4 : 8;
     const uint64_t payload = n * 5 * value_bytes;
+    if (args.repeat > 0) {
+      ClientOptions co;
+      co.target = target;
+      co.stream.precision = precision;
+      co.stream.batch_size = batch;
+      co.stream.encoding = ColumnEncoding::kRaw;
+      auto client = *SamplerClient::Connect(co);
+      uint64_t received = 0;
+      StreamSeconds(*client, request, &received);  // builds and caches the tree
+      for (int i = 0; i < args.repeat; ++i) {
+        const double seconds = args.raw ? RawSeconds(raw_target, payload,
+                                                     static_cast<uint32_t>(batch * 5 * value_bytes))
+                                        : StreamSeconds(*client, request, &received);
+        std::printf("%s %s: %.4f s\n", name, args.raw ? "raw bytes" : "stream", seconds);
+      }
+      continue;
+    }
     const double raw_seconds = Best([&] {
       return RawSeconds(raw_target, payload, static_cast<uint32_t>(batch * 5 * value_bytes));
     });
@@ -284,6 +324,13 @@ int Run(uint64_t n) {
     }
   }
 
+  if (!only.empty() || args.repeat > 0) {
+    server->Shutdown(1);
+    unpipelined->Shutdown(1);
+    raw_server->Shutdown();
+    wire_server->Shutdown();
+    return 0;
+  }
   {
     // Cold: a fresh server each time, so the tree is built; then the same
     // request again from its cache. The best of three of each.
@@ -364,5 +411,27 @@ int Run(uint64_t n) {
 }  // namespace sfc
 
 int main(int argc, char** argv) {
-  return sfc::Run(argc > 1 ? std::strtoull(argv[1], nullptr, 10) : 10'000'000);
+  sfc::Args args;
+  int positional = 0;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a.rfind("--repeat=", 0) == 0) {
+      args.repeat = std::atoi(a.c_str() + 9);
+    } else if (a == "--raw") {
+      args.raw = true;
+    } else if (a == "--glibc-malloc") {
+      args.glibc_malloc = true;
+    } else if (positional == 0 && !a.empty() && a[0] != '-') {
+      args.n = std::strtoull(a.c_str(), nullptr, 10), ++positional;
+    } else if (positional == 1 && (a == "float32" || a == "float64")) {
+      args.only = a, ++positional;
+    } else {
+      std::fprintf(stderr,
+                   "usage: stream_benchmark [samples] [float32|float64] [--repeat=K [--raw]] "
+                   "[--glibc-malloc]\n");
+      return 2;
+    }
+  }
+  if (args.repeat > 0 && args.only.empty()) args.only = "float32";
+  return sfc::Run(args);
 }

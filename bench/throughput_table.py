@@ -14,7 +14,9 @@ noisy machine's load hits both sides alike):
     script writing the same file; 5 paired runs.
  4. float32 stream over loopback against a raw bytes stream of the same size,
     and 5. a cache hit against a cold request (eight, curvature density,
-    10^6): both from bench/stream_benchmark.
+    10^6): both from bench/stream_benchmark, whose process has the server's
+    malloc settings (both sides' buffers reuse resident pages; before branch stream-speed
+    it had glibc's defaults, under which the raw bytes ran about half as fast).
  6. STEP box with a fillet and a hole, 10^6 cold, against the built-in
     sphere (bench/model_benchmark).
  7. Mesh, 10^6 cold on the 81 920-triangle icosphere, against Open3D's

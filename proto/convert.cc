@@ -59,6 +59,11 @@ void StoreLittleEndian(double value, char* p) {
   for (size_t b = 0; b < sizeof bits; ++b) p[b] = static_cast<char>(bits >> (8 * b));
 }
 
+// Values converted a block at a time through a buffer on the stack, so that
+// the conversion runs in vector registers (a store through char* would make
+// the compiler reload the column's bounds after every value).
+constexpr size_t kConvertBlock = 1024;
+
 template <typename T>
 double LoadLittleEndian(const char* p) {
   using Bits = std::conditional_t<sizeof(T) == 8, uint64_t, uint32_t>;
@@ -80,9 +85,13 @@ void PutRaw(const std::vector<double>& from, std::string* to) {
     return;
   }
   if (kLittleEndian) {  // float32: convert, and store in host order
-    for (size_t i = 0; i < from.size(); ++i) {
-      const float f = static_cast<float>(from[i]);
-      std::memcpy(p + i * sizeof(float), &f, sizeof f);
+    const double* in = from.data();
+    const size_t n = from.size();
+    float block[kConvertBlock];
+    for (size_t i = 0; i < n; i += kConvertBlock) {
+      const size_t m = std::min(kConvertBlock, n - i);
+      for (size_t j = 0; j < m; ++j) block[j] = static_cast<float>(in[i + j]);
+      std::memcpy(p + i * sizeof(float), block, m * sizeof(float));
     }
     return;
   }
@@ -468,8 +477,16 @@ void ToProto(const SampleBatch& b, const SampleFields& fields, const StreamOptio
              v1::SampleBatch* out) {
   const size_t n = b.size();
   out->set_size(static_cast<uint32_t>(n));
+  // Whether the indices are consecutive, a block at a time (a test without an
+  // early exit inside the block runs in vector registers).
   bool consecutive = true;
-  for (size_t i = 1; i < n && consecutive; ++i) consecutive = b.index[i] == b.index[i - 1] + 1;
+  const uint64_t* index = b.index.data();
+  for (size_t i = 0; i < n && consecutive; i += kConvertBlock) {
+    const size_t end = std::min(n, i + kConvertBlock);
+    uint64_t differ = 0;
+    for (size_t j = i; j < end; ++j) differ |= index[j] ^ (index[0] + j);
+    consecutive = differ == 0;
+  }
   out->set_first_index(n ? b.index[0] : 0);
   if (!consecutive) {
     out->mutable_index()->Reserve(static_cast<int>(n));

@@ -36,6 +36,14 @@ bool MemoryTrimmer::TrimNow() {
 #endif
 }
 
+void SetServerMallocOptions() {
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_THRESHOLD, 4 << 20);
+  mallopt(M_TRIM_THRESHOLD, 64 << 20);
+  mallopt(M_ARENA_MAX, 2);
+#endif
+}
+
 uint64_t MemoryTrimmer::passes() const {
   std::lock_guard<std::mutex> lock(mu_);
   return passes_;

@@ -20,6 +20,24 @@
 
 namespace sfc {
 
+// The server process's malloc settings, set once at start (the server's main,
+// and bench/stream_benchmark so that it measures the server as run): a fixed
+// mmap threshold of 4 MiB, so that buffers larger than that (sorted index
+// ranges, tree arrays) go back to the system when freed and resident memory
+// falls back to what the budgets hold (cache_bytes, stream_memory_bytes;
+// glibc's adaptive threshold would keep raising it); a heap top kept up to 64 MiB, so that a
+// stream's per-message buffers (gRPC's serialized slices of up to 1 MiB, its
+// read buffers, 65536-sample columns) reuse resident pages instead of faulting
+// in fresh ones for every message (with the threshold fixed, glibc's trim
+// threshold would stay at 128 KiB: 19 000 faults a 10^7-sample float32
+// stream, 8% of its CPU); and at most 2 arenas, as each stream's producer
+// thread would otherwise get one of its own (up to 8 per core), each keeping
+// the pages its frees leave behind. What the heap keeps goes back within one
+// MemoryTrimmer interval (malloc_trim returns free pages anywhere in the
+// arenas; with no trimmer, up to 64 MiB of heap top stays). No-op without
+// glibc.
+void SetServerMallocOptions();
+
 class MemoryTrimmer {
  public:
   // interval <= 0: no thread (TrimNow() still works).

@@ -2,7 +2,6 @@
 // curve-tree cache. SIGTERM or SIGINT shuts it down gracefully: it stops
 // accepting, lets in-flight streams finish within --shutdown-grace, then
 // cancels them.
-#include <malloc.h>
 #include <signal.h>
 #include <unistd.h>
 
@@ -48,16 +47,7 @@ absl::Status ResolveModelCheckProgram(const std::string& flag, std::string* prog
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Large buffers (sorted index ranges, batches, messages, tree arrays) come
-  // and go with requests. A fixed mmap threshold gives each back to the
-  // system when freed; glibc's default raises the threshold after the first
-  // such free, and the heap then keeps the freed pages, so resident memory
-  // would not fall back to what the budgets hold (cache_bytes,
-  // stream_memory_bytes).
-  mallopt(M_MMAP_THRESHOLD, 1 << 20);
-  // Each stream's producer thread would otherwise get a malloc arena of its
-  // own (up to 8 per core), each keeping the pages its frees leave behind.
-  mallopt(M_ARENA_MAX, 2);
+  sfc::SetServerMallocOptions();
   sfc::ServerOptions o;
   int trim_interval_ms = 200;
   std::string token_file, log_level = "info";

@@ -180,6 +180,39 @@ TEST(RawColumns, RoundTripBitExactlyForEveryColumnAndPrecision) {
   }
 }
 
+TEST(RawColumns, LongBatchesRoundTripAndAnIndexOutOfStepAnywhereIsListed) {
+  // Columns are converted, and indices checked for steps of one, in blocks
+  // of 1024 samples: lengths around the block's edges, and one index out of
+  // step in the first, a middle or the last block.
+  const SampleFields fields = AllFields();
+  for (size_t n : {1023, 1024, 1025, 2048, 3001}) {
+    for (size_t bad : {size_t{0}, n / 2, n - 1, n}) {  // n: none out of step
+      SampleBatch sent = EveryColumn(n, n, /*consecutive=*/true);
+      if (bad < n) sent.index[bad] += 7;
+      for (auto precision : {ColumnPrecision::kFloat64, ColumnPrecision::kFloat32}) {
+        for (auto encoding : {ColumnEncoding::kRaw, ColumnEncoding::kPacked}) {
+          v1::SampleBatch wire;
+          ToProto(sent, fields, Stream(precision, encoding), &wire);
+          EXPECT_EQ(wire.index_size(), bad < n ? static_cast<int>(n) : 0) << n << " " << bad;
+          SampleBatch got;
+          ASSERT_TRUE(AppendFromProto(wire, fields, &got).ok());
+          ASSERT_EQ(got.index, sent.index);
+          for (auto column : kValueColumns) {
+            ASSERT_EQ((got.*column).size(), n);
+            for (size_t i = 0; i < n; ++i) {
+              const double expected =
+                  precision == ColumnPrecision::kFloat64
+                      ? (sent.*column)[i]
+                      : static_cast<double>(static_cast<float>((sent.*column)[i]));
+              ASSERT_EQ(Bits((got.*column)[i]), Bits(expected)) << n << " " << i;
+            }
+          }
+        }
+      }
+    }
+  }
+}
+
 TEST(RawColumns, AreLittleEndianIeeeValuesBackToBack) {
   // The layout the proto documents, checked byte by byte against the value's
   // bits rather than against our own decoder.

@@ -1,9 +1,11 @@
 // MemoryTrimmer gives freed heap pages back: resident memory falls after a
-// pass where, without one, glibc would keep it.
+// pass where, without one, glibc would keep it. SetServerMallocOptions keeps
+// a stream's message-sized buffers in the heap and maps large ones apart.
 #include "server/memory_trimmer.h"
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -11,6 +13,10 @@
 #include <vector>
 
 #include "gtest/gtest.h"
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 namespace sfc {
 namespace {
@@ -59,6 +65,28 @@ TEST(MemoryTrimmer, TheBackgroundThreadRunsPassesAndStopsOnDestruction) {
   }
   EXPECT_GE(trimmer.passes(), 3u);
 }  // the destructor joins: a hang here fails the test by its timeout
+
+#if defined(__GLIBC__)
+TEST(SetServerMallocOptions, AStreamsMessageBuffersStayInTheHeapAndLargeOnesGoBack) {
+  SetServerMallocOptions();
+  // A float32 message of 65536 samples (1.3 MB) comes from the heap, and its
+  // pages stay resident at the heap's top when it is freed, for the next
+  // message (with the old fixed 1 MiB threshold it was a mapping of its own,
+  // and glibc's default heap top of 128 KiB would not have kept it either).
+  constexpr size_t kMessage = 1'310'720;
+  const size_t mapped = mallinfo2().hblks;
+  char* volatile message = static_cast<char*>(std::malloc(kMessage));  // volatile: not elided
+  for (size_t i = 0; i < kMessage; i += 4096) message[i] = 1;
+  EXPECT_EQ(mallinfo2().hblks, mapped);
+  std::free(message);
+  EXPECT_GE(mallinfo2().keepcost, kMessage);
+  // A buffer of 4 MiB or more is its own mapping, given back when freed.
+  void* volatile large = std::malloc(8 << 20);
+  EXPECT_EQ(mallinfo2().hblks, mapped + 1);
+  std::free(large);
+  EXPECT_EQ(mallinfo2().hblks, mapped);
+}
+#endif
 
 }  // namespace
 }  // namespace sfc
