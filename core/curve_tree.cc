@@ -7,6 +7,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "base/status_macros.h"
+#include "core/area_estimator.h"
 #include "core/vector_math.h"
 
 namespace sfc {
@@ -986,11 +987,12 @@ absl::StatusOr<CurveTreeOptions> ResolveOptions(const Surface& surface, CurveTre
   }
   if (options.max_leaves == 0) return absl::InvalidArgumentError("max_leaves must be >= 1");
   if (options.depth_cap == 0) options.depth_cap = curve.max_depth();
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  double u = 0, v = 0;
+  if (!WidenByGridPoints(surface, &lo, &hi, &u, &v)) return SurfaceNotFiniteError(u, v);
+  const double diagonal = Diagonal(lo, hi);
+  RETURN_IF_ERROR(CheckSize("the surface", diagonal));
   if (options.tolerance == 0) {
-    Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-    double u = 0, v = 0;
-    if (!WidenByGridPoints(surface, &lo, &hi, &u, &v)) return SurfaceNotFiniteError(u, v);
-    const double diagonal = Norm(hi - lo);
     if (!(diagonal > 0)) {
       return absl::InvalidArgumentError(
           "the surface maps the whole parameter box to one point; it has no area to sample");
@@ -1050,7 +1052,13 @@ absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Build(const Surface&
         "the surface has zero area (its area element vanishes on the whole parameter box, e.g. "
         "it is a curve or a point); there is nothing to sample");
   }
-  if (!(base > 0) || !std::isfinite(base)) {
+  if (std::isnan(base) || base == INFINITY) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the density times the area element integrates to %g over the surface: the density's "
+        "values overflow double precision; scale it down (only its ratios matter)",
+        base));
+  }
+  if (!(base > 0)) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "the density integrates to %g over the surface; it must be positive somewhere (check "
         "the density, or add a floor)",
