@@ -717,12 +717,34 @@ class CurveTree::Builder {
   static constexpr int kHiddenLevels = 12;
   static constexpr int kHiddenEvaluations = 64;
 
+  // Whether the density at one of the 3 x 3 cell centres of [u0, u1] x
+  // [v0, v1] exceeds `limit` (or cannot be evaluated): a feature there,
+  // seen. A bound above the limit that no probe of the narrowed part
+  // confirms is interval arithmetic's overestimate, not a feature: where
+  // terms cancel (x*x - 2*x*y + y*y, sin(u)^2 + cos(u)^2) its widening
+  // shrinks only in proportion to the part, and the part would be split
+  // without end.
+  bool Confirmed(double u0, double u1, double v0, double v1, double limit) const {
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        const absl::StatusOr<DensityAt> at = EvaluateDensity(
+            surface_, density_, u0 + (u1 - u0) * (2 * i + 1) / 6, v0 + (v1 - v0) * (2 * j + 1) / 6);
+        if (!at.ok() || !(at->delta <= limit)) return true;
+      }
+    }
+    return false;
+  }
+
   // The sum of UpperBound times parameter area over the parts of [u0, u1] x
-  // [v0, v1] whose bound exceeds `limit`, given its own `bound` (> limit).
+  // [v0, v1] whose bound exceeds `limit`, given its own `bound` (> limit),
+  // each narrowed part counted only when a probe in it confirms the bound
+  // (Confirmed).
   double BoundAbove(double u0, double u1, double v0, double v1, double bound, int level,
                     double limit, int* budget) const {
     const double whole = bound * (u1 - u0) * (v1 - v0);
-    if (level == kHiddenLevels || *budget < 4) return whole;
+    if (level == kHiddenLevels || *budget < 4) {
+      return Confirmed(u0, u1, v0, v1, limit) ? whole : 0.0;
+    }
     *budget -= 4;
     const double um = u0 + (u1 - u0) / 2, vm = v0 + (v1 - v0) / 2;
     const double b[4] = {density_.UpperBound(surface_, u0, um, v0, v1),
