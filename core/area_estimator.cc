@@ -114,6 +114,21 @@ absl::Status SurfaceNotFiniteError(double u, double v) {
       u, v));
 }
 
+double Diagonal(const Vec3& lo, const Vec3& hi) {
+  return std::hypot(std::hypot(hi.x - lo.x, hi.y - lo.y), hi.z - lo.z);
+}
+
+absl::Status CheckSize(std::string_view what, double diagonal) {
+  if (diagonal == 0 || (diagonal >= kSmallestSize && diagonal <= kLargestSize)) {
+    return absl::OkStatus();
+  }
+  return absl::InvalidArgumentError(absl::StrFormat(
+      "%s spans %g (its bounding box's diagonal), outside [%g, %g], where its area element "
+      "would %s double precision; scale it into that range and scale the samples back",
+      what, diagonal, kSmallestSize, kLargestSize,
+      diagonal > kLargestSize ? "overflow" : "lose its digits in"));
+}
+
 absl::StatusOr<DensityAt> EvaluateDensity(const Surface& surface, const Density& density, double u,
                                           double v) {
   // Curvatures and the normal are computed only for densities that read them:

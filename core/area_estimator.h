@@ -20,6 +20,20 @@ namespace sfc {
 // INVALID_ARGUMENT saying the surface is not finite at (u, v) and what to fix.
 absl::Status SurfaceNotFiniteError(double u, double v);
 
+// The sizes (a bounding box's diagonal) whose area elements double precision
+// holds: |f_u x f_v| and the first fundamental form's E G - F^2 take the
+// fourth power of a size, which overflows past about 1e77 and loses its
+// digits to subnormals below about 1e-77.
+inline constexpr double kSmallestSize = 1e-75;
+inline constexpr double kLargestSize = 1e75;
+// The diagonal of the box [lo, hi], without overflow or underflow in its
+// squares.
+double Diagonal(const Vec3& lo, const Vec3& hi);
+// OK when `diagonal` is 0 (left to the caller's "no area" message) or in
+// [kSmallestSize, kLargestSize]; else INVALID_ARGUMENT naming `what` (the
+// surface, a mesh) and saying to scale it.
+absl::Status CheckSize(std::string_view what, double diagonal);
+
 // The density's view of the point (u, v) whose jet is `jet`, with the area
 // element there in *area_element (|f_u x f_v|; infinite on a singular line).
 // The normal and curvatures are filled only when `curvature` is set.

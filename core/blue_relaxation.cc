@@ -205,8 +205,9 @@ absl::Status Relaxation::ForParts(size_t n,
 template <typename F>
 bool Relaxation::AnyNear(uint32_t i, const Vec3& x, const F& f) const {
   const double ri = r_[i];
-  // Every cell that meets the cube of side 2 r_i around x (two a side when
-  // r_i is at most half a cell).
+  // Every cell that meets the cube of side 2 r_i around x (one or two a
+  // side at the median radius, cells being kCellRadii median radii; more for
+  // a radius clamped at kMaxSpacingRatio medians).
   const int64_t x0 = main_.Cell(x.x - ri), x1 = main_.Cell(x.x + ri);
   const int64_t y0 = main_.Cell(x.y - ri), y1 = main_.Cell(x.y + ri);
   const int64_t z0 = main_.Cell(x.z - ri), z1 = main_.Cell(x.z + ri);
@@ -218,7 +219,7 @@ bool Relaxation::AnyNear(uint32_t i, const Vec3& x, const F& f) const {
     return d2 < r * r && f(e.id, d2 / (r * r));
   };
   // The cells' Morton codes from each coordinate's spread bits, spread once
-  // (a query meets 2 x 2 x 2 cells of both grids: 6 spreads, not 48).
+  // (a query of 2 x 2 x 2 cells of both grids: 6 spreads, not 48).
   constexpr int64_t kKept = 4;
   uint64_t sz[kKept];
   for (int64_t c = z0; c <= std::min(z1, z0 + kKept - 1); ++c)

@@ -7,6 +7,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "base/status_macros.h"
+#include "core/area_estimator.h"
 #include "core/vector_math.h"
 
 namespace sfc {
@@ -716,12 +717,34 @@ class CurveTree::Builder {
   static constexpr int kHiddenLevels = 12;
   static constexpr int kHiddenEvaluations = 64;
 
+  // Whether the density at one of the 3 x 3 cell centres of [u0, u1] x
+  // [v0, v1] exceeds `limit` (or cannot be evaluated): a feature there,
+  // seen. A bound above the limit that no probe of the narrowed part
+  // confirms is interval arithmetic's overestimate, not a feature: where
+  // terms cancel (x*x - 2*x*y + y*y, sin(u)^2 + cos(u)^2) its widening
+  // shrinks only in proportion to the part, and the part would be split
+  // without end.
+  bool Confirmed(double u0, double u1, double v0, double v1, double limit) const {
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        const absl::StatusOr<DensityAt> at = EvaluateDensity(
+            surface_, density_, u0 + (u1 - u0) * (2 * i + 1) / 6, v0 + (v1 - v0) * (2 * j + 1) / 6);
+        if (!at.ok() || !(at->delta <= limit)) return true;
+      }
+    }
+    return false;
+  }
+
   // The sum of UpperBound times parameter area over the parts of [u0, u1] x
-  // [v0, v1] whose bound exceeds `limit`, given its own `bound` (> limit).
+  // [v0, v1] whose bound exceeds `limit`, given its own `bound` (> limit),
+  // each narrowed part counted only when a probe in it confirms the bound
+  // (Confirmed).
   double BoundAbove(double u0, double u1, double v0, double v1, double bound, int level,
                     double limit, int* budget) const {
     const double whole = bound * (u1 - u0) * (v1 - v0);
-    if (level == kHiddenLevels || *budget < 4) return whole;
+    if (level == kHiddenLevels || *budget < 4) {
+      return Confirmed(u0, u1, v0, v1, limit) ? whole : 0.0;
+    }
     *budget -= 4;
     const double um = u0 + (u1 - u0) / 2, vm = v0 + (v1 - v0) / 2;
     const double b[4] = {density_.UpperBound(surface_, u0, um, v0, v1),
@@ -986,11 +1009,12 @@ absl::StatusOr<CurveTreeOptions> ResolveOptions(const Surface& surface, CurveTre
   }
   if (options.max_leaves == 0) return absl::InvalidArgumentError("max_leaves must be >= 1");
   if (options.depth_cap == 0) options.depth_cap = curve.max_depth();
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  double u = 0, v = 0;
+  if (!WidenByGridPoints(surface, &lo, &hi, &u, &v)) return SurfaceNotFiniteError(u, v);
+  const double diagonal = Diagonal(lo, hi);
+  RETURN_IF_ERROR(CheckSize("the surface", diagonal));
   if (options.tolerance == 0) {
-    Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-    double u = 0, v = 0;
-    if (!WidenByGridPoints(surface, &lo, &hi, &u, &v)) return SurfaceNotFiniteError(u, v);
-    const double diagonal = Norm(hi - lo);
     if (!(diagonal > 0)) {
       return absl::InvalidArgumentError(
           "the surface maps the whole parameter box to one point; it has no area to sample");
@@ -1050,7 +1074,13 @@ absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Build(const Surface&
         "the surface has zero area (its area element vanishes on the whole parameter box, e.g. "
         "it is a curve or a point); there is nothing to sample");
   }
-  if (!(base > 0) || !std::isfinite(base)) {
+  if (std::isnan(base) || base == INFINITY) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the density times the area element integrates to %g over the surface: the density's "
+        "values overflow double precision; scale it down (only its ratios matter)",
+        base));
+  }
+  if (!(base > 0)) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "the density integrates to %g over the surface; it must be positive somewhere (check "
         "the density, or add a floor)",

@@ -5,6 +5,8 @@
 #include <utility>
 
 #include "absl/strings/str_format.h"
+#include "base/status_macros.h"
+#include "core/area_estimator.h"
 
 namespace sfc {
 
@@ -63,13 +65,18 @@ absl::Status FinalizeMesh(TriangleMesh* mesh) {
     return absl::InvalidArgumentError(
         absl::StrFormat("mesh '%s' has no triangles: give a file with at least one face", name));
   }
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
   for (size_t i = 0; i < nv; ++i) {
-    if (!IsFinite(mesh->positions[i])) {
+    const Vec3& p = mesh->positions[i];
+    if (!IsFinite(p)) {
       return absl::InvalidArgumentError(absl::StrFormat(
           "mesh '%s': vertex %d has a coordinate that is not a finite number (NaN or infinity)",
           name, i));
     }
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
   }
+  if (nv > 0) RETURN_IF_ERROR(CheckSize(absl::StrFormat("mesh '%s'", name), Diagonal(lo, hi)));
   if (!mesh->normals.empty()) {
     if (mesh->normals.size() != nv) {
       return absl::InvalidArgumentError(absl::StrFormat(

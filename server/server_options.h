@@ -64,10 +64,11 @@ struct ServerOptions {
   // An upload that sends no chunk for this long is cut (so an idle client
   // holds its stream and the model budget it reserved no longer than that).
   double upload_idle_timeout_seconds = 30;
-  // After its first upload_idle_timeout_seconds an upload must have averaged
-  // at least this many bytes a second since it began, or it is cut: a client
-  // that sends a byte just before every idle cut would otherwise hold its
-  // declared size for ever.
+  // An upload t seconds old must have sent at least this many bytes a second
+  // times (t - upload_idle_timeout_seconds), checked at each chunk (a grace
+  // of one idle timeout, then the rate), or it is cut: a client that sends a
+  // byte just before every idle cut would otherwise hold its declared size
+  // for ever.
   double upload_min_bytes_per_second = 256 << 10;
   double shutdown_grace_seconds = 10;          // SIGTERM: in-flight streams get this long
 

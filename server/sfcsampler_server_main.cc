@@ -163,8 +163,8 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   app.add_option("--upload-min-rate", o.upload_min_bytes_per_second,
-                 "bytes a second an UploadModel stream must average once it is "
-                 "--upload-idle-timeout seconds old, or it is cut")
+                 "bytes a second an UploadModel stream must keep up after a grace of "
+                 "--upload-idle-timeout seconds, or it is cut")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   app.add_option("--generation-threads", o.limits.generation_threads,

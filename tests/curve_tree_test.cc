@@ -239,6 +239,37 @@ TEST(CurveTree, ADensityTooSmallToResolveIsRefusedAndSmallOnesAreUniform) {
   for (int q : quadrant) EXPECT_NEAR(q, n / 4.0, 2.0);  // one sample a stratum: exact to 2
 }
 
+// Sizes whose area element overflows or underflows double precision, and
+// densities whose values overflow, are refused with what to scale: not as a
+// density that "integrates to nan" or a surface of "zero area". Sizes well
+// inside the range still sample.
+TEST(CurveTree, SizesAndDensitiesBeyondDoublePrecisionAreRefusedWithWhatToScale) {
+  const auto density = MakeDensity("uniform");
+  ASSERT_TRUE(density.ok());
+  for (const char* spec : {"sphere:r=1e100", "sphere:r=1e-100", "torus:R=1e160;r=1",
+                           "expr:x=1e200*u;y=v;z=0"}) {
+    auto surface = MakeSurface(spec);
+    ASSERT_TRUE(surface.ok()) << spec << surface.status();
+    const auto tree = CurveTree::Build(*surface->surface, *density->density, {}, 10);
+    ASSERT_EQ(tree.status().code(), absl::StatusCode::kInvalidArgument) << spec;
+    EXPECT_NE(tree.status().message().find("scale it into that range"), std::string::npos)
+        << tree.status();
+  }
+  for (const char* spec : {"sphere:r=1e60", "sphere:r=1e-60"}) {
+    const auto s = MakeSetup(spec, "uniform", 1000);
+    EXPECT_NE(s.tree, nullptr) << spec;
+  }
+  // Each value is finite, but their integral over a sphere of area 1.3e5 is
+  // not.
+  const auto sphere = MakeSurface("sphere:r=100");
+  ASSERT_TRUE(sphere.ok());
+  const auto huge = MakeDensity("expr:1e306*(1+u)");
+  ASSERT_TRUE(huge.ok()) << huge.status();
+  const auto tree = CurveTree::Build(*sphere->surface, *huge->density, {}, 10);
+  ASSERT_EQ(tree.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(tree.status().message().find("overflow"), std::string::npos) << tree.status();
+}
+
 TEST(CurveTree, SingularLinesAreLocatedAndTheTreeStaysSmall) {
   // The paper's Sect. 5.3 surface without reparameterisation: the area
   // element is infinite on u = 1/2 and v in {0, 1/4, 1/2, 3/4, 1}. Those

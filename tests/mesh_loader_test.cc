@@ -194,6 +194,20 @@ void ExpectIdentical(const TriangleMesh& a, const TriangleMesh& b) {
 // The direct reader of plain binary PLY (mesh/plain_ply.h) takes the files it
 // claims and makes the mesh CGAL's reader makes of the same values in ASCII
 // (17 digits: exact); every other layout goes to CGAL's reader.
+// A mesh whose triangles' areas overflow or underflow double precision is
+// refused as too large or too small, not as "degenerate".
+TEST(MeshLoader, AMeshBeyondDoublePrecisionIsRefusedWithWhatToScale) {
+  for (const char* size : {"1e200", "1e-200"}) {
+    const std::string obj =
+        absl::StrFormat("v 0 0 0\nv %s 0 0\nv 0 %s 0\nf 1 2 3\n", size, size);
+    auto loaded = LoadMesh(obj, "far.obj");
+    ASSERT_EQ(loaded.status().code(), absl::StatusCode::kInvalidArgument) << size;
+    EXPECT_NE(loaded.status().message().find("mesh 'far.obj' spans"), std::string::npos)
+        << loaded.status();
+  }
+  EXPECT_TRUE(LoadMesh("v 0 0 0\nv 1e30 0 0\nv 0 1e30 0\nf 1 2 3\n", "wide.obj").ok());
+}
+
 TEST(MeshLoader, PlainBinaryPlyReadsAsTheGeneralReaderDoes) {
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> wobble(-0.2, 0.2);

@@ -129,14 +129,14 @@ TEST(ServerModels, ATricklingUploadIsCutAtTheMinimumRate) {
   auto channel = grpc::CreateChannel("127.0.0.1:" + std::to_string(r.server->port()),
                                      grpc::InsecureChannelCredentials());
   auto stub = v1::Sampler::NewStub(channel);
-  const auto upload = [&](int bytes_a_chunk) {
+  const auto upload = [&](size_t size, int bytes_a_chunk) {
     grpc::ClientContext context;
     // Bounds the test should the server never cut it.
     context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
     v1::ModelInfo info;
     auto writer = stub->UploadModel(&context, &info);
     const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-    std::string rest = obj + std::string(3000 - obj.size(), '\n');  // a valid OBJ of 3 000 bytes
+    std::string rest = obj + std::string(size - obj.size(), '\n');  // a valid OBJ
     v1::ModelChunk chunk;
     chunk.set_format("obj");
     chunk.set_total_bytes(rest.size());
@@ -155,7 +155,7 @@ TEST(ServerModels, ATricklingUploadIsCutAtTheMinimumRate) {
   };
   // 8 bytes every 0.25 s: 32 bytes a second.
   const auto start = std::chrono::steady_clock::now();
-  const grpc::Status slow = upload(8);
+  const grpc::Status slow = upload(6000, 8);
   EXPECT_EQ(slow.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED) << slow.error_message();
   EXPECT_NE(slow.error_message().find("upload_min_rate"), std::string::npos)
       << slow.error_message();
@@ -167,9 +167,9 @@ TEST(ServerModels, ATricklingUploadIsCutAtTheMinimumRate) {
   }
   EXPECT_EQ(r.server->models().stats().upload_bytes, 0u);
   EXPECT_EQ(r.server->models().stats().models, 0u);
-  // 500 bytes every 0.25 s, twice the minimum rate, for longer than the
-  // idle timeout: stored.
-  const grpc::Status fast = upload(500);
+  // 1 000 bytes every 0.25 s, twice the minimum rate, for twice the idle
+  // timeout: stored.
+  const grpc::Status fast = upload(6000, 1000);
   EXPECT_TRUE(fast.ok()) << fast.error_message();
   EXPECT_EQ(r.server->models().stats().models, 1u);
 }
