@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/vector_math.h"
+
 namespace sfc {
 namespace {
 
@@ -18,7 +20,7 @@ constexpr double kPeriodicLimit = 1e6;
 // One ulp outward, for correctly rounded operations.
 double Down(double x) { return std::nextafter(x, -kInf); }
 double Up(double x) { return std::nextafter(x, kInf); }
-// The library margin outward, for C library functions and composite steps.
+// The library margin outward, for elementary functions and composite steps.
 double LibDown(double x) {
   return std::isfinite(x) ? x - (std::fabs(x) * kLibmMargin + kTiny) : x;
 }
@@ -36,7 +38,7 @@ Interval LibMake(double a, double b) {
 bool HasInf(const Interval& x) { return std::isinf(x.lo) || std::isinf(x.hi); }
 bool HasZero(const Interval& x) { return x.lo <= 0 && x.hi >= 0; }
 
-// A C library function that is non-decreasing on the interval.
+// An elementary function that is non-decreasing on the interval.
 template <typename F>
 Interval Increasing(const Interval& x, F f) {
   if (x.maybe_nan) return Interval::NaN();
@@ -126,7 +128,7 @@ Interval Fourth(const Interval& x) {
 Interval Pow(const Interval& x, const Interval& y) {
   if (y.IsPoint() && y.lo == 0) return Interval::Point(1);  // pow(anything, 0) = 1
   if (x.maybe_nan || y.maybe_nan) return Interval::NaN();
-  auto pow = [](double a, double b) { return std::pow(a, b); };
+  auto pow = [](double a, double b) { return math::Pow(a, b); };
   if (y.IsPoint()) {
     const double n = y.lo;
     if (std::isfinite(n) && n == std::floor(n)) {
@@ -151,7 +153,7 @@ Interval Pow(const Interval& x, const Interval& y) {
 Interval Sin(const Interval& x) {
   if (x.maybe_nan || HasInf(x)) return Interval::NaN();  // sin(inf) is NaN
   if (!Periodic(x, 2 * kPi)) return Interval::Of(LibDown(-1), LibUp(1));
-  Interval r = LibMake(std::sin(x.lo), std::sin(x.hi));
+  Interval r = LibMake(math::SinCosOf(x.lo).sin, math::SinCosOf(x.hi).sin);
   if (HasCritical(x, kPi / 2, 2 * kPi)) r.hi = LibUp(1);
   if (HasCritical(x, -kPi / 2, 2 * kPi)) r.lo = LibDown(-1);
   return r;
@@ -160,7 +162,7 @@ Interval Sin(const Interval& x) {
 Interval Cos(const Interval& x) {
   if (x.maybe_nan || HasInf(x)) return Interval::NaN();
   if (!Periodic(x, 2 * kPi)) return Interval::Of(LibDown(-1), LibUp(1));
-  Interval r = LibMake(std::cos(x.lo), std::cos(x.hi));
+  Interval r = LibMake(math::SinCosOf(x.lo).cos, math::SinCosOf(x.hi).cos);
   if (HasCritical(x, 0, 2 * kPi)) r.hi = LibUp(1);
   if (HasCritical(x, kPi, 2 * kPi)) r.lo = LibDown(-1);
   return r;
@@ -169,80 +171,80 @@ Interval Cos(const Interval& x) {
 Interval Tan(const Interval& x) {
   if (x.maybe_nan || HasInf(x)) return Interval::NaN();
   if (!Periodic(x, kPi) || HasCritical(x, kPi / 2, kPi)) return Interval::Of(-kInf, kInf);
-  return Increasing(x, [](double t) { return std::tan(t); });
+  return Increasing(x, [](double t) { return math::Tan(t); });
 }
 
 Interval Asin(const Interval& x) {
   if (x.lo < -1 || x.hi > 1) return Interval::NaN();
-  return Increasing(x, [](double t) { return std::asin(t); });
+  return Increasing(x, [](double t) { return math::Asin(t); });
 }
 
 Interval Acos(const Interval& x) {
   if (x.lo < -1 || x.hi > 1) return Interval::NaN();
-  return Decreasing(x, [](double t) { return std::acos(t); });
+  return Decreasing(x, [](double t) { return math::Acos(t); });
 }
 
 Interval Atan(const Interval& x) {
-  return Increasing(x, [](double t) { return std::atan(t); });
+  return Increasing(x, [](double t) { return math::Atan(t); });
 }
 
 Interval Atan2(const Interval& y, const Interval& x) {
   if (x.maybe_nan || y.maybe_nan) return Interval::NaN();
   if (x.lo > 0 && !HasInf(x) && !HasInf(y)) {
     // On the right half-plane atan2 is monotone in each argument: corners.
-    const double c[4] = {std::atan2(y.lo, x.lo), std::atan2(y.lo, x.hi), std::atan2(y.hi, x.lo),
-                         std::atan2(y.hi, x.hi)};
+    const double c[4] = {math::Atan2(y.lo, x.lo), math::Atan2(y.lo, x.hi), math::Atan2(y.hi, x.lo),
+                         math::Atan2(y.hi, x.hi)};
     return Make(LibDown(*std::min_element(c, c + 4)), LibUp(*std::max_element(c, c + 4)));
   }
   return Interval::Of(LibDown(-kPi), LibUp(kPi));
 }
 
 Interval Sinh(const Interval& x) {
-  return Increasing(x, [](double t) { return std::sinh(t); });
+  return Increasing(x, [](double t) { return math::Sinh(t); });
 }
 
 Interval Cosh(const Interval& x) {
   if (x.maybe_nan) return Interval::NaN();
-  const double big = std::cosh(std::max(-x.lo, x.hi));
-  const double small = HasZero(x) ? 1 : std::cosh(std::min(std::fabs(x.lo), std::fabs(x.hi)));
+  const double big = math::Cosh(std::max(-x.lo, x.hi));
+  const double small = HasZero(x) ? 1 : math::Cosh(std::min(std::fabs(x.lo), std::fabs(x.hi)));
   return Make(LibDown(small), LibUp(big));
 }
 
 Interval Tanh(const Interval& x) {
-  return Increasing(x, [](double t) { return std::tanh(t); });
+  return Increasing(x, [](double t) { return math::Tanh(t); });
 }
 
 Interval Asinh(const Interval& x) {
-  return Increasing(x, [](double t) { return std::asinh(t); });
+  return Increasing(x, [](double t) { return math::Asinh(t); });
 }
 
 Interval Acosh(const Interval& x) {
   if (x.lo < 1) return Interval::NaN();
-  return Increasing(x, [](double t) { return std::acosh(t); });
+  return Increasing(x, [](double t) { return math::Acosh(t); });
 }
 
 Interval Atanh(const Interval& x) {
   if (x.lo < -1 || x.hi > 1) return Interval::NaN();
-  return Increasing(x, [](double t) { return std::atanh(t); });
+  return Increasing(x, [](double t) { return math::Atanh(t); });
 }
 
 Interval Exp(const Interval& x) {
-  return Increasing(x, [](double t) { return std::exp(t); });
+  return Increasing(x, [](double t) { return math::Exp(t); });
 }
 
 Interval Log(const Interval& x) {
   if (x.lo < 0) return Interval::NaN();
-  return Increasing(x, [](double t) { return std::log(t); });
+  return Increasing(x, [](double t) { return math::Log(t); });
 }
 
 Interval Log2(const Interval& x) {
   if (x.lo < 0) return Interval::NaN();
-  return Increasing(x, [](double t) { return std::log2(t); });
+  return Increasing(x, [](double t) { return math::Log2(t); });
 }
 
 Interval Log10(const Interval& x) {
   if (x.lo < 0) return Interval::NaN();
-  return Increasing(x, [](double t) { return std::log10(t); });
+  return Increasing(x, [](double t) { return math::Log10(t); });
 }
 
 Interval Sqrt(const Interval& x) {

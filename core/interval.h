@@ -2,14 +2,21 @@
 // patches (Surface::Bound) and of user expressions.
 //
 // An Interval [lo, hi] encloses every double that the same computation, done
-// in ordinary round-to-nearest double arithmetic with the C library, yields
-// for any inputs inside the input intervals; for the continuous operations it
-// also encloses the exact real result (rint, sign and the comparisons enclose
-// what the double code computes, which is what sampling needs). Each operation computes its end
-// points in round-to-nearest and then widens them outward: one ulp (std::nextafter) after the
-// correctly rounded operations (+ - * / sqrt), and a relative margin of kLibmMargin after C library
-// functions, whose results glibc documents to within a few ulp and which need not be monotone to
-// the last bit.
+// in ordinary round-to-nearest double arithmetic with the project's
+// elementary functions (core/vector_math.h: SLEEF's, as the double code
+// uses) or the C library's, yields for any inputs inside the input
+// intervals; for the continuous operations it also encloses the exact real
+// result (rint, sign and the comparisons enclose what the double code
+// computes, which is what sampling needs). Each operation computes its end
+// points in round-to-nearest and then widens them outward: one ulp
+// (std::nextafter) after the correctly rounded operations (+ - * / sqrt), and
+// a relative margin of kLibmMargin after elementary functions, whose results
+// SLEEF and glibc document to within a few ulp and which need not be monotone
+// to the last bit. The end points come from core/vector_math.h's functions,
+// not the C library's (whose FMA code paths differ in the last bit between
+// CPUs), so a bound is the same bits on every machine: the tree's
+// hidden-mass check compares bounds, and its trees must not depend on the
+// CPU.
 //
 // NaN is tracked explicitly: `maybe_nan` says the computation may yield NaN
 // (sqrt of a negative, 0 * inf, inf - inf, sin(inf), pow of a negative to a
@@ -41,7 +48,7 @@ struct Interval {
   bool Contains(double x) const { return maybe_nan || (x >= lo && x <= hi); }
 };
 
-// Relative outward margin after C library functions (about 450 ulp).
+// Relative outward margin after elementary functions (about 450 ulp).
 inline constexpr double kLibmMargin = 1e-13;
 
 // The smallest interval holding both.
@@ -59,10 +66,10 @@ Interval Square(const Interval& x);
 Interval Cube(const Interval& x);
 Interval Fourth(const Interval& x);
 
-// std::pow(x, y).
+// Pow(x, y) (math::Pow, the C library's pow within 1 ulp).
 Interval Pow(const Interval& x, const Interval& y);
 
-// The C library functions of the same name.
+// The elementary functions of the same name (core/vector_math.h).
 Interval Sin(const Interval& x);
 Interval Cos(const Interval& x);
 Interval Tan(const Interval& x);
