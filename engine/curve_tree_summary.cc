@@ -26,6 +26,7 @@ void FillTreeSummary(const CurveTree& tree, TreeSummary* out) {
   for (const DepthCapHit& hit : precision.worst) out->warnings.push_back(ToCell(hit));
   out->error_samples = precision.error_samples;
   out->unresolved_error_samples = precision.unresolved_error_samples;
+  out->hidden_share = precision.hidden_share;
   out->singular_leaves = precision.singular_leaves;
   out->warped_leaves = precision.warped_leaves;
   out->small_failing_leaves = precision.small_failing_leaves;

@@ -282,6 +282,7 @@ void ToProto(const TreeSummary& s, v1::TreeInfo* out) {
   for (const TreeSummary::Cell& cell : s.warnings) ToProto(cell, out->add_warnings());
   out->set_error_samples(s.error_samples);
   out->set_unresolved_error_samples(s.unresolved_error_samples);
+  out->set_hidden_share(s.hidden_share);
   out->set_singular_leaves(s.singular_leaves);
   out->set_warped_leaves(s.warped_leaves);
   out->set_small_failing_leaves(s.small_failing_leaves);
@@ -307,6 +308,7 @@ TreeSummary FromProto(const v1::TreeInfo& p) {
   s.warnings = FromProto(p.warnings());
   s.error_samples = p.error_samples();
   s.unresolved_error_samples = p.unresolved_error_samples();
+  s.hidden_share = p.hidden_share();
   s.singular_leaves = p.singular_leaves();
   s.warped_leaves = p.warped_leaves();
   s.small_failing_leaves = p.small_failing_leaves();

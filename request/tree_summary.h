@@ -51,6 +51,12 @@ struct TreeSummary {
   // The leaf models' mass error summed over all leaves, in samples of the
   // grade, and the part of it in leaves the tests still wanted to split.
   double error_samples = 0, unresolved_error_samples = 0;
+  // What the leaves may still hide of the total mass in features narrower
+  // than the tree's probes (found by interval bounds, confirmed by a probe;
+  // docs/ALGORITHM.md, "Features narrower than the probes"); the build is
+  // refused above CurveTree::kHiddenShare. 0 for densities that cannot bound
+  // themselves.
+  double hidden_share = 0;
   // Leaves with a singular area element that no edge power law fits, those
   // fitted by one (warped), the finest of either (at most 8), and leaves the
   // error test wanted to split that carry too few samples to matter.

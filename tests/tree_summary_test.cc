@@ -68,6 +68,7 @@ void ExpectSameSummary(const TreeSummary& a, const TreeSummary& b) {
   ExpectSameCells(a.warnings, b.warnings, "warnings ");
   EXPECT_EQ(a.error_samples, b.error_samples);
   EXPECT_EQ(a.unresolved_error_samples, b.unresolved_error_samples);
+  EXPECT_EQ(a.hidden_share, b.hidden_share);
   EXPECT_EQ(a.singular_leaves, b.singular_leaves);
   EXPECT_EQ(a.warped_leaves, b.warped_leaves);
   EXPECT_EQ(a.small_failing_leaves, b.small_failing_leaves);
@@ -157,6 +158,20 @@ TEST(TreeSummary, SingularLeavesReadTheSameInProcessAndFromAServer) {
   EXPECT_GT(hard.warped_leaves, 0u);
   EXPECT_FALSE(hard.singular.empty());
   EXPECT_GT(hard.error_samples, 0);
+}
+
+// A density with a spot narrower than the tree's probes: the tree follows
+// it, and what its leaves may still hide reaches the client as in process.
+TEST(TreeSummary, AHiddenFeaturesShareReadsTheSameInProcessAndFromAServer) {
+  Running r = StartServer(LoopbackOptions());
+  TreeSpec spot = Spec("plane");
+  spot.density = "expr:0.001+1000*((u-0.6180339887)^2+(v-0.4142135624)^2<1e-7)";
+  const TreeSummary plane = ExpectSameInProcessAndFromServer(r, spot, spot, 10000);
+  EXPECT_GT(plane.hidden_share, 0);
+  EXPECT_LE(plane.hidden_share, 1.0 / 1024);
+  const TreeSummary smooth =
+      ExpectSameInProcessAndFromServer(r, Spec("torus"), Spec("torus"), 10000);
+  EXPECT_EQ(smooth.hidden_share, 0);
 }
 
 // A model's file in process, its upload on the server: the same tree key,

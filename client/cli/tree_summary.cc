@@ -33,6 +33,12 @@ void PrintFacts(const TreeSummary& t, const Verbosity& verbosity) {
                  "precision: model error %.3g samples in all (%.3g where the tests wanted more) at "
                  "N = 2^%d\n",
                  t.error_samples, t.unresolved_error_samples, t.grade);
+    if (t.hidden_share > 0) {
+      std::fprintf(stderr,
+                   "precision: features narrower than the tree's probes were found and followed; "
+                   "its leaves may still hide %.3g of the mass (refused above 1/1024)\n",
+                   t.hidden_share);
+    }
   }
   if (verbosity.no_warnings) return;
   // A note, not a warning: the power laws follow the mass (-q drops it).

@@ -40,6 +40,7 @@ py::dict TreeSummaryDict(const TreeSummary& s) {
   d["canonical"] = s.canonical;
   d["error_samples"] = s.error_samples;
   d["unresolved_error_samples"] = s.unresolved_error_samples;
+  d["hidden_share"] = s.hidden_share;
   d["singular_leaves"] = s.singular_leaves;
   d["singular"] = CellList(s.singular);
   d["small_failing_leaves"] = s.small_failing_leaves;
