@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "core/curve_tree.h"
+
 namespace sfc {
 namespace {
 
@@ -36,8 +38,8 @@ void PrintFacts(const TreeSummary& t, const Verbosity& verbosity) {
     if (t.hidden_share > 0) {
       std::fprintf(stderr,
                    "precision: features narrower than the tree's probes were found and followed; "
-                   "its leaves may still hide %.3g of the mass (refused above 1/1024)\n",
-                   t.hidden_share);
+                   "its leaves may still hide %.3g of the mass (refused above %.3g)\n",
+                   t.hidden_share, CurveTree::kHiddenShare);
     }
   }
   if (verbosity.no_warnings) return;
