@@ -17,6 +17,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -132,6 +133,18 @@ SampleRequest Request(const std::string& surface, const std::string& density, ui
   return r;
 }
 
+// A client of `target` that asks for columns of `precision` in batches of
+// `batch`, encoded as `encoding`.
+std::unique_ptr<SamplerClient> StreamClient(const std::string& target, ColumnPrecision precision,
+                                            uint32_t batch, ColumnEncoding encoding) {
+  ClientOptions co;
+  co.target = target;
+  co.stream.precision = precision;
+  co.stream.batch_size = batch;
+  co.stream.encoding = encoding;
+  return *SamplerClient::Connect(co);
+}
+
 // Streams a request, touching every sample; returns seconds and bytes of payload.
 double StreamSeconds(SamplerClient& client, const SampleRequest& request, uint64_t* received) {
   const auto start = Clock::now();
@@ -230,12 +243,7 @@ int Run(const Args& args) {
     const size_t value_bytes = precision == ColumnPrecision::kFloat32 ? 4 : 8;
     const uint64_t payload = n * 5 * value_bytes;
     if (args.repeat > 0) {
-      ClientOptions co;
-      co.target = target;
-      co.stream.precision = precision;
-      co.stream.batch_size = batch;
-      co.stream.encoding = ColumnEncoding::kRaw;
-      auto client = *SamplerClient::Connect(co);
+      auto client = StreamClient(target, precision, batch, ColumnEncoding::kRaw);
       uint64_t received = 0;
       StreamSeconds(*client, request, &received);  // builds and caches the tree
       for (int i = 0; i < args.repeat; ++i) {
@@ -270,12 +278,7 @@ int Run(const Args& args) {
         {"pipelined, packed columns", &target, ColumnEncoding::kPacked},
         {"pipelined, raw columns", &target, ColumnEncoding::kRaw}};
     for (const Setup& setup : setups) {
-      ClientOptions co;
-      co.target = *setup.target;
-      co.stream.precision = precision;
-      co.stream.batch_size = batch;
-      co.stream.encoding = setup.encoding;
-      auto client = *SamplerClient::Connect(co);
+      auto client = StreamClient(*setup.target, precision, batch, setup.encoding);
       uint64_t received = 0;
       StreamSeconds(*client, request, &received);  // warm: build and cache the tree
       const double seconds = Best([&] { return StreamSeconds(*client, request, &received); });
@@ -291,12 +294,7 @@ int Run(const Args& args) {
       // (SampleFields::uv): 3 columns a sample instead of 5.
       SampleRequest points = request;
       points.fields.uv = false;
-      ClientOptions co;
-      co.target = target;
-      co.stream.precision = precision;
-      co.stream.batch_size = batch;
-      co.stream.encoding = ColumnEncoding::kRaw;
-      auto client = *SamplerClient::Connect(co);
+      auto client = StreamClient(target, precision, batch, ColumnEncoding::kRaw);
       uint64_t received = 0;
       StreamSeconds(*client, points, &received);
       const double seconds = Best([&] { return StreamSeconds(*client, points, &received); });
@@ -307,12 +305,7 @@ int Run(const Args& args) {
           received * 3.0 * value_bytes / seconds / 1e6);
     }
     for (auto encoding : {ColumnEncoding::kPacked, ColumnEncoding::kRaw}) {
-      ClientOptions co;
-      co.target = wire_target;
-      co.stream.precision = precision;
-      co.stream.batch_size = batch;
-      co.stream.encoding = encoding;
-      auto wire_client = *SamplerClient::Connect(co);
+      auto wire_client = StreamClient(wire_target, precision, batch, encoding);
       uint64_t received = 0;
       const double wire_seconds =
           Best([&] { return StreamSeconds(*wire_client, request, &received); });

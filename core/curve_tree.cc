@@ -203,7 +203,7 @@ class CurveTree::Builder {
   // The hidden-mass sum of the tree being refined (set before RefineCell).
   void set_hidden_units(uint64_t units) { hidden_units_ = units; }
 
-  // Stage 1's certified refinement (docs/ALGORITHM.md, "Features narrower
+  // Stage 1's hidden-mass refinement (docs/ALGORITHM.md, "Features narrower
   // than the probes"): while a stage-1 leaf's hidden-mass bound exceeds
   // kStage1HiddenShare of the stage's mass, it is replaced by its children,
   // in rounds (each round's threshold from the mass of the round before), so
@@ -688,10 +688,10 @@ class CurveTree::Builder {
   // The leaf's hidden-mass bound (docs/ALGORITHM.md, "Features narrower
   // than the probes"): what the cell's mass may exceed its estimate by in the
   // parts where the density's interval upper bound (Density::UpperBound)
-  // exceeds kHiddenFactor times the largest density its Gauss nodes saw,
-  // each part counted at its bound times its share of the cell's area (the
-  // quadrature's). A part the density cannot bound, and a cell whose area
-  // element is singular, count 0.
+  // exceeds kHiddenFactor times the largest density its Gauss nodes saw and
+  // a probe confirms it (BoundAbove), each part counted at its bound times
+  // its share of the cell's area (the quadrature's). A part the density
+  // cannot bound, and a cell whose area element is singular, count 0.
   double HiddenMass(const CellEval& eval, double u0, double v0, double h) const {
     if (!density_.Bounds() || eval.piecewise || eval.singular || !std::isfinite(eval.area) ||
         !(eval.area > 0)) {

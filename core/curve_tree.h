@@ -184,12 +184,13 @@ class CurveTree {
   // of kEdgeBand of the cell.
   static constexpr double kEdgeJump = 0.05;
   static constexpr double kEdgeBand = 1.0 / 16;
-  // The hidden-mass certificate (docs/ALGORITHM.md, "Features narrower than
-  // the probes"), for densities that bound themselves (Density::Bounds). A
-  // part of a leaf may hide mass where the density's interval upper bound
-  // there exceeds kHiddenFactor times the largest density the leaf's Gauss
-  // nodes saw; the leaf's hidden-mass bound is the sum of those parts'
-  // bounds times their share of the leaf's area.
+  // The hidden-mass check (docs/ALGORITHM.md, "Features narrower than the
+  // probes"), for densities that bound themselves (Density::Bounds). A part
+  // of a leaf may hide mass where the density's interval upper bound there
+  // exceeds kHiddenFactor times the largest density the leaf's Gauss nodes
+  // saw and a probe inside the narrowed part confirms it; the leaf's hidden
+  // mass is the sum of those parts' bounds times their share of the leaf's
+  // area.
   static constexpr double kHiddenFactor = 8;
   // Stage 1 splits a leaf while its bound exceeds kStage1HiddenShare of the
   // stage's mass, within kStage1HiddenLeaves leaves added; stage 2 examines

@@ -29,8 +29,9 @@ namespace sfc {
 // stream's per-message buffers (gRPC's serialized slices of up to 1 MiB, its
 // read buffers, 65536-sample columns) reuse resident pages instead of faulting
 // in fresh ones for every message (with the threshold fixed, glibc's trim
-// threshold would stay at 128 KiB: 19 000 faults a 10^7-sample float32
-// stream, 8% of its CPU); and at most 2 arenas, as each stream's producer
+// threshold would stay at 128 KiB: 5 196 faults a 10^7-sample float32
+// stream, against 54 with these settings; docs/MEASURED.md, "Branch
+// stream-speed"); and at most 2 arenas, as each stream's producer
 // thread would otherwise get one of its own (up to 8 per core), each keeping
 // the pages its frees leave behind. What the heap keeps goes back within one
 // MemoryTrimmer interval (malloc_trim returns free pages anywhere in the

@@ -2,9 +2,9 @@
 // narrower than the probes"): a strip, a spot and a spot on the torus, each
 // at irrational positions, too narrow for any Gauss node of the tree's first
 // levels, with shares from closed forms written here. Before the hidden-mass
-// certificate each of them got no samples at all, with status OK. The same
+// check each of them got no samples at all, with status OK. The same
 // densities with their interval bounds hidden (NoBound) show that: the
-// certificate is what finds them, and it changes nothing for smooth
+// check is what finds them, and it changes nothing for smooth
 // densities or steps whose contrast the probes see.
 #include <cmath>
 #include <memory>
@@ -25,7 +25,7 @@ std::string Number(double x) {
 }
 
 // The density with its values but without its bound: the tree as it was
-// before the certificate.
+// before the check.
 class NoBound final : public Density {
  public:
   explicit NoBound(std::shared_ptr<const Density> d) : d_(std::move(d)) {}
@@ -199,7 +199,7 @@ TEST(HiddenFeatures, SmoothDensitiesAndVisibleStepsKeepTheirTrees) {
   }
 }
 
-// The certificate's refinement depends on the grade only through the leaves'
+// The check's refinement depends on the grade only through the leaves'
 // fail grades, so a cached tree refined for more samples is a fresh build.
 TEST(HiddenFeatures, ARefinedTreeAroundASpotEqualsAFreshBuild) {
   const double a = (std::sqrt(5.0) - 1) / 2, b = std::sqrt(2.0) - 1;

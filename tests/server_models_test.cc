@@ -8,6 +8,7 @@
 #include <cstring>
 #include <ctime>
 #include <functional>
+#include <memory>
 #include <string>
 #include <thread>
 #include <utility>
@@ -50,6 +51,24 @@ ServerOptions ModelServerOptions() {
   return options;
 }
 
+// A stub of the server's own service, for streams the client library would
+// not send (idle, trickling).
+std::unique_ptr<v1::Sampler::Stub> RawStub(const Running& r) {
+  return v1::Sampler::NewStub(grpc::CreateChannel(
+      "127.0.0.1:" + std::to_string(r.server->port()), grpc::InsecureChannelCredentials()));
+}
+
+// The bytes uploads hold once cut uploads' handlers have returned (they give
+// the bytes back as they return, just after the cut): waits up to 2 s for 0.
+uint64_t UploadBytesOnceFreed(const Running& r) {
+  const auto freed_by = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  while (r.server->models().stats().upload_bytes != 0 &&
+         std::chrono::steady_clock::now() < freed_by) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return r.server->models().stats().upload_bytes;
+}
+
 constexpr char kSquareObj[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
 
 // An upload that declared its size holds that size from its first chunk;
@@ -63,9 +82,7 @@ TEST(ServerModels, IdleUploadsHoldTheirDeclaredSizeOnlyUntilCut) {
   options.model_bytes = 4 * 1000 + 40;  // the 48-byte square does not fit beside them
   options.upload_idle_timeout_seconds = 3;
   Running r = StartServer(options);
-  auto channel = grpc::CreateChannel("127.0.0.1:" + std::to_string(r.server->port()),
-                                     grpc::InsecureChannelCredentials());
-  auto stub = v1::Sampler::NewStub(channel);
+  auto stub = RawStub(r);
   struct Idle {
     grpc::ClientContext context;
     v1::ModelInfo info;
@@ -103,13 +120,7 @@ TEST(ServerModels, IdleUploadsHoldTheirDeclaredSizeOnlyUntilCut) {
     EXPECT_EQ(status.error_code(), grpc::StatusCode::CANCELLED) << status.error_message();
   }
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(15));
-  // Their handlers give the bytes back as they return, just after the cut.
-  const auto freed_by = std::chrono::steady_clock::now() + std::chrono::seconds(2);
-  while (r.server->models().stats().upload_bytes != 0 &&
-         std::chrono::steady_clock::now() < freed_by) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  EXPECT_EQ(r.server->models().stats().upload_bytes, 0u);
+  EXPECT_EQ(UploadBytesOnceFreed(r), 0u);
   EXPECT_EQ(r.server->models().stats().models, 0u);  // no partial model was stored
   auto info = r.client->UploadModel("obj", "square.obj", kSquareObj);
   ASSERT_TRUE(info.ok()) << info.status();
@@ -126,9 +137,7 @@ TEST(ServerModels, ATricklingUploadIsCutAtTheMinimumRate) {
   options.upload_idle_timeout_seconds = 0.6;
   options.upload_min_bytes_per_second = 2000;
   Running r = StartServer(options);
-  auto channel = grpc::CreateChannel("127.0.0.1:" + std::to_string(r.server->port()),
-                                     grpc::InsecureChannelCredentials());
-  auto stub = v1::Sampler::NewStub(channel);
+  auto stub = RawStub(r);
   const auto upload = [&](size_t size, int bytes_a_chunk) {
     grpc::ClientContext context;
     // Bounds the test should the server never cut it.
@@ -160,12 +169,7 @@ TEST(ServerModels, ATricklingUploadIsCutAtTheMinimumRate) {
   EXPECT_NE(slow.error_message().find("upload_min_rate"), std::string::npos)
       << slow.error_message();
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
-  const auto freed_by = std::chrono::steady_clock::now() + std::chrono::seconds(2);
-  while (r.server->models().stats().upload_bytes != 0 &&
-         std::chrono::steady_clock::now() < freed_by) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  EXPECT_EQ(r.server->models().stats().upload_bytes, 0u);
+  EXPECT_EQ(UploadBytesOnceFreed(r), 0u);
   EXPECT_EQ(r.server->models().stats().models, 0u);
   // 1 000 bytes every 0.25 s, twice the minimum rate, for twice the idle
   // timeout: stored.
