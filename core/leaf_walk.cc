@@ -165,6 +165,18 @@ int LeafWalk::TabulateExact(const Square& leaf, int levels, std::vector<double>&
 }
 
 void LeafWalk::Place(const double* m, size_t n, double* u, double* v, double* curve_position) {
+  u_ = u, v_ = v, curve_position_ = curve_position;
+  t_.resize(n), reached_of_.resize(n);
+  reached_.clear(), frames_.clear();
+  // Samples [waiting, i) have their squares and wait for Continue, up to
+  // kContinueBatch of them; a warped leaf's are continued at once (its
+  // warp is the current leaf's).
+  size_t waiting = 0;
+  const auto flush = [&](size_t end, bool warped) {
+    Continue(waiting, end, warped);
+    reached_.clear(), frames_.clear();
+    waiting = end;
+  };
   size_t i = 0;
   while (i < n) {
     const size_t l = LeafFor(m[i]);
@@ -173,22 +185,27 @@ void LeafWalk::Place(const double* m, size_t n, double* u, double* v, double* cu
     // m < S_l alone puts a sample here.
     size_t j = i + 1;
     while (j < n && m[j] >= m[j - 1] && (m[j] < end_mass_ || LeafFor(m[j]) == l)) ++j;
-    double* position = curve_position == nullptr ? nullptr : curve_position + i;
-    PlaceInLeaf(m + i, j - i, u + i, v + i, position);
+    if (warped_) {
+      flush(i, false);
+      PlaceInLeaf(m + i, i, j - i);
+      flush(j, true);
+    } else {
+      PlaceInLeaf(m + i, i, j - i);
+      if (j - waiting >= kContinueBatch) flush(j, false);
+    }
     i = j;
   }
+  flush(n, false);
 }
 
-void LeafWalk::PlaceInLeaf(const double* m, size_t n, double* u, double* v,
-                           double* curve_position) {
-  t_.resize(n);
-  for (size_t i = 0; i < n; ++i) t_[i] = std::clamp((m[i] - begin_mass_) / leaf_mass_, 0.0, 1.0);
-  u_ = u, v_ = v, curve_position_ = curve_position;
-  const Square leaf{0, 1, 0, 0, 1, 0, 1, 1, 0, 0, cell_.state, 0};
-  reached_.clear();
-  reached_of_.resize(n);
-  PlaceInSquare(leaf, 0, static_cast<uint32_t>(n), 0);
-  Continue(n);
+void LeafWalk::PlaceInLeaf(const double* m, size_t begin, size_t n) {
+  for (size_t i = 0; i < n; ++i) {
+    t_[begin + i] = std::clamp((m[i] - begin_mass_) / leaf_mass_, 0.0, 1.0);
+  }
+  const uint32_t frame = static_cast<uint32_t>(frames_.size());
+  frames_.push_back({cell_.u0, cell_.v0, cell_.size, leaf_start_, leaf_span_});
+  const Square leaf{0, 1, 0, 0, 1, 0, 1, 1, 0, 0, cell_.state, 0, frame};
+  PlaceInSquare(leaf, static_cast<uint32_t>(begin), static_cast<uint32_t>(begin + n), 0);
 }
 
 int LeafWalk::CellsAtOrBelow(const double* bounds, int from, double t) {
@@ -248,6 +265,7 @@ void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end,
     cell.pos = square.pos + k * span, cell.span = span;
     cell.state = order[k].state;
     cell.depth = square.depth + levels;
+    cell.frame = square.frame;
     cell.mass = 1, cell.gx = cell.gy = 0;
     if (level < kMaxModelLevels && (cell.t1 - cell.t0) * samples_ >= kTableSamples) {
       PlaceInSquare(cell, i, j, level + 1);
@@ -265,15 +283,19 @@ void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end,
   }
 }
 
-void LeafWalk::Continue(size_t n) {
+void LeafWalk::Continue(size_t begin, size_t end, bool warped) {
   // The rest of t down its square's own curve, to the centre of the cell
   // reached: the curve digits of all n samples first, then one batch of
-  // curve decoding, then the coordinates.
+  // curve decoding, then the coordinates. Arrays of the batch are indexed
+  // from `begin`.
+  if (end <= begin) return;
+  const size_t n = end - begin;
+  const uint32_t* square_of = reached_of_.data() + begin;
   const uint64_t scale = continuation_scale_;
   fraction_.resize(n), digits_.resize(n), states_.resize(n), cx_.resize(n), cy_.resize(n);
   for (size_t i = 0; i < n; ++i) {
-    const Square& at = reached_[reached_of_[i]];
-    const double t = t_[i];
+    const Square& at = reached_[square_of[i]];
+    const double t = t_[begin + i];
     const double tr = at.t1 > at.t0 ? std::clamp((t - at.t0) / (at.t1 - at.t0), 0.0, 1.0) : 0.0;
     fraction_[i] = tr;
     // Conversions through int64_t: every value here is below 2^63, so they
@@ -289,7 +311,7 @@ void LeafWalk::Continue(size_t n) {
   // one vectorised pass (slope_batch.h).
   fx_.resize(n), fy_.resize(n), mass_.resize(n), gx_.resize(n), gy_.resize(n);
   for (size_t i = 0; i < n; ++i) {
-    const Square& at = reached_[reached_of_[i]];
+    const Square& at = reached_[square_of[i]];
     fx_[i] = static_cast<double>(static_cast<int64_t>(cx_[i])) + 0.5;
     fy_[i] = static_cast<double>(static_cast<int64_t>(cy_[i])) + 0.5;
     mass_[i] = at.mass, gx_[i] = at.gx, gy_[i] = at.gy;
@@ -300,30 +322,31 @@ void LeafWalk::Continue(size_t n) {
   slope_batch::FollowSlopes(fy_.data(), mass_.data(), gy_.data(), n, cells_power_of_two_,
                             continuation_cells_, inverse_cells_);
   for (size_t i = 0; i < n; ++i) {
-    const Square& at = reached_[reached_of_[i]];
-    if (!warped_) {
+    const Square& at = reached_[square_of[i]];
+    const Frame& leaf = frames_[at.frame];
+    if (!warped) {
       const double px = at.x0 + fx_[i] * at.side, py = at.y0 + fy_[i] * at.side;
-      u_[i] = cell_.u0 + px * cell_.size;
-      v_[i] = cell_.v0 + py * cell_.size;
+      u_[begin + i] = leaf.u0 + px * leaf.size;
+      v_[begin + i] = leaf.v0 + py * leaf.size;
     }
     if (curve_position_ != nullptr) {
       const double pos = at.pos + fraction_[i] * at.span;
-      curve_position_[i] =
-          CurvePosition(leaf_start_ + pos * leaf_span_, static_cast<double>(curve_.Span(0)));
+      curve_position_[begin + i] =
+          CurvePosition(leaf.start + pos * leaf.span, static_cast<double>(curve_.Span(0)));
     }
   }
-  if (!warped_) return;
-  PlaceWarped(0, n, fx_.data(), u_);
-  PlaceWarped(1, n, fy_.data(), v_);
+  if (!warped) return;
+  PlaceWarped(0, begin, n, fx_.data(), u_ + begin);
+  PlaceWarped(1, begin, n, fy_.data(), v_ + begin);
 }
 
-void LeafWalk::PlaceWarped(int axis, size_t n, const double* f, double* out) {
+void LeafWalk::PlaceWarped(int axis, size_t begin, size_t n, const double* f, double* out) {
   // Warp's and Unwarp's operations in order, their powers taken in batch
   // calls (the same bits as the one-value functions).
   const AxisWarp& w = model_->warp[axis];
   const double sc = split_[axis], k = w.power;
   const double origin = axis == 0 ? cell_.u0 : cell_.v0;
-  auto square = [&](size_t i) -> const Square& { return reached_[reached_of_[i]]; };
+  auto square = [&](size_t i) -> const Square& { return reached_[reached_of_[begin + i]]; };
   auto lower = [&](size_t i) { return axis == 0 ? square(i).x0 : square(i).y0; };
   base_.resize(2 * n), power_.resize(2 * n), place_.resize(n);
   double* base = base_.data();

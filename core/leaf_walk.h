@@ -100,18 +100,30 @@ class LeafWalk {
   // mass, gx, gy: FollowSlope's p and q along x and y, the density across
   // the square along x being 1 + (gx / mass)(2s - 1) at fraction s (gx = gy
   // = 0: uniform, where no model table reached the square).
+  // frame: its leaf's entry in frames_.
   struct Square {
     double t0, t1, x0, y0, side, pos, span, mass, gx, gy;
     int state;
     int depth;
+    uint32_t frame;
   };
+  // Where a leaf's unit square lies in the surface's parameters, and its
+  // span along the curve: what Continue reads of a leaf whose samples it
+  // places after the walk has left it.
+  struct Frame {
+    double u0, v0, size, start, span;
+  };
+  // Leaves with fewer samples than this wait for the next leaves' and have
+  // their curve bits followed in one batch (Continue): the batch calls are
+  // vectorised, and a leaf of a dozen samples filled few lanes.
+  static constexpr size_t kContinueBatch = 1024;
 
-  // The current run's n samples in a leaf with a warped model along `axis`
-  // (0: u, 1: v): out[i] gets the parameter of the point at fraction f[i]
-  // of the cell [x0, x0 + side] sample i reached along that axis: W of it
-  // where the curve descended in warped coordinates (DescendsWarped), else
-  // uniform in warped coordinates inside the cell.
-  void PlaceWarped(int axis, size_t n, const double* f, double* out);
+  // The run's samples [begin, begin + n), in the current leaf, whose model is
+  // warped along `axis` (0: u, 1: v): out[i] gets the parameter of the point
+  // at fraction f[i] of the cell [x0, x0 + side] sample begin + i reached
+  // along that axis: W of it where the curve descended in warped coordinates
+  // (DescendsWarped), else uniform in warped coordinates inside the cell.
+  void PlaceWarped(int axis, size_t begin, size_t n, const double* f, double* out);
   // The leaf holding m: a forward step from the current one, else a search.
   size_t LeafFor(double m) const;
   // Makes l the current leaf.
@@ -139,11 +151,13 @@ class LeafWalk {
   static int CellsAtOrBelow(const double* bounds, int from, double t);
   // Records that samples [begin, end) end in `square` (pure curve bits from there).
   void Reached(const Square& square, uint32_t begin, uint32_t end);
-  // Places the current run's n samples by pure curve bits inside the
-  // squares they reached.
-  void Continue(size_t n);
-  // Places n samples of the current leaf with non-decreasing m.
-  void PlaceInLeaf(const double* m, size_t n, double* u, double* v, double* curve_position);
+  // Places samples [begin, end) of the run by pure curve bits inside the
+  // squares they reached; `warped`: they are the current leaf's, and its
+  // model is warped.
+  void Continue(size_t begin, size_t end, bool warped);
+  // Finds the squares of the run's samples [begin, begin + n), the current
+  // leaf's, with non-decreasing m (Continue places them).
+  void PlaceInLeaf(const double* m, size_t begin, size_t n);
 
   const CurveTree& tree_;
   const Surface& surface_;
@@ -175,6 +189,7 @@ class LeafWalk {
   std::vector<GridFactors> factors_;                // their cell integrals, as factors
   std::vector<double> cell_us_, cell_vs_, cell_m_;  // an exact table's centres and densities
   std::vector<Square> reached_;                     // the squares samples end in
+  std::vector<Frame> frames_;                       // their leaves
   std::vector<uint32_t> reached_of_;                // each sample's square in reached_
   std::vector<double> fraction_;                    // each sample's fraction of its square's t
   std::vector<uint64_t> digits_, cx_, cy_;          // its curve digits and the cell they reach
