@@ -5,6 +5,7 @@
 #include <Bnd_Box2d.hxx>
 #include <Geom2dAdaptor_Curve.hxx>
 #include <Geom2d_Curve.hxx>
+#include <Precision.hxx>
 #include <Standard_Failure.hxx>
 #include <TopAbs_State.hxx>
 #include <TopExp_Explorer.hxx>
@@ -17,6 +18,7 @@
 #include <gp_Vec.hxx>
 #include <limits>
 #include <queue>
+#include <type_traits>
 
 namespace sfc::cad {
 namespace {
@@ -79,7 +81,120 @@ FaceSurface::FaceSurface(const TopoDS_Face& face, const UnitSquareMap& map,
     : face_(face),
       map_(map),
       closed_(std::move(closed)),
-      adaptors_([face] { return std::make_unique<BRepAdaptor_Surface>(face, true); }) {}
+      adaptors_([face] { return std::make_unique<BRepAdaptor_Surface>(face, true); }) {
+  if (closed_) return;
+  try {
+    const BRepAdaptor_Surface adaptor(face, true);
+    auto largest_pole = [this](const auto& patch) {
+      for (int i = 1; i <= patch->NbUPoles(); ++i) {
+        for (int j = 1; j <= patch->NbVPoles(); ++j) {
+          const gp_Pnt& p = patch->Pole(i, j);
+          kernel_size_ =
+              std::max({kernel_size_, std::abs(p.X()), std::abs(p.Y()), std::abs(p.Z())});
+        }
+      }
+    };
+    switch (adaptor.GetType()) {
+      case GeomAbs_BSplineSurface:
+        if (adaptor.NbUPoles() * static_cast<int64_t>(adaptor.NbVPoles()) <= kMaxBoundPoles) {
+          bspline_ = adaptor.BSpline();
+          largest_pole(bspline_);
+        }
+        break;
+      case GeomAbs_BezierSurface:
+        if (adaptor.NbUPoles() * static_cast<int64_t>(adaptor.NbVPoles()) <= kMaxBoundPoles) {
+          bezier_ = adaptor.Bezier();
+          largest_pole(bezier_);
+        }
+        break;
+      default:
+        placed_ = ClosedForm::FormOf(adaptor);
+        if (placed_) {
+          kernel_size_ = std::max({std::abs(placed_->o[0]), std::abs(placed_->o[1]),
+                                   std::abs(placed_->o[2])}) +
+                         std::abs(placed_->radius) + std::abs(placed_->minor);
+        }
+    }
+  } catch (const Standard_Failure&) {
+    placed_.reset(), bspline_.Nullify(), bezier_.Nullify();
+  }
+  if (!std::isfinite(kernel_size_)) placed_.reset(), bspline_.Nullify(), bezier_.Nullify();
+}
+
+Interval FaceSurface::NativeU(double u0, double u1) const {
+  const Interval width = Interval::Point(map_.box.u1 - map_.box.u0);
+  return map_.reversed ? Interval::Point(map_.box.u1) - Interval::Of(u0, u1) * width
+                       : Interval::Point(map_.box.u0) + Interval::Of(u0, u1) * width;
+}
+
+Interval FaceSurface::NativeV(double v0, double v1) const {
+  return Interval::Point(map_.box.v0) +
+         Interval::Of(v0, v1) * Interval::Point(map_.box.v1 - map_.box.v0);
+}
+
+template <typename Patch>
+std::optional<Box3> FaceSurface::PolesBound(const Handle(Patch) & patch, double a0, double a1,
+                                            double b0, double b1) const {
+  double first_u, last_u, first_v, last_v;
+  patch->Bounds(first_u, last_u, first_v, last_v);
+  // Widened by twice the tolerance within which Segment treats a boundary
+  // as the knot beside it, so the segment holds the whole patch.
+  const double tolerance = Precision::PConfusion();
+  auto clamp = [&](double* lo, double* hi, double first, double last, bool periodic) {
+    *lo -= 2 * tolerance, *hi += 2 * tolerance;
+    if (!periodic) *lo = std::max(*lo, first), *hi = std::min(*hi, last);
+    return *lo < *hi;
+  };
+  if (!clamp(&a0, &a1, first_u, last_u, patch->IsUPeriodic()) ||
+      !clamp(&b0, &b1, first_v, last_v, patch->IsVPeriodic())) {
+    return std::nullopt;
+  }
+  const Handle(Patch) piece = Handle(Patch)::DownCast(patch->Copy());
+  if constexpr (std::is_same_v<Patch, Geom_BSplineSurface>) {
+    piece->Segment(a0, a1, b0, b1, tolerance, tolerance);
+  } else {
+    piece->Segment(a0, a1, b0, b1);
+  }
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  for (int i = 1; i <= piece->NbUPoles(); ++i) {
+    for (int j = 1; j <= piece->NbVPoles(); ++j) {
+      const gp_Pnt& p = piece->Pole(i, j);
+      lo = {std::min(lo.x, p.X()), std::min(lo.y, p.Y()), std::min(lo.z, p.Z())};
+      hi = {std::max(hi.x, p.X()), std::max(hi.y, p.Y()), std::max(hi.z, p.Z())};
+    }
+  }
+  return Box3{lo, hi};
+}
+
+std::optional<Box3> FaceSurface::Bound(double u0, double u1, double v0, double v1) const {
+  const Interval u = NativeU(u0, u1), v = NativeV(v0, v1);
+  if (closed_) return closed_->Bound(u, v);
+  std::optional<Box3> box;
+  try {
+    if (placed_) {
+      box = placed_->Bound(u, v);
+    } else if (!bspline_.IsNull()) {
+      box = PolesBound(bspline_, u.lo, u.hi, v.lo, v.hi);
+    } else if (!bezier_.IsNull()) {
+      box = PolesBound(bezier_, u.lo, u.hi, v.lo, v.hi);
+    }
+  } catch (const Standard_Failure&) {
+    return std::nullopt;
+  }
+  if (!box) return std::nullopt;
+  // The kernel's rounding: kKernelMargin of the face's size, of the box's
+  // and, for a plane or a cylinder, of the parameters' (which a point's
+  // terms are multiples of).
+  const double size = std::max(
+      {kernel_size_, std::abs(box->lo.x), std::abs(box->lo.y), std::abs(box->lo.z),
+       std::abs(box->hi.x), std::abs(box->hi.y), std::abs(box->hi.z),
+       placed_ ? std::max({std::abs(u.lo), std::abs(u.hi), std::abs(v.lo), std::abs(v.hi)}) : 0});
+  const double margin = kKernelMargin * size;
+  if (!std::isfinite(margin)) return std::nullopt;
+  box->lo = {box->lo.x - margin, box->lo.y - margin, box->lo.z - margin};
+  box->hi = {box->hi.x + margin, box->hi.y + margin, box->hi.z + margin};
+  return box;
+}
 
 Vec3 FaceSurface::KernelPoint(BRepAdaptor_Surface& adaptor, double u, double v) const {
   try {
@@ -220,8 +335,8 @@ FaceTrim::FaceTrim(const TopoDS_Face& face, const UnitSquareMap& map, double tol
       continue;
     }
     const Geom2dAdaptor_Curve curve(pcurve);
-    lines_and_circles_ = lines_and_circles_ && (curve.GetType() == GeomAbs_Line ||
-                                                curve.GetType() == GeomAbs_Circle);
+    lines_and_circles_ = lines_and_circles_ &&
+                         (curve.GetType() == GeomAbs_Line || curve.GetType() == GeomAbs_Circle);
     const int edge_index = static_cast<int>(pcurves_.size());
     pcurves_.push_back(pcurve);
     struct Pending {
