@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "base/status_macros.h"
+#include "catalog/catalog.h"
 #include "cad/fixtures.h"
 #include "cad/load.h"
 #include "cad/model_sampler.h"
@@ -351,6 +352,48 @@ TEST(EngineCad, ASpotTheTreeCannotFollowIsRefusedSayingWhatToChange) {
   for (const char* what : {"face 3", "box_with_hole", "narrower than the curve tree can see",
                            "Widen or smooth", "raise the depth cap (9)"}) {
     EXPECT_NE(status.message().find(what), std::string::npos) << what << ": " << status;
+  }
+}
+
+// A density with its interval bound hidden: the tree a build gives without
+// the hidden-mass check.
+class NoBound final : public Density {
+ public:
+  explicit NoBound(std::shared_ptr<const Density> d) : d_(std::move(d)) {}
+  double Value(const SurfacePoint& p) const override { return d_->Value(p); }
+
+ private:
+  std::shared_ptr<const Density> d_;
+};
+
+// Smooth densities and steps the probes see keep their trees, bit for bit,
+// on trimmed faces too: the nodes outside a trim see 0, so a cell the trim
+// crosses is left unchecked rather than split along the trim.
+TEST(EngineCad, SmoothDensitiesKeepTheirTreesOnTrimmedFaces) {
+  for (fx::Solid solid : {fx::Solid::kBoxWithHole, fx::Solid::kCylinder}) {
+    auto bytes = fx::SolidBytes(solid, ModelFormat::kStep);
+    ASSERT_TRUE(bytes.ok()) << bytes.status();
+    auto model = cad::Load(ModelFormat::kStep, *bytes, fx::SolidName(solid));
+    ASSERT_TRUE(model.ok()) << model.status();
+    for (const char* spec : {"expr:1+x/40", "expr:u+v", "expr:1+9*(z>7.3)"}) {
+      auto density = MakeDensity(spec);
+      ASSERT_TRUE(density.ok()) << density.status();
+      auto with = cad::ModelTree::Build(*model, density->density, {}, 20000);
+      auto without =
+          cad::ModelTree::Build(*model, std::make_shared<NoBound>(density->density), {}, 20000);
+      ASSERT_TRUE(with.ok()) << with.status();
+      ASSERT_TRUE(without.ok()) << without.status();
+      ASSERT_EQ((*with)->pieces().size(), (*without)->pieces().size());
+      for (size_t p = 0; p < (*with)->pieces().size(); ++p) {
+        const CurveTree& a = *(*with)->pieces()[p].tree;
+        const CurveTree& b = *(*without)->pieces()[p].tree;
+        ASSERT_EQ(a.leaf_count(), b.leaf_count()) << fx::SolidName(solid) << " " << spec;
+        for (size_t l = 0; l < a.leaf_count(); ++l) {
+          ASSERT_EQ(a.leaf_start(l), b.leaf_start(l));
+          ASSERT_EQ(a.mass_end(l), b.mass_end(l));
+        }
+      }
+    }
   }
 }
 
