@@ -2,6 +2,9 @@
 
 #include <BRep_Tool.hxx>
 #include <BndLib_Add2dCurve.hxx>
+#include <GeomConvert_BSplineSurfaceToBezierSurface.hxx>
+#include <Geom_BezierSurface.hxx>
+#include <TColStd_Array1OfReal.hxx>
 #include <Bnd_Box2d.hxx>
 #include <Geom2dAdaptor_Curve.hxx>
 #include <Geom2d_Curve.hxx>
@@ -18,7 +21,6 @@
 #include <gp_Vec.hxx>
 #include <limits>
 #include <queue>
-#include <type_traits>
 
 namespace sfc::cad {
 namespace {
@@ -85,27 +87,54 @@ FaceSurface::FaceSurface(const TopoDS_Face& face, const UnitSquareMap& map,
   if (closed_) return;
   try {
     const BRepAdaptor_Surface adaptor(face, true);
-    auto largest_pole = [this](const auto& patch) {
-      for (int i = 1; i <= patch->NbUPoles(); ++i) {
-        for (int j = 1; j <= patch->NbVPoles(); ++j) {
-          const gp_Pnt& p = patch->Pole(i, j);
-          kernel_size_ =
-              std::max({kernel_size_, std::abs(p.X()), std::abs(p.Y()), std::abs(p.Z())});
+    auto note_size = [this](const gp_Pnt& p) {
+      kernel_size_ = std::max({kernel_size_, std::abs(p.X()), std::abs(p.Y()), std::abs(p.Z())});
+    };
+    // The Bezier patches' homogeneous control points, for SpanHull.
+    std::vector<double> points;
+    int pu = 0, pv = 0;
+    auto add_patch = [&](const Geom_BezierSurface& patch) {
+      pu = patch.NbUPoles(), pv = patch.NbVPoles();
+      for (int i = 1; i <= pu; ++i) {
+        for (int j = 1; j <= pv; ++j) {
+          const gp_Pnt& p = patch.Pole(i, j);
+          const double w = patch.Weight(i, j);
+          points.insert(points.end(), {w * p.X(), w * p.Y(), w * p.Z(), w});
+          note_size(p);
         }
       }
     };
-    switch (adaptor.GetType()) {
-      case GeomAbs_BSplineSurface:
-        if (adaptor.NbUPoles() * static_cast<int64_t>(adaptor.NbVPoles()) <= kMaxBoundPoles) {
-          bspline_ = adaptor.BSpline();
-          largest_pole(bspline_);
+    const bool small =
+        adaptor.GetType() != GeomAbs_BSplineSurface && adaptor.GetType() != GeomAbs_BezierSurface
+            ? true
+            : adaptor.NbUPoles() * static_cast<int64_t>(adaptor.NbVPoles()) <= kMaxBoundPoles;
+    switch (small ? adaptor.GetType() : GeomAbs_OtherSurface) {
+      case GeomAbs_BSplineSurface: {
+        const Handle(Geom_BSplineSurface) bspline = adaptor.BSpline();
+        if (bspline->IsUPeriodic() || bspline->IsVPeriodic()) {
+          periodic_ = bspline;
+          for (int i = 1; i <= bspline->NbUPoles(); ++i) {
+            for (int j = 1; j <= bspline->NbVPoles(); ++j) note_size(bspline->Pole(i, j));
+          }
+          break;
         }
+        GeomConvert_BSplineSurfaceToBezierSurface convert(bspline);
+        TColStd_Array1OfReal uk(1, convert.NbUPatches() + 1), vk(1, convert.NbVPatches() + 1);
+        convert.UKnots(uk);
+        convert.VKnots(vk);
+        for (int a = 1; a <= convert.NbUPatches(); ++a) {
+          for (int b = 1; b <= convert.NbVPatches(); ++b) add_patch(*convert.Patch(a, b));
+        }
+        spans_.emplace(std::vector<double>(uk.begin(), uk.end()),
+                       std::vector<double>(vk.begin(), vk.end()), pu, pv, std::move(points));
         break;
+      }
       case GeomAbs_BezierSurface:
-        if (adaptor.NbUPoles() * static_cast<int64_t>(adaptor.NbVPoles()) <= kMaxBoundPoles) {
-          bezier_ = adaptor.Bezier();
-          largest_pole(bezier_);
-        }
+        add_patch(*adaptor.Bezier());
+        spans_.emplace(std::vector<double>{0, 1}, std::vector<double>{0, 1}, pu, pv,
+                       std::move(points));
+        break;
+      case GeomAbs_OtherSurface:
         break;
       default:
         placed_ = ClosedForm::FormOf(adaptor);
@@ -116,9 +145,9 @@ FaceSurface::FaceSurface(const TopoDS_Face& face, const UnitSquareMap& map,
         }
     }
   } catch (const Standard_Failure&) {
-    placed_.reset(), bspline_.Nullify(), bezier_.Nullify();
+    placed_.reset(), spans_.reset(), periodic_.Nullify();
   }
-  if (!std::isfinite(kernel_size_)) placed_.reset(), bspline_.Nullify(), bezier_.Nullify();
+  if (!std::isfinite(kernel_size_)) placed_.reset(), spans_.reset(), periodic_.Nullify();
 }
 
 Interval FaceSurface::NativeU(double u0, double u1) const {
@@ -132,29 +161,22 @@ Interval FaceSurface::NativeV(double v0, double v1) const {
          Interval::Of(v0, v1) * Interval::Point(map_.box.v1 - map_.box.v0);
 }
 
-template <typename Patch>
-std::optional<Box3> FaceSurface::PolesBound(const Handle(Patch) & patch, double a0, double a1,
-                                            double b0, double b1) const {
+std::optional<Box3> FaceSurface::PolesBound(const Geom_BSplineSurface& spline, double a0,
+                                            double a1, double b0, double b1) const {
   double first_u, last_u, first_v, last_v;
-  patch->Bounds(first_u, last_u, first_v, last_v);
-  // Widened by twice the tolerance within which Segment treats a boundary
-  // as the knot beside it, so the segment holds the whole patch.
+  spline.Bounds(first_u, last_u, first_v, last_v);
   const double tolerance = Precision::PConfusion();
   auto clamp = [&](double* lo, double* hi, double first, double last, bool periodic) {
     *lo -= 2 * tolerance, *hi += 2 * tolerance;
     if (!periodic) *lo = std::max(*lo, first), *hi = std::min(*hi, last);
     return *lo < *hi;
   };
-  if (!clamp(&a0, &a1, first_u, last_u, patch->IsUPeriodic()) ||
-      !clamp(&b0, &b1, first_v, last_v, patch->IsVPeriodic())) {
+  if (!clamp(&a0, &a1, first_u, last_u, spline.IsUPeriodic()) ||
+      !clamp(&b0, &b1, first_v, last_v, spline.IsVPeriodic())) {
     return std::nullopt;
   }
-  const Handle(Patch) piece = Handle(Patch)::DownCast(patch->Copy());
-  if constexpr (std::is_same_v<Patch, Geom_BSplineSurface>) {
-    piece->Segment(a0, a1, b0, b1, tolerance, tolerance);
-  } else {
-    piece->Segment(a0, a1, b0, b1);
-  }
+  const Handle(Geom_BSplineSurface) piece = Handle(Geom_BSplineSurface)::DownCast(spline.Copy());
+  piece->Segment(a0, a1, b0, b1, tolerance, tolerance);
   Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
   for (int i = 1; i <= piece->NbUPoles(); ++i) {
     for (int j = 1; j <= piece->NbVPoles(); ++j) {
@@ -173,10 +195,10 @@ std::optional<Box3> FaceSurface::Bound(double u0, double u1, double v0, double v
   try {
     if (placed_) {
       box = placed_->Bound(u, v);
-    } else if (!bspline_.IsNull()) {
-      box = PolesBound(bspline_, u.lo, u.hi, v.lo, v.hi);
-    } else if (!bezier_.IsNull()) {
-      box = PolesBound(bezier_, u.lo, u.hi, v.lo, v.hi);
+    } else if (spans_) {
+      box = spans_->Bound(u.lo, u.hi, v.lo, v.hi);
+    } else if (!periodic_.IsNull()) {
+      box = PolesBound(*periodic_, u.lo, u.hi, v.lo, v.hi);
     }
   } catch (const Standard_Failure&) {
     return std::nullopt;

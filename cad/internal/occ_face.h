@@ -16,7 +16,6 @@
 #include <BRepTopAdaptor_FClass2d.hxx>
 #include <Geom2d_Curve.hxx>
 #include <Geom_BSplineSurface.hxx>
-#include <Geom_BezierSurface.hxx>
 #include <TopoDS_Face.hxx>
 #include <functional>
 #include <memory>
@@ -28,6 +27,7 @@
 #include "absl/synchronization/mutex.h"
 #include "cad/internal/closed_form.h"
 #include "cad/internal/line_circle_trim.h"
+#include "cad/internal/span_hull.h"
 #include "cad/model.h"
 #include "core/surface.h"
 
@@ -124,13 +124,13 @@ class FaceSurface final : public Surface {
   // (ClosedForm::Bound), exact for the double code. Through the kernel: a
   // plane, cylinder, cone, sphere or torus under a transformation by the same
   // formula with the location applied, and a B-spline or Bezier face by the
-  // control points of the sub-patch (the kernel's Segment of a copy; a
-  // rational patch lies in the convex hull of its poles, its weights being
-  // positive), each widened by kKernelMargin of the face's size for the
-  // kernel's rounding. Both are arithmetic only or SLEEF's, so the same bits
-  // on every CPU. nullopt for every other face (surfaces of revolution and
-  // extrusion, offsets, ...), for B-splines of more than kMaxBoundPoles
-  // poles, and when the kernel throws.
+  // control points of the sub-patch (SpanHull over the kernel's Bezier
+  // patches; a periodic B-spline by the poles of the kernel's Segment of a
+  // copy, a copy a bound), each widened by kKernelMargin of the face's
+  // size for the kernel's rounding. All are arithmetic only or SLEEF's, so
+  // the same bits on every CPU. nullopt for every other face (surfaces of
+  // revolution and extrusion, offsets, ...), for B-splines of more than
+  // kMaxBoundPoles poles, and when the kernel throws.
   std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override;
 
   // True when the face is evaluated from its closed form (ClosedForm), not
@@ -142,9 +142,10 @@ class FaceSurface final : public Surface {
   // are affine combinations of values of the face's size), and the sub-patch's
   // poles are within a few ulp of the exact ones; 1e-9 is millions of ulp.
   static constexpr double kKernelMargin = 1e-9;
-  // Copying and segmenting a B-spline costs a pass over its poles on every
-  // bound; larger ones are not bounded (a hostile file could make each
-  // bound of a tree build cost milliseconds).
+  // B-splines of more poles are not bounded: their Bezier patches take up
+  // to (degree + 1)^2 times the memory, and a periodic one's copy is a pass
+  // over its poles on every bound (a hostile file could make each bound of a
+  // tree build cost milliseconds).
   static constexpr int kMaxBoundPoles = 4096;
 
  private:
@@ -163,11 +164,11 @@ class FaceSurface final : public Surface {
   // operations on intervals.
   Interval NativeU(double u0, double u1) const;
   Interval NativeV(double v0, double v1) const;
-  // A box holding every point of a copy of `patch` segmented to [a0, a1] x
-  // [b0, b1] (clamped to its domain): its poles' box.
-  template <typename Patch>
-  std::optional<Box3> PolesBound(const Handle(Patch) & patch, double a0, double a1, double b0,
-                                 double b1) const;
+  // The box of the poles of a copy of `spline` segmented to [a0, a1] x
+  // [b0, b1] (the kernel's Segment; each end widened by twice the tolerance
+  // within which Segment takes it for the knot beside it).
+  std::optional<Box3> PolesBound(const Geom_BSplineSurface& spline, double a0, double a1,
+                                 double b0, double b1) const;
 
   const TopoDS_Face face_;
   const UnitSquareMap map_;
@@ -175,10 +176,10 @@ class FaceSurface final : public Surface {
   mutable LeasePool<BRepAdaptor_Surface> adaptors_;  // thread-safe
   // For Bound through the kernel, constant after construction and only read
   // (Copy reads its source): at most one of these is set.
-  std::optional<ClosedForm> placed_;     // an elementary face under a transformation
-  Handle(Geom_BSplineSurface) bspline_;  // located, of at most kMaxBoundPoles poles
-  Handle(Geom_BezierSurface) bezier_;    // located, of at most kMaxBoundPoles poles
-  double kernel_size_ = 0;               // the largest pole coordinate, or the form's size
+  std::optional<ClosedForm> placed_;      // an elementary face under a transformation
+  std::optional<SpanHull> spans_;         // a B-spline or Bezier face (located)
+  Handle(Geom_BSplineSurface) periodic_;  // a periodic B-spline face (located)
+  double kernel_size_ = 0;                // the largest pole coordinate, or the form's size
 };
 
 // An axis-aligned box in unit-square parameters.
