@@ -29,6 +29,29 @@ class TrimmedDensity final : public Density {
   // ~1/2048 of it (the STEP box with a hole: 197 588 leaves and 60 s for
   // 10^6 samples, against 0.23 s before).
   double StepResolution() const override { return face_->trimmed() ? Face::TrimGridCell() : 0; }
+  // The inner density's bound (an expression's reads x, y, z from the face's
+  // Surface::Bound) on a cell inside the trim, 0 on one outside it (every
+  // value there is 0), and none (+infinity: the hidden-mass check counts
+  // nothing) on a cell the trim may cross. There the nodes outside the trim
+  // see 0, so any mass inside would look hidden: the trim itself, a step
+  // the tree need not follow (StepResolution), would split the cells along
+  // it (the STEP box's smooth densities gained 400 leaves, the cylinder's
+  // 600). So a feature within such a cell of a trim curve is not checked.
+  bool Bounds() const override { return inner_->Bounds(); }
+  double UpperBound(const Surface& surface, double u0, double u1, double v0,
+                    double v1) const override {
+    if (face_->trimmed()) {
+      switch (face_->Classify(u0, u1, v0, v1)) {
+        case CellState::kOutside:
+          return 0;
+        case CellState::kStraddles:
+          return INFINITY;
+        case CellState::kInside:
+          break;
+      }
+    }
+    return inner_->UpperBound(surface, u0, u1, v0, v1);
+  }
 
  private:
   const Face* face_;  // owned by the model, which the tree keeps alive
@@ -99,7 +122,7 @@ absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
   };
   // Builds face f's tree at `grade` into a new piece, or counts the face as
   // skipped; false when the face has nothing to sample.
-  auto build_face = [&](int f, int grade) -> absl::StatusOr<bool> {
+  auto build_face = [&](int f, int grade, bool refuse_hidden = true) -> absl::StatusOr<bool> {
     const Face& face = model->faces()[f];
     Piece piece;
     piece.face = f;
@@ -108,7 +131,9 @@ absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
     if (leaves >= options.max_leaves) return over_budget();
     CurveTreeOptions o = options;
     o.max_leaves = options.max_leaves - leaves;  // what the faces before left
-    auto built = CurveTree::Build(*piece.surface, *piece.density, o, grade, control_after(bytes));
+    BuildControl face_control = control_after(bytes);
+    face_control.refuse_hidden = refuse_hidden;
+    auto built = CurveTree::Build(*piece.surface, *piece.density, o, grade, face_control);
     if (!built.ok()) {
       if (HasNothingToSample(built.status())) {
         ++tree->skipped_faces_;
@@ -155,13 +180,15 @@ absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
     }
     if (tree->pieces_.empty() || !(total_mass() > 0)) return nothing_to_sample();
   } else {
-    // Stage one: every face's coarse tree (grade 0), for its mass.
+    // Stage one: every face's coarse tree (grade 0), for its mass. A feature
+    // its leaves may hide is followed by the refinement, which refuses what
+    // it cannot resolve (and a face kept at grade 0 is checked below).
     for (int f : model->curve_order()) {
       if (!(model->faces()[f].area() > 0)) {
         ++tree->skipped_faces_;
         continue;
       }
-      RETURN_IF_ERROR(build_face(f, 0).status());
+      RETURN_IF_ERROR(build_face(f, 0, /*refuse_hidden=*/false).status());
     }
     const double coarse_total = total_mass();
     if (tree->pieces_.empty() || !(coarse_total > 0)) return nothing_to_sample();
@@ -171,7 +198,9 @@ absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
     leaves = 0, bytes = 0;
     for (Piece& piece : tree->pieces_) {
       const int grade = grade_for(piece.tree->total_mass() / coarse_total);
-      if (grade > 0) {
+      // Refining to the same grade re-examines its hidden features and
+      // refuses them as a fresh build would.
+      if (grade > 0 || piece.tree->precision().hidden_share > CurveTree::kHiddenShare) {
         auto refined =
             piece.tree->Refined(*piece.surface, *piece.density, grade, control_after(bytes));
         if (!refined.ok()) return on_face(piece.face, refined.status());

@@ -325,7 +325,7 @@ class CurveTree::Builder {
     tree->ComputeReport();
     const double share = static_cast<double>(hidden_units_) / static_cast<double>(sum);
     tree->precision_.hidden_share = share;
-    if (share > CurveTree::kHiddenShare) return HiddenError(share);
+    if (share > CurveTree::kHiddenShare && control_.refuse_hidden) return HiddenError(share);
     return absl::OkStatus();
   }
 

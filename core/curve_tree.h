@@ -104,6 +104,11 @@ struct BuildControl {
   // (leaves x kBytesPerLeaf), so a shared memory budget can count builds in
   // progress; a non-OK status aborts the build likewise. Empty: not told.
   std::function<absl::Status(uint64_t bytes)> charge;
+  // False: a tree whose leaves may hide more than CurveTree::kHiddenShare of
+  // its mass is returned anyway (precision().hidden_share says how much), for
+  // a coarse tree that only measures a part's mass before the refinement that
+  // checks it (a CAD model's faces, cad/model_sampler.h).
+  bool refuse_hidden = true;
   static constexpr uint64_t kCheckInterval = 4096;
 };
 
@@ -138,7 +143,8 @@ class CurveTree {
   // Builds the tree of `grade` (0 <= grade <= 62). Errors: INVALID_ARGUMENT
   // for bad options, a surface that is not finite, a negative density, a
   // density that integrates to zero, or leaves that may hide more than
-  // kHiddenShare of the mass; RESOURCE_EXHAUSTED past max_leaves.
+  // kHiddenShare of the mass (unless control.refuse_hidden is false);
+  // RESOURCE_EXHAUSTED past max_leaves.
   static absl::StatusOr<std::shared_ptr<const CurveTree>> Build(const Surface& surface,
                                                                 const Density& density,
                                                                 const CurveTreeOptions& options,

@@ -5,12 +5,14 @@
 // as well as the built-in sphere; the same bytes for any thread count; a box
 // region is the filtered full set; malformed files are refused by name.
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <map>
 #include <string>
 #include <vector>
 
 #include "base/status_macros.h"
+#include "catalog/catalog.h"
 #include "cad/fixtures.h"
 #include "cad/load.h"
 #include "cad/model_sampler.h"
@@ -296,6 +298,124 @@ TEST(EngineCad, MalformedModelsAreRefusedByName) {
   SampleRequest triangle = ModelRequest("step:" + Fixture(fx::Solid::kSphere), 100);
   triangle.fields.triangle = true;  // triangles are meshes'
   EXPECT_EQ(e.engine.Start(triangle).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+// The share of samples inside the ball |p - c|^2 < s2 under the density
+// 0.001 + 10^4 there, at N = 10^4, the mean over seeds 1-3.
+std::string SpotDensity(const Vec3& c, double s2) {
+  char text[256];
+  std::snprintf(text, sizeof(text), "expr:0.001+1e4*((x-%.17g)^2+(y-%.17g)^2+(z-%.17g)^2<%.17g)",
+                c.x, c.y, c.z, s2);
+  return text;
+}
+
+double SpotShare(const std::string& model, const Vec3& c, double s2) {
+  LocalEngine e;
+  double sum = 0;
+  for (uint64_t seed : {1, 2, 3}) {
+    SampleRequest r = ModelRequest(model, 10000, seed);
+    r.tree.density = SpotDensity(c, s2);
+    const SampleBatch batch = DrawAll(e.engine, r);
+    EXPECT_EQ(batch.size(), 10000u);
+    int in = 0;
+    for (size_t i = 0; i < batch.size(); ++i) {
+      const Vec3 d = Vec3{batch.x[i], batch.y[i], batch.z[i]} - c;
+      in += Dot(d, d) < s2;
+    }
+    sum += in / 1e4;
+  }
+  return sum / 3;
+}
+
+// Spots no Gauss node of a face's tree falls in (before faces bounded their
+// patches, none of their samples landed there), at irrational positions: a
+// ball of radius sqrt(rho^2 + d^2), rho = 0.01 (the models measure 20 to 40),
+// whose centre lies d = 0.001 sqrt(3) off the face. The hidden-mass check
+// finds them through the face's Surface::Bound. A binomial standard error at
+// N = 10^4 is 0.005; the seeds agree to 0.0001.
+constexpr double kSpotRho2 = 1e-4;
+const double kSpotD = 0.001 * std::sqrt(3.0);
+const double kPi = 3.14159265358979323846;
+
+// The box's face y = 0 (a plane) meets the ball in a disk of radius rho.
+const Vec3 kBoxSpot{10 + std::sqrt(2.0) / 3, -kSpotD, 7 + std::exp(1.0) / 7};
+
+TEST(EngineCad, ASpotNoProbeSeesGetsItsShareOnAStepPlane) {
+  // The model's area: two trimmed 40 x 30 plates, four sides, the fillet's
+  // quarter cylinder and the hole (cad/fixtures.h).
+  const double area = 5062 + 184.5 * kPi, disk = kPi * kSpotRho2;
+  const double exact = (1e4 + 0.001) * disk / (0.001 * (area - disk) + (1e4 + 0.001) * disk);
+  // Measured 0.35760 +- 0.00006 (exact 0.35768).
+  EXPECT_NEAR(SpotShare("step:" + Fixture(fx::Solid::kBoxWithHole), kBoxSpot,
+                        kSpotRho2 + kSpotD * kSpotD),
+              exact, 0.005);
+}
+
+TEST(EngineCad, ASpotNoProbeSeesGetsItsShareOnAStepSphere) {
+  // A ball of radius s about a point at distance D > R from the centre cuts
+  // from the sphere of radius R a cap of area pi R (s^2 - (D - R)^2) / D.
+  const double r = fx::kSphereRadius, dist = r + kSpotD, s2 = kSpotRho2 + kSpotD * kSpotD;
+  const Vec3 v{1, std::sqrt(2.0) * std::cos(0.7), std::sqrt(2.0) * std::sin(0.7)};
+  const Vec3 n = v * (1 / Norm(v));
+  const double cap = kPi * r * kSpotRho2 / dist, area = 4 * kPi * r * r;
+  const double exact = (1e4 + 0.001) * cap / (0.001 * (area - cap) + (1e4 + 0.001) * cap);
+  // Measured 0.71420 +- 0.00000 (exact 0.71425).
+  EXPECT_NEAR(SpotShare("step:" + Fixture(fx::Solid::kSphere), n * dist, s2), exact, 0.005);
+}
+
+TEST(EngineCad, ASpotTheTreeCannotFollowIsRefusedSayingWhatToChange) {
+  LocalEngine e;
+  SampleRequest r = ModelRequest("step:" + Fixture(fx::Solid::kBoxWithHole), 10000, 1);
+  r.tree.density = SpotDensity(kBoxSpot, kSpotRho2 + kSpotD * kSpotD);
+  r.tree.options.depth_cap = 9;
+  const absl::Status status = e.engine.Start(r).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << status;
+  for (const char* what : {"face 3", "box_with_hole", "narrower than the curve tree can see",
+                           "Widen or smooth", "raise the depth cap (9)"}) {
+    EXPECT_NE(status.message().find(what), std::string::npos) << what << ": " << status;
+  }
+}
+
+// A density with its interval bound hidden: the tree a build gives without
+// the hidden-mass check.
+class NoBound final : public Density {
+ public:
+  explicit NoBound(std::shared_ptr<const Density> d) : d_(std::move(d)) {}
+  double Value(const SurfacePoint& p) const override { return d_->Value(p); }
+
+ private:
+  std::shared_ptr<const Density> d_;
+};
+
+// Smooth densities and steps the probes see keep their trees, bit for bit,
+// on trimmed faces too: the nodes outside a trim see 0, so a cell the trim
+// crosses is left unchecked rather than split along the trim.
+TEST(EngineCad, SmoothDensitiesKeepTheirTreesOnTrimmedFaces) {
+  for (fx::Solid solid : {fx::Solid::kBoxWithHole, fx::Solid::kCylinder}) {
+    auto bytes = fx::SolidBytes(solid, ModelFormat::kStep);
+    ASSERT_TRUE(bytes.ok()) << bytes.status();
+    auto model = cad::Load(ModelFormat::kStep, *bytes, fx::SolidName(solid));
+    ASSERT_TRUE(model.ok()) << model.status();
+    for (const char* spec : {"expr:1+x/40", "expr:u+v", "expr:1+9*(z>7.3)"}) {
+      auto density = MakeDensity(spec);
+      ASSERT_TRUE(density.ok()) << density.status();
+      auto with = cad::ModelTree::Build(*model, density->density, {}, 20000);
+      auto without =
+          cad::ModelTree::Build(*model, std::make_shared<NoBound>(density->density), {}, 20000);
+      ASSERT_TRUE(with.ok()) << with.status();
+      ASSERT_TRUE(without.ok()) << without.status();
+      ASSERT_EQ((*with)->pieces().size(), (*without)->pieces().size());
+      for (size_t p = 0; p < (*with)->pieces().size(); ++p) {
+        const CurveTree& a = *(*with)->pieces()[p].tree;
+        const CurveTree& b = *(*without)->pieces()[p].tree;
+        ASSERT_EQ(a.leaf_count(), b.leaf_count()) << fx::SolidName(solid) << " " << spec;
+        for (size_t l = 0; l < a.leaf_count(); ++l) {
+          ASSERT_EQ(a.leaf_start(l), b.leaf_start(l));
+          ASSERT_EQ(a.mass_end(l), b.mass_end(l));
+        }
+      }
+    }
+  }
 }
 
 // Every sample lies on the face it names, by a measure that shares nothing

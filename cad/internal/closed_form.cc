@@ -197,42 +197,99 @@ void ClosedForm::Points(const double* u, const double* v, size_t n, double* px, 
   }
 }
 
-std::optional<ClosedForm> ClosedForm::Extract(const BRepAdaptor_Surface& adaptor) {
-  if (adaptor.Trsf().Form() != gp_Identity) return std::nullopt;
+std::optional<ClosedForm> ClosedForm::FormOf(const Adaptor3d_Surface& surface) {
   ClosedForm form;
   try {
-    const GeomAdaptor_Surface& local = adaptor.Surface();
-    switch (local.GetType()) {
+    switch (surface.GetType()) {
       case GeomAbs_Plane:
         form.type = Type::kPlane;
-        Place(local.Plane().Position(), &form);
+        Place(surface.Plane().Position(), &form);
         break;
       case GeomAbs_Cylinder:
         form.type = Type::kCylinder;
-        Place(local.Cylinder().Position(), &form);
-        form.radius = local.Cylinder().Radius();
+        Place(surface.Cylinder().Position(), &form);
+        form.radius = surface.Cylinder().Radius();
         break;
       case GeomAbs_Cone:
         form.type = Type::kCone;
-        Place(local.Cone().Position(), &form);
-        form.radius = local.Cone().RefRadius();
-        form.sin_angle = math::SinCosOf(local.Cone().SemiAngle()).sin;
-        form.cos_angle = math::SinCosOf(local.Cone().SemiAngle()).cos;
+        Place(surface.Cone().Position(), &form);
+        form.radius = surface.Cone().RefRadius();
+        form.sin_angle = math::SinCosOf(surface.Cone().SemiAngle()).sin;
+        form.cos_angle = math::SinCosOf(surface.Cone().SemiAngle()).cos;
         break;
       case GeomAbs_Sphere:
         form.type = Type::kSphere;
-        Place(local.Sphere().Position(), &form);
-        form.radius = local.Sphere().Radius();
+        Place(surface.Sphere().Position(), &form);
+        form.radius = surface.Sphere().Radius();
         break;
       case GeomAbs_Torus:
         form.type = Type::kTorus;
-        Place(local.Torus().Position(), &form);
-        form.radius = local.Torus().MajorRadius();
-        form.minor = local.Torus().MinorRadius();
+        Place(surface.Torus().Position(), &form);
+        form.radius = surface.Torus().MajorRadius();
+        form.minor = surface.Torus().MinorRadius();
         break;
       default:
         return std::nullopt;
     }
+  } catch (const Standard_Failure&) {
+    return std::nullopt;
+  }
+  return form;
+}
+
+Box3 ClosedForm::Bound(const Interval& u, const Interval& v) const {
+  // EvaluateWith's order-0 formulas, operation for operation, on intervals.
+  const Interval nan = Interval::NaN();
+  const Interval cu = TakesTrigU() ? Cos(u) : nan, su = TakesTrigU() ? Sin(u) : nan;
+  const Interval cv = TakesTrigV() ? Cos(v) : nan, sv = TakesTrigV() ? Sin(v) : nan;
+  Interval a1, a2, a3;
+  switch (type) {
+    case Type::kPlane:
+      a1 = u, a2 = v, a3 = Interval::Point(0);
+      break;
+    case Type::kCylinder:
+      a1 = Interval::Point(radius) * cu, a2 = Interval::Point(radius) * su, a3 = v;
+      break;
+    case Type::kCone: {
+      const Interval r = Interval::Point(radius) + v * Interval::Point(sin_angle);
+      a1 = r * cu, a2 = r * su, a3 = v * Interval::Point(cos_angle);
+      break;
+    }
+    case Type::kSphere: {
+      const Interval r = Interval::Point(radius) * cv;
+      a1 = r * cu, a2 = r * su, a3 = Interval::Point(radius) * sv;
+      break;
+    }
+    case Type::kTorus: {
+      // tiny() maps values within eps of 0 to 0: the interval of its image
+      // holds both.
+      const double eps = 10. * (minor + radius) * DBL_EPSILON;
+      auto tiny = [eps](const Interval& a) {
+        return a.maybe_nan || (a.lo <= eps && a.hi >= -eps) ? Hull(a, Interval::Point(0)) : a;
+      };
+      const Interval r = Interval::Point(radius) + Interval::Point(minor) * cv;
+      a1 = tiny(r * cu), a2 = tiny(r * su), a3 = tiny(Interval::Point(minor) * sv);
+      break;
+    }
+  }
+  Interval p[3];
+  for (int k = 0; k < 3; ++k) {
+    if (type == Type::kPlane) {  // u * x + v * y + o
+      p[k] = a1 * Interval::Point(x[k]) + a2 * Interval::Point(y[k]) + Interval::Point(o[k]);
+    } else {  // a1 * x + a2 * y + a3 * z + o
+      p[k] = a1 * Interval::Point(x[k]) + a2 * Interval::Point(y[k]) + a3 * Interval::Point(z[k]) +
+             Interval::Point(o[k]);
+    }
+  }
+  return BoxOf(p[0], p[1], p[2]);
+}
+
+std::optional<ClosedForm> ClosedForm::Extract(const BRepAdaptor_Surface& adaptor) {
+  if (adaptor.Trsf().Form() != gp_Identity) return std::nullopt;
+  std::optional<ClosedForm> found = FormOf(adaptor.Surface());
+  if (!found) return std::nullopt;
+  ClosedForm form = *found;
+  try {
     // The kernel's values on a grid of its parameter box, and well outside
     // it, for every order, within kTolerance of the form's size (or of the
     // value's, where that is larger: a derivative along a length is a unit

@@ -11,11 +11,13 @@
 #ifndef SFCSAMPLER_CAD_INTERNAL_CLOSED_FORM_H_
 #define SFCSAMPLER_CAD_INTERNAL_CLOSED_FORM_H_
 
+#include <Adaptor3d_Surface.hxx>
 #include <BRepAdaptor_Surface.hxx>
-
 #include <cmath>
 #include <optional>
 
+#include "core/interval.h"
+#include "core/surface.h"
 #include "core/vector_math.h"
 
 namespace sfc::cad {
@@ -62,6 +64,18 @@ struct ClosedForm {
   // Evaluate with tu = TrigU(u) and tv = TrigV(v) given.
   void EvaluateWith(double u, double v, const Trig& tu, const Trig& tv, int order,
                     double d[][3]) const;
+
+  // A box holding Evaluate's point (order 0) at every native (u, v) in the
+  // intervals u x v, as the double code computes it and as the exact real
+  // formula gives it: EvaluateWith's order-0 formula on intervals
+  // (core/interval.h, whose sines and cosines are SLEEF's, so the same bits
+  // on every CPU). What FaceSurface::Bound answers for a closed-form face.
+  Box3 Bound(const Interval& u, const Interval& v) const;
+
+  // The form of a plane, cylinder, cone, sphere or torus as `surface`
+  // describes it (a BRepAdaptor_Surface's with the face's location applied),
+  // unchecked against the kernel's evaluation; nullopt for any other type.
+  static std::optional<ClosedForm> FormOf(const Adaptor3d_Surface& surface);
 
   // How far Extract lets a closed form's value be from the kernel's, as a
   // fraction of the form's size (the largest of its origin's coordinates, its

@@ -2,9 +2,13 @@
 
 #include <BRep_Tool.hxx>
 #include <BndLib_Add2dCurve.hxx>
+#include <GeomConvert_BSplineSurfaceToBezierSurface.hxx>
+#include <Geom_BezierSurface.hxx>
+#include <TColStd_Array1OfReal.hxx>
 #include <Bnd_Box2d.hxx>
 #include <Geom2dAdaptor_Curve.hxx>
 #include <Geom2d_Curve.hxx>
+#include <Precision.hxx>
 #include <Standard_Failure.hxx>
 #include <TopAbs_State.hxx>
 #include <TopExp_Explorer.hxx>
@@ -79,7 +83,140 @@ FaceSurface::FaceSurface(const TopoDS_Face& face, const UnitSquareMap& map,
     : face_(face),
       map_(map),
       closed_(std::move(closed)),
-      adaptors_([face] { return std::make_unique<BRepAdaptor_Surface>(face, true); }) {}
+      adaptors_([face] { return std::make_unique<BRepAdaptor_Surface>(face, true); }) {
+  if (closed_) return;
+  try {
+    const BRepAdaptor_Surface adaptor(face, true);
+    auto note_size = [this](const gp_Pnt& p) {
+      kernel_size_ = std::max({kernel_size_, std::abs(p.X()), std::abs(p.Y()), std::abs(p.Z())});
+    };
+    // The Bezier patches' homogeneous control points, for SpanHull.
+    std::vector<double> points;
+    int pu = 0, pv = 0;
+    auto add_patch = [&](const Geom_BezierSurface& patch) {
+      pu = patch.NbUPoles(), pv = patch.NbVPoles();
+      for (int i = 1; i <= pu; ++i) {
+        for (int j = 1; j <= pv; ++j) {
+          const gp_Pnt& p = patch.Pole(i, j);
+          const double w = patch.Weight(i, j);
+          points.insert(points.end(), {w * p.X(), w * p.Y(), w * p.Z(), w});
+          note_size(p);
+        }
+      }
+    };
+    const bool small =
+        adaptor.GetType() != GeomAbs_BSplineSurface && adaptor.GetType() != GeomAbs_BezierSurface
+            ? true
+            : adaptor.NbUPoles() * static_cast<int64_t>(adaptor.NbVPoles()) <= kMaxBoundPoles;
+    switch (small ? adaptor.GetType() : GeomAbs_OtherSurface) {
+      case GeomAbs_BSplineSurface: {
+        const Handle(Geom_BSplineSurface) bspline = adaptor.BSpline();
+        if (bspline->IsUPeriodic() || bspline->IsVPeriodic()) {
+          periodic_ = bspline;
+          for (int i = 1; i <= bspline->NbUPoles(); ++i) {
+            for (int j = 1; j <= bspline->NbVPoles(); ++j) note_size(bspline->Pole(i, j));
+          }
+          break;
+        }
+        GeomConvert_BSplineSurfaceToBezierSurface convert(bspline);
+        TColStd_Array1OfReal uk(1, convert.NbUPatches() + 1), vk(1, convert.NbVPatches() + 1);
+        convert.UKnots(uk);
+        convert.VKnots(vk);
+        for (int a = 1; a <= convert.NbUPatches(); ++a) {
+          for (int b = 1; b <= convert.NbVPatches(); ++b) add_patch(*convert.Patch(a, b));
+        }
+        spans_.emplace(std::vector<double>(uk.begin(), uk.end()),
+                       std::vector<double>(vk.begin(), vk.end()), pu, pv, std::move(points));
+        break;
+      }
+      case GeomAbs_BezierSurface:
+        add_patch(*adaptor.Bezier());
+        spans_.emplace(std::vector<double>{0, 1}, std::vector<double>{0, 1}, pu, pv,
+                       std::move(points));
+        break;
+      case GeomAbs_OtherSurface:
+        break;
+      default:
+        placed_ = ClosedForm::FormOf(adaptor);
+        if (placed_) {
+          kernel_size_ = std::max({std::abs(placed_->o[0]), std::abs(placed_->o[1]),
+                                   std::abs(placed_->o[2])}) +
+                         std::abs(placed_->radius) + std::abs(placed_->minor);
+        }
+    }
+  } catch (const Standard_Failure&) {
+    placed_.reset(), spans_.reset(), periodic_.Nullify();
+  }
+  if (!std::isfinite(kernel_size_)) placed_.reset(), spans_.reset(), periodic_.Nullify();
+}
+
+Interval FaceSurface::NativeU(double u0, double u1) const {
+  const Interval width = Interval::Point(map_.box.u1 - map_.box.u0);
+  return map_.reversed ? Interval::Point(map_.box.u1) - Interval::Of(u0, u1) * width
+                       : Interval::Point(map_.box.u0) + Interval::Of(u0, u1) * width;
+}
+
+Interval FaceSurface::NativeV(double v0, double v1) const {
+  return Interval::Point(map_.box.v0) +
+         Interval::Of(v0, v1) * Interval::Point(map_.box.v1 - map_.box.v0);
+}
+
+std::optional<Box3> FaceSurface::PolesBound(const Geom_BSplineSurface& spline, double a0,
+                                            double a1, double b0, double b1) const {
+  double first_u, last_u, first_v, last_v;
+  spline.Bounds(first_u, last_u, first_v, last_v);
+  const double tolerance = Precision::PConfusion();
+  auto clamp = [&](double* lo, double* hi, double first, double last, bool periodic) {
+    *lo -= 2 * tolerance, *hi += 2 * tolerance;
+    if (!periodic) *lo = std::max(*lo, first), *hi = std::min(*hi, last);
+    return *lo < *hi;
+  };
+  if (!clamp(&a0, &a1, first_u, last_u, spline.IsUPeriodic()) ||
+      !clamp(&b0, &b1, first_v, last_v, spline.IsVPeriodic())) {
+    return std::nullopt;
+  }
+  const Handle(Geom_BSplineSurface) piece = Handle(Geom_BSplineSurface)::DownCast(spline.Copy());
+  piece->Segment(a0, a1, b0, b1, tolerance, tolerance);
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  for (int i = 1; i <= piece->NbUPoles(); ++i) {
+    for (int j = 1; j <= piece->NbVPoles(); ++j) {
+      const gp_Pnt& p = piece->Pole(i, j);
+      lo = {std::min(lo.x, p.X()), std::min(lo.y, p.Y()), std::min(lo.z, p.Z())};
+      hi = {std::max(hi.x, p.X()), std::max(hi.y, p.Y()), std::max(hi.z, p.Z())};
+    }
+  }
+  return Box3{lo, hi};
+}
+
+std::optional<Box3> FaceSurface::Bound(double u0, double u1, double v0, double v1) const {
+  const Interval u = NativeU(u0, u1), v = NativeV(v0, v1);
+  if (closed_) return closed_->Bound(u, v);
+  std::optional<Box3> box;
+  try {
+    if (placed_) {
+      box = placed_->Bound(u, v);
+    } else if (spans_) {
+      box = spans_->Bound(u.lo, u.hi, v.lo, v.hi);
+    } else if (!periodic_.IsNull()) {
+      box = PolesBound(*periodic_, u.lo, u.hi, v.lo, v.hi);
+    }
+  } catch (const Standard_Failure&) {
+    return std::nullopt;
+  }
+  if (!box) return std::nullopt;
+  // The kernel's rounding: kKernelMargin of the face's size, of the box's
+  // and, for a plane or a cylinder, of the parameters' (which a point's
+  // terms are multiples of).
+  const double size = std::max(
+      {kernel_size_, std::abs(box->lo.x), std::abs(box->lo.y), std::abs(box->lo.z),
+       std::abs(box->hi.x), std::abs(box->hi.y), std::abs(box->hi.z),
+       placed_ ? std::max({std::abs(u.lo), std::abs(u.hi), std::abs(v.lo), std::abs(v.hi)}) : 0});
+  const double margin = kKernelMargin * size;
+  if (!std::isfinite(margin)) return std::nullopt;
+  box->lo = {box->lo.x - margin, box->lo.y - margin, box->lo.z - margin};
+  box->hi = {box->hi.x + margin, box->hi.y + margin, box->hi.z + margin};
+  return box;
+}
 
 Vec3 FaceSurface::KernelPoint(BRepAdaptor_Surface& adaptor, double u, double v) const {
   try {
@@ -220,8 +357,8 @@ FaceTrim::FaceTrim(const TopoDS_Face& face, const UnitSquareMap& map, double tol
       continue;
     }
     const Geom2dAdaptor_Curve curve(pcurve);
-    lines_and_circles_ = lines_and_circles_ && (curve.GetType() == GeomAbs_Line ||
-                                                curve.GetType() == GeomAbs_Circle);
+    lines_and_circles_ = lines_and_circles_ &&
+                         (curve.GetType() == GeomAbs_Line || curve.GetType() == GeomAbs_Circle);
     const int edge_index = static_cast<int>(pcurves_.size());
     pcurves_.push_back(pcurve);
     struct Pending {

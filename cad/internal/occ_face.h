@@ -11,10 +11,11 @@
 #ifndef SFCSAMPLER_CAD_INTERNAL_OCC_FACE_H_
 #define SFCSAMPLER_CAD_INTERNAL_OCC_FACE_H_
 
-#include <BRepAdaptor_Surface.hxx>
 #include <Adaptor2d_Curve2d.hxx>
+#include <BRepAdaptor_Surface.hxx>
 #include <BRepTopAdaptor_FClass2d.hxx>
 #include <Geom2d_Curve.hxx>
+#include <Geom_BSplineSurface.hxx>
 #include <TopoDS_Face.hxx>
 #include <functional>
 #include <memory>
@@ -26,6 +27,7 @@
 #include "absl/synchronization/mutex.h"
 #include "cad/internal/closed_form.h"
 #include "cad/internal/line_circle_trim.h"
+#include "cad/internal/span_hull.h"
 #include "cad/model.h"
 #include "core/surface.h"
 
@@ -99,13 +101,14 @@ struct UnitSquareMap {
 // The face as f : [0,1]^2 -> R^3, through BRepAdaptor_Surface (the face's
 // location applied). Jet gives the kernel's exact derivatives (D1, D2) times
 // the map's scale factors. A kernel exception at a singular point gives a
-// non-finite result (core/surface.h's contract).
+// non-finite result (core/surface.h's contract). Bound boxes a patch for
+// the planes, cylinders, cones, spheres, tori, B-spline and Bezier faces
+// (docs/MODELS.md, "Bounds of a face's patches").
 class FaceSurface final : public Surface {
  public:
   // `closed`: the face's closed form (ClosedForm::Extract), evaluated instead
   // of the kernel; nullopt: the kernel evaluates.
-  FaceSurface(const TopoDS_Face& face, const UnitSquareMap& map,
-              std::optional<ClosedForm> closed);
+  FaceSurface(const TopoDS_Face& face, const UnitSquareMap& map, std::optional<ClosedForm> closed);
 
   Vec3 Point(double u, double v) const override;
   SurfaceJet Jet(double u, double v, int order) const override;
@@ -116,9 +119,34 @@ class FaceSurface final : public Surface {
   void Points(const double* u, const double* v, size_t n, double* x, double* y,
               double* z) const override;
 
+  // Core's contract (core/surface.h): a box holding Point at every unit-square
+  // (u, v) of the patch. A closed-form face: its formula on intervals
+  // (ClosedForm::Bound), exact for the double code. Through the kernel: a
+  // plane, cylinder, cone, sphere or torus under a transformation by the same
+  // formula with the location applied, and a B-spline or Bezier face by the
+  // control points of the sub-patch (SpanHull over the kernel's Bezier
+  // patches; a periodic B-spline by the poles of the kernel's Segment of a
+  // copy, a copy a bound), each widened by kKernelMargin of the face's
+  // size for the kernel's rounding. All are arithmetic only or SLEEF's, so
+  // the same bits on every CPU. nullopt for every other face (surfaces of
+  // revolution and extrusion, offsets, ...), for B-splines of more than
+  // kMaxBoundPoles poles, and when the kernel throws.
+  std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const override;
+
   // True when the face is evaluated from its closed form (ClosedForm), not
   // through the kernel's adaptors.
   bool closed_form() const { return closed_.has_value(); }
+
+  // Relative widening of a kernel face's bound: the kernel's point is within
+  // a few ulp of the exact surface (its de Boor sums and ElSLib's formulas
+  // are affine combinations of values of the face's size), and the sub-patch's
+  // poles are within a few ulp of the exact ones; 1e-9 is millions of ulp.
+  static constexpr double kKernelMargin = 1e-9;
+  // B-splines of more poles are not bounded: their Bezier patches take up
+  // to (degree + 1)^2 times the memory, and a periodic one's copy is a pass
+  // over its poles on every bound (a hostile file could make each bound of a
+  // tree build cost milliseconds).
+  static constexpr int kMaxBoundPoles = 4096;
 
  private:
   // Through the kernel's `adaptor`, at unit-square (u, v).
@@ -132,10 +160,26 @@ class FaceSurface final : public Surface {
   void ClosedJet(double u, double v, const ClosedForm::Trig& tu, const ClosedForm::Trig& tv,
                  int order, SurfaceJet* jet) const;
 
+  // The native parameter intervals of the unit-square ones, by map_'s
+  // operations on intervals.
+  Interval NativeU(double u0, double u1) const;
+  Interval NativeV(double v0, double v1) const;
+  // The box of the poles of a copy of `spline` segmented to [a0, a1] x
+  // [b0, b1] (the kernel's Segment; each end widened by twice the tolerance
+  // within which Segment takes it for the knot beside it).
+  std::optional<Box3> PolesBound(const Geom_BSplineSurface& spline, double a0, double a1,
+                                 double b0, double b1) const;
+
   const TopoDS_Face face_;
   const UnitSquareMap map_;
   std::optional<ClosedForm> closed_;
   mutable LeasePool<BRepAdaptor_Surface> adaptors_;  // thread-safe
+  // For Bound through the kernel, constant after construction and only read
+  // (Copy reads its source): at most one of these is set.
+  std::optional<ClosedForm> placed_;      // an elementary face under a transformation
+  std::optional<SpanHull> spans_;         // a B-spline or Bezier face (located)
+  Handle(Geom_BSplineSurface) periodic_;  // a periodic B-spline face (located)
+  double kernel_size_ = 0;                // the largest pole coordinate, or the form's size
 };
 
 // An axis-aligned box in unit-square parameters.
