@@ -1,6 +1,7 @@
 #include "core/blue_relaxation.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -40,6 +41,16 @@ constexpr double kJumpReach = 2;
 // milliseconds of work: placing a sample through a cursor takes about a
 // microsecond, a neighbour query less).
 constexpr size_t kCheckEvery = 4096;
+// A sample with this many neighbours closer than its radius sits where the
+// surface is thinner than the spacing (a tube or band narrower than rho
+// d_k, where every point of its stratum is that crowded): it keeps its
+// place, and queries stop counting there, so time and memory stay O(N).
+// A relaxed set has none within the radius, a jittered one a few.
+constexpr int kMostNeighbours = 16;
+// A stratum whose candidates' box meets more grid cells than this is long
+// and thin in 3D: its candidates are checked one by one (AnyNear), not
+// against one gather of the box, whose cells could number millions.
+constexpr int64_t kMostGatherCells = 4096;
 
 // Points in a grid of cubic cells of side `cell`, hashed by Morton code: a
 // bucket array of cell lists in CSR form, each entry a copy of its point and radius (so a
@@ -142,6 +153,24 @@ class Relaxation {
   // order of `near` when it is above floor).
   double Crowding(uint32_t i, const Vec3& x, double floor,
                   const std::vector<HashGrid::Entry>& near) const;
+  // The full minimum of Crowding, from the grids directly (a query of the
+  // cube of side 2 r_i around x).
+  double CrowdingAt(uint32_t i, const Vec3& x) const {
+    double worst = 1;
+    AnyNear(i, x, [&](uint32_t, double ratio2) {
+      worst = std::min(worst, ratio2);
+      return false;
+    });
+    return worst;
+  }
+  // The number of grid cells Gather(i, lo, hi, ...) visits.
+  double GatherCells(uint32_t i, const Vec3& lo, const Vec3& hi) const {
+    const double ri = r_[i];
+    const auto span = [&](double a, double b) {
+      return static_cast<double>(main_.Cell(b + ri) - main_.Cell(a - ri) + 1);
+    };
+    return span(lo.x, hi.x) * span(lo.y, hi.y) * span(lo.z, hi.z);
+  }
   // Fills *near with the live points of the grids, other than sample i's,
   // in the cells that meet the box [lo, hi] widened by r_i on every side
   // (entries outside that box are left out).
@@ -242,8 +271,10 @@ absl::Status Relaxation::FreezeBesideJumps() {
   if (uniform_density_) return absl::OkStatus();
   // Sample i looks kJumpReach d_i around its point (d_i as clamped in r_);
   // a pair is found from its sparse end in any case.
-  std::vector<std::vector<uint32_t>> found(threads_);
-  RETURN_IF_ERROR(ForParts(n_, [&](int part, size_t begin, size_t end) {
+  // Marked by any thread that finds the sample in a pair (one byte a sample,
+  // however many pairs a sample is in).
+  std::vector<std::atomic<uint8_t>> beside(n_);
+  RETURN_IF_ERROR(ForParts(n_, [&](int, size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) {
       if ((i - begin) % kCheckEvery == 0) RETURN_IF_ERROR(Check());
       const double reach = kJumpReach * r_[i] / options_.rho;
@@ -253,7 +284,7 @@ absl::Status Relaxation::FreezeBesideJumps() {
         const Vec3 v = e.p - x;
         if (Dot(v, v) < reach * reach &&
             (delta_[e.id] * kDensityJump < delta_[i] || delta_[e.id] > kDensityJump * delta_[i])) {
-          found[part].push_back(e.id);
+          beside[e.id].store(1, std::memory_order_relaxed);
           jump = true;
         }
         return false;
@@ -265,13 +296,11 @@ absl::Status Relaxation::FreezeBesideJumps() {
           for (int64_t c = main_.Cell(x.z - reach); c <= z1; ++c) main_.AnyIn(a, b, c, visit);
         }
       }
-      if (jump) found[part].push_back(static_cast<uint32_t>(i));
+      if (jump) beside[i].store(1, std::memory_order_relaxed);
     }
     return absl::OkStatus();
   }));
-  for (const std::vector<uint32_t>& part : found) {
-    for (uint32_t k : part) frozen_[k] = 1;
-  }
+  for (uint64_t i = 0; i < n_; ++i) frozen_[i] = beside[i].load(std::memory_order_relaxed);
   return absl::OkStatus();
 }
 
@@ -350,13 +379,16 @@ absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
       // higher priority moves this sweep.
       double c = 1;
       bool waits = false;
+      int neighbours = 0;
       const uint64_t mine = Priority(sweep, k);
       AnyNear(k, p_[k], [&](uint32_t j, double ratio2) {
         c = std::min(c, ratio2);
-        waits = in_todo_[j] && Priority(sweep, j) > mine;
-        return waits;
+        waits = waits || (in_todo_[j] && Priority(sweep, j) > mine);
+        return ++neighbours >= kMostNeighbours;
       });
-      if (c >= 1) {
+      if (neighbours >= kMostNeighbours) {
+        frozen_[k] = 1;  // the surface is thinner than the spacing here
+      } else if (c >= 1) {
         suspect_[k] = 0;
       } else if (!waits) {
         searching.push_back({static_cast<uint32_t>(t), c, q_[k], p_[k]});
@@ -405,7 +437,8 @@ absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
           lo = {std::min(lo.x, x.x), std::min(lo.y, x.y), std::min(lo.z, x.z)};
           hi = {std::max(hi.x, x.x), std::max(hi.y, x.y), std::max(hi.z, x.z)};
         }
-        Gather(k, lo, hi, &near);
+        const bool one_by_one = GatherCells(k, lo, hi) > kMostGatherCells;
+        if (!one_by_one) Gather(k, lo, hi, &near);
         const uint64_t order = CounterHash(seed_, hash_stream::kBlueOrder,
                                            static_cast<uint64_t>(k) * options_.sweeps + sweep);
         uint64_t step = (order >> 32) % tries;
@@ -421,7 +454,8 @@ absl::Status Relaxation::HalfSweep(int sweep, const std::vector<uint32_t>& todo,
               !(cd[c] * kDensityJump >= delta_[k] && cd[c] <= kDensityJump * delta_[k])) {
             continue;
           }
-          const double crowding = Crowding(k, cp[c], search.best, near);
+          const double crowding =
+              one_by_one ? CrowdingAt(k, cp[c]) : Crowding(k, cp[c], search.best, near);
           if (crowding >= 1 || crowding > search.best) {
             // Ties go to the first in the hashed order.
             search.best = crowding, search.q = cq[c], search.p = cp[c];
@@ -543,9 +577,10 @@ absl::StatusOr<BlueNoiseSet> Relaxation::Run(double total_mass) {
         for (size_t t = begin; t < end; ++t) {
           const uint32_t k = moved[t];
           suspect_[k] = 0;
+          int neighbours = 0;
           AnyNear(k, p_[k], [&](uint32_t j, double) {
             mine.push_back(k), mine.push_back(j);
-            return false;
+            return ++neighbours >= kMostNeighbours;
           });
         }
         return absl::OkStatus();

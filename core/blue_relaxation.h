@@ -33,6 +33,11 @@
 // Steigleder and McCool's curve sampling; Jacobi colouring as in parallel
 // Poisson-disk sampling (Wei 2008).
 //
+// Where the surface is thinner than the spacing, a sample with
+// kMostNeighbours neighbours within its radius keeps its place, and a
+// stratum whose candidates span too many grid cells checks them one by one
+// (blue_relaxation.cc), so time and memory stay O(N) on any surface.
+//
 // The set is computed whole (O(N) time, kBlueNoiseBytesPerSample), so a shard,
 // index range or region of a blue set costs the whole set's relaxation and
 // gives its exact bytes.
