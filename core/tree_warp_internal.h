@@ -1,9 +1,10 @@
-// The vector paths of TreeWarp (core/tree_warp.h): AVX-512F, built apart with
-// -mavx512f in core/tree_warp_avx512.cc, which TreeWarp calls only on the
-// kAvx512 vector path (math::BestVectorPath()); AVX2, built with -mavx2 in
-// core/tree_warp_avx2.cc, called only on the kAvx2 path. Each gives the bits
-// of the scalar code in core/tree_warp.cc (which the other paths run).
-// Not for use outside TreeWarp.
+// The vector paths of TreeWarp (core/tree_warp.h): one source,
+// core/tree_warp_lanes.h, built for AVX-512F in core/tree_warp_avx512.cc,
+// which TreeWarp calls only on the kAvx512 vector path
+// (math::BestVectorPath()), and for AVX2 in core/tree_warp_avx2.cc, called
+// only on the kAvx2 path. Each gives the bits of the scalar code in
+// core/tree_warp.cc (which the other paths run). Not for use outside
+// TreeWarp.
 #ifndef SFCSAMPLER_CORE_TREE_WARP_INTERNAL_H_
 #define SFCSAMPLER_CORE_TREE_WARP_INTERNAL_H_
 
@@ -20,15 +21,15 @@ using math::kBelowOne;
 // The Newton steps an inverse CDF takes at most (then its value as it stands).
 inline constexpr int kCdfMaxSteps = 100;
 
-// TreeWarp::Descend<2> for the points i < m, eight lanes to a vector; see
-// core/tree_warp_avx512.cc. Returns how many points it took (a multiple of
-// eight, at most 64); the caller descends the rest.
+// TreeWarp::Descend<2> for the points i < m, eight lanes to a vector.
+// Returns how many points it took (a multiple of eight, at most 64); the
+// caller descends the rest.
 size_t DescendGrid2Avx512(size_t m, double* a, double* b, int32_t* ref, uint8_t* state,
                           const double* splits, const int32_t* children, const int32_t* state_at);
 
 // TreeWarp::DigitsInLeaf for a Hilbert tree, eight points to a vector.
 // Returns how many points it took (a multiple of eight); the caller encodes
-// the rest.
+// the rest (none unless cells <= 2^30).
 size_t DigitsGrid2Avx512(size_t m, const double* x, const double* y, const uint8_t* state,
                          double cells, uint64_t top, int chunks, int head, const int32_t* child_at,
                          const int32_t* state_at, const uint64_t* encode, uint64_t* digits);
@@ -38,7 +39,7 @@ size_t DigitsGrid2Avx512(size_t m, const double* x, const double* y, const uint8
 void InvertCdfsAvx512(size_t n, const uint8_t* lanes, const double (*p)[3], const double* share,
                       double* out);
 
-// The same three, four lanes to a vector on AVX2 (core/tree_warp_avx2.cc):
+// The same three, four lanes to a vector on AVX2:
 // DescendGrid2Avx2 returns a multiple of four (at most 64), DigitsGrid2Avx2
 // a multiple of four (none unless cells <= 2^30).
 size_t DescendGrid2Avx2(size_t m, double* a, double* b, int32_t* ref, uint8_t* state,

@@ -1,14 +1,15 @@
-// The mesh warp's batch loops (mesh/mesh_warp.h), kLanes at a time in GCC's
-// vector extensions: each lane does the scalar code's IEEE operations in its
-// order (comparisons and selects for its branches and clamps; the build has
-// -ffp-contract=off), so every instruction set gives the scalar code's bits.
-// mesh_warp.cc builds them for the baseline (SSE2), mesh_warp_avx.cc for AVX,
-// mesh_warp_avx2.cc for AVX2 (the kAvx2 path: 256-bit integer lanes and
-// gathers) and mesh_warp_avx512.cc for AVX-512F; MeshWarp dispatches on
-// math::BestVectorPath(). Internal linkage (an anonymous namespace) on
-// purpose: each of the four files keeps its own copy, compiled for its
-// instruction set, which the linker never merges (nm shows none of the wider
-// builds' objects exporting a weak symbol the baseline could pick up).
+// The mesh warp's batch loops (mesh/mesh_warp.h), kLanes at a time in
+// generic vectors (core/vector_lanes.h): each lane does the scalar code's
+// IEEE operations in its order (comparisons and selects for its branches and
+// clamps; the build has -ffp-contract=off), so every instruction set gives
+// the scalar code's bits. mesh_warp.cc builds them for the baseline (SSE2),
+// mesh_warp_avx.cc for AVX, mesh_warp_avx2.cc for AVX2 (the kAvx2 path:
+// 256-bit integer lanes and gathers) and mesh_warp_avx512.cc for AVX-512F;
+// MeshWarp dispatches on math::BestVectorPath(). Internal linkage (an
+// anonymous namespace) on purpose: each of the four files keeps its own
+// copy, compiled for its instruction set, which the linker never merges (nm
+// shows none of the wider builds' objects exporting a weak symbol the
+// baseline could pick up).
 //
 // Thread-safety: pure functions.
 #ifndef SFCSAMPLER_MESH_MESH_WARP_LANES_H_
@@ -20,10 +21,7 @@
 #include <cstdint>
 #include <cstring>
 
-#if defined(__AVX512F__) || defined(__AVX2__)
-#include <immintrin.h>
-#endif
-
+#include "core/vector_lanes.h"
 #include "core/vector_math.h"
 #include "mesh/mesh_curve_tree.h"
 
@@ -68,20 +66,12 @@ void PlaceUniformAvx(size_t n, const double* f, const double* g, double* pa, dou
 
 namespace {
 
-// As many lanes as the build's registers hold: 8 with AVX-512F, 4 with AVX,
-// 2 in the baseline's SSE2 (wider generic vectors there would be split into
-// many registers, spilled and partly done a lane at a time: three times
-// slower).
-#if defined(__AVX512F__)
-constexpr int kLanes = 8;
-#elif defined(__AVX__)
-constexpr int kLanes = 4;
-#else
-constexpr int kLanes = 2;
-#endif
-typedef double Doubles __attribute__((vector_size(8 * kLanes)));
-typedef int64_t Ints __attribute__((vector_size(8 * kLanes)));
-typedef uint64_t Words __attribute__((vector_size(8 * kLanes)));
+using vector_lanes::Any;
+using vector_lanes::Doubles;
+using vector_lanes::Gather;
+using vector_lanes::Ints;
+using vector_lanes::kLanes;
+using vector_lanes::Words;
 
 // MeshCurveTree::PathOf over kLanes x kVectors lanes at once. The vectors
 // are independent chains of kLevels steps that the CPU overlaps.
@@ -155,44 +145,6 @@ __attribute__((always_inline)) inline void PathsOfLanes(size_t n, const double* 
   }
 }
 
-__attribute__((always_inline)) inline bool Any(Ints mask) {
-#ifdef __AVX512F__
-  return _mm512_test_epi64_mask((__m512i)mask, (__m512i)mask) != 0;
-#elif defined(__AVX2__)
-  return !_mm256_testz_si256((__m256i)mask, (__m256i)mask);
-#else
-  int64_t any = 0;
-  for (int k = 0; k < kLanes; ++k) any |= mask[k];
-  return any != 0;
-#endif
-}
-// p[index[k]] in each lane: one gather instruction where the build has
-// AVX-512F or AVX2.
-__attribute__((always_inline)) inline Doubles Gather(const double* p, Ints index) {
-#ifdef __AVX512F__
-  return (Doubles)_mm512_mask_i64gather_pd(_mm512_setzero_pd(), 0xff, (__m512i)index, p, 8);
-#elif defined(__AVX2__)
-  return (Doubles)_mm256_i64gather_pd(p, (__m256i)index, 8);
-#else
-  Doubles r;
-  for (int k = 0; k < kLanes; ++k) r[k] = p[index[k]];
-  return r;
-#endif
-}
-__attribute__((always_inline)) inline Ints Gather(const uint32_t* p, Ints index) {
-#ifdef __AVX512F__
-  const __m256i r = _mm512_mask_i64gather_epi32(_mm256_setzero_si256(), 0xff, (__m512i)index, p, 4);
-  typedef uint32_t Words8 __attribute__((vector_size(32)));
-  return __builtin_convertvector((Words8)r, Ints);
-#elif defined(__AVX2__)
-  const __m128i r = _mm256_i64gather_epi32(reinterpret_cast<const int*>(p), (__m256i)index, 4);
-  return (Ints)_mm256_cvtepu32_epi64(r);
-#else
-  Ints r;
-  for (int k = 0; k < kLanes; ++k) r[k] = p[index[k]];
-  return r;
-#endif
-}
 // x exactly, for 0 <= x < 2^52: x in the mantissa of 2^52, less 2^52.
 __attribute__((always_inline)) inline Doubles ExactDouble(Ints x) {
   return (Doubles)(x | 0x4330000000000000LL) - 0x1.0p52;

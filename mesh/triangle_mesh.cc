@@ -65,18 +65,32 @@ absl::Status FinalizeMesh(TriangleMesh* mesh) {
     return absl::InvalidArgumentError(
         absl::StrFormat("mesh '%s' has no triangles: give a file with at least one face", name));
   }
-  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
   for (size_t i = 0; i < nv; ++i) {
-    const Vec3& p = mesh->positions[i];
-    if (!IsFinite(p)) {
+    if (!IsFinite(mesh->positions[i])) {
       return absl::InvalidArgumentError(absl::StrFormat(
           "mesh '%s': vertex %d has a coordinate that is not a finite number (NaN or infinity)",
           name, i));
     }
-    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
   }
-  if (nv > 0) RETURN_IF_ERROR(CheckSize(absl::StrFormat("mesh '%s'", name), Diagonal(lo, hi)));
+  // The size is that of the vertices the triangles use: a stray vertex that
+  // no triangle uses is never sampled, so it neither widens the box nor makes
+  // a mesh too large.
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  for (size_t t = 0; t < mesh->triangles.size(); ++t) {
+    const auto& f = mesh->triangles[t];
+    for (int c = 0; c < 3; ++c) {
+      if (f[c] >= nv) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "mesh '%s': triangle %d uses vertex %d but the mesh has %d vertices (a truncated "
+            "file?)",
+            name, t, f[c], nv));
+      }
+      const Vec3& p = mesh->positions[f[c]];
+      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    }
+  }
+  RETURN_IF_ERROR(CheckSize(absl::StrFormat("mesh '%s'", name), Diagonal(lo, hi)));
   if (!mesh->normals.empty()) {
     if (mesh->normals.size() != nv) {
       return absl::InvalidArgumentError(absl::StrFormat(
@@ -108,15 +122,6 @@ absl::Status FinalizeMesh(TriangleMesh* mesh) {
   stats.degenerate_triangles = 0;
   stats.area = 0;
   for (size_t t = 0; t < mesh->triangles.size(); ++t) {
-    const auto& f = mesh->triangles[t];
-    for (int c = 0; c < 3; ++c) {
-      if (f[c] >= nv) {
-        return absl::InvalidArgumentError(absl::StrFormat(
-            "mesh '%s': triangle %d uses vertex %d but the mesh has %d vertices (a truncated "
-            "file?)",
-            name, t, f[c], nv));
-      }
-    }
     const double cross_norm = Norm(mesh->FaceCross(t));
     if (IsDegenerateTriangle(*mesh, t, cross_norm)) {
       ++stats.degenerate_triangles;

@@ -59,8 +59,10 @@ void ForEachEdge(const TriangleMesh& mesh,
 // Errors (INVALID_ARGUMENT, naming mesh->name): no triangles or only
 // degenerate ones, a corner index past the vertices, a non-finite
 // coordinate, normal or weight, a negative weight, normals or weights whose
-// count differs from the vertex count. Degenerate triangles are counted and
-// kept (so triangle indices stay those of the file); non-manifold edges are
+// count differs from the vertex count, a size out of CheckSize's range
+// (core/area_estimator.h) over the vertices the triangles use (vertices no
+// triangle uses do not count). Degenerate triangles are counted and kept (so
+// triangle indices stay those of the file); non-manifold edges are
 // accepted.
 absl::Status FinalizeMesh(TriangleMesh* mesh);
 

@@ -226,6 +226,48 @@ TEST(EngineMesh, BadMeshSpecsAndFilesAreRefusedWithTheFileNamed) {
             absl::StatusCode::kInvalidArgument);
 }
 
+// A mesh's size (core/area_estimator.h's CheckSize) is that of the vertices
+// its triangles use: a stray vertex at 1e200 that no triangle uses changes no
+// sample, in a PLY and an OBJ; a triangle that uses it makes the mesh too
+// large, refused with what to scale.
+TEST(EngineMesh, AFarVertexCountsForTheSizeOnlyWhenATriangleUsesIt) {
+  DirectTreeSource source;
+  FileModelSource files;
+  SamplingEngine engine(RegisteredSurfaceKinds(), {}, &source, &files);
+  const TriangleMesh sphere = MakeIcosphere(3);
+  TriangleMesh stray = sphere;
+  stray.positions.push_back({1e200, 0, 0});
+  for (const bool obj : {false, true}) {
+    SCOPED_TRACE(obj ? "obj" : "ply");
+    auto spec = [&](const std::string& name, const TriangleMesh& mesh) {
+      const std::string file = absl::StrCat(name, obj ? ".obj" : ".ply");
+      return absl::StrCat(obj ? "obj:" : "ply:",
+                          WriteTemp(file, obj ? MeshToObj(mesh) : MeshToPly(mesh, true)));
+    };
+    for (const SequenceKind sequence : {SequenceKind::kJittered, SequenceKind::kSobol}) {
+      SampleRequest plain = MeshRequest(spec("engine_mesh_plain", sphere), 5000);
+      SampleRequest with_stray = MeshRequest(spec("engine_mesh_stray", stray), 5000);
+      plain.sequence = with_stray.sequence = sequence;
+      const SampleBatch a = DrawAll(engine, plain);
+      const SampleBatch b = DrawAll(engine, with_stray);
+      ASSERT_EQ(b.size(), 5000u);
+      EXPECT_EQ(b.x, a.x);
+      EXPECT_EQ(b.y, a.y);
+      EXPECT_EQ(b.z, a.z);
+      EXPECT_EQ(b.triangle, a.triangle);
+    }
+    TriangleMesh far = stray;
+    far.triangles.push_back({0, 1, static_cast<uint32_t>(stray.positions.size() - 1)});
+    const absl::Status refused =
+        engine.Start(MeshRequest(spec("engine_mesh_far", far), 10)).status();
+    EXPECT_EQ(refused.code(), absl::StatusCode::kInvalidArgument) << refused;
+    EXPECT_NE(refused.message().find("spans 1e+200 (its bounding box's diagonal)"),
+              std::string::npos)
+        << refused;
+    EXPECT_NE(refused.message().find("scale it into that range"), std::string::npos) << refused;
+  }
+}
+
 TEST(EngineMesh, PerVertexWeightsFromAPlyPropertyShiftTheSamples) {
   TriangleMesh sphere = MakeIcosphere(3);
   sphere.weights.clear();

@@ -32,6 +32,7 @@ namespace {
 
 namespace v1 = ::sfcsampler::v1;
 
+using testing::ConnectWithDeadline;
 using testing::LoopbackOptions;
 using testing::Request;
 using testing::Running;
@@ -349,10 +350,7 @@ TEST(ServerModels, AGoodRequestWhileFourHostileUploadsParseTakesAtMostTwiceItsTi
   std::vector<std::thread> hostile;
   std::vector<std::unique_ptr<SamplerClient>> clients;
   for (const std::string& spec : specs) {
-    ClientOptions o;
-    o.target = "127.0.0.1:" + std::to_string(r.server->port());
-    o.deadline_seconds = 20;
-    clients.push_back(*SamplerClient::Connect(o));
+    clients.push_back(ConnectWithDeadline(*r.server, 20));
     hostile.emplace_back([client = clients.back().get(), spec] {
       SampleStatus(*client, Request(spec, 1000)).IgnoreError();
     });
@@ -418,10 +416,8 @@ TEST(ServerModels, ASmallStepIsServedWhileHostileStepsParse) {
       auto info = r.client->UploadModel("step", "hostile.step",
                                         HostileShellStep(40000 + 10 * hostile_count + i));
       ASSERT_TRUE(info.ok()) << info.status();
-      ClientOptions o;
-      o.target = "127.0.0.1:" + std::to_string(r.server->port());
-      o.deadline_seconds = 4;  // stays connected 4 s, then leaves: its parse stops
-      clients.push_back(*SamplerClient::Connect(o));
+      // Stays connected 4 s, then leaves: its parse stops.
+      clients.push_back(ConnectWithDeadline(*r.server, 4));
       hostile.emplace_back([client = clients.back().get(), spec = info->spec()] {
         SampleStatus(*client, Request(spec, 1000)).IgnoreError();
       });

@@ -24,6 +24,7 @@ namespace {
 namespace v1 = ::sfcsampler::v1;
 using std::chrono::milliseconds;
 
+using testing::ConnectWithDeadline;
 using testing::LoopbackOptions;
 using testing::Request;
 using testing::Running;
@@ -365,10 +366,7 @@ bool Within(double seconds, const std::function<bool()>& done) {
 
 TEST(Server, ABuildNobodyWaitsForAnyMoreStopsAndFreesItsSlot) {
   Running r = StartServer(HeavyOptions());
-  ClientOptions co;
-  co.target = "127.0.0.1:" + std::to_string(r.server->port());
-  co.deadline_seconds = 0.5;
-  auto impatient = *SamplerClient::Connect(co);
+  auto impatient = ConnectWithDeadline(*r.server, 0.5);
   const auto start = std::chrono::steady_clock::now();
   ExpectStatus(Fetch(*impatient, HeavyBuild()).status(), absl::StatusCode::kDeadlineExceeded, "");
   EXPECT_LT(std::chrono::steady_clock::now() - start, milliseconds(3000));
@@ -401,16 +399,11 @@ TEST(Server, AWaiterLeavesAtItsOwnDeadlineWhileTheBuildGoesOnForOthers) {
   Running r = StartServer(HeavyOptions());
   absl::Status patient_status;
   // The patient client's deadline outlives the impatient one's by seconds.
-  ClientOptions pc;
-  pc.target = "127.0.0.1:" + std::to_string(r.server->port());
-  pc.deadline_seconds = 3;
-  auto patient = *SamplerClient::Connect(pc);
+  auto patient = ConnectWithDeadline(*r.server, 3);
   std::thread first([&] { patient_status = Fetch(*patient, HeavyBuild()).status(); });
   ASSERT_TRUE(Within(5, [&] { return r.server->cache().stats().builds_running == 1; }));
 
-  ClientOptions ic = pc;
-  ic.deadline_seconds = 0.3;
-  auto impatient = *SamplerClient::Connect(ic);
+  auto impatient = ConnectWithDeadline(*r.server, 0.3);
   ExpectStatus(Fetch(*impatient, HeavyBuild()).status(), absl::StatusCode::kDeadlineExceeded, "");
   // The impatient client joined the same build and left it; the build goes on.
   EXPECT_EQ(r.server->cache().stats().waits, 1u);
@@ -425,10 +418,7 @@ TEST(Server, BuildsBeyondTheQueueAreTurnedAwayAndNamedTheLimit) {
   options.max_concurrent_builds = 1;
   options.max_queued_builds = 0;
   Running r = StartServer(options);
-  ClientOptions co;
-  co.target = "127.0.0.1:" + std::to_string(r.server->port());
-  co.deadline_seconds = 2;
-  auto client = *SamplerClient::Connect(co);
+  auto client = ConnectWithDeadline(*r.server, 2);
   std::thread first([&] { (void)Fetch(*client, HeavyBuild("0.3")); });
   ASSERT_TRUE(Within(5, [&] { return r.server->cache().stats().builds_running == 1; }));
   ExpectStatus(Fetch(*r.client, HeavyBuild("0.4")).status(), absl::StatusCode::kResourceExhausted,
@@ -780,10 +770,7 @@ TEST(Server, AClientThatGivesUpStopsABlueRelaxationAndFreesItsMemory) {
   co.max_resumes = 0;
   Running r = StartServer(LoopbackOptions(), co);
   WarmTreeOf(*r.client, LongBlueRelaxation());
-  ClientOptions ic = co;
-  ic.target = "127.0.0.1:" + std::to_string(r.server->port());
-  ic.deadline_seconds = 0.5;
-  auto impatient = *SamplerClient::Connect(ic);
+  auto impatient = ConnectWithDeadline(*r.server, 0.5, co);
   const auto start = std::chrono::steady_clock::now();
   EXPECT_EQ(Fetch(*impatient, LongBlueRelaxation()).status().code(),
             absl::StatusCode::kDeadlineExceeded);

@@ -1,6 +1,6 @@
 // Helpers shared by the tests that run a real server on loopback: a server
-// with no health or metrics ports, a client connected to it, and a plain
-// request.
+// with no health or metrics ports, a client connected to it (or another one,
+// with a deadline of its own), and a plain request.
 #ifndef SFCSAMPLER_TESTS_SERVER_TEST_UTIL_H_
 #define SFCSAMPLER_TESTS_SERVER_TEST_UTIL_H_
 
@@ -35,6 +35,16 @@ inline Running StartServer(const ServerOptions& options, ClientOptions client = 
   client.target = "127.0.0.1:" + std::to_string(r.server->port());
   r.client = *SamplerClient::Connect(client);
   return r;
+}
+
+// A further client of `server` with `options`, whose calls give up after
+// `deadline_seconds` (ClientOptions::deadline_seconds).
+inline std::unique_ptr<SamplerClient> ConnectWithDeadline(const SamplerServer& server,
+                                                          double deadline_seconds,
+                                                          ClientOptions options = {}) {
+  options.target = "127.0.0.1:" + std::to_string(server.port());
+  options.deadline_seconds = deadline_seconds;
+  return *SamplerClient::Connect(options);
 }
 
 inline SampleRequest Request(const std::string& surface, uint64_t count, uint64_t seed = 1) {

@@ -35,4 +35,5 @@ PYBIND11_MODULE(_core, m) {
   sfc::python::RegisterRequest(m);
   sfc::python::RegisterSampling(m);
   sfc::python::RegisterCatalog(m);
+  sfc::python::RegisterModelIdentity(m);
 }

@@ -10,6 +10,8 @@ void RegisterErrors(pybind11::module_& m);    // errors.cc: Status -> sfcsampler
 void RegisterRequest(pybind11::module_& m);   // request.cc: Request
 void RegisterSampling(pybind11::module_& m);  // sampling.cc: Engine, Job
 void RegisterCatalog(pybind11::module_& m);   // catalog.cc: surfaces(), densities()
+// model_identity.cc: canonical_ply(), model_seed()
+void RegisterModelIdentity(pybind11::module_& m);
 
 }  // namespace sfc::python
 

@@ -181,7 +181,7 @@ class PyEngine {
       // The arrays stay alive (the caller holds them) and are only read.
       py::gil_scoped_release release;
       std::string ply;
-      if (!CanonicalPly(v, vertex_count, f, wide, face_count, &ply)) {
+      if (!CanonicalPly(v, vertex_count, nullptr, nullptr, f, wide, face_count, &ply)) {
         ply.clear();
       } else {
         const std::string spec = models_.Hold(ModelFormat::kPly, std::move(ply), name);

@@ -4,20 +4,14 @@ sample-many` and sfcsampler.dask share with it.
 Each model's seed is derived from the base seed and the model's content hash
 (the SHA-256 of its file bytes, or of the canonical PLY of a mesh given as
 arrays), so a model's samples do not depend on the order of the models, on
-which worker sampled it or on how many workers there were:
-
-    seed = first 8 bytes, big-endian, of
-           SHA-256("sfcsampler.model-seed\\0" + base seed as 8 bytes little-endian
-                   + the 32 bytes of the model's SHA-256), top bit cleared
-
-(model_seed(); C++ computes the same, request/model_spec.h ModelSeed). A
-model's result is then exactly sfcsampler.sample(surface="FORMAT:FILE",
-seed=model_seed(base, sha256), ...) on it alone.
+which worker sampled it or on how many workers there were: model_seed(), the
+CLI's own function (request/model_spec.h ModelSeed). A model's result is then
+exactly sfcsampler.sample(surface="FORMAT:FILE", seed=model_seed(base,
+sha256), ...) on it alone.
 """
 
 import concurrent.futures
 import glob as globlib
-import hashlib
 import os
 import shutil
 import sys
@@ -35,14 +29,13 @@ from sfcsampler.samples import (Samples, column_dtype, column_names, kept_column
 # File extensions of the model formats (lower case, with the dot) and their formats, the
 # CLI's table (request/model_files.h).
 EXTENSIONS = dict(_core.MODEL_EXTENSIONS)
-_SEED_TAG = b"sfcsampler.model-seed\0"
 
 
 def model_seed(base_seed, sha256_hex):
-    """The seed a model gets from the base seed and its content hash (64 hex digits)."""
-    digest = hashlib.sha256(_SEED_TAG + int(base_seed).to_bytes(8, "little") +
-                            bytes.fromhex(sha256_hex)).digest()
-    return int.from_bytes(digest[:8], "big") & ((1 << 63) - 1)
+    """The seed a model gets from the base seed and its content hash (64 hex digits): the
+    first 8 bytes, big-endian, of SHA-256("sfcsampler.model-seed\\0" + base seed as 8 bytes
+    little-endian + the hash's 32 bytes), top bit cleared; computed by C++ as the CLI does."""
+    return _core.model_seed(int(base_seed), sha256_hex)
 
 
 def model_format(path):

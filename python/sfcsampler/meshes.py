@@ -18,9 +18,10 @@ import hashlib
 
 import numpy as np
 
+from sfcsampler import _core
 from sfcsampler.errors import InvalidArgumentError
 
-WEIGHT_PROPERTY = "weight"  # the PLY vertex property per-vertex weights travel in
+WEIGHT_PROPERTY = _core.MESH_WEIGHT_PROPERTY  # the PLY vertex property per-vertex weights travel in
 _MAX_INDEX = 2**31 - 1      # faces are written as PLY int
 
 
@@ -142,30 +143,14 @@ def canonical_ply(vertices, faces, normals=None, weights=None):
 
     Raises TypeError (wrong dtype) or sfcsampler.InvalidArgumentError (a
     ValueError: empty arrays, wrong shapes, non-finite values, face indices
-    out of range, negative weights), each naming the argument.
+    out of range, negative weights), each naming the argument. The bytes are
+    written by C++ (python/bindings/mesh_arrays.h), as sample_many writes them.
     """
     v = check_vertices(vertices)
     f = check_faces(faces, v.shape[0])
-    fields = [("x", "<f8"), ("y", "<f8"), ("z", "<f8")]
-    columns = [v[:, 0], v[:, 1], v[:, 2]]
-    if normals is not None:
-        n = check_normals(normals, v.shape[0])
-        fields += [("nx", "<f8"), ("ny", "<f8"), ("nz", "<f8")]
-        columns += [n[:, 0], n[:, 1], n[:, 2]]
-    if weights is not None:
-        fields.append((WEIGHT_PROPERTY, "<f8"))
-        columns.append(check_weights(weights, v.shape[0]))
-    vertex = np.empty(v.shape[0], dtype=fields)
-    for (name, _), column in zip(fields, columns):
-        vertex[name] = column
-    face = np.empty(f.shape[0], dtype=[("n", "u1"), ("i", "<i4", (3,))])
-    face["n"] = 3
-    face["i"] = f
-    header = ["ply", "format binary_little_endian 1.0", f"element vertex {v.shape[0]}"]
-    header += [f"property double {name}" for name, _ in fields]
-    header += [f"element face {f.shape[0]}", "property list uchar int vertex_indices",
-               "end_header", ""]
-    return "\n".join(header).encode() + vertex.tobytes() + face.tobytes()
+    n = None if normals is None else check_normals(normals, v.shape[0])
+    w = None if weights is None else check_weights(weights, v.shape[0])
+    return _core.canonical_ply(v, f, n, w)
 
 
 def mesh_ply(mesh, weights=None):

@@ -104,6 +104,52 @@ def test_vertex_weights_equal_a_ply_property(tmp_path):
     assert upper > 0.8, upper  # most of the mass is above z = 0
 
 
+def reference_ply(v, f, n=None, w=None):
+    """The canonical PLY as documented (meshes.py), written with NumPy's structured arrays."""
+    fields = [("x", "<f8"), ("y", "<f8"), ("z", "<f8")]
+    columns = [v[:, 0], v[:, 1], v[:, 2]]
+    if n is not None:
+        fields += [("nx", "<f8"), ("ny", "<f8"), ("nz", "<f8")]
+        columns += [n[:, 0], n[:, 1], n[:, 2]]
+    if w is not None:
+        fields.append(("weight", "<f8"))
+        columns.append(w)
+    vertex = np.empty(len(v), dtype=fields)
+    for (name, _), column in zip(fields, columns):
+        vertex[name] = column
+    face = np.empty(len(f), dtype=[("n", "u1"), ("i", "<i4", (3,))])
+    face["n"], face["i"] = 3, f
+    header = ["ply", "format binary_little_endian 1.0", f"element vertex {len(v)}"]
+    header += [f"property double {name}" for name, _ in fields]
+    header += [f"element face {len(f)}", "property list uchar int vertex_indices", "end_header", ""]
+    return "\n".join(header).encode() + vertex.tobytes() + face.tobytes()
+
+
+def test_canonical_ply_and_model_seed_are_the_documented_ones():
+    # Both are C++ (python/bindings/mesh_arrays.h, request/model_spec.h), bound into Python:
+    # checked here against the formats written out independently.
+    import hashlib
+    from sfcsampler import many
+    v, f = torus_mesh(7, 5, wobble=0.1)
+    n = v / np.linalg.norm(v, axis=1)[:, None]
+    w = 0.5 + v[:, 0] ** 2
+    for normals, weights in [(None, None), (n, None), (None, w), (n, w)]:
+        for faces in (f, f.astype(np.int32)):
+            for vertices in (v, v.astype(np.float32)):
+                got = meshes.canonical_ply(vertices, faces, normals, weights)
+                assert got == reference_ply(vertices.astype(np.float64), faces, normals, weights)
+    for base in (0, 1, 11, 2**63 + 5, 2**64 - 1):
+        for digest in (hashlib.sha256(b"").hexdigest(), hashlib.sha256(b"mesh").hexdigest()):
+            expected = hashlib.sha256(b"sfcsampler.model-seed\0" + base.to_bytes(8, "little") +
+                                      bytes.fromhex(digest)).digest()
+            assert many.model_seed(base, digest) == (
+                int.from_bytes(expected[:8], "big") & ((1 << 63) - 1))
+    with pytest.raises(OverflowError):
+        many.model_seed(-1, digest)
+    with pytest.raises(ValueError):
+        many.model_seed(1, "not hex")
+
+
 def test_mesh_sampler_keeps_the_tree():
     v, f = torus_mesh()
     s = sfcsampler.Sampler(max_trees=2)
