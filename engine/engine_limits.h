@@ -10,7 +10,11 @@
 namespace sfc {
 
 struct EngineLimits {
-  uint64_t max_count = 100'000'000;  // largest N
+  // Samples one request delivers at most (its index range, shard or whole
+  // set), and the largest N of a set: a range of a set of 10^9 costs its own
+  // samples, so only the range is held to max_count.
+  uint64_t max_count = 100'000'000;
+  uint64_t max_set_count = uint64_t{1} << 40;
   uint64_t max_tree_leaves = uint64_t{1}
                              << 22;  // per tree: 73 B a leaf (CurveTree::kBytesPerLeaf), 292 MiB
   size_t max_spec_length = 4096;     // surface/density spec, in characters

@@ -103,11 +103,10 @@ TreeSummary SummarizeTree(const PreparedTree& t) {
 
 absl::Status SamplingEngine::CheckCount(uint64_t count) const {
   if (count == 0) return absl::InvalidArgumentError("count must be >= 1");
-  if (count > limits_.max_count) {
+  if (count > limits_.max_set_count) {
     return absl::InvalidArgumentError(absl::StrFormat(
-        "count %d is above this server's limit of %d samples per request (max_count); split the "
-        "request into index ranges or shards",
-        count, limits_.max_count));
+        "count %d is above the largest set this server samples, %d samples (max_set_count)",
+        count, limits_.max_set_count));
   }
   return absl::OkStatus();
 }
@@ -155,6 +154,12 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
         "the %s sequence supports at most 2^32 samples", SequenceName(request.sequence)));
   }
   ASSIGN_OR_RETURN(const auto range, ResolveIndexRange(request));
+  if (range.second - range.first > limits_.max_count) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "this request covers %d samples, above this server's limit of %d samples per request "
+        "(max_count); ask for index ranges or shards of at most that many (count may stay %d)",
+        range.second - range.first, limits_.max_count, request.count));
+  }
   if (SequenceIsTwoDimensional(request.sequence) && request.count > limits_.max_sorted_range) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "the %s sequence sorts its whole set into curve order for every request (its index "

@@ -21,6 +21,7 @@ grpc::Status SamplerService::GetCacheStats(grpc::ServerContext* context,
     response->set_build_seconds(s.build_seconds);
     response->set_waits(s.waits);
     response->set_max_count(options_.limits.max_count);
+    response->set_max_set_count(options_.limits.max_set_count);
     response->set_max_tree_leaves(options_.limits.max_tree_leaves);
     response->set_max_spec_length(options_.limits.max_spec_length);
     response->set_max_concurrent_streams(options_.max_concurrent_streams);

@@ -59,7 +59,11 @@ int main(int argc, char** argv) {
   app.add_option("--metrics-address", o.metrics_address,
                  "host:port of Prometheus /metrics (\"\" = none)")
       ->capture_default_str();
-  app.add_option("--max-count", o.limits.max_count, "largest N per request")->capture_default_str();
+  app.add_option("--max-count", o.limits.max_count,
+                 "samples one request delivers at most (its index range, shard or whole set)")
+      ->capture_default_str();
+  app.add_option("--max-set-count", o.limits.max_set_count, "largest N of a set")
+      ->capture_default_str();
   app.add_option(
          "--max-tree-leaves", o.limits.max_tree_leaves,
          absl::StrFormat("largest tree, in leaves (%d bytes each)", sfc::CurveTree::kBytesPerLeaf))

@@ -104,6 +104,36 @@ TEST(Engine, CountOfZeroOrAboveTheLimitIsInvalidArgument) {
               absl::StatusCode::kInvalidArgument, "max_count");
 }
 
+// max_count bounds what one request delivers, not N: index ranges and shards
+// of a set far larger than it are served (each costs its own samples), and
+// N itself is bounded by max_set_count.
+TEST(Engine, RangesOfASetLargerThanARequestAreServed) {
+  DirectTreeSource source;
+  EngineLimits limits;
+  limits.max_count = 1000;
+  limits.max_set_count = 1'000'000'000;
+  SamplingEngine engine(RegisteredSurfaceKinds(), limits, &source);
+  SampleRequest r;
+  r.tree.surface = "torus";
+  r.count = 1'000'000'000;
+  r.seed = 1;
+  r.begin = 123'456'789;
+  r.end = r.begin + 1000;
+  absl::StatusOr<SamplingJob> job = engine.Start(r);
+  ASSERT_TRUE(job.ok()) << job.status();
+  EXPECT_EQ(job->end - job->begin, 1000u);
+  r.end = r.begin + 1001;
+  ExpectError(engine.Start(r).status(), absl::StatusCode::kInvalidArgument, "max_count");
+  r.begin = r.end = 0;
+  r.shard_count = 1'000'000;
+  r.shard_index = 999'999;
+  EXPECT_TRUE(engine.Start(r).ok());
+  r.shard_count = r.shard_index = 0;
+  r.count = limits.max_set_count + 1;
+  r.begin = 0, r.end = 10;
+  ExpectError(engine.Start(r).status(), absl::StatusCode::kInvalidArgument, "max_set_count");
+}
+
 TEST(Engine, UnknownSurfaceDensityOrParameterIsInvalidArgument) {
   ExpectError(StartWith("klein", "uniform", 10).status(), absl::StatusCode::kInvalidArgument,
               "known: plane");
