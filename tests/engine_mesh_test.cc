@@ -282,6 +282,44 @@ TEST(EngineMesh, PolygonsOf256OrMoreCornersAreReadWhole) {
   }
 }
 
+// A density whose integral overflows double precision is refused on a mesh as
+// on a formula surface (one message, CurveTree::CheckMassIsFinite); it used to
+// put every sample on one point (D3 of the hostile-client probe).
+TEST(EngineMesh, ADensityWhoseIntegralOverflowsIsRefused) {
+  DirectTreeSource source;
+  FileModelSource files;
+  SamplingEngine engine(RegisteredSurfaceKinds(), {}, &source, &files);
+  auto expect_refused = [&](const SampleRequest& r, const std::string& file) {
+    const absl::Status refused = engine.Start(r).status();
+    EXPECT_EQ(refused.code(), absl::StatusCode::kInvalidArgument) << refused;
+    EXPECT_NE(refused.message().find("overflow double precision; scale it down"), std::string::npos)
+        << refused;
+    EXPECT_NE(refused.message().find(file), std::string::npos) << refused;
+  };
+  const std::string square = WriteTemp(
+      "engine_mesh_overflow.obj", "v 0 0 0\nv 100 0 0\nv 100 100 0\nv 0 100 0\nf 1 2 3\nf 1 3 4\n");
+  SampleRequest r = MeshRequest("obj:" + square, 1000);
+  r.tree.density = "expr:1e306";  // 1e310 over the square
+  expect_refused(r, "engine_mesh_overflow.obj");
+  // A density a hundred times smaller integrates to 1e308: sampled, spread.
+  r.tree.density = "expr:1e304";
+  const SampleBatch spread = DrawAll(engine, r);
+  ASSERT_EQ(spread.size(), 1000u);
+  size_t right = 0;
+  for (double x : spread.x) right += x > 50;
+  EXPECT_NEAR(right, 500.0, 10.0);
+
+  const std::string weighted =
+      WriteTemp("engine_mesh_overflow.ply",
+                "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\n"
+                "property double z\nproperty double weight\nelement face 2\n"
+                "property list uchar int vertex_indices\nend_header\n0 0 0 1e300\n1e5 0 0 1e300\n"
+                "1e5 1e5 0 1e300\n0 1e5 0 1e300\n3 0 1 2\n3 0 2 3\n");
+  SampleRequest w = MeshRequest("ply:" + weighted, 1000);
+  w.tree.density = "vertex:weight";
+  expect_refused(w, "engine_mesh_overflow.ply");
+}
+
 TEST(EngineMesh, PerVertexWeightsFromAPlyPropertyShiftTheSamples) {
   TriangleMesh sphere = MakeIcosphere(3);
   sphere.weights.clear();
