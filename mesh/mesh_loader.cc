@@ -660,4 +660,9 @@ absl::StatusOr<TriangleMesh> LoadMeshFile(const std::string& path, const MeshLoa
   return LoadMesh(bytes, path, resolved);
 }
 
+uint64_t MeshParseMemoryBytes(ModelFormat format, absl::string_view bytes) {
+  const uint64_t per_byte = format != ModelFormat::kPly || IsAsciiPly(bytes) ? 32 : 64;
+  return (uint64_t{1} << 20) + per_byte * bytes.size();
+}
+
 }  // namespace sfc
