@@ -11,6 +11,8 @@
 //       writes the soak's models into DIR, and STEP and IGES files of
 //       CAD_COPIES (default 400) boxes with a hole, then measures them all
 //   parse_memory FORMAT:FILE...
+//   parse_memory --worst DIR [MB]  (the meshes that cost the most a byte:
+//       mesh/mesh_loader.h's MeshParseMemoryBytes; MB, default 16, each)
 //   parse_memory --repeat N FORMAT:FILE    (N parses in one process: VmRSS)
 //   parse_memory --time-reads FORMAT:FILE  (Load against ReadToBrep + LoadBrep)
 #include <sys/wait.h>
@@ -19,12 +21,13 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <utility>
-#include <optional>
 #include <vector>
 
 #include "absl/strings/numbers.h"
+#include "absl/strings/str_format.h"
 #include "bench/soak_models.h"
 #include "cad/fixtures.h"
 #include "cad/load.h"
@@ -84,6 +87,11 @@ int Measure(const std::string& spec, bool curvature) {
   }
   const uint64_t peak = StatusBytes("VmHWM");
   const double growth = peak > before ? static_cast<double>(peak - before) : 0.0;
+  if (format == "ply" || format == "obj") {
+    what += absl::StrFormat(" (reserved %.1f a byte)",
+                            static_cast<double>(sfc::MeshParseMemoryBytes(model->format, bytes)) /
+                                static_cast<double>(bytes.size()));
+  }
   std::printf("%-6s %-10s %12zu %12.0f %8.2f  %s\n", format.c_str(), curvature ? "curvature" : "",
               bytes.size(), growth, growth / static_cast<double>(bytes.size()), what.c_str());
   std::fflush(stdout);
@@ -102,6 +110,49 @@ bool WriteCadArrays(const std::string& dir, int copies, std::vector<std::string>
     specs->push_back(std::string(name) + ":" + path);
   }
   return true;
+}
+
+// The meshes that cost the most memory a byte of file, of about `size`
+// bytes each, in `dir`: OBJ lines "f 1 2 3" (tinyobjloader's faces), OBJ and
+// ASCII PLY faces of 100 one-digit corners (a triangle every two bytes),
+// binary PLY faces of 255 uchar corners (a triangle every byte).
+bool WriteWorstMeshes(const std::string& dir, size_t size, std::vector<std::string>* specs) {
+  auto write = [&](const std::string& name, const std::string& head, const std::string& unit) {
+    std::ofstream out(dir + "/" + name, std::ios::binary);
+    out << head;
+    for (size_t n = head.size(); n < size; n += unit.size()) out << unit;
+    specs->push_back(name.substr(name.rfind('.') + 1) + ":" + dir + "/" + name);
+    return static_cast<bool>(out);
+  };
+  std::string obj_polygon = "f", ascii_face = "100", binary_face(1, '\xff');
+  for (int c = 0; c < 100; ++c) obj_polygon += absl::StrFormat(" %d", c % 3 + 1);
+  for (int c = 0; c < 100; ++c) ascii_face += absl::StrFormat(" %d", c % 3);
+  for (int c = 0; c < 255; ++c) binary_face += static_cast<char>(c % 3);
+  const std::string vertices = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  auto ply_head = [&](const char* encoding, const std::string& face, const char* index) {
+    const float corners[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    const bool binary = std::string(encoding) != "ascii";
+    return absl::StrFormat(
+               "ply\nformat %s 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+               "property float z\nelement face %d\nproperty list uchar %s "
+               "vertex_indices\nend_header\n",
+               encoding, size / face.size(), index) +
+           (binary ? std::string(reinterpret_cast<const char*>(corners), sizeof(corners))
+                   : "0 0 0\n1 0 0\n0 1 0\n");
+  };
+  // A PLY's face count is exact: its faces fill `size` less nothing.
+  auto write_ply = [&](const std::string& name, const char* encoding, const std::string& face,
+                       const char* index) {
+    std::ofstream out(dir + "/" + name, std::ios::binary);
+    out << ply_head(encoding, face, index);
+    for (size_t f = 0; f < size / face.size(); ++f) out << face;
+    specs->push_back("ply:" + dir + "/" + name);
+    return static_cast<bool>(out);
+  };
+  return write("worst_triangles.obj", vertices, "f 1 2 3\n") &&
+         write("worst_polygons.obj", vertices, obj_polygon + "\n") &&
+         write_ply("worst_ascii.ply", "ascii", ascii_face + "\n", "int") &&
+         write_ply("worst_binary.ply", "binary_little_endian", binary_face, "uchar");
 }
 
 // Parses `spec` `times` times in this process and prints VmRSS every tenth
@@ -167,7 +218,14 @@ int main(int argc, char** argv) {
     return 2;
   }
   std::vector<std::string> specs;
-  if (std::string(argv[1]).find(':') == std::string::npos) {
+  if (std::string(argv[1]) == "--worst") {
+    int mb = 16;
+    if (argc < 3 || (argc > 3 && !absl::SimpleAtoi(argv[3], &mb))) return 2;
+    if (!WriteWorstMeshes(argv[2], size_t(mb) << 20, &specs)) {
+      std::fprintf(stderr, "could not write the meshes into %s\n", argv[2]);
+      return 1;
+    }
+  } else if (std::string(argv[1]).find(':') == std::string::npos) {
     int subdivisions = 8;
     if (argc > 2 && !absl::SimpleAtoi(argv[2], &subdivisions)) return 2;
     auto models = sfc::SoakModels::Write(argv[1], subdivisions);

@@ -83,6 +83,7 @@ absl::StatusOr<double> ModelTolerance(const Model& model, const BuildControl& co
 // area (a degenerate face), or no density mass inside its trim.
 bool HasNothingToSample(const absl::Status& status) {
   return status.code() == absl::StatusCode::kInvalidArgument &&
+         !CurveTree::IsMassOverflow(status) &&
          (absl::StrContains(status.message(), "zero area") ||
           absl::StrContains(status.message(), "integrates to") ||
           absl::StrContains(status.message(), "to one point"));
@@ -157,6 +158,10 @@ absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
     for (const Piece& piece : tree->pieces_) total += piece.tree->total_mass();
     return total;
   };
+  // The faces' masses may each be finite and their sum not.
+  auto check_total = [&](double total) {
+    return CurveTree::CheckMassIsFinite(total, absl::StrFormat("model \"%s\"", model->name()));
+  };
   auto nothing_to_sample = [&] {
     return absl::InvalidArgumentError(absl::StrFormat(
         "the model \"%s\" has no face to sample: its %d faces have no area or no density mass",
@@ -191,6 +196,7 @@ absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
       RETURN_IF_ERROR(build_face(f, 0, /*refuse_hidden=*/false).status());
     }
     const double coarse_total = total_mass();
+    RETURN_IF_ERROR(check_total(coarse_total));
     if (tree->pieces_.empty() || !(coarse_total > 0)) return nothing_to_sample();
     // Stage two: each face's tree refined for the samples its coarse share
     // brings. Each refinement is bounded by the budget its coarse build was
@@ -214,6 +220,7 @@ absl::StatusOr<std::shared_ptr<const ModelTree>> ModelTree::Build(
   // The windows, from the refined masses; one double per boundary, so
   // neighbouring windows split the samples exactly.
   const double total = total_mass();
+  RETURN_IF_ERROR(check_total(total));
   double running = 0;
   for (size_t i = 0; i < tree->pieces_.size(); ++i) {
     Piece& piece = tree->pieces_[i];

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "base/status_macros.h"
@@ -1074,12 +1075,7 @@ absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Build(const Surface&
         "the surface has zero area (its area element vanishes on the whole parameter box, e.g. "
         "it is a curve or a point); there is nothing to sample");
   }
-  if (std::isnan(base) || base == INFINITY) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "the density times the area element integrates to %g over the surface: the density's "
-        "values overflow double precision; scale it down (only its ratios matter)",
-        base));
-  }
+  RETURN_IF_ERROR(CheckMassIsFinite(base, "the surface"));
   if (!(base > 0)) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "the density integrates to %g over the surface; it must be positive somewhere (check "
@@ -1105,6 +1101,23 @@ absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Build(const Surface&
   tree->precision_ = builder.report();
   RETURN_IF_ERROR(builder.Finish(tree.get()));
   return std::shared_ptr<const CurveTree>(std::move(tree));
+}
+
+namespace {
+constexpr absl::string_view kOverflowWords =
+    "the density's values overflow double precision; scale it down (only its ratios matter)";
+}  // namespace
+
+absl::Status CurveTree::CheckMassIsFinite(double mass, absl::string_view where) {
+  if (std::isfinite(mass)) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      absl::StrFormat("the density times the area element integrates to %g over %s: %s", mass,
+                      where, kOverflowWords));
+}
+
+bool CurveTree::IsMassOverflow(const absl::Status& status) {
+  return status.code() == absl::StatusCode::kInvalidArgument &&
+         absl::StrContains(status.message(), kOverflowWords);
 }
 
 absl::StatusOr<std::shared_ptr<const CurveTree>> CurveTree::Refined(

@@ -62,6 +62,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "base/pod_array.h"
 #include "core/area_estimator.h"
 #include "core/curve.h"
@@ -185,6 +186,15 @@ class CurveTree {
   // a mesh's small leaves' masses leave the normal doubles, and samples
   // coincide (docs/ALGORITHM.md, "Tiny densities").
   static constexpr double kSmallestMass = 0x1p-966;
+  // The refusal of a density whose total `mass` over `where` ("the surface",
+  // "mesh 'NAME'", ...) overflows double precision (inf or nan), where the
+  // tree would put every sample on one point (docs/ALGORITHM.md, "Huge
+  // densities"); OK for any other mass. Surfaces, meshes and CAD models all
+  // refuse with this one message.
+  static absl::Status CheckMassIsFinite(double mass, absl::string_view where);
+  // Whether `status` is CheckMassIsFinite's refusal (a CAD face whose mass
+  // overflows is refused, never skipped as one with nothing to sample).
+  static bool IsMassOverflow(const absl::Status& status);
   // The edge probe (EdgeError): a gap of kEdgeJump of the largest node value
   // between m and the model at a corner or edge midpoint counts, over a band
   // of kEdgeBand of the cell.

@@ -185,6 +185,7 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
       tree->mass_ends_[r] = running;
     }
     tree->rank_first_leaf_[ranks] = static_cast<uint32_t>(ranks);
+    RETURN_IF_ERROR(CurveTree::CheckMassIsFinite(running, absl::StrFormat("mesh '%s'", mesh.name)));
   } else {
     // Densities at the mesh vertices, shared by the triangles' roots.
     std::vector<double> vertex_density(mesh.positions.size(), -1);
@@ -208,6 +209,7 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
       RETURN_IF_ERROR(probe.Masses(t, c, root_f[r], area, &root_q[r], &root_l[r]));
       total0 += root_q[r];
     }
+    RETURN_IF_ERROR(CurveTree::CheckMassIsFinite(total0, absl::StrFormat("mesh '%s'", mesh.name)));
     if (!(total0 > 0)) {
       return absl::FailedPreconditionError(absl::StrFormat(
           "the density '%s' is zero on the whole of mesh '%s': there is nothing to sample",

@@ -48,10 +48,20 @@ void AddPolygon(const std::vector<uint32_t>& corners, TriangleMesh* mesh) {
 
 // ---------------------------------------------------------------- OBJ
 
+// A face line of 256 or more corners: tinyobjloader keeps each face's corner
+// count in an unsigned char (mesh_t::num_face_vertices), so the line scan
+// keeps the true count of these few.
+struct LongObjFace {
+  uint64_t ordinal = 0;  // the face's place among the file's faces, from 0
+  uint64_t corners = 0;
+  size_t line_number = 0;
+};
+
 // What the line scan of an OBJ file found: its face lines, which the mesh
-// must all hold afterwards (nothing dropped silently).
+// must all hold afterwards (nothing dropped silently), and the long ones.
 struct ObjCensus {
   uint64_t face_lines = 0;
+  std::vector<LongObjFace> long_faces;  // by ordinal
 };
 
 // One corner's index of kind `what` ("vertex", "texture coordinate",
@@ -100,6 +110,9 @@ absl::StatusOr<ObjCensus> CheckObjLines(absl::string_view text, absl::string_vie
     std::vector<absl::string_view> tokens =
         absl::StrSplit(line.substr(2), absl::ByAnyChar(" \t\r"), absl::SkipEmpty());
     if (f) {
+      if (tokens.size() > std::numeric_limits<unsigned char>::max()) {
+        census.long_faces.push_back({census.face_lines, tokens.size(), line_number});
+      }
       ++census.face_lines;
       if (tokens.size() < 3) {
         return Malformed(name, absl::StrFormat("line %d: a face needs three corners, found %d "
@@ -198,12 +211,33 @@ absl::StatusOr<TriangleMesh> LoadObj(absl::string_view bytes, absl::string_view 
   std::vector<int> normal_of(nv, -1);
   bool vertex_normals = !attrib.normals.empty();
   std::vector<uint32_t> corners;
+  uint64_t ordinal = 0;  // the face's place in the file, as the census counts
+  auto next_long = census.long_faces.begin();
   for (const tinyobj::shape_t& shape : reader.GetShapes()) {
+    const std::vector<tinyobj::index_t>& indices = shape.mesh.indices;
     size_t offset = 0;
-    for (const unsigned int count : shape.mesh.num_face_vertices) {
+    for (const unsigned int kept : shape.mesh.num_face_vertices) {
+      // The reader's count is the true one modulo 256.
+      uint64_t count = kept;
+      size_t line_number = 0;
+      if (next_long != census.long_faces.end() && next_long->ordinal == ordinal) {
+        count = next_long->corners;
+        line_number = next_long->line_number;
+        ++next_long;
+      }
+      ++ordinal;
+      if (count % 256 != kept || count > indices.size() - offset) {
+        return Malformed(
+            name,
+            absl::StrFormat("face %d%s: the OBJ reader's corner count (%d, of %d corners "
+                            "left in its group) does not match the file's (%d); refusing "
+                            "rather than reading misaligned corners",
+                            ordinal, line_number ? absl::StrFormat(" (line %d)", line_number) : "",
+                            kept, indices.size() - offset, count));
+      }
       corners.clear();
       for (size_t c = 0; c < count; ++c) {
-        const tinyobj::index_t& index = shape.mesh.indices[offset + c];
+        const tinyobj::index_t& index = indices[offset + c];
         if (index.vertex_index < 0 || static_cast<size_t>(index.vertex_index) >= nv) {
           return Malformed(name, absl::StrFormat("a face uses vertex %d but the file has %d "
                                                  "vertices (a truncated file?)",
@@ -223,6 +257,12 @@ absl::StatusOr<TriangleMesh> LoadObj(absl::string_view bytes, absl::string_view 
       }
       offset += count;
       AddPolygon(corners, &mesh);
+    }
+    if (offset != indices.size()) {
+      return Malformed(name, absl::StrFormat("the OBJ reader kept %d face corners in the group "
+                                             "ending with face %d but its faces count %d; "
+                                             "refusing rather than reading misaligned corners",
+                                             indices.size(), ordinal, offset));
     }
   }
   if (vertex_normals) {
@@ -618,6 +658,11 @@ absl::StatusOr<TriangleMesh> LoadMeshFile(const std::string& path, const MeshLoa
     if (named == ModelFormat::kObj || named == ModelFormat::kPly) resolved.format = named;
   }
   return LoadMesh(bytes, path, resolved);
+}
+
+uint64_t MeshParseMemoryBytes(ModelFormat format, absl::string_view bytes) {
+  const uint64_t per_byte = format != ModelFormat::kPly || IsAsciiPly(bytes) ? 32 : 64;
+  return (uint64_t{1} << 20) + per_byte * bytes.size();
 }
 
 }  // namespace sfc

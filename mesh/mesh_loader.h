@@ -53,6 +53,18 @@ absl::StatusOr<TriangleMesh> LoadMesh(absl::string_view bytes, absl::string_view
 absl::StatusOr<TriangleMesh> LoadMeshFile(const std::string& path,
                                           const MeshLoadOptions& options = {});
 
+// The peak memory that LoadMesh of `bytes` in `format` (kObj or kPly) and
+// MeshSurface::Create of its mesh, with curvature, may take beyond the bytes
+// themselves: what a server reserves before the parse starts. The worst
+// files make a triangle of every two bytes (long faces of one-digit corners:
+// OBJ, ASCII PLY) or of every byte (binary PLY with uchar indices), a triangle
+// costing about 50 bytes read and kept, or a face of every 8 bytes (OBJ
+// "f 1 2 3" lines: tinyobjloader's faces cost about 190 bytes). Measured by
+// bench/parse_memory (docs/MODELS.md): at most 24.5 bytes a byte of OBJ, 24.7
+// of ASCII PLY and 49.1 of binary PLY; reserved with a margin of 1.3, plus
+// 1 MiB for any file.
+uint64_t MeshParseMemoryBytes(ModelFormat format, absl::string_view bytes);
+
 }  // namespace sfc
 
 #endif  // SFCSAMPLER_MESH_MESH_LOADER_H_

@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--parse-memory-bytes", o.limits.parse_memory_bytes,
                  "working memory of the model parses running at once, bytes, estimated from each "
-                 "file's size (about 30 bytes a byte of STEP or IGES, 5-8 of a mesh); a model "
+                 "file's size (about 30 bytes a byte of STEP or IGES, 32-64 of a mesh); a model "
                  "needing more is RESOURCE_EXHAUSTED (0: no limit)")
       ->capture_default_str();
   app.add_option("--model-parse-threads", o.limits.model_parse_threads,

@@ -7,15 +7,17 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
 
+#include "absl/strings/str_format.h"
 #include "base/status_macros.h"
-#include "catalog/catalog.h"
 #include "cad/fixtures.h"
 #include "cad/load.h"
 #include "cad/model_sampler.h"
+#include "catalog/catalog.h"
 #include "core/density.h"
 #include "engine/sampling_engine.h"
 #include "evaluation/blue_noise.h"
@@ -123,6 +125,43 @@ TEST(EngineCad, FacesGetSamplesInProportionToTheirExactAreas) {
       // stretch of the curve; the trims' model error adds at most a sample.
       EXPECT_NEAR(counts[face.index()], expected, 2.0) << "face " << face.index() << ", N = " << n;
     }
+  }
+}
+
+// A density whose integral overflows double precision is refused on a model
+// as on a formula surface: a face whose mass overflows is not skipped as one
+// with nothing to sample, and faces whose masses are finite but sum past
+// double precision are refused too (D3 of the hostile-client probe: every
+// sample fell on one face).
+TEST(EngineCad, ADensityWhoseIntegralOverflowsIsRefused) {
+  LocalEngine e;
+  SampleRequest r = ModelRequest("step:" + Fixture(fx::Solid::kBoxWithHole), 1000);
+  auto model = BoxModel();
+  ASSERT_TRUE(model.ok()) << model.status();
+  double largest = 0;
+  for (const cad::Face& face : (*model)->faces()) largest = std::max(largest, face.area());
+  // One constant whose integral overflows on some faces, one that overflows
+  // only on the sum of the faces.
+  const double on_a_face = std::numeric_limits<double>::max() / largest * 2;
+  const double on_the_sum = 0.9 * std::numeric_limits<double>::max() / largest;
+  ASSERT_GT(on_the_sum * (*model)->total_area(), std::numeric_limits<double>::max());
+  for (const double c : {1e306, on_a_face, on_the_sum}) {
+    r.tree.density = absl::StrFormat("expr:%.17g", c);
+    const absl::Status refused = e.engine.Start(r).status();
+    EXPECT_EQ(refused.code(), absl::StatusCode::kInvalidArgument) << c << ": " << refused;
+    EXPECT_NE(refused.message().find("overflow double precision; scale it down"), std::string::npos)
+        << refused;
+  }
+  // A constant whose integral fits: every face gets its area's share.
+  r.tree.density =
+      absl::StrFormat("expr:%.17g", 0.5 * on_the_sum / (*model)->total_area() * largest);
+  const SampleBatch b = DrawAll(e.engine, r);
+  ASSERT_EQ(b.size(), 1000u);
+  std::map<uint32_t, double> counts;
+  for (uint32_t f : b.face) ++counts[f];
+  for (const cad::Face& face : (*model)->faces()) {
+    EXPECT_NEAR(counts[face.index()], 1000 * face.area() / (*model)->total_area(), 3.0)
+        << "face " << face.index();
   }
 }
 

@@ -11,10 +11,12 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "engine/sampling_engine.h"
 #include "gtest/gtest.h"
 #include "kinds/registered_kinds.h"
 #include "mesh/icosphere.h"
+#include "mesh/mesh_loader.h"
 #include "mesh/mesh_writer.h"
 #include "tests/engine_helpers.h"
 
@@ -266,6 +268,98 @@ TEST(EngineMesh, AFarVertexCountsForTheSizeOnlyWhenATriangleUsesIt) {
         << refused;
     EXPECT_NE(refused.message().find("scale it into that range"), std::string::npos) << refused;
   }
+}
+
+// A convex n-gon of circumradius 1 in one face line, plus a separate triangle
+// of area 1/2 beside it. tinyobjloader keeps corner counts in an unsigned
+// char: a 300-gon was read as a 44-gon and the triangle after it from
+// misaligned corners (D2 of the hostile-client probe).
+std::string PolygonAndTriangle(int n, bool ply) {
+  std::string vertices;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * M_PI * i / n;
+    vertices +=
+        absl::StrFormat(ply ? "%.17g %.17g 0\n" : "v %.17g %.17g 0\n", std::cos(a), std::sin(a));
+  }
+  vertices += ply ? "3 0 0\n4 0 0\n3 1 0\n" : "v 3 0 0\nv 4 0 0\nv 3 1 0\n";
+  std::string polygon = ply ? absl::StrCat(n) : "f";
+  for (int i = 0; i < n; ++i) absl::StrAppend(&polygon, " ", ply ? i : i + 1);
+  if (!ply) return absl::StrFormat("%s%s\nf %d %d %d\n", vertices, polygon, n + 1, n + 2, n + 3);
+  return absl::StrFormat(
+      "ply\nformat ascii 1.0\nelement vertex %d\nproperty double x\nproperty double y\n"
+      "property double z\nelement face 2\nproperty list ushort int vertex_indices\n"
+      "end_header\n%s%s\n3 %d %d %d\n",
+      n + 3, vertices, polygon, n, n + 1, n + 2);
+}
+
+TEST(EngineMesh, PolygonsOf256OrMoreCornersAreReadWhole) {
+  DirectTreeSource source;
+  FileModelSource files;
+  SamplingEngine engine(RegisteredSurfaceKinds(), {}, &source, &files);
+  for (const int n : {256, 300, 1000}) {
+    SCOPED_TRACE(n);
+    const double polygon_area = 0.5 * n * std::sin(2 * M_PI / n);
+    for (const bool ply : {false, true}) {
+      const std::string bytes = PolygonAndTriangle(n, ply);
+      auto mesh = LoadMesh(bytes, ply ? "ngon.ply" : "ngon.obj");
+      ASSERT_TRUE(mesh.ok()) << mesh.status();
+      EXPECT_EQ(mesh->stats.faces, 2u);
+      EXPECT_EQ(mesh->triangles.size(), static_cast<size_t>(n - 2 + 1));
+      EXPECT_NEAR(mesh->stats.area, polygon_area + 0.5, 1e-12);
+    }
+    const std::string path =
+        WriteTemp(absl::StrCat("engine_mesh_ngon", n, ".obj"), PolygonAndTriangle(n, false));
+    const SampleBatch b = DrawAll(engine, MeshRequest("obj:" + path, 20000));
+    ASSERT_EQ(b.size(), 20000u);
+    size_t on_triangle = 0;
+    for (size_t i = 0; i < b.size(); ++i) on_triangle += b.x[i] >= 3 && b.x[i] <= 4;
+    // Jittered samples: the triangle's share is its area's within a few
+    // samples of the strata the triangle's edges cut.
+    EXPECT_NEAR(static_cast<double>(on_triangle) / b.size(), 0.5 / (polygon_area + 0.5), 0.005);
+    // The polygon's samples fill its disc, not only its rim.
+    size_t inner = 0;
+    for (size_t i = 0; i < b.size(); ++i) inner += std::hypot(b.x[i], b.y[i]) < 0.5;
+    EXPECT_NEAR(static_cast<double>(inner) / (b.size() - on_triangle), 0.25 * M_PI / polygon_area,
+                0.01);
+  }
+}
+
+// A density whose integral overflows double precision is refused on a mesh as
+// on a formula surface (one message, CurveTree::CheckMassIsFinite); it used to
+// put every sample on one point (D3 of the hostile-client probe).
+TEST(EngineMesh, ADensityWhoseIntegralOverflowsIsRefused) {
+  DirectTreeSource source;
+  FileModelSource files;
+  SamplingEngine engine(RegisteredSurfaceKinds(), {}, &source, &files);
+  auto expect_refused = [&](const SampleRequest& r, const std::string& file) {
+    const absl::Status refused = engine.Start(r).status();
+    EXPECT_EQ(refused.code(), absl::StatusCode::kInvalidArgument) << refused;
+    EXPECT_NE(refused.message().find("overflow double precision; scale it down"), std::string::npos)
+        << refused;
+    EXPECT_NE(refused.message().find(file), std::string::npos) << refused;
+  };
+  const std::string square = WriteTemp(
+      "engine_mesh_overflow.obj", "v 0 0 0\nv 100 0 0\nv 100 100 0\nv 0 100 0\nf 1 2 3\nf 1 3 4\n");
+  SampleRequest r = MeshRequest("obj:" + square, 1000);
+  r.tree.density = "expr:1e306";  // 1e310 over the square
+  expect_refused(r, "engine_mesh_overflow.obj");
+  // A density a hundred times smaller integrates to 1e308: sampled, spread.
+  r.tree.density = "expr:1e304";
+  const SampleBatch spread = DrawAll(engine, r);
+  ASSERT_EQ(spread.size(), 1000u);
+  size_t right = 0;
+  for (double x : spread.x) right += x > 50;
+  EXPECT_NEAR(right, 500.0, 10.0);
+
+  const std::string weighted =
+      WriteTemp("engine_mesh_overflow.ply",
+                "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\n"
+                "property double z\nproperty double weight\nelement face 2\n"
+                "property list uchar int vertex_indices\nend_header\n0 0 0 1e300\n1e5 0 0 1e300\n"
+                "1e5 1e5 0 1e300\n0 1e5 0 1e300\n3 0 1 2\n3 0 2 3\n");
+  SampleRequest w = MeshRequest("ply:" + weighted, 1000);
+  w.tree.density = "vertex:weight";
+  expect_refused(w, "engine_mesh_overflow.ply");
 }
 
 TEST(EngineMesh, PerVertexWeightsFromAPlyPropertyShiftTheSamples) {

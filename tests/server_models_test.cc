@@ -21,6 +21,7 @@
 #include "engine/model_source.h"
 #include "grpcpp/create_channel.h"
 #include "gtest/gtest.h"
+#include "mesh/mesh_loader.h"
 #include "proto/convert.h"
 #include "request/model_spec.h"
 #include "request/routing_key.h"
@@ -499,9 +500,12 @@ TEST(ServerModels, ParsedModelsAreCountedAndDroppedWithFailedRequestsAndEvictedU
 TEST(ServerModels, ParseMemoryAndUploadsInFlightFollowTheirBudgets) {
   ServerOptions options = LoopbackOptions();
   const std::string small = GridObj(10), large = GridObj(200);
-  // Room for the small grid's parse (1 MiB + 8 bytes a byte), not the large one's.
-  options.limits.parse_memory_bytes = (uint64_t{1} << 20) + 8 * (small.size() + large.size()) / 2;
-  ASSERT_GT((uint64_t{1} << 20) + 8 * large.size(), options.limits.parse_memory_bytes);
+  // Room for the small grid's parse, not the large one's.
+  const uint64_t small_parse = MeshParseMemoryBytes(ModelFormat::kObj, small);
+  const uint64_t large_parse = MeshParseMemoryBytes(ModelFormat::kObj, large);
+  options.limits.parse_memory_bytes = (small_parse + large_parse) / 2;
+  ASSERT_GT(large_parse, options.limits.parse_memory_bytes);
+  ASSERT_LT(small_parse, options.limits.parse_memory_bytes);
   Running r = StartServer(options);
   auto info_small = r.client->UploadModel("obj", "small.obj", small);
   ASSERT_TRUE(info_small.ok()) << info_small.status();

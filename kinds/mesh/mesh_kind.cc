@@ -125,11 +125,7 @@ absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::
   options.format = model.format;
   options.weight_property = choice.weight_property;
   options.max_bytes = model.bytes->size();
-  // The parse's peak memory (bench/parse_memory, docs/MODELS.md): 2.0-4.2
-  // bytes a byte of PLY, 4.0-6.5 a byte of OBJ (files of 1-48 MB, with
-  // curvature), and under 1 MiB for small files; reserved with a margin.
-  const uint64_t working_bytes =
-      (uint64_t{1} << 20) + model.bytes->size() * (model.format == ModelFormat::kPly ? 5 : 8);
+  const uint64_t working_bytes = MeshParseMemoryBytes(model.format, *model.bytes);
   // The parse owns its inputs: it runs on a parse thread and may outlive the
   // request that started it.
   ASSIGN_OR_RETURN(
