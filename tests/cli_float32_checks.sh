@@ -21,4 +21,8 @@ f32_refusals() {
   f32_refused 'sphere:r=1e70' uniform "" "the x, y, z columns reach" "$@"
   f32_refused 'sphere:r=1e-50' uniform "" "the x, y, z columns span" "$@"
   f32_refused 'expr:x=u;y=v;z=0' 'expr:1e300*u' --density-column "the density column reaches" "$@"
+  # A mesh's box is its triangles' corners: an octahedron of radius 1e39.
+  printf 'v 1e39 0 0\nv -1e39 0 0\nv 0 1e39 0\nv 0 -1e39 0\nv 0 0 1e39\nv 0 0 -1e39\n' > "$tmp/big.obj"
+  printf 'f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n' >> "$tmp/big.obj"
+  f32_refused "obj:$tmp/big.obj" uniform "" "the x, y, z columns reach 1e+39" "$@"
 }

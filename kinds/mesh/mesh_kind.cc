@@ -1,6 +1,8 @@
 #include "kinds/mesh/mesh_kind.h"
 
 #include <algorithm>
+#include <cmath>
+#include <functional>
 #include <utility>
 
 #include "absl/strings/ascii.h"
@@ -12,6 +14,7 @@
 #include "catalog/catalog.h"
 #include "catalog/expression.h"
 #include "engine/batch_cursor.h"
+#include "engine/float32_range.h"
 #include "mesh/mesh_curve_tree.h"
 #include "mesh/mesh_loader.h"
 #include "mesh/mesh_sampler.h"
@@ -64,8 +67,8 @@ absl::StatusOr<MeshDensityChoice> ParseMeshDensity(const std::string& text) {
                       absl::StrContains(spec, "offset=");
   ASSIGN_OR_RETURN(const DensityFromSpec catalog,
                    MakeDensity(offset ? absl::StrReplaceAll(spec, {{"offset=", "floor="}}) : spec));
-  out.canonical = offset ? absl::StrReplaceAll(catalog.canonical, {{"floor=", "offset="}})
-                         : catalog.canonical;
+  out.canonical =
+      offset ? absl::StrReplaceAll(catalog.canonical, {{"floor=", "offset="}}) : catalog.canonical;
   const CurvatureFloor rule = offset ? CurvatureFloor::kOffset : CurvatureFloor::kMax;
   if (catalog.name == "uniform") {
     out.density = UniformMeshDensity();
@@ -85,11 +88,11 @@ absl::StatusOr<MeshDensityChoice> ParseMeshDensity(const std::string& text) {
                                              : MeanCurvatureMeshDensity(floor, rule);
     return out;
   }
-  return absl::InvalidArgumentError(absl::StrFormat(
-      "density \"%s\" is not available on meshes; use uniform, gaussian, mean, "
-      "gaussian:offset=F, mean:offset=F (|K| + F), "
-      "expr:EXPRESSION in x, y, z, or vertex:PROPERTY",
-      spec));
+  return absl::InvalidArgumentError(
+      absl::StrFormat("density \"%s\" is not available on meshes; use uniform, gaussian, mean, "
+                      "gaussian:offset=F, mean:offset=F (|K| + F), "
+                      "expr:EXPRESSION in x, y, z, or vertex:PROPERTY",
+                      spec));
 }
 
 // What a kept mesh surface costs: its arrays (positions, triangles,
@@ -106,6 +109,7 @@ uint64_t MeshSurfaceBytes(const MeshSurface& surface) {
 struct MeshTreeRecipe {
   std::string canonical_density;
   TreeFactory factory;
+  std::function<ValueExtent()> measure;  // ResolvedSurface::measure
 };
 
 // Parses `density` for a mesh, loads `model` (through `loaded`, on its parse
@@ -119,8 +123,8 @@ absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::
                                            const std::function<absl::Status()>& caller) {
   ASSIGN_OR_RETURN(MeshDensityChoice choice, ParseMeshDensity(density));
   const bool curvature = choice.density->needs_curvature();
-  const std::string key = absl::StrCat(model.Spec(), "|curvature=", curvature,
-                                       "|weights=", choice.weight_property);
+  const std::string key =
+      absl::StrCat(model.Spec(), "|curvature=", curvature, "|weights=", choice.weight_property);
   MeshLoadOptions options;
   options.format = model.format;
   options.weight_property = choice.weight_property;
@@ -136,8 +140,8 @@ absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::
       std::shared_ptr<const MeshSurface> surface,
       loaded->Get<MeshSurface>(
           key,
-          [model, options, curvature](const ParseCheck& check) mutable
-          -> absl::StatusOr<LoadedModels::Parsed> {
+          [model, options,
+           curvature](const ParseCheck& check) mutable -> absl::StatusOr<LoadedModels::Parsed> {
             options.check = check;
             const std::string name = model.name.empty() ? model.Spec() : model.name;
             ASSIGN_OR_RETURN(TriangleMesh mesh, LoadMesh(*model.bytes, name, options));
@@ -150,6 +154,22 @@ absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::
           caller, working_bytes));
   MeshTreeRecipe recipe;
   recipe.canonical_density = choice.canonical;
+  // The box of the triangles' corners holds every sample: its points are
+  // convex combinations of them. The density column is left to the cursor.
+  recipe.measure = [surface] {
+    const TriangleMesh& mesh = surface->mesh();
+    ValueExtent extent;
+    Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+    for (const auto& triangle : mesh.triangles) {
+      for (const auto corner : triangle) {
+        const Vec3& p = mesh.positions[corner];
+        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+      }
+    }
+    if (lo.x <= hi.x) extent.measured = true, extent.lo = lo, extent.hi = hi;
+    return extent;
+  };
   recipe.factory.build = [surface, density = choice.density, tolerance, max_leaves, threads](
                              int grade, const BuildControl& control) -> TreeFactory::Result {
     RETURN_IF_ERROR(control.check ? control.check() : absl::OkStatus());
@@ -195,17 +215,17 @@ class MeshKind final : public SurfaceKind {
   absl::StatusOr<ResolvedSurface> Resolve(const TreeSpec& spec, const StoredModel* model,
                                           const KindContext& context) const override {
     if (!model) return absl::InternalError("the mesh kind was given a spec that names no model");
-    ASSIGN_OR_RETURN(MeshTreeRecipe recipe,
-                     MeshTreeFor(*model, spec.density, spec.options.tolerance,
-                                 context.limits->max_tree_leaves,
-                                 context.limits->generation_threads, context.loaded,
-                                 context.caller));
+    ASSIGN_OR_RETURN(
+        MeshTreeRecipe recipe,
+        MeshTreeFor(*model, spec.density, spec.options.tolerance, context.limits->max_tree_leaves,
+                    context.limits->generation_threads, context.loaded, context.caller));
     CurveTreeOptions options;  // a mesh's curve has no options but the tolerance
     options.tolerance = spec.options.tolerance;
     ResolvedSurface out;
     out.key = MakeTreeKey(model->Spec(), recipe.canonical_density, options);
     out.factory = std::move(recipe.factory);
     out.open_cursor = OpenMeshCursor;
+    out.measure = std::move(recipe.measure);
     out.forget = [loaded = context.loaded, sha256 = model->sha256] { loaded->ForgetModel(sha256); };
     return out;
   }
