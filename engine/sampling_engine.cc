@@ -82,8 +82,8 @@ absl::StatusOr<std::string> SamplingEngine::DescribeModel(const std::string& spe
         "SFC_BUILD_CAD=OFF)");
   }
   if (!model || !kind || !kind->info().describes) {
-    return absl::InvalidArgumentError(absl::StrFormat("\"%s\" is not %s, which inspect describes",
-                                                      spec, describing->info().what));
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "\"%s\" is not %s, which inspect describes", spec, describing->info().what));
   }
   ASSIGN_OR_RETURN(const SpecKind found, KindOf(spec));
   return kind->Describe(*found.model, Context({}));

@@ -34,7 +34,7 @@ namespace sfc {
 // What a kind may use while it resolves a spec.
 struct KindContext {
   const EngineLimits* limits = nullptr;
-  LoadedModels* loaded = nullptr;        // parsed models, parsed on its own threads
+  LoadedModels* loaded = nullptr;     // parsed models, parsed on its own threads
   std::function<absl::Status()> caller;  // asked while a parse waits (client gone, deadline)
 };
 

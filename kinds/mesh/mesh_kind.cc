@@ -67,8 +67,8 @@ absl::StatusOr<MeshDensityChoice> ParseMeshDensity(const std::string& text) {
                       absl::StrContains(spec, "offset=");
   ASSIGN_OR_RETURN(const DensityFromSpec catalog,
                    MakeDensity(offset ? absl::StrReplaceAll(spec, {{"offset=", "floor="}}) : spec));
-  out.canonical =
-      offset ? absl::StrReplaceAll(catalog.canonical, {{"floor=", "offset="}}) : catalog.canonical;
+  out.canonical = offset ? absl::StrReplaceAll(catalog.canonical, {{"floor=", "offset="}})
+                         : catalog.canonical;
   const CurvatureFloor rule = offset ? CurvatureFloor::kOffset : CurvatureFloor::kMax;
   if (catalog.name == "uniform") {
     out.density = UniformMeshDensity();
@@ -88,11 +88,11 @@ absl::StatusOr<MeshDensityChoice> ParseMeshDensity(const std::string& text) {
                                              : MeanCurvatureMeshDensity(floor, rule);
     return out;
   }
-  return absl::InvalidArgumentError(
-      absl::StrFormat("density \"%s\" is not available on meshes; use uniform, gaussian, mean, "
-                      "gaussian:offset=F, mean:offset=F (|K| + F), "
-                      "expr:EXPRESSION in x, y, z, or vertex:PROPERTY",
-                      spec));
+  return absl::InvalidArgumentError(absl::StrFormat(
+      "density \"%s\" is not available on meshes; use uniform, gaussian, mean, "
+      "gaussian:offset=F, mean:offset=F (|K| + F), "
+      "expr:EXPRESSION in x, y, z, or vertex:PROPERTY",
+      spec));
 }
 
 // What a kept mesh surface costs: its arrays (positions, triangles,
@@ -123,8 +123,8 @@ absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::
                                            const std::function<absl::Status()>& caller) {
   ASSIGN_OR_RETURN(MeshDensityChoice choice, ParseMeshDensity(density));
   const bool curvature = choice.density->needs_curvature();
-  const std::string key =
-      absl::StrCat(model.Spec(), "|curvature=", curvature, "|weights=", choice.weight_property);
+  const std::string key = absl::StrCat(model.Spec(), "|curvature=", curvature,
+                                       "|weights=", choice.weight_property);
   MeshLoadOptions options;
   options.format = model.format;
   options.weight_property = choice.weight_property;
@@ -140,8 +140,8 @@ absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::
       std::shared_ptr<const MeshSurface> surface,
       loaded->Get<MeshSurface>(
           key,
-          [model, options,
-           curvature](const ParseCheck& check) mutable -> absl::StatusOr<LoadedModels::Parsed> {
+          [model, options, curvature](const ParseCheck& check) mutable
+          -> absl::StatusOr<LoadedModels::Parsed> {
             options.check = check;
             const std::string name = model.name.empty() ? model.Spec() : model.name;
             ASSIGN_OR_RETURN(TriangleMesh mesh, LoadMesh(*model.bytes, name, options));
@@ -215,10 +215,11 @@ class MeshKind final : public SurfaceKind {
   absl::StatusOr<ResolvedSurface> Resolve(const TreeSpec& spec, const StoredModel* model,
                                           const KindContext& context) const override {
     if (!model) return absl::InternalError("the mesh kind was given a spec that names no model");
-    ASSIGN_OR_RETURN(
-        MeshTreeRecipe recipe,
-        MeshTreeFor(*model, spec.density, spec.options.tolerance, context.limits->max_tree_leaves,
-                    context.limits->generation_threads, context.loaded, context.caller));
+    ASSIGN_OR_RETURN(MeshTreeRecipe recipe,
+                     MeshTreeFor(*model, spec.density, spec.options.tolerance,
+                                 context.limits->max_tree_leaves,
+                                 context.limits->generation_threads, context.loaded,
+                                 context.caller));
     CurveTreeOptions options;  // a mesh's curve has no options but the tolerance
     options.tolerance = spec.options.tolerance;
     ResolvedSurface out;
