@@ -3,6 +3,7 @@
 #include "absl/strings/str_format.h"
 #include "base/status_macros.h"
 #include "engine/blue_sequence.h"
+#include "engine/float32_range.h"
 #include "engine/model_source.h"
 #include "request/index_range.h"
 #include "request/tree_count.h"
@@ -131,6 +132,7 @@ absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint6
   prepared.grade = CurveTree::GradeFor(count);
   prepared.kind = found.kind->info().name;
   prepared.open_cursor = std::move(resolved.open_cursor);
+  prepared.measure = std::move(resolved.measure);
   auto lookup = source_->Get(prepared.key, prepared.grade, resolved.factory, caller);
   if (!lookup.ok()) {
     // What was parsed for a tree that failed is not kept for a next request
@@ -147,7 +149,8 @@ absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint6
 }
 
 absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
-                                                  const BuildControl& caller) const {
+                                                  const BuildControl& caller,
+                                                  ColumnPrecision precision) const {
   RETURN_IF_ERROR(CheckCount(request.count));  // before anything is built for it
   if (request.count > MaxSequenceCount(request.sequence)) {
     return absl::InvalidArgumentError(absl::StrFormat(
@@ -193,6 +196,10 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
   ASSIGN_OR_RETURN(const uint64_t tree_count, ResolveTreeCount(request));
   SamplingJob job;
   ASSIGN_OR_RETURN(job.tree, Prepare(request.tree, tree_count, caller));
+  const bool float32 = precision == ColumnPrecision::kFloat32;
+  if (float32 && job.tree.measure) {
+    RETURN_IF_ERROR(CheckFloat32Extent(job.tree.measure(), request.fields));
+  }
   job.begin = range.first;
   job.end = range.second;
   CursorSpec cursor;
@@ -210,6 +217,7 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
     sequence = Sequence(request.sequence, request.count, request.seed);
   }
   ASSIGN_OR_RETURN(job.cursor, job.tree.open_cursor(job.tree.lookup, sequence, cursor));
+  if (float32) job.cursor = Float32CheckedCursor(std::move(job.cursor));
   return job;
 }
 

@@ -8,6 +8,7 @@
 #ifndef SFCSAMPLER_ENGINE_SAMPLING_ENGINE_H_
 #define SFCSAMPLER_ENGINE_SAMPLING_ENGINE_H_
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -21,6 +22,7 @@
 #include "engine/surface_kind.h"
 #include "engine/tree_source.h"
 #include "request/sample_request.h"
+#include "request/stream_options.h"
 #include "request/tree_key.h"
 #include "request/tree_summary.h"
 
@@ -31,7 +33,8 @@ struct PreparedTree {
   int grade = 0;
   std::string_view kind = "surface";  // its SurfaceKind's name: TreeInfo.kind
   TreeLookup lookup;
-  CursorOpener open_cursor;  // how its kind samples it
+  CursorOpener open_cursor;              // how its kind samples it
+  std::function<ValueExtent()> measure;  // ResolvedSurface::measure
 };
 
 // The summary of `tree` (request/tree_summary.h): its request's fields, then
@@ -67,9 +70,12 @@ class SamplingEngine {
   // Validates `request` and opens its cursor. Errors as Prepare, plus
   // INVALID_ARGUMENT for a bad range, shard, region or tree_count. A blue
   // set's relaxation asks `caller.check` too, and stops with its status.
-  absl::StatusOr<SamplingJob> Start(const SampleRequest& request,
-                                    const BuildControl& caller = {}) const;
-
+  // For `precision` float32, INVALID_ARGUMENT too when the kind's measure of
+  // the values shows a column float32 cannot hold, and the cursor ends the
+  // job likewise at the first value it would make infinite
+  // (engine/float32_range.h): the one place every front door checks it.
+  absl::StatusOr<SamplingJob> Start(const SampleRequest& request, const BuildControl& caller = {},
+                                    ColumnPrecision precision = ColumnPrecision::kFloat64) const;
 
   // The parsed models (for statistics, and to forget an evicted upload's).
   LoadedModels& loaded_models() const { return *loaded_; }

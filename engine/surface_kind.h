@@ -22,6 +22,7 @@
 #include "core/types/sample_batch.h"
 #include "engine/batch_cursor.h"
 #include "engine/engine_limits.h"
+#include "engine/float32_range.h"
 #include "engine/loaded_models.h"
 #include "engine/model_source.h"
 #include "engine/tree_source.h"
@@ -57,6 +58,10 @@ struct ResolvedSurface {
   // Drops what was parsed for this spec when its tree could not be made (so a
   // next request does not keep it); empty when nothing was parsed.
   std::function<void()> forget;
+  // What the kind measures of the samples' values before sampling, for a
+  // float32 request's check (engine/float32_range.h); empty: nothing (each
+  // batch is still checked).
+  std::function<ValueExtent()> measure;
 };
 
 // What a kind is, for the engine's choices and messages.

@@ -149,7 +149,7 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
       stream_memory_.Reserve(StreamWorkingBytes(request, stream, options_.stream_pipeline_depth),
                              "this stream", control.check);
   if (!memory.ok()) return ToGrpcStatus(memory.status());
-  auto job = engine_.Start(request, control);
+  auto job = engine_.Start(request, control, stream.precision);
   if (!job.ok()) return ToGrpcStatus(job.status());
 
   v1::StreamHeader header;

@@ -32,6 +32,10 @@ set +e
 "$probe" --address "127.0.0.1:1" --timeout 0.5 > /dev/null 2>&1; [ $? -eq 2 ] || fail "an unreachable server should exit 2"
 set -e
 
+# float32 columns that cannot hold the values, refused by the server.
+. "$(dirname "$0")/cli_float32_checks.sh"
+f32_refusals --server "$addr"
+
 # A mesh (an octahedron) travels once, by content hash, and gives the same
 # bytes over the wire as in process.
 printf 'v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\nf 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n' > "$tmp/octahedron.obj"

@@ -73,4 +73,7 @@ set +e
 code=$?
 set -e
 [ "$code" -eq 1 ] && grep -q "stays on the server" "$tmp/err" || fail "render curve with --server"
+# float32 columns that cannot hold the values, in process.
+. "$(dirname "$0")/cli_float32_checks.sh"
+f32_refusals
 echo "cli_test: all checks passed"

@@ -39,6 +39,7 @@ TreeReport Report(const PreparedTree& tree, double seconds) {
 
 InProcessSampleSource::InProcessSampleSource(const SampleSourceOptions& options)
     : batch_size_(options.batch_size == 0 ? kDefaultBatchSize : options.batch_size),
+      precision_(options.precision),
       engine_(RegisteredSurfaceKinds(), LimitsFor(options), &trees_, &files_) {}
 
 absl::StatusOr<TreeReport> InProcessSampleSource::Prepare(const TreeSpec& spec, uint64_t count,
@@ -57,7 +58,7 @@ absl::StatusOr<std::string> InProcessSampleSource::Sample(const SampleRequest& r
                                                           const BatchCallback& on_batch) {
   const auto start = std::chrono::steady_clock::now();
   progress->StartPhase("building the curve tree");
-  auto job = engine_.Start(request);
+  auto job = engine_.Start(request, {}, precision_);
   progress->EndPhase();
   RETURN_IF_ERROR(job.status());
   if (on_tree) on_tree(Report(job->tree, SecondsSince(start)));

@@ -30,6 +30,7 @@ class InProcessSampleSource final : public SampleSource {
 
  private:
   const size_t batch_size_;
+  const OutputPrecision precision_;  // checked by the engine (engine/float32_range.h)
   DirectTreeSource trees_;
   FileModelSource files_;
   SamplingEngine engine_;

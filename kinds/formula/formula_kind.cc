@@ -6,6 +6,7 @@
 #include "catalog/catalog.h"
 #include "core/curve_tree.h"
 #include "core/sampler.h"
+#include "engine/float32_range.h"
 
 namespace sfc {
 namespace {
@@ -47,6 +48,9 @@ class FormulaKind final : public SurfaceKind {
                        SampleCursor::Create(std::move(sampler), spec.begin, spec.end, spec.region,
                                             spec.fields, spec.threads));
       return std::make_unique<SurfaceBatchCursor>(std::move(cursor));
+    };
+    out.measure = [surface = surface.surface, density = density.density] {
+      return MeasureValues(*surface, *density);
     };
     return out;
   }

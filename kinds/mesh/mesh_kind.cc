@@ -1,6 +1,8 @@
 #include "kinds/mesh/mesh_kind.h"
 
 #include <algorithm>
+#include <cmath>
+#include <functional>
 #include <utility>
 
 #include "absl/strings/ascii.h"
@@ -12,6 +14,7 @@
 #include "catalog/catalog.h"
 #include "catalog/expression.h"
 #include "engine/batch_cursor.h"
+#include "engine/float32_range.h"
 #include "mesh/mesh_curve_tree.h"
 #include "mesh/mesh_loader.h"
 #include "mesh/mesh_sampler.h"
@@ -106,6 +109,7 @@ uint64_t MeshSurfaceBytes(const MeshSurface& surface) {
 struct MeshTreeRecipe {
   std::string canonical_density;
   TreeFactory factory;
+  std::function<ValueExtent()> measure;  // ResolvedSurface::measure
 };
 
 // Parses `density` for a mesh, loads `model` (through `loaded`, on its parse
@@ -146,6 +150,22 @@ absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::
           caller, working_bytes));
   MeshTreeRecipe recipe;
   recipe.canonical_density = choice.canonical;
+  // The box of the triangles' corners holds every sample: its points are
+  // convex combinations of them. The density column is left to the cursor.
+  recipe.measure = [surface] {
+    const TriangleMesh& mesh = surface->mesh();
+    ValueExtent extent;
+    Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+    for (const auto& triangle : mesh.triangles) {
+      for (const auto corner : triangle) {
+        const Vec3& p = mesh.positions[corner];
+        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+      }
+    }
+    if (lo.x <= hi.x) extent.measured = true, extent.lo = lo, extent.hi = hi;
+    return extent;
+  };
   recipe.factory.build = [surface, density = choice.density, tolerance, max_leaves, threads](
                              int grade, const BuildControl& control) -> TreeFactory::Result {
     RETURN_IF_ERROR(control.check ? control.check() : absl::OkStatus());
@@ -202,6 +222,7 @@ class MeshKind final : public SurfaceKind {
     out.key = MakeTreeKey(model->Spec(), recipe.canonical_density, options);
     out.factory = std::move(recipe.factory);
     out.open_cursor = OpenMeshCursor;
+    out.measure = std::move(recipe.measure);
     out.forget = [loaded = context.loaded, sha256 = model->sha256] { loaded->ForgetModel(sha256); };
     return out;
   }

@@ -139,7 +139,7 @@ class PyEngine {
     absl::StatusOr<SamplingJob> job;
     {
       py::gil_scoped_release release;
-      job = engine_.Start(r.request);
+      job = engine_.Start(r.request, {}, *parsed);
     }
     ThrowIfError(job.status());
     return std::make_unique<PyJob>(*std::move(job), r.request, *parsed == ColumnPrecision::kFloat32,
@@ -200,7 +200,7 @@ class PyEngine {
           job = parsed_request.status();
         } else {
           request = *std::move(parsed_request);
-          job = engine_.Start(request);
+          job = engine_.Start(request, {}, *parsed);
           if (job.ok()) {
             Fill(*job, request.fields, request.region.kind != Region::Kind::kAll, float32, 0,
                  uint64_t{1} << 62, pool_.get(), &filled);

@@ -129,7 +129,8 @@ def sample(*, precision="float64", threads=0, **request):
       region=""                             "uv:U0,U1,V0,V1" or "box:X0,Y0,Z0,X1,Y1,Z1"
       normals=False, density_column=False, curve_position=False
       face=False, triangle=False            model columns: CAD face, mesh triangle
-      precision="float64"                   or "float32" (half the memory)
+      precision="float64"                   or "float32" (half the memory; values float32
+                                            cannot hold raise InvalidArgumentError)
       columns=None                          keep only these columns, e.g. ("x", "y", "z"):
                                             the others are freed at once (the rest of
                                             Samples' columns are None); default all

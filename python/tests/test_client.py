@@ -132,6 +132,16 @@ def test_empty_region(server):
     assert s.tree["key"] == sfcsampler.sample(surface="sphere", count=1000).tree["key"]
 
 
+def test_float32_that_cannot_hold_the_values_is_refused_by_the_server(server):
+    with sfcsampler.Client(server) as client:
+        with pytest.raises(sfcsampler.InvalidArgumentError) as info:
+            client.sample(surface="expr:x=u;y=v;z=0", density="expr:1e300*u", density_column=True,
+                          count=500, precision="float32")
+        assert "the density column reaches" in info.value.message
+        assert "received 0 samples" in info.value.message
+        assert len(client.sample(surface="sphere:r=1e70", count=500)) == 500
+
+
 def test_server_errors_carry_code_and_message(server):
     with sfcsampler.Client(server) as client:
         with pytest.raises(sfcsampler.InvalidArgumentError) as info:

@@ -288,3 +288,26 @@ def test_import_and_embedded_sampling_load_no_grpc_until_a_client_is_used():
                "assert 'sfcsampler._client' in sys.modules and grpc()\n")
     done = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
+
+
+# float32 columns that cannot hold the values (engine/float32_range.h): refused
+# by the engine Python shares with the CLI, naming the column; float64 serves them.
+FLOAT32_REFUSED = [
+    (dict(surface="sphere:r=1e70"), "the x, y, z columns reach"),
+    (dict(surface="sphere:r=1e-50"), "the x, y, z columns span"),
+    (dict(surface="expr:x=u;y=v;z=0", density="expr:1e300*u", density_column=True),
+     "the density column reaches"),
+    # A spike between the points measured upfront: found as the samples are made.
+    (dict(surface="expr:x=u;y=v;z=1e40*exp(-1e4*(u-0.53)^2)"), "the z column's value"),
+]
+
+
+@pytest.mark.parametrize("kwargs,names", FLOAT32_REFUSED)
+def test_float32_that_cannot_hold_the_values_is_refused(kwargs, names):
+    with pytest.raises(sfcsampler.InvalidArgumentError) as info:
+        sfcsampler.sample(count=500, precision="float32", **kwargs)
+    assert info.value.code == "INVALID_ARGUMENT"
+    assert names in info.value.message and "float64" in info.value.message
+    with pytest.raises(sfcsampler.InvalidArgumentError, match="float32"):
+        list(sfcsampler.batches(count=500, precision="float32", batch_size=100, **kwargs))
+    assert len(sfcsampler.sample(count=500, **kwargs)) == 500
