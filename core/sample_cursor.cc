@@ -419,11 +419,14 @@ absl::Status SampleCursor::GenerateParallel(uint64_t k0, size_t n, SampleBatch* 
                                             const CurveAddress* at) {
   // threads_ contiguous parts of the run, on the shared pool, each filling its
   // own rows of the grown columns; part 0 with the cursor's filler, the others
-  // with their own. A sample is a pure function of k, so the bytes are the
-  // same for any split.
+  // with theirs. A sample is a pure function of k, so the bytes are the same
+  // for any split.
   const size_t s0 = batch->size();
   const SampleRows out = Grow(batch, n);
   const int parts = threads_;
+  while (part_fillers_.size() + 1 < static_cast<size_t>(parts)) {
+    part_fillers_.push_back(samples_->NewFiller(region_, fields_));
+  }
   std::vector<absl::Status> status(parts);
   auto bound = [&](int i) { return n * i / parts; };
   WorkerPool::Shared().ParallelFor(parts, [&](int i) {
@@ -432,8 +435,8 @@ absl::Status SampleCursor::GenerateParallel(uint64_t k0, size_t n, SampleBatch* 
     if (i == 0) {
       status[i] = Fill(k0, nullptr, count, *filler_, out, part_at);
     } else {
-      const std::unique_ptr<SampleFiller> filler = samples_->NewFiller(region_, fields_);
-      status[i] = Fill(k0 + begin, nullptr, count, *filler, out.From(begin), part_at);
+      status[i] =
+          Fill(k0 + begin, nullptr, count, *part_fillers_[i - 1], out.From(begin), part_at);
     }
   });
   for (const absl::Status& st : status) {
