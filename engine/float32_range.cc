@@ -88,11 +88,19 @@ absl::Status CheckFloat32Extent(const ValueExtent& extent, const SampleFields& f
                       absl::StrJoin(problems, "; "), WhatToDo(surface, density)));
 }
 
-absl::Status CheckFloat32Batch(const SampleBatch& batch, size_t begin) {
+absl::Status CheckFloat32Batch(const SampleBatch& batch, size_t begin,
+                               const SampleFields& fields) {
+  // SampleBatch::ValueColumns()'s columns, in its order: their names, and
+  // whether `fields` sends them (the engine computes u, v, x, y, z always).
   static constexpr const char* kNames[] = {"u",  "v",  "x",  "y",       "z",
                                            "nx", "ny", "nz", "density", "curve_position"};
+  const bool sent[] = {fields.uv,     fields.uv,     fields.xyz,     fields.xyz,
+                       fields.xyz,    fields.normal, fields.normal,  fields.normal,
+                       fields.density, fields.curve_position};
   const auto& columns = SampleBatch::ValueColumns();
+  static_assert(std::size(kNames) == std::tuple_size_v<std::decay_t<decltype(columns)>>);
   for (size_t c = 0; c < columns.size(); ++c) {
+    if (!sent[c]) continue;
     const std::vector<double>& column = batch.*columns[c];
     // The whole column without an early exit, so the test runs in vector
     // registers; the first offender is looked up only when there is one.
@@ -115,23 +123,26 @@ namespace {
 
 class Float32Checked final : public BatchCursor {
  public:
-  explicit Float32Checked(std::unique_ptr<BatchCursor> cursor) : cursor_(std::move(cursor)) {}
+  Float32Checked(std::unique_ptr<BatchCursor> cursor, const SampleFields& fields)
+      : cursor_(std::move(cursor)), fields_(fields) {}
   absl::StatusOr<size_t> Next(size_t max, SampleBatch* batch) override {
     const size_t begin = batch->size();
     absl::StatusOr<size_t> n = cursor_->Next(max, batch);
     if (!n.ok()) return n;
-    if (absl::Status s = CheckFloat32Batch(*batch, begin); !s.ok()) return s;
+    if (absl::Status s = CheckFloat32Batch(*batch, begin, fields_); !s.ok()) return s;
     return n;
   }
 
  private:
   std::unique_ptr<BatchCursor> cursor_;
+  const SampleFields fields_;
 };
 
 }  // namespace
 
-std::unique_ptr<BatchCursor> Float32CheckedCursor(std::unique_ptr<BatchCursor> cursor) {
-  return std::make_unique<Float32Checked>(std::move(cursor));
+std::unique_ptr<BatchCursor> Float32CheckedCursor(std::unique_ptr<BatchCursor> cursor,
+                                                  const SampleFields& fields) {
+  return std::make_unique<Float32Checked>(std::move(cursor), fields);
 }
 
 }  // namespace sfc

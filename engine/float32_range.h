@@ -59,13 +59,16 @@ ValueExtent MeasureValues(const Surface& surface, const Density& density);
 // density by max_density) and what to do.
 absl::Status CheckFloat32Extent(const ValueExtent& extent, const SampleFields& fields);
 
-// OK when every value of samples [begin, batch.size()) of `batch` rounds to a
-// finite float (non-finite doubles stay as they are); else INVALID_ARGUMENT
-// naming the first such column and the sample's index.
-absl::Status CheckFloat32Batch(const SampleBatch& batch, size_t begin);
+// OK when every value of samples [begin, batch.size()) of `batch`, in the
+// columns `fields` sends, rounds to a finite float (non-finite doubles stay
+// as they are); else INVALID_ARGUMENT naming the first such column and the
+// sample's index. Columns the client did not ask for are not checked.
+absl::Status CheckFloat32Batch(const SampleBatch& batch, size_t begin,
+                               const SampleFields& fields);
 
 // `cursor`, with each batch it appends checked by CheckFloat32Batch.
-std::unique_ptr<BatchCursor> Float32CheckedCursor(std::unique_ptr<BatchCursor> cursor);
+std::unique_ptr<BatchCursor> Float32CheckedCursor(std::unique_ptr<BatchCursor> cursor,
+                                                  const SampleFields& fields);
 
 }  // namespace sfc
 

@@ -217,7 +217,7 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
     sequence = Sequence(request.sequence, request.count, request.seed);
   }
   ASSIGN_OR_RETURN(job.cursor, job.tree.open_cursor(job.tree.lookup, sequence, cursor));
-  if (float32) job.cursor = Float32CheckedCursor(std::move(job.cursor));
+  if (float32) job.cursor = Float32CheckedCursor(std::move(job.cursor), request.fields);
   return job;
 }
 

@@ -170,11 +170,37 @@ TEST(Float32Range, TheBatchCheckFollowsFloat32Rounding) {
   b.index = {7, 8};
   b.u = b.v = b.x = b.y = {0, 0};
   b.z = {std::nextafter(static_cast<double>(FLT_MAX), INFINITY), INFINITY};
-  EXPECT_TRUE(CheckFloat32Batch(b, 0).ok());  // rounds to FLT_MAX; infinity stays infinity
+  const SampleFields fields;  // u, v, x, y, z
+  EXPECT_TRUE(CheckFloat32Batch(b, 0, fields).ok());  // rounds to FLT_MAX; inf stays inf
   b.z[1] = 1e39;
-  ExpectRefused(CheckFloat32Batch(b, 0), "the z column's value 1e+39 at sample index 8",
+  ExpectRefused(CheckFloat32Batch(b, 0, fields), "the z column's value 1e+39 at sample index 8",
                 "scale the surface");
-  EXPECT_TRUE(CheckFloat32Batch(b, 2).ok());  // only the samples appended are looked at
+  EXPECT_TRUE(CheckFloat32Batch(b, 2, fields).ok());  // only the samples appended are looked at
+}
+
+// Only the columns the client asked for are checked: the engine computes
+// x, y, z for every request, and a request for u, v alone sends none of them
+// (a review of stop 46 found such a request refused for its x).
+TEST(Float32Range, ColumnsNotAskedForAreNotChecked) {
+  SampleBatch b;
+  b.index = {0};
+  b.u = b.v = {0.5};
+  b.x = {1e39};
+  b.y = b.z = {0};
+  SampleFields uv_only;
+  uv_only.xyz = false;
+  EXPECT_TRUE(CheckFloat32Batch(b, 0, uv_only).ok());
+  ExpectRefused(CheckFloat32Batch(b, 0, SampleFields()), "the x column's value 1e+39",
+                "scale the surface");
+  // Through the engine: the surface reaches 1e39 in x, and u, v are asked for.
+  SampleRequest r;
+  r.tree.surface = "expr:x=u*1e39;y=v;z=0";
+  r.count = 100;
+  r.seed = 1;
+  r.fields.xyz = false;
+  const auto served = Embedded(r, ColumnPrecision::kFloat32);
+  ASSERT_TRUE(served.ok()) << served.status();
+  EXPECT_EQ(served->size(), 100u);
 }
 
 }  // namespace
