@@ -331,7 +331,7 @@ BadCase BadRequest(std::mt19937_64& rng, const ServerLimits& limits) {
   switch (rng() % 50 == 0 ? 10 : rng() % 10) {
     case 0: r.tree.surface = "klein"; return invalid("unknown surface");
     case 1: r.count = 0; return invalid("count 0");
-    case 2: r.count = limits.max_count + 1; return invalid("count above max_count");
+    case 2: r.count = limits.max_count + 1; return invalid("a whole set above max_count");
     case 3: r.begin = 500, r.end = 100; return invalid("begin > end");
     case 4: r.shard_index = 3, r.shard_count = 3; return invalid("shard index >= shard count");
     case 5: r.region = Region::ParameterRect(0.5, 0.5, 0, 1); return invalid("empty region");

@@ -44,7 +44,7 @@ constexpr size_t kCheckEvery = 4096;
 // A sample with this many neighbours closer than its radius sits where the
 // surface is thinner than the spacing (a tube or band narrower than rho
 // d_k, where every point of its stratum is that crowded): it keeps its
-// place, and queries stop counting there, so time and memory stay O(N).
+// place, and the half-sweeps' queries stop counting there.
 // A relaxed set has none within the radius, a jittered one a few.
 constexpr int kMostNeighbours = 16;
 // A stratum whose candidates' box meets more grid cells than this is long

@@ -36,7 +36,9 @@
 // Where the surface is thinner than the spacing, a sample with
 // kMostNeighbours neighbours within its radius keeps its place, and a
 // stratum whose candidates span too many grid cells checks them one by one
-// (blue_relaxation.cc), so time and memory stay O(N) on any surface.
+// (blue_relaxation.cc), so memory stays O(N) on any surface, and the
+// half-sweeps' time too (the density-step pass before them visits every
+// sample within two spacings, which a surface folded onto itself may crowd).
 //
 // The set is computed whole (O(N) time, kBlueNoiseBytesPerSample), so a shard,
 // index range or region of a blue set costs the whole set's relaxation and

@@ -61,8 +61,8 @@ absl::Status LeafBudgetError(uint64_t max_leaves, int grade) {
   }
   return absl::ResourceExhaustedError(absl::StrCat(
       budget,
-      "; ask for fewer samples, raise the tolerance or rho, lower the depth cap, or raise the "
-      "budget"));
+      "; ask for fewer samples (a smaller count: the tree is sized for the whole set, also for "
+      "a range of it), raise the tolerance or rho, lower the depth cap, or raise the budget"));
 }
 
 double TriangleArea(const Vec3& a, const Vec3& b, const Vec3& c) {

@@ -88,11 +88,12 @@ class LeafWalk {
   // sample i's unit-square parameters and, when `curve_position` is not
   // null, curve_position[i] its position along the curve in [0, 1). Any
   // order is accepted; a non-decreasing one is a walk (a step back starts a
-  // search).
+  // search). REQUIRES: n < 2^32 (samples are indexed by uint32_t).
   void Place(const double* m, size_t n, double* u, double* v, double* curve_position);
 
  private:
-  // A square reached inside the current leaf: leaf-fraction interval
+  // A square reached inside a leaf (frames_[frame]; samples wait for
+  // Continue after the walk has left their leaf): leaf-fraction interval
   // [t0, t1), its square [x0, x0 + side) x [y0, y0 + side) in leaf units (in
   // the coordinates the walk descends in), its orientation, its start and
   // share along the leaf's curve (fractions of the leaf's span), and how many
@@ -140,8 +141,9 @@ class LeafWalk {
   // The same for the whole leaf from the true mass density at the cells'
   // centres; -1 where it is not finite or vanishes (the model's table then).
   int TabulateExact(const Square& leaf, int levels, std::vector<double>& bounds);
-  // Places the current leaf's samples [begin, end), which lie in `square` in
-  // t order, using the table of recursion `level`.
+  // Finds the squares of the current leaf's samples [begin, end) (indices of
+  // the Place call's run), which lie in `square` in t order, using the table
+  // of recursion `level`.
   void PlaceInSquare(const Square& square, uint32_t begin, uint32_t end, int level);
   // Bounds compared at once when matching samples to cells.
   static constexpr int kScanWidth = 16;
@@ -183,7 +185,8 @@ class LeafWalk {
   bool warped_ = false;  // the model has a power law (LeafModel::warp)
   double split_[2] = {};  // WarpSplit of each axis's warp, when warped_
   bool exact_ = false;   // the first table follows the true mass density (kExactCells)
-  // Scratch of PlaceInLeaf, kept to reuse its memory.
+  // Scratch of a Place call (indexed by the run's samples), kept to reuse its
+  // memory.
   std::vector<double> t_;                           // each sample's fraction of the leaf's mass
   std::vector<std::vector<double>> tables_;         // cell bounds, one table per recursion level
   std::vector<GridFactors> factors_;                // their cell integrals, as factors
@@ -197,7 +200,7 @@ class LeafWalk {
   std::vector<double> fx_, fy_;                     // its fractions of its square
   std::vector<double> mass_, gx_, gy_;              // its square's FollowSlope p and q
   std::vector<double> base_, power_, place_;        // PlaceWarped's powers and places
-  // The run being placed: output columns (curve_position_ may be null).
+  // The Place call's output columns (curve_position_ may be null).
   double *u_ = nullptr, *v_ = nullptr, *curve_position_ = nullptr;
 };
 

@@ -60,7 +60,7 @@ class SamplingEngine {
   const EngineLimits& limits() const { return limits_; }
 
   // The tree for `spec`, fine enough for `count` samples. Errors:
-  // INVALID_ARGUMENT (bad spec, count 0 or above max_count, surface or density
+  // INVALID_ARGUMENT (bad spec, count 0 or above max_set_count, surface or density
   // errors), RESOURCE_EXHAUSTED (tree budget).
   // `caller.check` is asked while the tree is built or waited for; its non-OK
   // status (client gone, deadline) ends the call with that status.
@@ -92,7 +92,7 @@ class SamplingEngine {
     std::optional<StoredModel> model;
   };
   absl::StatusOr<SpecKind> KindOf(const std::string& spec) const;
-  // INVALID_ARGUMENT for a count of 0 or past limits_.max_count.
+  // INVALID_ARGUMENT for a count (N) of 0 or past limits_.max_set_count.
   absl::Status CheckCount(uint64_t count) const;
   KindContext Context(const BuildControl& caller) const;
 

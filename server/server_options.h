@@ -17,7 +17,8 @@ struct ServerOptions {
   std::string health_address = "127.0.0.1:50052";
   std::string metrics_address = "127.0.0.1:9464";  // Prometheus /metrics ("" = none)
 
-  // max_count, max_tree_leaves, max_spec_length, generation_threads (2 here).
+  // max_count, max_set_count, max_tree_leaves, max_spec_length,
+  // generation_threads (2 here).
   EngineLimits limits = [] {
     EngineLimits l;
     l.generation_threads = 2;

@@ -225,7 +225,7 @@ TEST(Engine, SobolSetsAreBoundedByTheirWholeCount) {
   DirectTreeSource source;
   EngineLimits limits;
   limits.max_sorted_range = 1000;
-  limits.max_count = uint64_t{1} << 40;
+  limits.max_set_count = uint64_t{1} << 40;  // N past 2^32 meets the sequence's own limit
   SamplingEngine engine(RegisteredSurfaceKinds(), limits, &source);
   SampleRequest r;
   r.tree.surface = "plane";
