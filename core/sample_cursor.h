@@ -89,7 +89,8 @@ class SampleCursor {
   bool use_addresses_ = false;
   // The cursor's own filler, and those of parallel parts 1, 2, ..., made at
   // their first batch and kept with their scratch memory: a filler made for
-  // each batch faulted in its buffers every time (two threads gave 1.65x).
+  // each batch faulted in its buffers every time (two threads: 1.70-1.73x
+  // before, 1.75-1.77x after, docs/MEASURED.md).
   std::unique_ptr<SampleFiller> filler_;
   std::vector<std::unique_ptr<SampleFiller>> part_fillers_;
   int threads_ = 1;

@@ -91,6 +91,7 @@ absl::Status FinalizeMesh(TriangleMesh* mesh) {
     }
   }
   RETURN_IF_ERROR(CheckSize(absl::StrFormat("mesh '%s'", name), Diagonal(lo, hi)));
+  stats.lo = lo, stats.hi = hi;
   if (!mesh->normals.empty()) {
     if (mesh->normals.size() != nv) {
       return absl::InvalidArgumentError(absl::StrFormat(

@@ -25,6 +25,9 @@ struct MeshStats {
   uint64_t non_manifold_edges = 0;     // edges of more than two triangles (CountEdges)
   uint64_t boundary_edges = 0;         // edges of exactly one triangle (CountEdges)
   double area = 0;                     // total area of the non-degenerate triangles
+  // The box of the vertices the triangles use: it holds every sample (a
+  // sample is a convex combination of its triangle's corners).
+  Vec3 lo, hi;
 };
 
 struct TriangleMesh {

@@ -150,20 +150,12 @@ absl::StatusOr<MeshTreeRecipe> MeshTreeFor(const StoredModel& model, const std::
           caller, working_bytes));
   MeshTreeRecipe recipe;
   recipe.canonical_density = choice.canonical;
-  // The box of the triangles' corners holds every sample: its points are
-  // convex combinations of them. The density column is left to the cursor.
+  // The box FinalizeMesh found holds every sample (MeshStats::lo, hi). The
+  // density column is left to the cursor.
   recipe.measure = [surface] {
-    const TriangleMesh& mesh = surface->mesh();
+    const MeshStats& stats = surface->mesh().stats;
     ValueExtent extent;
-    Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-    for (const auto& triangle : mesh.triangles) {
-      for (const auto corner : triangle) {
-        const Vec3& p = mesh.positions[corner];
-        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-      }
-    }
-    if (lo.x <= hi.x) extent.measured = true, extent.lo = lo, extent.hi = hi;
+    extent.measured = true, extent.lo = stats.lo, extent.hi = stats.hi;
     return extent;
   };
   recipe.factory.build = [surface, density = choice.density, tolerance, max_leaves, threads](
