@@ -2,6 +2,11 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
 
 namespace sfc {
 
@@ -11,11 +16,38 @@ struct WorkerPool::Loop {
   std::atomic<int> next{0};  // the next unclaimed task
   std::mutex mu;
   std::condition_variable finished;
-  int done = 0;  // guarded by mu
+  std::atomic<int> done{0};  // written under mu; read without it while spinning
 };
 
 namespace {
 std::atomic<WorkerPool*> g_shared_from{nullptr};  // set by ShareFrom
+
+// How long a thread polls before it sleeps, when it waits for a loop's tasks
+// (a worker) or for a loop to finish (its caller). A cursor's batches follow
+// each other within microseconds, while waking a sleeping thread takes tens of
+// them; split in two, a 64 Ki-sample batch is 0.5 ms a part, so one wake-up a
+// batch on each side cost two threads about a tenth of their speed
+// (docs/MEASURED.md, "Threads that stay awake between batches").
+constexpr auto kSpin = std::chrono::microseconds(100);
+
+void Pause() {
+#if defined(__x86_64__) || defined(__i386__)
+  _mm_pause();
+#endif
+}
+
+// Polls `ready` until it holds or kSpin has passed; returns whether it held.
+template <typename Ready>
+bool SpinUntil(Ready ready) {
+  const auto deadline = std::chrono::steady_clock::now() + kSpin;
+  while (true) {
+    for (int i = 0; i < 64; ++i) {
+      if (ready()) return true;
+      Pause();
+    }
+    if (std::chrono::steady_clock::now() >= deadline) return ready();
+  }
+}
 }  // namespace
 
 WorkerPool& WorkerPool::Shared() {
@@ -50,13 +82,13 @@ void WorkerPool::RunTasks(Loop& loop) {
   }
   if (ran > 0) {
     std::lock_guard<std::mutex> lock(loop.mu);
-    loop.done += ran;
-    if (loop.done == loop.n) loop.finished.notify_all();
+    if (loop.done.fetch_add(ran) + ran == loop.n) loop.finished.notify_all();
   }
 }
 
 void WorkerPool::Work() {
   while (true) {
+    SpinUntil([this] { return queued_.load(std::memory_order_acquire) > 0; });
     std::shared_ptr<Loop> loop;
     {
       std::unique_lock<std::mutex> lock(mu_);
@@ -64,6 +96,7 @@ void WorkerPool::Work() {
       if (queue_.empty()) return;  // stopping
       loop = std::move(queue_.front());
       queue_.pop_front();
+      queued_.store(static_cast<int>(queue_.size()), std::memory_order_release);
     }
     RunTasks(*loop);  // a loop already finished has nothing left to claim
   }
@@ -78,12 +111,14 @@ void WorkerPool::ParallelFor(int n, const std::function<void(int)>& task) {
     {
       std::lock_guard<std::mutex> lock(mu_);
       for (int i = 1; i < n; ++i) queue_.push_back(loop);
+      queued_.store(static_cast<int>(queue_.size()), std::memory_order_release);
     }
     for (int i = 1; i < n; ++i) wake_.notify_one();
   }
   RunTasks(*loop);
+  if (SpinUntil([&] { return loop->done.load(std::memory_order_acquire) == loop->n; })) return;
   std::unique_lock<std::mutex> lock(loop->mu);
-  loop->finished.wait(lock, [&] { return loop->done == loop->n; });
+  loop->finished.wait(lock, [&] { return loop->done.load() == loop->n; });
 }
 
 }  // namespace sfc

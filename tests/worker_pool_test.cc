@@ -4,6 +4,7 @@
 #include "base/worker_pool.h"
 
 #include <atomic>
+#include <chrono>
 #include <thread>
 #include <vector>
 
@@ -34,6 +35,31 @@ TEST(WorkerPool, ManyCallersAtOnceAllFinishOnASmallPool) {
   }
   for (auto& t : callers) t.join();
   EXPECT_EQ(total.load(), 8L * 50 * (1 + 2 + 3 + 4));
+}
+
+// A worker polls for a while after a loop, then sleeps: a loop must reach it
+// in both states. Task 0 waits (up to 10 s) for task 1 to start, which only a
+// worker can do while the caller is inside task 0.
+TEST(WorkerPool, AWorkerTakesLoopsWhetherPollingOrAsleep) {
+  WorkerPool pool(1);
+  for (int us : {0, 20, 20000, 0}) {
+    const std::chrono::microseconds idle(us);
+    std::this_thread::sleep_for(idle);
+    std::atomic<bool> second_started{false};
+    bool seen = false;
+    pool.ParallelFor(2, [&](int i) {
+      if (i == 1) {
+        second_started = true;
+        return;
+      }
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+      while (!second_started && std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::yield();
+      }
+      seen = second_started;
+    });
+    EXPECT_TRUE(seen) << "after " << idle.count() << " us idle, no worker took task 1";
+  }
 }
 
 }  // namespace
