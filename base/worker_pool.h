@@ -52,7 +52,7 @@ class WorkerPool {
   std::mutex mu_;
   std::condition_variable wake_;
   std::deque<std::shared_ptr<Loop>> queue_;  // one entry per task offered to a worker
-  std::atomic<int> queued_{0};  // queue_.size(), written under mu_, polled without it
+  std::atomic<int> queued_{0};               // queue_.size(), written under mu_, polled without it
   bool stopping_ = false;
   std::vector<std::thread> threads_;
 };
