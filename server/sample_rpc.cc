@@ -79,7 +79,8 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
   // refused in its slot, as any other bad request, or before it takes one
   // when it names a model (PrepareModelOutsideSlot).
   const absl::StatusOr<SampleCall> call = FromProto(*request);
-  if (status.ok()) status = PrepareModelOutsideSlot(context, *request, call);
+  LookupOutsideSlot outside;
+  if (status.ok()) status = PrepareModelOutsideSlot(context, *request, call, &outside);
   if (status.ok()) {
     // Claim a stream slot; give it back on every path out.
     if (active_streams_.fetch_add(1) >= options_.max_concurrent_streams) {
@@ -91,7 +92,7 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
                                        options_.max_concurrent_streams));
     } else {
       metrics_->StreamStarted();
-      status = call.ok() ? RunSample(context, *request, *call, writer, &sent)
+      status = call.ok() ? RunSample(context, *request, *call, outside, writer, &sent)
                          : ToGrpcStatus(call.status());
       metrics_->StreamEnded();
       active_streams_.fetch_sub(1);
@@ -108,7 +109,8 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
 
 grpc::Status SamplerService::PrepareModelOutsideSlot(grpc::ServerContext* context,
                                                      const v1::SampleRequest& wire,
-                                                     const absl::StatusOr<SampleCall>& call) {
+                                                     const absl::StatusOr<SampleCall>& call,
+                                                     LookupOutsideSlot* lookup) {
   // The wire's surface: whether the request names a model comes before
   // whether the rest of it reads.
   auto model = ParseModelSpec(wire.tree().surface());
@@ -124,11 +126,12 @@ grpc::Status SamplerService::PrepareModelOutsideSlot(grpc::ServerContext* contex
       engine_.Prepare(request.tree, *tree_count,
                       RequestControl(context, deadline, options_.request_deadline_seconds));
   if (!prepared.ok()) return ToGrpcStatus(prepared.status());
+  *lookup = {true, prepared->lookup.cache_hit, prepared->lookup.refined};
   return grpc::Status::OK;
 }
 
 grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::SampleRequest& wire,
-                                       const SampleCall& call,
+                                       const SampleCall& call, const LookupOutsideSlot& outside,
                                        grpc::ServerWriter<v1::SampleResponse>* writer,
                                        uint64_t* sent) {
   const auto start = Clock::now();
@@ -153,7 +156,9 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
   if (!job.ok()) return ToGrpcStatus(job.status());
 
   v1::StreamHeader header;
-  ToProto(SummarizeTree(job->tree), header.mutable_tree());
+  TreeSummary summary = SummarizeTree(job->tree);
+  if (outside.made) summary.cache_hit = outside.cache_hit, summary.refined = outside.refined;
+  ToProto(summary, header.mutable_tree());
   header.set_algorithm_version(options_.algorithm_version);
   header.set_seed(request.seed);
   *header.mutable_request() = wire;  // echoed as it came

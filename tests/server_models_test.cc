@@ -545,6 +545,32 @@ TEST(ServerModels, ACachedMeshTreeCountsTheMeshItKeepsAlive) {
   EXPECT_GE(stats.bytes(), mesh_bytes);
 }
 
+// A model's tree is made before the stream takes a slot, where the stream
+// then finds it cached: the header still reports what this request did
+// (built, a hit, refined or made for more samples), as for a formula surface.
+TEST(ServerModels, TheHeaderReportsAModelsTreeAsTheRequestFoundIt) {
+  Running r = StartServer(LoopbackOptions());
+  auto info = r.client->UploadModel("obj", "grid.obj", GridObj(20));
+  ASSERT_TRUE(info.ok()) << info.status();
+  const auto header_tree = [&](uint64_t count) {
+    auto s =
+        r.client->Sample(Request(info->spec(), count),
+                         [](const StreamInfo&, const SampleBatch&) { return absl::OkStatus(); });
+    EXPECT_TRUE(s.ok()) << s.status();
+    return s.ok() ? s->header.tree : TreeSummary{};
+  };
+  const TreeSummary first = header_tree(1000);
+  EXPECT_FALSE(first.cache_hit);
+  EXPECT_FALSE(first.refined);
+  const TreeSummary again = header_tree(1000);
+  EXPECT_TRUE(again.cache_hit);
+  EXPECT_FALSE(again.refined);
+  // More samples than the cached tree's grade: a tree made for them.
+  const TreeSummary larger = header_tree(1000000);
+  EXPECT_FALSE(larger.cache_hit);
+  EXPECT_TRUE(larger.refined || larger.key_with_grade != first.key_with_grade);
+}
+
 // The same for a CAD model: its cached tree counts the model it keeps alive.
 TEST(ServerModels, ACachedCadTreeCountsTheModelItKeepsAlive) {
   auto step = cad::fixtures::SolidBytes(cad::fixtures::Solid::kSphere, ModelFormat::kStep);
