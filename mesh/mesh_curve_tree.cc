@@ -211,8 +211,9 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
     }
     RETURN_IF_ERROR(CurveTree::CheckMassIsFinite(total0, absl::StrFormat("mesh '%s'", mesh.name)));
     if (!(total0 > 0)) {
-      return absl::FailedPreconditionError(absl::StrFormat(
-          "the density '%s' is zero on the whole of mesh '%s': there is nothing to sample",
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "the density '%s' is zero on the whole of mesh '%s': there is nothing to sample (check "
+          "the density, or add a floor)",
           density->spec(), mesh.name));
     }
     if (total0 < CurveTree::kSmallestMass) {
@@ -252,8 +253,10 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
     tree->rank_first_leaf_[ranks] = static_cast<uint32_t>(tree->mass_ends_.size());
     stats.density_evaluations = probe.evaluations() + builder.evaluations();
     if (!(running > 0)) {
-      return absl::FailedPreconditionError(absl::StrFormat(
-          "the density '%s' is zero on the whole of mesh '%s'", density->spec(), mesh.name));
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "the density '%s' is zero on the whole of mesh '%s': there is nothing to sample (check "
+          "the density, or add a floor)",
+          density->spec(), mesh.name));
     }
   }
   stats.leaves = tree->mass_ends_.size();

@@ -364,8 +364,9 @@ TEST(MeshCurveTree, BadDensitiesAreErrors) {
   auto r1 = MeshCurveTree::Build(Icosphere(2), negative, {});
   EXPECT_EQ(r1.status().code(), absl::StatusCode::kInvalidArgument);
   auto zero = std::make_shared<FunctionMeshDensity>([](const MeshPoint&) { return 0.0; }, "0");
+  // INVALID_ARGUMENT, as a formula surface's density that integrates to zero.
   EXPECT_EQ(MeshCurveTree::Build(Icosphere(2), zero, {}).status().code(),
-            absl::StatusCode::kFailedPrecondition);
+            absl::StatusCode::kInvalidArgument);
   EXPECT_EQ(MeshCurveTree::Build(Icosphere(2), VertexWeightMeshDensity(), {}).status().code(),
             absl::StatusCode::kInvalidArgument);
   EXPECT_EQ(MeshCurveTree::Build(Icosphere(2), GaussianCurvatureMeshDensity(0), {}).status().code(),
