@@ -148,9 +148,7 @@ absl::StatusOr<PreparedTree> SamplingEngine::Prepare(const TreeSpec& spec, uint6
   return prepared;
 }
 
-absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
-                                                  const BuildControl& caller,
-                                                  ColumnPrecision precision) const {
+absl::Status SamplingEngine::CheckRequest(const SampleRequest& request) const {
   RETURN_IF_ERROR(CheckCount(request.count));  // before anything is built for it
   if (request.count > MaxSequenceCount(request.sequence)) {
     return absl::InvalidArgumentError(absl::StrFormat(
@@ -193,6 +191,14 @@ absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
       RETURN_IF_ERROR(CheckColumn(kinds_, kind, &KindInfo::triangle_column, "triangle"));
     }
   }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<SamplingJob> SamplingEngine::Start(const SampleRequest& request,
+                                                  const BuildControl& caller,
+                                                  ColumnPrecision precision) const {
+  RETURN_IF_ERROR(CheckRequest(request));
+  const auto range = *ResolveIndexRange(request);  // CheckRequest resolved it
   ASSIGN_OR_RETURN(const uint64_t tree_count, ResolveTreeCount(request));
   SamplingJob job;
   ASSIGN_OR_RETURN(job.tree, Prepare(request.tree, tree_count, caller));

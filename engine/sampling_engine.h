@@ -67,6 +67,11 @@ class SamplingEngine {
   absl::StatusOr<PreparedTree> Prepare(const TreeSpec& spec, uint64_t count,
                                        const BuildControl& caller = {}) const;
 
+  // The checks of `request` that need no tree (count, range, sequence,
+  // region, columns), which Start makes first: INVALID_ARGUMENT as Start's.
+  // For a front door that reserves memory for the request between the two.
+  absl::Status CheckRequest(const SampleRequest& request) const;
+
   // Validates `request` and opens its cursor. Errors as Prepare, plus
   // INVALID_ARGUMENT for a bad range, shard, region or tree_count. A blue
   // set's relaxation asks `caller.check` too, and stops with its status.

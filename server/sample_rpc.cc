@@ -56,6 +56,17 @@ uint64_t StreamWorkingBytes(const SampleRequest& request, const StreamOptions& s
   return sort + blue + per_sample * std::min(n, batch);
 }
 
+// What a request whose working memory is over the budget can ask instead:
+// a blue set is relaxed, and a sobol set sorted, whole, whatever part of it
+// the stream sends, so only a smaller set needs less.
+const char* LessWorkingMemory(SequenceKind sequence) {
+  if (sequence == SequenceKind::kBlue || SequenceIsTwoDimensional(sequence)) {
+    return "this sequence works on its whole set whatever range, shard or region is asked: ask "
+           "for a set of fewer samples (count) or fewer columns";
+  }
+  return "ask for a smaller index range or fewer columns";
+}
+
 // The bytes the stream header takes in the first message, at most, over what
 // may differ between two asks of the same request: whether the tree was
 // cached or refined, and the batch_size echoed. So the largest batch size it
@@ -147,10 +158,13 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
                                         stream.batch_size, options_.max_batch_size));
   }
   const BuildControl control = RequestControl(context, deadline, options_.request_deadline_seconds);
-  // The stream's working memory, reserved before its cursor sorts anything.
+  // The request's own checks first, so that a request the engine refuses
+  // gets its reason rather than a memory refusal; then the stream's working
+  // memory, reserved before its cursor sorts anything.
+  if (absl::Status valid = engine_.CheckRequest(request); !valid.ok()) return ToGrpcStatus(valid);
   auto memory =
       stream_memory_.Reserve(StreamWorkingBytes(request, stream, options_.stream_pipeline_depth),
-                             "this stream", control.check);
+                             "this stream", LessWorkingMemory(request.sequence), control.check);
   if (!memory.ok()) return ToGrpcStatus(memory.status());
   auto job = engine_.Start(request, control, stream.precision);
   if (!job.ok()) return ToGrpcStatus(job.status());

@@ -24,12 +24,13 @@ StreamMemory::Reservation::~Reservation() {
 }
 
 absl::StatusOr<StreamMemory::Reservation> StreamMemory::Reserve(
-    uint64_t bytes, const char* what, const std::function<absl::Status()>& check) {
+    uint64_t bytes, const char* what, const char* advice,
+    const std::function<absl::Status()>& check) {
   if (bytes > budget_) {
     return absl::ResourceExhaustedError(absl::StrFormat(
         "%s needs %d bytes of working memory, more than this server's %d for all streams "
-        "(stream_memory_bytes); ask for a smaller index range or fewer columns",
-        what, bytes, budget_));
+        "(stream_memory_bytes); %s",
+        what, bytes, budget_, advice));
   }
   absl::MutexLock lock(&mu_);
   bool waited = false;

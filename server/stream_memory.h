@@ -46,8 +46,9 @@ class StreamMemory {
   // Reserves `bytes`, waiting while other streams hold the budget. `check` is
   // asked every few milliseconds while waiting; its non-OK status ends the
   // wait with that status. RESOURCE_EXHAUSTED when `bytes` exceeds the
-  // budget; `what` names the request's part that needs them, for the message.
-  absl::StatusOr<Reservation> Reserve(uint64_t bytes, const char* what,
+  // budget; `what` names the request's part that needs them and `advice`
+  // says what would need less, for the message.
+  absl::StatusOr<Reservation> Reserve(uint64_t bytes, const char* what, const char* advice,
                                       const std::function<absl::Status()>& check)
       ABSL_LOCKS_EXCLUDED(mu_);
 

@@ -749,6 +749,28 @@ uint64_t StreamMemoryReserved(SamplerClient& client) {
   return stats.ok() ? stats->stream_memory_reserved() : ~uint64_t{0};
 }
 
+// A blue set is relaxed whole, whatever part of it is asked: a set whose
+// relaxation is over the stream memory is refused with advice that can
+// help (fewer samples, not a smaller range), and one over the blue limit with
+// the engine's own reason, not a memory refusal.
+TEST(Server, ABlueSetTooLargeIsRefusedWithAdviceThatHelps) {
+  ServerOptions options = LoopbackOptions();
+  options.stream_memory_bytes = 1 << 20;
+  options.limits.max_blue_count = 100'000;
+  Running r = StartServer(options);
+  SampleRequest over_memory = Request("sphere", 50'000, 3);
+  over_memory.sequence = SequenceKind::kBlue;
+  over_memory.begin = 0, over_memory.end = 10;
+  const absl::Status memory = Fetch(*r.client, over_memory).status();
+  ExpectStatus(memory, absl::StatusCode::kResourceExhausted, "stream_memory_bytes");
+  ExpectStatus(memory, absl::StatusCode::kResourceExhausted, "fewer samples (count)");
+  EXPECT_EQ(memory.message().find("smaller index range"), std::string::npos) << memory;
+  SampleRequest over_limit = over_memory;
+  over_limit.count = 200'000;
+  ExpectStatus(Fetch(*r.client, over_limit).status(), absl::StatusCode::kInvalidArgument,
+               "max_blue_count");
+}
+
 TEST(Server, TheServerDeadlineStopsABlueRelaxationAndFreesItsMemory) {
   ServerOptions options = LoopbackOptions();
   options.request_deadline_seconds = 0.5;

@@ -19,7 +19,7 @@ TEST(StreamMemory, ReservationsTogetherNeverExceedTheBudget) {
   for (int t = 0; t < 8; ++t) {
     threads.emplace_back([&, t] {
       for (int i = 0; i < 50; ++i) {
-        auto r = memory.Reserve(100 + 50 * t, "test", nullptr);
+        auto r = memory.Reserve(100 + 50 * t, "test", "ask for less", nullptr);
         ASSERT_TRUE(r.ok()) << r.status();
         const uint64_t now = held += r->bytes();
         uint64_t p = peak.load();
@@ -35,11 +35,11 @@ TEST(StreamMemory, ReservationsTogetherNeverExceedTheBudget) {
 
 TEST(StreamMemory, AWaitingStreamGetsTheMemoryAnotherReturns) {
   StreamMemory memory(1000);
-  auto first = memory.Reserve(800, "first", nullptr);
+  auto first = memory.Reserve(800, "first", "ask for less", nullptr);
   ASSERT_TRUE(first.ok());
   std::atomic<bool> got{false};
   std::thread second([&] {
-    auto r = memory.Reserve(500, "second", nullptr);
+    auto r = memory.Reserve(500, "second", "ask for less", nullptr);
     EXPECT_TRUE(r.ok());
     got = true;
   });
@@ -53,18 +53,19 @@ TEST(StreamMemory, AWaitingStreamGetsTheMemoryAnotherReturns) {
 
 TEST(StreamMemory, AWaiterLeavesWhenItsCheckFailsAndTooMuchIsRefusedAtOnce) {
   StreamMemory memory(1000);
-  auto held = memory.Reserve(1000, "held", nullptr);
+  auto held = memory.Reserve(1000, "held", "ask for less", nullptr);
   ASSERT_TRUE(held.ok());
   std::atomic<int> asked{0};
-  auto r = memory.Reserve(10, "waiter", [&]() -> absl::Status {
+  auto r = memory.Reserve(10, "waiter", "ask for less", [&]() -> absl::Status {
     return ++asked > 3 ? absl::CancelledError("client gone") : absl::OkStatus();
   });
   EXPECT_EQ(r.status().code(), absl::StatusCode::kCancelled);
   EXPECT_EQ(memory.reserved_bytes(), 1000u);
 
-  auto big = memory.Reserve(1001, "a sorted range", nullptr);
+  auto big = memory.Reserve(1001, "a sorted range", "ask for less", nullptr);
   EXPECT_EQ(big.status().code(), absl::StatusCode::kResourceExhausted);
   EXPECT_NE(big.status().message().find("stream_memory_bytes"), std::string::npos);
+  EXPECT_NE(big.status().message().find("; ask for less"), std::string::npos);
 }
 
 }  // namespace
