@@ -22,12 +22,15 @@ struct WorkerPool::Loop {
 namespace {
 std::atomic<WorkerPool*> g_shared_from{nullptr};  // set by ShareFrom
 
-// How long a thread polls before it sleeps, when it waits for a loop's tasks
-// (a worker) or for a loop to finish (its caller). A cursor's batches follow
-// each other within microseconds, while waking a sleeping thread takes tens of
-// them; split in two, a 64 Ki-sample batch is 0.5 ms a part, so one wake-up a
-// batch on each side cost two threads about a tenth of their speed
-// (docs/MEASURED.md, "Threads that stay awake between batches").
+// How long a thread polls at most before it sleeps, when it waits for a loop's
+// tasks (a worker) or for a loop to finish (its caller). A cursor's batches
+// follow each other within microseconds, while waking a sleeping thread takes
+// tens of them; split in two, a 64 Ki-sample batch is 0.5 ms a part, so one
+// wake-up a batch on each side cost two threads about a tenth of their speed
+// (docs/MEASURED.md, "Threads that stay awake between batches"). A worker
+// halves its poll each time the next loop came later than kSpin, and doubles
+// it when one came sooner: a server that encodes and sends each batch between
+// loops would otherwise burn a full poll a batch.
 constexpr auto kSpin = std::chrono::microseconds(100);
 
 void Pause() {
@@ -36,10 +39,11 @@ void Pause() {
 #endif
 }
 
-// Polls `ready` until it holds or kSpin has passed; returns whether it held.
+// Polls `ready` until it holds or `spin` has passed; returns whether it held.
 template <typename Ready>
-bool SpinUntil(Ready ready) {
-  const auto deadline = std::chrono::steady_clock::now() + kSpin;
+bool SpinUntil(std::chrono::nanoseconds spin, Ready ready) {
+  if (spin.count() == 0) return ready();
+  const auto deadline = std::chrono::steady_clock::now() + spin;
   while (true) {
     for (int i = 0; i < 64; ++i) {
       if (ready()) return true;
@@ -87,8 +91,10 @@ void WorkerPool::RunTasks(Loop& loop) {
 }
 
 void WorkerPool::Work() {
+  std::chrono::nanoseconds spin = kSpin;
   while (true) {
-    SpinUntil([this] { return queued_.load(std::memory_order_acquire) > 0; });
+    const auto idle_from = std::chrono::steady_clock::now();
+    SpinUntil(spin, [this] { return queued_.load(std::memory_order_acquire) > 0; });
     std::shared_ptr<Loop> loop;
     {
       std::unique_lock<std::mutex> lock(mu_);
@@ -98,6 +104,11 @@ void WorkerPool::Work() {
       queue_.pop_front();
       queued_.store(static_cast<int>(queue_.size()), std::memory_order_release);
     }
+    // A loop that came within kSpin would have been caught by a full poll.
+    const bool soon = std::chrono::steady_clock::now() - idle_from <= kSpin;
+    spin = soon ? std::min<std::chrono::nanoseconds>(
+                      std::max(2 * spin, std::chrono::nanoseconds(1000)), kSpin)
+                : spin / 2;
     RunTasks(*loop);  // a loop already finished has nothing left to claim
   }
 }
@@ -116,7 +127,9 @@ void WorkerPool::ParallelFor(int n, const std::function<void(int)>& task) {
     for (int i = 1; i < n; ++i) wake_.notify_one();
   }
   RunTasks(*loop);
-  if (SpinUntil([&] { return loop->done.load(std::memory_order_acquire) == loop->n; })) return;
+  if (SpinUntil(kSpin, [&] { return loop->done.load(std::memory_order_acquire) == loop->n; })) {
+    return;
+  }
   std::unique_lock<std::mutex> lock(loop->mu);
   loop->finished.wait(lock, [&] { return loop->done.load() == loop->n; });
 }
