@@ -365,6 +365,20 @@ void SampleCursor::Truncate(SampleBatch* batch, size_t rows) const {
 absl::Status SampleCursor::Fill(uint64_t k0, const uint64_t* order, size_t n,
                                 SampleFiller& filler, const SampleRows& out,
                                 const CurveAddress* at) const {
+  // Runs of at most kFillRun samples, so that the filler's passes over a
+  // run's columns stay in cache: one call for 4 M samples had streamed each
+  // pass's 32 MB columns through memory.
+  for (size_t done = 0; done < n; done += kFillRun) {
+    const size_t run = std::min(kFillRun, n - done);
+    RETURN_IF_ERROR(FillRun(k0 + done, order != nullptr ? order + done : nullptr, run, filler,
+                            out.From(done), at != nullptr ? at + done : nullptr));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status SampleCursor::FillRun(uint64_t k0, const uint64_t* order, size_t n,
+                                   SampleFiller& filler, const SampleRows& out,
+                                   const CurveAddress* at) const {
   const CurveSamples& samples = *samples_;
   if (at != nullptr) {
     for (size_t i = 0; i < n; ++i) out.index[i] = at[i].index;

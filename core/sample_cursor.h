@@ -63,6 +63,11 @@ class SampleCursor {
   // null, the samples at addresses at[i].
   absl::Status Fill(uint64_t k0, const uint64_t* order, size_t n, SampleFiller& filler,
                     const SampleRows& out, const CurveAddress* at = nullptr) const;
+  // Fill's work for n <= kFillRun samples.
+  absl::Status FillRun(uint64_t k0, const uint64_t* order, size_t n, SampleFiller& filler,
+                       const SampleRows& out, const CurveAddress* at) const;
+  // The most samples the filler is handed at once.
+  static constexpr size_t kFillRun = size_t{1} << 14;
   // Appends the samples k0 + i (or order[i], or at at[i]), i < n, that lie
   // in the region; returns how many.
   absl::StatusOr<size_t> Generate(uint64_t k0, const uint64_t* order, size_t n,
