@@ -13,7 +13,8 @@ namespace sfc {
 struct WorkerPool::Loop {
   const std::function<void(int)>* task;
   int n;
-  std::atomic<int> next{0};  // the next unclaimed task
+  std::chrono::steady_clock::time_point queued_at;  // when ParallelFor offered it
+  std::atomic<int> next{0};                         // the next unclaimed task
   std::mutex mu;
   std::condition_variable finished;
   std::atomic<int> done{0};  // written under mu; read without it while spinning
@@ -36,10 +37,14 @@ constexpr auto kSpin = std::chrono::microseconds(100);
 void Pause() {
 #if defined(__x86_64__) || defined(__i386__)
   _mm_pause();
+#elif defined(__aarch64__)
+  asm volatile("yield");
 #endif
 }
 
 // Polls `ready` until it holds or `spin` has passed; returns whether it held.
+// Between rounds of polls it offers its core to any other runnable thread
+// (the one it waits for may need it, where threads outnumber cores).
 template <typename Ready>
 bool SpinUntil(std::chrono::nanoseconds spin, Ready ready) {
   if (spin.count() == 0) return ready();
@@ -50,6 +55,7 @@ bool SpinUntil(std::chrono::nanoseconds spin, Ready ready) {
       Pause();
     }
     if (std::chrono::steady_clock::now() >= deadline) return ready();
+    std::this_thread::yield();
   }
 }
 }  // namespace
@@ -104,8 +110,9 @@ void WorkerPool::Work() {
       queue_.pop_front();
       queued_.store(static_cast<int>(queue_.size()), std::memory_order_release);
     }
-    // A loop that came within kSpin would have been caught by a full poll.
-    const bool soon = std::chrono::steady_clock::now() - idle_from <= kSpin;
+    // A loop offered within kSpin of the last one would have been caught by
+    // a full poll (timed from its offer, not from this thread's wake-up).
+    const bool soon = loop->queued_at - idle_from <= kSpin;
     spin = soon ? std::min<std::chrono::nanoseconds>(
                       std::max(2 * spin, std::chrono::nanoseconds(1000)), kSpin)
                 : spin / 2;
@@ -118,6 +125,7 @@ void WorkerPool::ParallelFor(int n, const std::function<void(int)>& task) {
   auto loop = std::make_shared<Loop>();
   loop->task = &task;
   loop->n = n;
+  loop->queued_at = std::chrono::steady_clock::now();
   if (n > 1) {
     {
       std::lock_guard<std::mutex> lock(mu_);

@@ -144,11 +144,11 @@ std::unique_ptr<const SurfaceKind> MakeModuleKind(const KindInfo& info, std::str
 }
 
 std::string KindModuleAbi() {
-  return absl::StrCat(kAlgorithmVersion, "/", SFC_BUILD_ID, "/",
-                      sizeof(TreeSpec), ".", sizeof(KindContext), ".", sizeof(ResolvedSurface),
-                      ".", sizeof(CursorSpec), ".", sizeof(KindInfo), ".", sizeof(StoredModel),
-                      ".", sizeof(SampleBatch), ".", sizeof(EngineLimits), ".",
-                      sizeof(TreeLookup), ".", sizeof(BuildControl), ".", sizeof(TreeSummary));
+  return absl::StrCat(kAlgorithmVersion, "/", SFC_BUILD_ID, "/", sizeof(TreeSpec), ".",
+                      sizeof(KindContext), ".", sizeof(ResolvedSurface), ".", sizeof(CursorSpec),
+                      ".", sizeof(KindInfo), ".", sizeof(StoredModel), ".", sizeof(SampleBatch),
+                      ".", sizeof(EngineLimits), ".", sizeof(TreeLookup), ".", sizeof(BuildControl),
+                      ".", sizeof(TreeSummary), ".", sizeof(WorkerPool));
 }
 
 }  // namespace sfc

@@ -104,6 +104,15 @@ constexpr size_t kRanksPerBox = 8;
 // Meshes with fewer triangles place their ranks on one thread.
 constexpr size_t kParallelRanks = 16384;
 
+// A density with no mass on the whole mesh: INVALID_ARGUMENT, as a formula
+// surface's (core/curve_tree.cc).
+absl::Status ZeroDensity(const MeshDensity& density, const std::string& mesh) {
+  return absl::InvalidArgumentError(absl::StrFormat(
+      "the density '%s' is zero on the whole of mesh '%s': there is nothing to sample (check the "
+      "density, or add a floor)",
+      density.spec(), mesh));
+}
+
 std::array<Bary, 3> RootCorners(uint8_t roles) {
   const int entry = roles / 3, exit = roles % 3, apex = 3 - entry - exit;
   std::array<Bary, 3> c{};
@@ -211,10 +220,7 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
     }
     RETURN_IF_ERROR(CurveTree::CheckMassIsFinite(total0, absl::StrFormat("mesh '%s'", mesh.name)));
     if (!(total0 > 0)) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "the density '%s' is zero on the whole of mesh '%s': there is nothing to sample (check "
-          "the density, or add a floor)",
-          density->spec(), mesh.name));
+      return ZeroDensity(*density, mesh.name);
     }
     if (total0 < CurveTree::kSmallestMass) {
       return absl::InvalidArgumentError(absl::StrFormat(
@@ -253,10 +259,7 @@ absl::StatusOr<std::shared_ptr<const MeshCurveTree>> MeshCurveTree::Build(
     tree->rank_first_leaf_[ranks] = static_cast<uint32_t>(tree->mass_ends_.size());
     stats.density_evaluations = probe.evaluations() + builder.evaluations();
     if (!(running > 0)) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "the density '%s' is zero on the whole of mesh '%s': there is nothing to sample (check "
-          "the density, or add a floor)",
-          density->spec(), mesh.name));
+      return ZeroDensity(*density, mesh.name);
     }
   }
   stats.leaves = tree->mass_ends_.size();

@@ -29,7 +29,7 @@ namespace {
 // MessagePipeline; one without a pipeline), each per sample the columns on
 // the wire (float32 if asked; indices listed, at most). The batch is the requested size, or the
 // largest the server would choose. An invalid range counts nothing here:
-// Start refuses it.
+// SamplingEngine::CheckRequest has refused it before.
 uint64_t StreamWorkingBytes(const SampleRequest& request, const StreamOptions& stream,
                             int pipeline_depth) {
   const auto range = ResolveIndexRange(request);
@@ -56,13 +56,18 @@ uint64_t StreamWorkingBytes(const SampleRequest& request, const StreamOptions& s
   return sort + blue + per_sample * std::min(n, batch);
 }
 
-// What a request whose working memory is over the budget can ask instead:
-// a blue set is relaxed, and a sobol set sorted, whole, whatever part of it
-// the stream sends, so only a smaller set needs less.
+// What a request whose working memory (StreamWorkingBytes) is over the
+// budget can ask instead: a blue set is relaxed whole (128 bytes a sample,
+// which fewer columns hardly change), and a sobol set sorted whole, whatever
+// part of it the stream sends, so only a smaller set needs less.
 const char* LessWorkingMemory(SequenceKind sequence) {
-  if (sequence == SequenceKind::kBlue || SequenceIsTwoDimensional(sequence)) {
-    return "this sequence works on its whole set whatever range, shard or region is asked: ask "
-           "for a set of fewer samples (count) or fewer columns";
+  if (sequence == SequenceKind::kBlue) {
+    return "the blue sequence relaxes its whole set whatever range, shard or region is asked: "
+           "ask for a set of fewer samples (count)";
+  }
+  if (SequenceIsTwoDimensional(sequence)) {
+    return "this sequence sorts its whole set whatever range, shard or region is asked: ask for "
+           "a set of fewer samples (count) or fewer columns";
   }
   return "ask for a smaller index range or fewer columns";
 }
@@ -90,8 +95,8 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
   // refused in its slot, as any other bad request, or before it takes one
   // when it names a model (PrepareModelOutsideSlot).
   const absl::StatusOr<SampleCall> call = FromProto(*request);
-  LookupOutsideSlot outside;
-  if (status.ok()) status = PrepareModelOutsideSlot(context, *request, call, &outside);
+  std::optional<EarlyLookup> early;
+  if (status.ok()) status = PrepareModelOutsideSlot(context, *request, call, &early);
   if (status.ok()) {
     // Claim a stream slot; give it back on every path out.
     if (active_streams_.fetch_add(1) >= options_.max_concurrent_streams) {
@@ -103,7 +108,7 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
                                        options_.max_concurrent_streams));
     } else {
       metrics_->StreamStarted();
-      status = call.ok() ? RunSample(context, *request, *call, outside, writer, &sent)
+      status = call.ok() ? RunSample(context, *request, *call, early, writer, &sent)
                          : ToGrpcStatus(call.status());
       metrics_->StreamEnded();
       active_streams_.fetch_sub(1);
@@ -121,7 +126,7 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
 grpc::Status SamplerService::PrepareModelOutsideSlot(grpc::ServerContext* context,
                                                      const v1::SampleRequest& wire,
                                                      const absl::StatusOr<SampleCall>& call,
-                                                     LookupOutsideSlot* lookup) {
+                                                     std::optional<EarlyLookup>* early) {
   // The wire's surface: whether the request names a model comes before
   // whether the rest of it reads.
   auto model = ParseModelSpec(wire.tree().surface());
@@ -131,18 +136,21 @@ grpc::Status SamplerService::PrepareModelOutsideSlot(grpc::ServerContext* contex
   const auto deadline =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(
                          std::chrono::duration<double>(options_.request_deadline_seconds));
+  // The request's own checks first: a bad one is refused before a tree is made for it.
+  if (absl::Status valid = engine_.CheckRequest(request); !valid.ok()) return ToGrpcStatus(valid);
   auto tree_count = ResolveTreeCount(request);
   if (!tree_count.ok()) return ToGrpcStatus(tree_count.status());
   auto prepared =
       engine_.Prepare(request.tree, *tree_count,
                       RequestControl(context, deadline, options_.request_deadline_seconds));
   if (!prepared.ok()) return ToGrpcStatus(prepared.status());
-  *lookup = {true, prepared->lookup.cache_hit, prepared->lookup.refined};
+  *early = EarlyLookup{prepared->lookup.cache_hit, prepared->lookup.refined};
   return grpc::Status::OK;
 }
 
 grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::SampleRequest& wire,
-                                       const SampleCall& call, const LookupOutsideSlot& outside,
+                                       const SampleCall& call,
+                                       const std::optional<EarlyLookup>& early,
                                        grpc::ServerWriter<v1::SampleResponse>* writer,
                                        uint64_t* sent) {
   const auto start = Clock::now();
@@ -171,7 +179,10 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
 
   v1::StreamHeader header;
   TreeSummary summary = SummarizeTree(job->tree);
-  if (outside.made) summary.cache_hit = outside.cache_hit, summary.refined = outside.refined;
+  if (early) {  // the tree was found before the slot (evicted since, it was made again)
+    summary.cache_hit = early->cache_hit && summary.cache_hit;
+    summary.refined = early->refined || summary.refined;
+  }
   ToProto(summary, header.mutable_tree());
   header.set_algorithm_version(options_.algorithm_version);
   header.set_seed(request.seed);

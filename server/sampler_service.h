@@ -23,6 +23,7 @@
 
 #include <atomic>
 #include <memory>
+#include <optional>
 
 #include "absl/status/statusor.h"
 #include "engine/sampling_engine.h"
@@ -75,22 +76,21 @@ class SamplerService final : public ::sfcsampler::v1::Sampler::Service {
   // the stream takes a slot, so a slow or hostile parse holds none; `call`
   // is `wire` as read (proto/convert.h FromProto), its error returned here
   // for a model. OK for other requests (their errors are reported in a slot).
-  // `*lookup` gets how the tree was found then (a request that builds or
+  // `*early` gets how the tree was found then (a request that builds or
   // refines it here finds it cached in its slot).
-  struct LookupOutsideSlot {
-    bool made = false;  // the tree was looked up before the slot
+  struct EarlyLookup {
     bool cache_hit = false, refined = false;
   };
   grpc::Status PrepareModelOutsideSlot(grpc::ServerContext* context,
                                        const ::sfcsampler::v1::SampleRequest& wire,
                                        const absl::StatusOr<SampleCall>& call,
-                                       LookupOutsideSlot* lookup);
+                                       std::optional<EarlyLookup>* early);
   // Streams `call`, which `wire` reads as (the header echoes `wire`); its
   // stream options are passed down unchanged to the batch sizing and encoding.
-  // The header reports the tree's lookup outside the slot when there was
-  // one (`outside.made`), as the request's own.
+  // The header's cache_hit and refined take in the lookup before the slot,
+  // `early`, when there was one.
   grpc::Status RunSample(grpc::ServerContext* context, const ::sfcsampler::v1::SampleRequest& wire,
-                         const SampleCall& call, const LookupOutsideSlot& outside,
+                         const SampleCall& call, const std::optional<EarlyLookup>& early,
                          grpc::ServerWriter<::sfcsampler::v1::SampleResponse>* writer,
                          uint64_t* sent);
 

@@ -62,5 +62,22 @@ TEST(WorkerPool, AWorkerTakesLoopsWhetherPollingOrAsleep) {
   }
 }
 
+// A caller polls for its loop's end for a while, then sleeps: a worker's task
+// that outlasts the poll must still wake it. Tasks on other threads sleep 1 ms.
+TEST(WorkerPool, ACallerThatStopsPollingIsWokenWhenItsLoopEnds) {
+  WorkerPool pool(1);
+  const std::thread::id caller = std::this_thread::get_id();
+  for (int round = 0; round < 50; ++round) {
+    std::atomic<int> ran{0};
+    pool.ParallelFor(2, [&](int) {
+      if (std::this_thread::get_id() != caller) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
+      ++ran;
+    });
+    ASSERT_EQ(ran.load(), 2) << "round " << round;
+  }
+}
+
 }  // namespace
 }  // namespace sfc
