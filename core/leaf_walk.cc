@@ -166,7 +166,9 @@ int LeafWalk::TabulateExact(const Square& leaf, int levels, std::vector<double>&
 
 void LeafWalk::Place(const double* m, size_t n, double* u, double* v, double* curve_position) {
   u_ = u, v_ = v, curve_position_ = curve_position;
-  t_.resize(n), reached_of_.resize(n);
+  // kScanWidth entries past the run: PrefixBelow and Reached read and write
+  // whole windows.
+  t_.resize(n + kScanWidth), reached_of_.resize(n + kScanWidth);
   reached_.clear(), frames_.clear();
   // Samples [waiting, i) have their squares and wait for Continue, up to
   // kContinueBatch of them; a warped leaf's are continued at once (its
@@ -219,10 +221,24 @@ int LeafWalk::CellsAtOrBelow(const double* bounds, int from, double t) {
   }
 }
 
+uint32_t LeafWalk::PrefixBelow(const double* t, uint32_t begin, uint32_t end, double bound) {
+  // As CellsAtOrBelow: a window at a time, without branches inside.
+  while (true) {
+    int count = 0;
+    for (int d = 0; d < kScanWidth; ++d) count += (begin + d < end) & (t[begin + d] < bound);
+    begin += count;
+    if (count < kScanWidth) return begin;
+  }
+}
+
 void LeafWalk::Reached(const Square& square, uint32_t begin, uint32_t end) {
   const uint32_t index = static_cast<uint32_t>(reached_.size());
   reached_.push_back(square);
-  for (uint32_t i = begin; i < end; ++i) reached_of_[i] = index;
+  // Whole windows: the entries written past `end` are later samples', which
+  // get theirs later in the walk (samples reach their squares in order).
+  for (uint32_t i = begin; i < end; i += kScanWidth) {
+    for (int d = 0; d < kScanWidth; ++d) reached_of_[i + d] = index;
+  }
 }
 
 void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end, int level) {
@@ -252,12 +268,8 @@ void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end,
   while (i < end) {
     first = CellsAtOrBelow(bounds.data(), first, t_[i]);
     const int k = std::min(first, last);
-    uint32_t j = i + 1;
-    if (k == last) {
-      j = end;
-    } else {
-      while (j < end && t_[j] < bounds[k]) ++j;
-    }
+    // Sample i is below bounds[k] unless k is the last cell, which takes the rest.
+    const uint32_t j = k == last ? end : PrefixBelow(t_.data(), i + 1, end, bounds[k]);
     Square cell;
     cell.t0 = k == 0 ? square.t0 : bounds[k - 1], cell.t1 = bounds[k];
     cell.x0 = square.x0 + order[k].dx * side, cell.y0 = square.y0 + order[k].dy * side;

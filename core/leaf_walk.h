@@ -151,6 +151,10 @@ class LeafWalk {
   // where every entry before `from` is (bounds do not decrease and end in
   // kScanWidth entries of +inf).
   static int CellsAtOrBelow(const double* bounds, int from, double t);
+  // The first of samples [begin, end) whose t is at least `bound`, or end:
+  // their t do not decrease. Reads t[begin .. end + kScanWidth) in whole
+  // windows.
+  static uint32_t PrefixBelow(const double* t, uint32_t begin, uint32_t end, double bound);
   // Records that samples [begin, end) end in `square` (pure curve bits from there).
   void Reached(const Square& square, uint32_t begin, uint32_t end);
   // Places samples [begin, end) of the run by pure curve bits inside the
