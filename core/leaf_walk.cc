@@ -210,7 +210,7 @@ void LeafWalk::PlaceInLeaf(const double* m, size_t begin, size_t n) {
   PlaceInSquare(leaf, static_cast<uint32_t>(begin), static_cast<uint32_t>(begin + n), 0);
 }
 
-int LeafWalk::CellsAtOrBelow(const double* bounds, int from, double t) {
+__attribute__((always_inline)) inline int LeafWalk::CellsAtOrBelow(const double* bounds, int from, double t) {
   // A window of kScanWidth comparisons at a time, without branches inside:
   // the count of bounds <= t there is how far to move (they do not decrease).
   while (true) {
@@ -221,7 +221,7 @@ int LeafWalk::CellsAtOrBelow(const double* bounds, int from, double t) {
   }
 }
 
-uint32_t LeafWalk::PrefixBelow(const double* t, uint32_t begin, uint32_t end, double bound) {
+__attribute__((always_inline)) inline uint32_t LeafWalk::PrefixBelow(const double* t, uint32_t begin, uint32_t end, double bound) {
   // As CellsAtOrBelow: a window at a time, without branches inside.
   while (true) {
     int count = 0;
