@@ -261,15 +261,9 @@ void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end,
   const Curve::Child* order = curve_.CellsInOrder(square.state, levels);
   const double side = square.side / curve_.PowG(levels);
   const double span = square.span / static_cast<double>(curve_.PowW(levels));
-  // Samples in t order meet the cells in curve order: t goes to the first
-  // cell whose bound is above it (that cell has mass), and t >= t1 to the last.
-  int first = 0;  // bounds below first are <= every t from here on
-  uint32_t i = begin;
-  while (i < end) {
-    first = CellsAtOrBelow(bounds.data(), first, t_[i]);
-    const int k = std::min(first, last);
-    // Sample i is below bounds[k] unless k is the last cell, which takes the rest.
-    const uint32_t j = k == last ? end : PrefixBelow(t_.data(), i + 1, end, bounds[k]);
+  // Cell k takes samples [i, j) of the square (k's bound is above their t,
+  // and the earlier cells' bounds are not).
+  const auto place = [&](int k, uint32_t i, uint32_t j) {
     Square cell;
     cell.t0 = k == 0 ? square.t0 : bounds[k - 1], cell.t1 = bounds[k];
     cell.x0 = square.x0 + order[k].dx * side, cell.y0 = square.y0 + order[k].dy * side;
@@ -291,6 +285,32 @@ void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end,
       }
       Reached(cell, i, j);
     }
+  };
+  // Samples in t order meet the cells in curve order: t goes to the first
+  // cell whose bound is above it (that cell has mass), and t >= t1 to the
+  // last. So the cells before the last hold the samples whose t is below
+  // their bound, the last one the rest.
+  if (end - begin <= static_cast<uint32_t>(kScanWidth) && last < kSmallTableCells) {
+    // A few samples in a small table: each cell's end counted on its own,
+    // with no chain from one cell's samples to the next cell's.
+    uint32_t ends[kSmallTableCells];
+    for (int k = 0; k < last; ++k) ends[k] = PrefixBelow(t_.data(), begin, end, bounds[k]);
+    uint32_t i = begin;
+    for (int k = 0; k <= last && i < end; ++k) {
+      const uint32_t j = k == last ? end : ends[k];
+      if (j > i) place(k, i, j);
+      i = std::max(i, j);
+    }
+    return;
+  }
+  int first = 0;  // bounds below first are <= every t from here on
+  uint32_t i = begin;
+  while (i < end) {
+    first = CellsAtOrBelow(bounds.data(), first, t_[i]);
+    const int k = std::min(first, last);
+    // Sample i is below bounds[k] unless k is the last cell, which takes the rest.
+    const uint32_t j = k == last ? end : PrefixBelow(t_.data(), i + 1, end, bounds[k]);
+    place(k, i, j);
     i = j;
   }
 }

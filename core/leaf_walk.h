@@ -147,6 +147,9 @@ class LeafWalk {
   void PlaceInSquare(const Square& square, uint32_t begin, uint32_t end, int level);
   // Bounds compared at once when matching samples to cells.
   static constexpr int kScanWidth = 16;
+  // A table of fewer cells than this with at most kScanWidth samples has
+  // each cell's samples counted on its own.
+  static constexpr int kSmallTableCells = 64;
   // The number of entries of `bounds` that are <= t, counted from `from`,
   // where every entry before `from` is (bounds do not decrease and end in
   // kScanWidth entries of +inf).
