@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "core/area_estimator.h"
@@ -12,6 +13,10 @@
 namespace sfc {
 
 namespace {
+
+// Two lanes (the baseline's SSE2 registers).
+typedef double Pair __attribute__((vector_size(16)));
+typedef int64_t Ints __attribute__((vector_size(16)));
 
 // Below this mass a cell is placed uniformly: FollowSlope squares p.
 constexpr double kLeastSlopedMass = 1e-150;
@@ -293,8 +298,22 @@ void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end,
   if (end - begin <= static_cast<uint32_t>(kScanWidth) && last < kSmallTableCells) {
     // A few samples in a small table: each cell's end counted on its own,
     // with no chain from one cell's samples to the next cell's.
+    // The samples' t in pairs (SSE2 registers), +inf past the square's end.
+    constexpr int kPairs = kScanWidth / 2;
+    Pair t[kPairs];
+    const int64_t count = end - begin;
+    for (int d = 0; d < kPairs; ++d) {
+      Pair pair;
+      std::memcpy(&pair, &t_[begin + 2 * d], sizeof pair);
+      const Ints inside = Ints{2 * d, 2 * d + 1} < count;
+      t[d] = inside ? pair : Pair{} + std::numeric_limits<double>::infinity();
+    }
     uint32_t ends[kSmallTableCells];
-    for (int k = 0; k < last; ++k) ends[k] = PrefixBelow(t_.data(), begin, end, bounds[k]);
+    for (int k = 0; k < last; ++k) {
+      Ints below{};  // -1 for each t below the bound
+      for (int d = 0; d < kPairs; ++d) below += t[d] < bounds[k];
+      ends[k] = begin + static_cast<uint32_t>(-(below[0] + below[1]));
+    }
     uint32_t i = begin;
     for (int k = 0; k <= last && i < end; ++k) {
       const uint32_t j = k == last ? end : ends[k];
