@@ -174,14 +174,14 @@ void LeafWalk::Place(const double* m, size_t n, double* u, double* v, double* cu
   // kScanWidth entries past the run: PrefixBelow and Reached read and write
   // whole windows.
   t_.resize(n + kScanWidth), reached_of_.resize(n + kScanWidth);
-  reached_.clear(), frames_.clear();
+  reached_.clear(), frames_.clear(), warped_runs_.clear();
   // Samples [waiting, i) have their squares and wait for Continue, up to
-  // kContinueBatch of them; a warped leaf's are continued at once (its
-  // warp is the current leaf's).
+  // kContinueBatch of them, warped leaves' among them (each leaf's warp is
+  // in its frame).
   size_t waiting = 0;
-  const auto flush = [&](size_t end, bool warped) {
-    Continue(waiting, end, warped);
-    reached_.clear(), frames_.clear();
+  const auto flush = [&](size_t end) {
+    Continue(waiting, end);
+    reached_.clear(), frames_.clear(), warped_runs_.clear();
     waiting = end;
   };
   size_t i = 0;
@@ -192,17 +192,12 @@ void LeafWalk::Place(const double* m, size_t n, double* u, double* v, double* cu
     // m < S_l alone puts a sample here.
     size_t j = i + 1;
     while (j < n && m[j] >= m[j - 1] && (m[j] < end_mass_ || LeafFor(m[j]) == l)) ++j;
-    if (warped_) {
-      flush(i, false);
-      PlaceInLeaf(m + i, i, j - i);
-      flush(j, true);
-    } else {
-      PlaceInLeaf(m + i, i, j - i);
-      if (j - waiting >= kContinueBatch) flush(j, false);
-    }
+    PlaceInLeaf(m + i, i, j - i);
+    if (warped_) warped_runs_.push_back({i, j, static_cast<uint32_t>(frames_.size() - 1)});
+    if (j - waiting >= kContinueBatch) flush(j);
     i = j;
   }
-  flush(n, false);
+  flush(n);
 }
 
 void LeafWalk::PlaceInLeaf(const double* m, size_t begin, size_t n) {
@@ -210,7 +205,8 @@ void LeafWalk::PlaceInLeaf(const double* m, size_t begin, size_t n) {
     t_[begin + i] = std::clamp((m[i] - begin_mass_) / leaf_mass_, 0.0, 1.0);
   }
   const uint32_t frame = static_cast<uint32_t>(frames_.size());
-  frames_.push_back({cell_.u0, cell_.v0, cell_.size, leaf_start_, leaf_span_});
+  frames_.push_back({cell_.u0, cell_.v0, cell_.size, leaf_start_, leaf_span_, warped_,
+                     {model_->warp[0], model_->warp[1]}, {split_[0], split_[1]}});
   const Square leaf{0, 1, 0, 0, 1, 0, 1, 1, 0, 0, cell_.state, 0, frame};
   PlaceInSquare(leaf, static_cast<uint32_t>(begin), static_cast<uint32_t>(begin + n), 0);
 }
@@ -334,7 +330,7 @@ void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end,
   }
 }
 
-void LeafWalk::Continue(size_t begin, size_t end, bool warped) {
+void LeafWalk::Continue(size_t begin, size_t end) {
   // The rest of t down its square's own curve, to the centre of the cell
   // reached: the curve digits of all n samples first, then one batch of
   // curve decoding, then the coordinates. Arrays of the batch are indexed
@@ -375,7 +371,7 @@ void LeafWalk::Continue(size_t begin, size_t end, bool warped) {
   for (size_t i = 0; i < n; ++i) {
     const Square& at = reached_[square_of[i]];
     const Frame& leaf = frames_[at.frame];
-    if (!warped) {
+    if (!leaf.warped) {
       const double px = at.x0 + fx_[i] * at.side, py = at.y0 + fy_[i] * at.side;
       u_[begin + i] = leaf.u0 + px * leaf.size;
       v_[begin + i] = leaf.v0 + py * leaf.size;
@@ -386,17 +382,21 @@ void LeafWalk::Continue(size_t begin, size_t end, bool warped) {
           CurvePosition(leaf.start + pos * leaf.span, static_cast<double>(curve_.Span(0)));
     }
   }
-  if (!warped) return;
-  PlaceWarped(0, begin, n, fx_.data(), u_ + begin);
-  PlaceWarped(1, begin, n, fy_.data(), v_ + begin);
+  for (const WarpedRun& run : warped_runs_) {
+    const Frame& leaf = frames_[run.frame];
+    const size_t at = run.begin - begin, count = run.end - run.begin;
+    PlaceWarped(leaf, 0, run.begin, count, fx_.data() + at, u_ + run.begin);
+    PlaceWarped(leaf, 1, run.begin, count, fy_.data() + at, v_ + run.begin);
+  }
 }
 
-void LeafWalk::PlaceWarped(int axis, size_t begin, size_t n, const double* f, double* out) {
+void LeafWalk::PlaceWarped(const Frame& leaf, int axis, size_t begin, size_t n, const double* f,
+                           double* out) {
   // Warp's and Unwarp's operations in order, their powers taken in batch
   // calls (the same bits as the one-value functions).
-  const AxisWarp& w = model_->warp[axis];
-  const double sc = split_[axis], k = w.power;
-  const double origin = axis == 0 ? cell_.u0 : cell_.v0;
+  const AxisWarp& w = leaf.warp[axis];
+  const double sc = leaf.split[axis], k = w.power;
+  const double origin = axis == 0 ? leaf.u0 : leaf.v0;
   auto square = [&](size_t i) -> const Square& { return reached_[reached_of_[begin + i]]; };
   auto lower = [&](size_t i) { return axis == 0 ? square(i).x0 : square(i).y0; };
   base_.resize(2 * n), power_.resize(2 * n), place_.resize(n);
@@ -434,7 +434,7 @@ void LeafWalk::PlaceWarped(int axis, size_t begin, size_t n, const double* f, do
       s[i] = std::clamp(WarpFrom(w, sc, s[i], power[i]), x0, x0 + square(i).side);
     }
   }
-  for (size_t i = 0; i < n; ++i) out[i] = origin + s[i] * cell_.size;
+  for (size_t i = 0; i < n; ++i) out[i] = origin + s[i] * leaf.size;
 }
 
 }  // namespace sfc

@@ -108,23 +108,33 @@ class LeafWalk {
     int depth;
     uint32_t frame;
   };
-  // Where a leaf's unit square lies in the surface's parameters, and its
-  // span along the curve: what Continue reads of a leaf whose samples it
-  // places after the walk has left it.
+  // Where a leaf's unit square lies in the surface's parameters, its span
+  // along the curve, and its model's warp (with WarpSplit of each axis's,
+  // when warped): what Continue reads of a leaf whose samples it places
+  // after the walk has left it.
   struct Frame {
     double u0, v0, size, start, span;
+    bool warped;
+    AxisWarp warp[2];
+    double split[2];
+  };
+  // Samples [begin, end) of the run, all of the warped leaf frames_[frame].
+  struct WarpedRun {
+    size_t begin, end;
+    uint32_t frame;
   };
   // Leaves with fewer samples than this wait for the next leaves' and have
   // their curve bits followed in one batch (Continue): the batch calls are
   // vectorised, and a leaf of a dozen samples filled few lanes.
   static constexpr size_t kContinueBatch = 1024;
 
-  // The run's samples [begin, begin + n), in the current leaf, whose model is
+  // The run's samples [begin, begin + n), in the leaf `leaf`, whose model is
   // warped along `axis` (0: u, 1: v): out[i] gets the parameter of the point
   // at fraction f[i] of the cell [x0, x0 + side] sample begin + i reached
   // along that axis: W of it where the curve descended in warped coordinates
   // (DescendsWarped), else uniform in warped coordinates inside the cell.
-  void PlaceWarped(int axis, size_t begin, size_t n, const double* f, double* out);
+  void PlaceWarped(const Frame& leaf, int axis, size_t begin, size_t n, const double* f,
+                   double* out);
   // The leaf holding m: a forward step from the current one, else a search.
   size_t LeafFor(double m) const;
   // Makes l the current leaf.
@@ -161,9 +171,9 @@ class LeafWalk {
   // Records that samples [begin, end) end in `square` (pure curve bits from there).
   void Reached(const Square& square, uint32_t begin, uint32_t end);
   // Places samples [begin, end) of the run by pure curve bits inside the
-  // squares they reached; `warped`: they are the current leaf's, and its
-  // model is warped.
-  void Continue(size_t begin, size_t end, bool warped);
+  // squares they reached (those of warped leaves, warped_runs_, through
+  // their warps).
+  void Continue(size_t begin, size_t end);
   // Finds the squares of the run's samples [begin, begin + n), the current
   // leaf's, with non-decreasing m (Continue places them).
   void PlaceInLeaf(const double* m, size_t begin, size_t n);
@@ -200,6 +210,7 @@ class LeafWalk {
   std::vector<double> cell_us_, cell_vs_, cell_m_;  // an exact table's centres and densities
   std::vector<Square> reached_;                     // the squares samples end in
   std::vector<Frame> frames_;                       // their leaves
+  std::vector<WarpedRun> warped_runs_;              // the samples of warped leaves among them
   std::vector<uint32_t> reached_of_;                // each sample's square in reached_
   std::vector<double> fraction_;                    // each sample's fraction of its square's t
   std::vector<uint64_t> digits_, cx_, cy_;          // its curve digits and the cell they reach
