@@ -205,13 +205,16 @@ void LeafWalk::PlaceInLeaf(const double* m, size_t begin, size_t n) {
     t_[begin + i] = std::clamp((m[i] - begin_mass_) / leaf_mass_, 0.0, 1.0);
   }
   const uint32_t frame = static_cast<uint32_t>(frames_.size());
-  frames_.push_back({cell_.u0, cell_.v0, cell_.size, leaf_start_, leaf_span_, warped_,
-                     {model_->warp[0], model_->warp[1]}, {split_[0], split_[1]}});
+  Frame leaf_frame{cell_.u0, cell_.v0, cell_.size, leaf_start_, leaf_span_, warped_, {}, {}};
+  leaf_frame.warp[0] = model_->warp[0], leaf_frame.warp[1] = model_->warp[1];
+  leaf_frame.split[0] = split_[0], leaf_frame.split[1] = split_[1];
+  frames_.push_back(leaf_frame);
   const Square leaf{0, 1, 0, 0, 1, 0, 1, 1, 0, 0, cell_.state, 0, frame};
   PlaceInSquare(leaf, static_cast<uint32_t>(begin), static_cast<uint32_t>(begin + n), 0);
 }
 
-__attribute__((always_inline)) inline int LeafWalk::CellsAtOrBelow(const double* bounds, int from, double t) {
+__attribute__((always_inline)) inline int LeafWalk::CellsAtOrBelow(const double* bounds, int from,
+                                                                   double t) {
   // A window of kScanWidth comparisons at a time, without branches inside:
   // the count of bounds <= t there is how far to move (they do not decrease).
   while (true) {
@@ -222,7 +225,9 @@ __attribute__((always_inline)) inline int LeafWalk::CellsAtOrBelow(const double*
   }
 }
 
-__attribute__((always_inline)) inline uint32_t LeafWalk::PrefixBelow(const double* t, uint32_t begin, uint32_t end, double bound) {
+__attribute__((always_inline)) inline uint32_t LeafWalk::PrefixBelow(const double* t,
+                                                                     uint32_t begin, uint32_t end,
+                                                                     double bound) {
   // As CellsAtOrBelow: a window at a time, without branches inside.
   while (true) {
     int count = 0;

@@ -199,9 +199,9 @@ class LeafWalk {
   double leaf_start_ = 0, leaf_span_ = 0;  // curve indices, for curve_position
   const LeafModel* model_ = nullptr;
   LeafModel::Kind kind_ = LeafModel::Kind::kQuadratic;
-  bool warped_ = false;  // the model has a power law (LeafModel::warp)
+  bool warped_ = false;   // the model has a power law (LeafModel::warp)
   double split_[2] = {};  // WarpSplit of each axis's warp, when warped_
-  bool exact_ = false;   // the first table follows the true mass density (kExactCells)
+  bool exact_ = false;    // the first table follows the true mass density (kExactCells)
   // Scratch of a Place call (indexed by the run's samples), kept to reuse its
   // memory.
   std::vector<double> t_;                           // each sample's fraction of the leaf's mass

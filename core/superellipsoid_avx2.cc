@@ -5,7 +5,7 @@
 namespace sfc::superellipsoid_internal {
 
 size_t PointsAvx2(Shape shape, const double* u, const double* v, size_t n, double* x, double* y,
-                double* z) {
+                  double* z) {
   return PointsLanes(shape, u, v, n, x, y, z);
 }
 

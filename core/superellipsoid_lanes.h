@@ -1,14 +1,15 @@
 // The superellipsoid's batch points (core/superellipsoid_internal.h) in
-// generic vectors (core/vector_lanes.h), a block of points at a time: each lane does Superellipsoid::Point's
-// IEEE operations in its order (core/builtin_surfaces.cc: Angle, Turn, the
-// powers of |cos| and |sin| and their signs; selects for its branches, sign
-// bits for fabs, copysign and negation; the build has -ffp-contract=off) and
-// calls SLEEF's cinz functions, whose bits are the same at every width, so
-// every instruction set gives the scalar reference's bits.
-// superellipsoid_avx2.cc builds it for AVX2 (four lanes, with SLEEF's AVX
-// functions) and superellipsoid_avx512.cc for AVX-512F (eight lanes).
-// Internal linkage on purpose (an anonymous namespace): each file keeps its
-// own copy, compiled for its instruction set.
+// generic vectors (core/vector_lanes.h), a block of points at a time: each
+// lane does Superellipsoid::Point's IEEE operations in its order
+// (core/builtin_surfaces.cc: Angle, Turn, the powers of |cos| and |sin| and
+// their signs; selects for its branches, sign bits for fabs, copysign and
+// negation; the build has -ffp-contract=off) and calls SLEEF's cinz
+// functions, whose bits are the same at every width, so every instruction
+// set gives the scalar reference's bits. superellipsoid_avx2.cc builds it
+// for AVX2 (four lanes, with SLEEF's AVX functions) and
+// superellipsoid_avx512.cc for AVX-512F (eight lanes). Internal linkage on
+// purpose (an anonymous namespace): each file keeps its own copy, compiled
+// for its instruction set.
 //
 // Thread-safety: pure functions.
 #ifndef SFCSAMPLER_CORE_SUPERELLIPSOID_LANES_H_
@@ -61,17 +62,20 @@ __attribute__((always_inline)) inline Doubles NegateWhere(Ints mask, Doubles x) 
   return (Doubles)((Words)x ^ ((Words)mask & kSignBit));
 }
 
-// Rounded toward zero, and toward -infinity: exact, one instruction.
+// Rounded toward zero, and toward -infinity: exact, one instruction (the
+// zero-masked AVX-512F form: GCC's unmasked one warns of its undefined source).
 __attribute__((always_inline)) inline Doubles Trunc(Doubles x) {
 #ifdef __AVX512F__
-  return (Doubles)_mm512_roundscale_pd((__m512d)x, _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC);
+  return (Doubles)_mm512_maskz_roundscale_pd(0xff, (__m512d)x,
+                                             _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC);
 #else
   return (Doubles)_mm256_round_pd((__m256d)x, _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC);
 #endif
 }
 __attribute__((always_inline)) inline Doubles Floor(Doubles x) {
 #ifdef __AVX512F__
-  return (Doubles)_mm512_roundscale_pd((__m512d)x, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+  return (Doubles)_mm512_maskz_roundscale_pd(0xff, (__m512d)x,
+                                             _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
 #else
   return (Doubles)_mm256_round_pd((__m256d)x, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
 #endif
@@ -103,7 +107,7 @@ struct Angles {
   Doubles quarter, offset;
 };
 __attribute__((always_inline)) inline Angles AngleOf(Doubles x, double start, double pieces,
-                                                      bool reparam) {
+                                                     bool reparam) {
   const Doubles y = x * pieces;
   if (!reparam) {
     // RoundHalfAway: the integer part with y's sign, then halves away from zero.

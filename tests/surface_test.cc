@@ -3,8 +3,8 @@
 // superellipsoid's jet reports its singular lines as infinite.
 #include <cmath>
 #include <cstring>
-#include <random>
 #include <memory>
+#include <random>
 #include <vector>
 
 #include "core/builtin_surfaces.h"
