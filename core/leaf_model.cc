@@ -132,41 +132,51 @@ void AxisIntegrals(double o, double step, int n, double (*full)[kMaxGridCells],
   }
 }
 
-// ComputeGridFactors of a quadratic whose axes are both descended in (no
-// power law below 1: the common case): the same operations, with its three
-// factors known at compile time, two cells at a time, and each integral
-// written where it belongs.
-void QuadraticGridFactors(const LeafModel& model, double x0, double y0, double side, int n,
+}  // namespace
+
+void ComputeAxisFactors(double origin, double side, int n, AxisFactors* out) {
+  out->n = n;
+  AxisIntegrals(origin, side / n, n, out->full, out->low);
+  if (n % 2 != 0) {  // QuadraticGridFactors takes rows in pairs: the last one's partner
+    for (int b = 0; b < 3; ++b) out->full[b][n] = out->low[b][n] = 0;
+  }
+}
+
+bool HasQuadraticGridFactors(const LeafModel& model, LeafModel::Kind kind) {
+  return kind == LeafModel::Kind::kQuadratic && !(model.warp[0].power < 1) &&
+         !(model.warp[1].power < 1);
+}
+
+void QuadraticGridFactors(const LeafModel& model, const AxisFactors& x, const AxisFactors& y,
                           GridFactors* out) {
+  const int n = x.n;
   out->factors = 3;
   out->halves[0] = out->halves[1] = true;
-  const double step = side / n;
-  double fy[3][kMaxGridCells], low_y[3][kMaxGridCells];
-  AxisIntegrals(x0, step, n, out->x, out->x_low);
-  AxisIntegrals(y0, step, n, fy, low_y);
-  if (n % 2 != 0) {  // the rows go in pairs: the last one's partner (n < kMaxGridCells)
-    for (int b = 0; b < 3; ++b) fy[b][n] = low_y[b][n] = 0;
+  for (int b = 0; b < 3; ++b) {
+    std::copy(x.full[b], x.full[b] + n, out->x[b]);
+    std::copy(x.low[b], x.low[b] + n, out->x_low[b]);
   }
   for (int a = 0; a < 3; ++a) {
     const double c0 = model.c[3 * a], c1 = model.c[3 * a + 1], c2 = model.c[3 * a + 2];
     for (int j = 0; j < n; j += 2) {
       Pair sum = {0, 0}, sum_low = {0, 0};
-      sum += c0 * Load(&fy[0][j]), sum_low += c0 * Load(&low_y[0][j]);
-      sum += c1 * Load(&fy[1][j]), sum_low += c1 * Load(&low_y[1][j]);
-      sum += c2 * Load(&fy[2][j]), sum_low += c2 * Load(&low_y[2][j]);
+      sum += c0 * Load(&y.full[0][j]), sum_low += c0 * Load(&y.low[0][j]);
+      sum += c1 * Load(&y.full[1][j]), sum_low += c1 * Load(&y.low[1][j]);
+      sum += c2 * Load(&y.full[2][j]), sum_low += c2 * Load(&y.low[2][j]);
       out->row[a][j] = sum[0], out->row_low[a][j] = sum_low[0];
       if (j + 1 < n) out->row[a][j + 1] = sum[1], out->row_low[a][j + 1] = sum_low[1];
     }
   }
 }
 
-}  // namespace
-
 void ComputeGridFactors(const LeafModel& model, LeafModel::Kind kind, int grid, double x0,
                         double y0, double side, int n, GridFactors* out) {
   const bool quadratic = kind == LeafModel::Kind::kQuadratic;
-  if (quadratic && !(model.warp[0].power < 1) && !(model.warp[1].power < 1)) {
-    QuadraticGridFactors(model, x0, y0, side, n, out);
+  if (HasQuadraticGridFactors(model, kind)) {
+    AxisFactors x, y;
+    ComputeAxisFactors(x0, side, n, &x);
+    ComputeAxisFactors(y0, side, n, &y);
+    QuadraticGridFactors(model, x, y, out);
     return;
   }
   const int factors = quadratic ? 3 : grid;

@@ -61,6 +61,10 @@ LeafWalk::LeafWalk(const CurveTree& tree, const Surface& surface, const Density&
   int exponent;
   cells_power_of_two_ = std::frexp(continuation_cells_, &exponent) == 0.5;
   tables_.resize(kMaxModelLevels + 1);
+  unit_axes_.resize(curve_.table_levels() + 1);
+  for (int levels = 1; levels <= curve_.table_levels(); ++levels) {
+    ComputeAxisFactors(0, 1, static_cast<int>(curve_.PowG(levels)), &unit_axes_[levels]);
+  }
   factors_.resize(kMaxModelLevels + 1);
   last_positive_leaf_ = tree.leaf_count() - 1;
   while (last_positive_leaf_ > 0 &&
@@ -121,7 +125,14 @@ int LeafWalk::Tabulate(const Square& square, int levels, std::vector<double>& bo
                        GridFactors& factors) {
   const int n = static_cast<int>(curve_.PowG(levels));
   const int cells = n * n;
-  ComputeGridFactors(*model_, kind_, grid_, square.x0, square.y0, square.side, n, &factors);
+  if (square.x0 == 0 && square.y0 == 0 && square.side == 1 &&
+      HasQuadraticGridFactors(*model_, kind_)) {
+    // A leaf's own table: its axes' integrals are every leaf's.
+    const AxisFactors& axis = unit_axes_[levels];
+    QuadraticGridFactors(*model_, axis, axis, &factors);
+  } else {
+    ComputeGridFactors(*model_, kind_, grid_, square.x0, square.y0, square.side, n, &factors);
+  }
   const Curve::Child* order = curve_.CellsInOrder(square.state, levels);
   SizeBounds(bounds, cells, kScanWidth);
   // Running sums in curve order of the cells' integrals (GridFactors;

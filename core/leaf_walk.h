@@ -207,6 +207,7 @@ class LeafWalk {
   std::vector<double> t_;                           // each sample's fraction of the leaf's mass
   std::vector<std::vector<double>> tables_;         // cell bounds, one table per recursion level
   std::vector<GridFactors> factors_;                // their cell integrals, as factors
+  std::vector<AxisFactors> unit_axes_;              // [levels]: a leaf's own table's axes
   std::vector<double> cell_us_, cell_vs_, cell_m_;  // an exact table's centres and densities
   std::vector<Square> reached_;                     // the squares samples end in
   std::vector<Frame> frames_;                       // their leaves
