@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/superellipsoid_internal.h"
 #include "core/vector_math.h"
 
 namespace sfc {
@@ -373,10 +374,31 @@ PowTrig SignedPowOf(double c, double dc, double e, int order) {
 
 class Superellipsoid final : public Surface {
  public:
-  // Point's operations in chunks: the angles' sin and cos, then the four
-  // powers of each point, in batch calls of the vector path (the same bits).
+  // On the AVX2 and AVX-512F paths, whole blocks of points in vectors
+  // (core/superellipsoid_lanes.h); on the others, and for a tail or a block
+  // with parameters outside [0, 1], PointsInChunks. The same bits.
   void Points(const double* u, const double* v, size_t n, double* x, double* y,
               double* z) const override {
+    static const math::VectorPath path = math::BestVectorPath();
+    const superellipsoid_internal::Shape shape{e_, reparam_};
+    constexpr size_t kBlock = superellipsoid_internal::kBlock;
+    size_t i = 0;
+    while (path == math::VectorPath::kAvx512 || path == math::VectorPath::kAvx2) {
+      i += path == math::VectorPath::kAvx512
+               ? superellipsoid_internal::PointsAvx512(shape, u + i, v + i, n - i, x + i, y + i,
+                                                       z + i)
+               : superellipsoid_internal::PointsAvx2(shape, u + i, v + i, n - i, x + i, y + i,
+                                                     z + i);
+      if (n - i < kBlock) break;
+      PointsInChunks(u + i, v + i, kBlock, x + i, y + i, z + i);  // a parameter outside [0, 1]
+      i += kBlock;
+    }
+    PointsInChunks(u + i, v + i, n - i, x + i, y + i, z + i);
+  }
+  // Point's operations in chunks: the angles' sin and cos, then the four
+  // powers of each point, in batch calls of the vector path (the same bits).
+  void PointsInChunks(const double* u, const double* v, size_t n, double* x, double* y,
+                      double* z) const {
     constexpr size_t kChunk = 256;
     int quarter[2 * kChunk];
     double offset[2 * kChunk], s[2 * kChunk], c[2 * kChunk], base[4 * kChunk], g[4 * kChunk];

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <type_traits>
 
 namespace sfc {
 namespace {
@@ -84,9 +86,99 @@ double ModelIntegral(const LeafModel& model, LeafModel::Kind kind, int grid, dou
   return sum;
 }
 
+namespace {
+
+// Two lanes of doubles (the baseline's SSE2 register): each lane does the
+// scalar code's IEEE operations (no contraction: -ffp-contract=off).
+typedef double Pair __attribute__((vector_size(16)));
+Pair Load(const double* p) {
+  Pair r;
+  std::memcpy(&r, p, sizeof r);
+  return r;
+}
+void Store(Pair x, double* p) { std::memcpy(p, &x, sizeof x); }
+
+// BasisIntegrals(a, b, ...) into out[0][k], out[1][k], out[2][k]; with T =
+// Pair, for two intervals at once (out[.][k], out[.][k + 1]); the same bits.
+template <typename T>
+void BasisIntegralsAt(T a, T b, double (*out)[kMaxGridCells], int k) {
+  using leaf_model_internal::kBasisTable;
+  const T d = b - a, mid = (a + b) / 2, d3 = d * d * d / 12;
+  for (int i = 0; i < 3; ++i) {
+    const double* c = kBasisTable.k[i];
+    const T value = d * (c[0] + mid * (c[1] + mid * c[2])) + c[2] * d3;
+    if constexpr (std::is_same_v<T, Pair>) {
+      Store(value, &out[i][k]);
+    } else {
+      out[i][k] = value;
+    }
+  }
+}
+
+// The integrals along one axis over the cells [o + k step, o + (k + 1) step]
+// into full[.][k] and over their lower halves into low[.][k], k < n.
+void AxisIntegrals(double o, double step, int n, double (*full)[kMaxGridCells],
+                   double (*low)[kMaxGridCells]) {
+  int k = 0;
+  for (; k + 2 <= n; k += 2) {
+    const Pair a = {o + k * step, o + (k + 1) * step};
+    BasisIntegralsAt(a, Pair{o + (k + 1) * step, o + (k + 2) * step}, full, k);
+    BasisIntegralsAt(a, Pair{o + (k + 0.5) * step, o + (k + 1 + 0.5) * step}, low, k);
+  }
+  for (; k < n; ++k) {
+    const double a = o + k * step;
+    BasisIntegralsAt(a, o + (k + 1) * step, full, k);
+    BasisIntegralsAt(a, o + (k + 0.5) * step, low, k);
+  }
+}
+
+}  // namespace
+
+void ComputeAxisFactors(double origin, double side, int n, AxisFactors* out) {
+  out->n = n;
+  AxisIntegrals(origin, side / n, n, out->full, out->low);
+  if (n % 2 != 0) {  // QuadraticGridFactors takes rows in pairs: the last one's partner
+    for (int b = 0; b < 3; ++b) out->full[b][n] = out->low[b][n] = 0;
+  }
+}
+
+bool HasQuadraticGridFactors(const LeafModel& model, LeafModel::Kind kind) {
+  return kind == LeafModel::Kind::kQuadratic && !(model.warp[0].power < 1) &&
+         !(model.warp[1].power < 1);
+}
+
+void QuadraticGridFactors(const LeafModel& model, const AxisFactors& x, const AxisFactors& y,
+                          GridFactors* out) {
+  const int n = x.n;
+  out->factors = 3;
+  out->halves[0] = out->halves[1] = true;
+  for (int b = 0; b < 3; ++b) {
+    std::copy(x.full[b], x.full[b] + n, out->x[b]);
+    std::copy(x.low[b], x.low[b] + n, out->x_low[b]);
+  }
+  for (int a = 0; a < 3; ++a) {
+    const double c0 = model.c[3 * a], c1 = model.c[3 * a + 1], c2 = model.c[3 * a + 2];
+    for (int j = 0; j < n; j += 2) {
+      Pair sum = {0, 0}, sum_low = {0, 0};
+      sum += c0 * Load(&y.full[0][j]), sum_low += c0 * Load(&y.low[0][j]);
+      sum += c1 * Load(&y.full[1][j]), sum_low += c1 * Load(&y.low[1][j]);
+      sum += c2 * Load(&y.full[2][j]), sum_low += c2 * Load(&y.low[2][j]);
+      out->row[a][j] = sum[0], out->row_low[a][j] = sum_low[0];
+      if (j + 1 < n) out->row[a][j + 1] = sum[1], out->row_low[a][j + 1] = sum_low[1];
+    }
+  }
+}
+
 void ComputeGridFactors(const LeafModel& model, LeafModel::Kind kind, int grid, double x0,
                         double y0, double side, int n, GridFactors* out) {
   const bool quadratic = kind == LeafModel::Kind::kQuadratic;
+  if (HasQuadraticGridFactors(model, kind)) {
+    AxisFactors x, y;
+    ComputeAxisFactors(x0, side, n, &x);
+    ComputeAxisFactors(y0, side, n, &y);
+    QuadraticGridFactors(model, x, y, out);
+    return;
+  }
   const int factors = quadratic ? 3 : grid;
   out->factors = factors;
   const double step = side / n;

@@ -229,6 +229,26 @@ struct GridFactors {
 void ComputeGridFactors(const LeafModel& model, LeafModel::Kind kind, int grid, double x0,
                         double y0, double side, int n, GridFactors* out);
 
+// ComputeGridFactors in two steps where the model is a quadratic with no
+// power law below 1 (HasQuadraticGridFactors): the 1D integrals of the three
+// basis functions along each axis (the same for every such model, so a
+// caller may keep those of a square it meets often, such as a leaf's own),
+// then the model's combination of them. The same bits.
+struct AxisFactors {
+  int n;
+  double full[3][kMaxGridCells];  // full[b][k]: basis b's integral over cell k of n
+  double low[3][kMaxGridCells];   // the same over its lower half
+};
+// The integrals over the n cells of [origin, origin + side] and their
+// lower halves. REQUIRES: 1 <= n <= kMaxGridCells.
+void ComputeAxisFactors(double origin, double side, int n, AxisFactors* out);
+bool HasQuadraticGridFactors(const LeafModel& model, LeafModel::Kind kind);
+// ComputeGridFactors(model, kQuadratic, ., x0, y0, side, n, out) from x and
+// y, ComputeAxisFactors of (x0, side, n) and (y0, side, n).
+// REQUIRES: HasQuadraticGridFactors(model, kQuadratic).
+void QuadraticGridFactors(const LeafModel& model, const AxisFactors& x, const AxisFactors& y,
+                          GridFactors* out);
+
 // The quadratic through unnormalised node values at (x, y) of the leaf's own
 // coordinates (no warp); also outside the nodes, as an extrapolation.
 inline double QuadraticAt(const double values[9], double x, double y) {

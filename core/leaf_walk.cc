@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "core/area_estimator.h"
@@ -12,6 +13,10 @@
 namespace sfc {
 
 namespace {
+
+// Two lanes (the baseline's SSE2 registers).
+typedef double Pair __attribute__((vector_size(16)));
+typedef int64_t Ints __attribute__((vector_size(16)));
 
 // Below this mass a cell is placed uniformly: FollowSlope squares p.
 constexpr double kLeastSlopedMass = 1e-150;
@@ -56,6 +61,10 @@ LeafWalk::LeafWalk(const CurveTree& tree, const Surface& surface, const Density&
   int exponent;
   cells_power_of_two_ = std::frexp(continuation_cells_, &exponent) == 0.5;
   tables_.resize(kMaxModelLevels + 1);
+  unit_axes_.resize(curve_.table_levels() + 1);
+  for (int levels = 1; levels <= curve_.table_levels(); ++levels) {
+    ComputeAxisFactors(0, 1, static_cast<int>(curve_.PowG(levels)), &unit_axes_[levels]);
+  }
   factors_.resize(kMaxModelLevels + 1);
   last_positive_leaf_ = tree.leaf_count() - 1;
   while (last_positive_leaf_ > 0 &&
@@ -116,7 +125,14 @@ int LeafWalk::Tabulate(const Square& square, int levels, std::vector<double>& bo
                        GridFactors& factors) {
   const int n = static_cast<int>(curve_.PowG(levels));
   const int cells = n * n;
-  ComputeGridFactors(*model_, kind_, grid_, square.x0, square.y0, square.side, n, &factors);
+  if (square.x0 == 0 && square.y0 == 0 && square.side == 1 &&
+      HasQuadraticGridFactors(*model_, kind_)) {
+    // A leaf's own table: its axes' integrals are every leaf's.
+    const AxisFactors& axis = unit_axes_[levels];
+    QuadraticGridFactors(*model_, axis, axis, &factors);
+  } else {
+    ComputeGridFactors(*model_, kind_, grid_, square.x0, square.y0, square.side, n, &factors);
+  }
   const Curve::Child* order = curve_.CellsInOrder(square.state, levels);
   SizeBounds(bounds, cells, kScanWidth);
   // Running sums in curve order of the cells' integrals (GridFactors;
@@ -166,15 +182,17 @@ int LeafWalk::TabulateExact(const Square& leaf, int levels, std::vector<double>&
 
 void LeafWalk::Place(const double* m, size_t n, double* u, double* v, double* curve_position) {
   u_ = u, v_ = v, curve_position_ = curve_position;
-  t_.resize(n), reached_of_.resize(n);
-  reached_.clear(), frames_.clear();
+  // kScanWidth entries past the run: PrefixBelow and Reached read and write
+  // whole windows.
+  t_.resize(n + kScanWidth), reached_of_.resize(n + kScanWidth);
+  reached_.clear(), frames_.clear(), warped_runs_.clear();
   // Samples [waiting, i) have their squares and wait for Continue, up to
-  // kContinueBatch of them; a warped leaf's are continued at once (its
-  // warp is the current leaf's).
+  // kContinueBatch of them, warped leaves' among them (each leaf's warp is
+  // in its frame).
   size_t waiting = 0;
-  const auto flush = [&](size_t end, bool warped) {
-    Continue(waiting, end, warped);
-    reached_.clear(), frames_.clear();
+  const auto flush = [&](size_t end) {
+    Continue(waiting, end);
+    reached_.clear(), frames_.clear(), warped_runs_.clear();
     waiting = end;
   };
   size_t i = 0;
@@ -185,17 +203,12 @@ void LeafWalk::Place(const double* m, size_t n, double* u, double* v, double* cu
     // m < S_l alone puts a sample here.
     size_t j = i + 1;
     while (j < n && m[j] >= m[j - 1] && (m[j] < end_mass_ || LeafFor(m[j]) == l)) ++j;
-    if (warped_) {
-      flush(i, false);
-      PlaceInLeaf(m + i, i, j - i);
-      flush(j, true);
-    } else {
-      PlaceInLeaf(m + i, i, j - i);
-      if (j - waiting >= kContinueBatch) flush(j, false);
-    }
+    PlaceInLeaf(m + i, i, j - i);
+    if (warped_) warped_runs_.push_back({i, j, static_cast<uint32_t>(frames_.size() - 1)});
+    if (j - waiting >= kContinueBatch) flush(j);
     i = j;
   }
-  flush(n, false);
+  flush(n);
 }
 
 void LeafWalk::PlaceInLeaf(const double* m, size_t begin, size_t n) {
@@ -203,12 +216,16 @@ void LeafWalk::PlaceInLeaf(const double* m, size_t begin, size_t n) {
     t_[begin + i] = std::clamp((m[i] - begin_mass_) / leaf_mass_, 0.0, 1.0);
   }
   const uint32_t frame = static_cast<uint32_t>(frames_.size());
-  frames_.push_back({cell_.u0, cell_.v0, cell_.size, leaf_start_, leaf_span_});
+  Frame leaf_frame{cell_.u0, cell_.v0, cell_.size, leaf_start_, leaf_span_, warped_, {}, {}};
+  leaf_frame.warp[0] = model_->warp[0], leaf_frame.warp[1] = model_->warp[1];
+  leaf_frame.split[0] = split_[0], leaf_frame.split[1] = split_[1];
+  frames_.push_back(leaf_frame);
   const Square leaf{0, 1, 0, 0, 1, 0, 1, 1, 0, 0, cell_.state, 0, frame};
   PlaceInSquare(leaf, static_cast<uint32_t>(begin), static_cast<uint32_t>(begin + n), 0);
 }
 
-int LeafWalk::CellsAtOrBelow(const double* bounds, int from, double t) {
+__attribute__((always_inline)) inline int LeafWalk::CellsAtOrBelow(const double* bounds, int from,
+                                                                   double t) {
   // A window of kScanWidth comparisons at a time, without branches inside:
   // the count of bounds <= t there is how far to move (they do not decrease).
   while (true) {
@@ -219,10 +236,26 @@ int LeafWalk::CellsAtOrBelow(const double* bounds, int from, double t) {
   }
 }
 
+__attribute__((always_inline)) inline uint32_t LeafWalk::PrefixBelow(const double* t,
+                                                                     uint32_t begin, uint32_t end,
+                                                                     double bound) {
+  // As CellsAtOrBelow: a window at a time, without branches inside.
+  while (true) {
+    int count = 0;
+    for (int d = 0; d < kScanWidth; ++d) count += (begin + d < end) & (t[begin + d] < bound);
+    begin += count;
+    if (count < kScanWidth) return begin;
+  }
+}
+
 void LeafWalk::Reached(const Square& square, uint32_t begin, uint32_t end) {
   const uint32_t index = static_cast<uint32_t>(reached_.size());
   reached_.push_back(square);
-  for (uint32_t i = begin; i < end; ++i) reached_of_[i] = index;
+  // Whole windows: the entries written past `end` are later samples', which
+  // get theirs later in the walk (samples reach their squares in order).
+  for (uint32_t i = begin; i < end; i += kScanWidth) {
+    for (int d = 0; d < kScanWidth; ++d) reached_of_[i + d] = index;
+  }
 }
 
 void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end, int level) {
@@ -245,19 +278,9 @@ void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end,
   const Curve::Child* order = curve_.CellsInOrder(square.state, levels);
   const double side = square.side / curve_.PowG(levels);
   const double span = square.span / static_cast<double>(curve_.PowW(levels));
-  // Samples in t order meet the cells in curve order: t goes to the first
-  // cell whose bound is above it (that cell has mass), and t >= t1 to the last.
-  int first = 0;  // bounds below first are <= every t from here on
-  uint32_t i = begin;
-  while (i < end) {
-    first = CellsAtOrBelow(bounds.data(), first, t_[i]);
-    const int k = std::min(first, last);
-    uint32_t j = i + 1;
-    if (k == last) {
-      j = end;
-    } else {
-      while (j < end && t_[j] < bounds[k]) ++j;
-    }
+  // Cell k takes samples [i, j) of the square (k's bound is above their t,
+  // and the earlier cells' bounds are not).
+  const auto place = [&](int k, uint32_t i, uint32_t j) {
     Square cell;
     cell.t0 = k == 0 ? square.t0 : bounds[k - 1], cell.t1 = bounds[k];
     cell.x0 = square.x0 + order[k].dx * side, cell.y0 = square.y0 + order[k].dy * side;
@@ -279,11 +302,51 @@ void LeafWalk::PlaceInSquare(const Square& square, uint32_t begin, uint32_t end,
       }
       Reached(cell, i, j);
     }
+  };
+  // Samples in t order meet the cells in curve order: t goes to the first
+  // cell whose bound is above it (that cell has mass), and t >= t1 to the
+  // last. So the cells before the last hold the samples whose t is below
+  // their bound, the last one the rest.
+  if (end - begin <= static_cast<uint32_t>(kScanWidth) && last < kSmallTableCells) {
+    // A few samples in a small table: each cell's end counted on its own,
+    // with no chain from one cell's samples to the next cell's.
+    // The samples' t in pairs (SSE2 registers), +inf past the square's end.
+    constexpr int kPairs = kScanWidth / 2;
+    Pair t[kPairs];
+    const int64_t count = end - begin;
+    for (int d = 0; d < kPairs; ++d) {
+      Pair pair;
+      std::memcpy(&pair, &t_[begin + 2 * d], sizeof pair);
+      const Ints inside = Ints{2 * d, 2 * d + 1} < count;
+      t[d] = inside ? pair : Pair{} + std::numeric_limits<double>::infinity();
+    }
+    uint32_t ends[kSmallTableCells];
+    for (int k = 0; k < last; ++k) {
+      Ints below{};  // -1 for each t below the bound
+      for (int d = 0; d < kPairs; ++d) below += t[d] < bounds[k];
+      ends[k] = begin + static_cast<uint32_t>(-(below[0] + below[1]));
+    }
+    uint32_t i = begin;
+    for (int k = 0; k <= last && i < end; ++k) {
+      const uint32_t j = k == last ? end : ends[k];
+      if (j > i) place(k, i, j);
+      i = std::max(i, j);
+    }
+    return;
+  }
+  int first = 0;  // bounds below first are <= every t from here on
+  uint32_t i = begin;
+  while (i < end) {
+    first = CellsAtOrBelow(bounds.data(), first, t_[i]);
+    const int k = std::min(first, last);
+    // Sample i is below bounds[k] unless k is the last cell, which takes the rest.
+    const uint32_t j = k == last ? end : PrefixBelow(t_.data(), i + 1, end, bounds[k]);
+    place(k, i, j);
     i = j;
   }
 }
 
-void LeafWalk::Continue(size_t begin, size_t end, bool warped) {
+void LeafWalk::Continue(size_t begin, size_t end) {
   // The rest of t down its square's own curve, to the centre of the cell
   // reached: the curve digits of all n samples first, then one batch of
   // curve decoding, then the coordinates. Arrays of the batch are indexed
@@ -324,7 +387,7 @@ void LeafWalk::Continue(size_t begin, size_t end, bool warped) {
   for (size_t i = 0; i < n; ++i) {
     const Square& at = reached_[square_of[i]];
     const Frame& leaf = frames_[at.frame];
-    if (!warped) {
+    if (!leaf.warped) {
       const double px = at.x0 + fx_[i] * at.side, py = at.y0 + fy_[i] * at.side;
       u_[begin + i] = leaf.u0 + px * leaf.size;
       v_[begin + i] = leaf.v0 + py * leaf.size;
@@ -335,17 +398,21 @@ void LeafWalk::Continue(size_t begin, size_t end, bool warped) {
           CurvePosition(leaf.start + pos * leaf.span, static_cast<double>(curve_.Span(0)));
     }
   }
-  if (!warped) return;
-  PlaceWarped(0, begin, n, fx_.data(), u_ + begin);
-  PlaceWarped(1, begin, n, fy_.data(), v_ + begin);
+  for (const WarpedRun& run : warped_runs_) {
+    const Frame& leaf = frames_[run.frame];
+    const size_t at = run.begin - begin, count = run.end - run.begin;
+    PlaceWarped(leaf, 0, run.begin, count, fx_.data() + at, u_ + run.begin);
+    PlaceWarped(leaf, 1, run.begin, count, fy_.data() + at, v_ + run.begin);
+  }
 }
 
-void LeafWalk::PlaceWarped(int axis, size_t begin, size_t n, const double* f, double* out) {
+void LeafWalk::PlaceWarped(const Frame& leaf, int axis, size_t begin, size_t n, const double* f,
+                           double* out) {
   // Warp's and Unwarp's operations in order, their powers taken in batch
   // calls (the same bits as the one-value functions).
-  const AxisWarp& w = model_->warp[axis];
-  const double sc = split_[axis], k = w.power;
-  const double origin = axis == 0 ? cell_.u0 : cell_.v0;
+  const AxisWarp& w = leaf.warp[axis];
+  const double sc = leaf.split[axis], k = w.power;
+  const double origin = axis == 0 ? leaf.u0 : leaf.v0;
   auto square = [&](size_t i) -> const Square& { return reached_[reached_of_[begin + i]]; };
   auto lower = [&](size_t i) { return axis == 0 ? square(i).x0 : square(i).y0; };
   base_.resize(2 * n), power_.resize(2 * n), place_.resize(n);
@@ -383,7 +450,7 @@ void LeafWalk::PlaceWarped(int axis, size_t begin, size_t n, const double* f, do
       s[i] = std::clamp(WarpFrom(w, sc, s[i], power[i]), x0, x0 + square(i).side);
     }
   }
-  for (size_t i = 0; i < n; ++i) out[i] = origin + s[i] * cell_.size;
+  for (size_t i = 0; i < n; ++i) out[i] = origin + s[i] * leaf.size;
 }
 
 }  // namespace sfc

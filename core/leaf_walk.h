@@ -108,23 +108,33 @@ class LeafWalk {
     int depth;
     uint32_t frame;
   };
-  // Where a leaf's unit square lies in the surface's parameters, and its
-  // span along the curve: what Continue reads of a leaf whose samples it
-  // places after the walk has left it.
+  // Where a leaf's unit square lies in the surface's parameters, its span
+  // along the curve, and its model's warp (with WarpSplit of each axis's,
+  // when warped): what Continue reads of a leaf whose samples it places
+  // after the walk has left it.
   struct Frame {
     double u0, v0, size, start, span;
+    bool warped;
+    AxisWarp warp[2];
+    double split[2];
+  };
+  // Samples [begin, end) of the run, all of the warped leaf frames_[frame].
+  struct WarpedRun {
+    size_t begin, end;
+    uint32_t frame;
   };
   // Leaves with fewer samples than this wait for the next leaves' and have
   // their curve bits followed in one batch (Continue): the batch calls are
   // vectorised, and a leaf of a dozen samples filled few lanes.
   static constexpr size_t kContinueBatch = 1024;
 
-  // The run's samples [begin, begin + n), in the current leaf, whose model is
+  // The run's samples [begin, begin + n), in the leaf `leaf`, whose model is
   // warped along `axis` (0: u, 1: v): out[i] gets the parameter of the point
   // at fraction f[i] of the cell [x0, x0 + side] sample begin + i reached
   // along that axis: W of it where the curve descended in warped coordinates
   // (DescendsWarped), else uniform in warped coordinates inside the cell.
-  void PlaceWarped(int axis, size_t begin, size_t n, const double* f, double* out);
+  void PlaceWarped(const Frame& leaf, int axis, size_t begin, size_t n, const double* f,
+                   double* out);
   // The leaf holding m: a forward step from the current one, else a search.
   size_t LeafFor(double m) const;
   // Makes l the current leaf.
@@ -147,16 +157,23 @@ class LeafWalk {
   void PlaceInSquare(const Square& square, uint32_t begin, uint32_t end, int level);
   // Bounds compared at once when matching samples to cells.
   static constexpr int kScanWidth = 16;
+  // A table of fewer cells than this with at most kScanWidth samples has
+  // each cell's samples counted on its own.
+  static constexpr int kSmallTableCells = 64;
   // The number of entries of `bounds` that are <= t, counted from `from`,
   // where every entry before `from` is (bounds do not decrease and end in
   // kScanWidth entries of +inf).
   static int CellsAtOrBelow(const double* bounds, int from, double t);
+  // The first of samples [begin, end) whose t is at least `bound`, or end:
+  // their t do not decrease. Reads t[begin .. end + kScanWidth) in whole
+  // windows.
+  static uint32_t PrefixBelow(const double* t, uint32_t begin, uint32_t end, double bound);
   // Records that samples [begin, end) end in `square` (pure curve bits from there).
   void Reached(const Square& square, uint32_t begin, uint32_t end);
   // Places samples [begin, end) of the run by pure curve bits inside the
-  // squares they reached; `warped`: they are the current leaf's, and its
-  // model is warped.
-  void Continue(size_t begin, size_t end, bool warped);
+  // squares they reached (those of warped leaves, warped_runs_, through
+  // their warps).
+  void Continue(size_t begin, size_t end);
   // Finds the squares of the run's samples [begin, begin + n), the current
   // leaf's, with non-decreasing m (Continue places them).
   void PlaceInLeaf(const double* m, size_t begin, size_t n);
@@ -182,17 +199,19 @@ class LeafWalk {
   double leaf_start_ = 0, leaf_span_ = 0;  // curve indices, for curve_position
   const LeafModel* model_ = nullptr;
   LeafModel::Kind kind_ = LeafModel::Kind::kQuadratic;
-  bool warped_ = false;  // the model has a power law (LeafModel::warp)
+  bool warped_ = false;   // the model has a power law (LeafModel::warp)
   double split_[2] = {};  // WarpSplit of each axis's warp, when warped_
-  bool exact_ = false;   // the first table follows the true mass density (kExactCells)
+  bool exact_ = false;    // the first table follows the true mass density (kExactCells)
   // Scratch of a Place call (indexed by the run's samples), kept to reuse its
   // memory.
   std::vector<double> t_;                           // each sample's fraction of the leaf's mass
   std::vector<std::vector<double>> tables_;         // cell bounds, one table per recursion level
   std::vector<GridFactors> factors_;                // their cell integrals, as factors
+  std::vector<AxisFactors> unit_axes_;              // [levels]: a leaf's own table's axes
   std::vector<double> cell_us_, cell_vs_, cell_m_;  // an exact table's centres and densities
   std::vector<Square> reached_;                     // the squares samples end in
   std::vector<Frame> frames_;                       // their leaves
+  std::vector<WarpedRun> warped_runs_;              // the samples of warped leaves among them
   std::vector<uint32_t> reached_of_;                // each sample's square in reached_
   std::vector<double> fraction_;                    // each sample's fraction of its square's t
   std::vector<uint64_t> digits_, cx_, cy_;          // its curve digits and the cell they reach

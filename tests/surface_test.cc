@@ -4,9 +4,12 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <random>
 #include <vector>
 
 #include "core/builtin_surfaces.h"
+#include "core/superellipsoid_internal.h"
+#include "core/vector_math.h"
 #include "gtest/gtest.h"
 
 namespace sfc {
@@ -128,6 +131,68 @@ TEST(BuiltinSurfaces, PointsIsPointBitForBit) {
       const Vec3 p = surface->Point(u[i], v[i]);
       const double got[3] = {x[i], y[i], z[i]}, want[3] = {p.x, p.y, p.z};
       ASSERT_EQ(std::memcmp(got, want, sizeof(got)), 0) << "at (" << u[i] << ", " << v[i] << ")";
+    }
+  }
+}
+
+// The superellipsoid's vector kernels (AVX2, AVX-512F: those this CPU runs)
+// are Point bit for bit: every shape's branches (the cube root and Pow,
+// plain and reparameterised angles), random parameters and those on and
+// beside the quarter turns (the angles' pieces and roundings, the singular
+// lines, -0); a block with a parameter outside [0, 1] stops the kernel
+// there, and the batch call still gives Point's bits for it.
+TEST(BuiltinSurfaces, SuperellipsoidVectorKernelsArePointBitForBit) {
+  using superellipsoid_internal::Shape;
+  std::vector<double> u, v;
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> unit(0, 1);
+  std::vector<double> special = {0.0, -0.0, 1.0, math::kBelowOne};
+  for (int k = 1; k < 16; ++k) {
+    const double at = k / 16.0;
+    special.insert(special.end(), {at, std::nextafter(at, 0.0), std::nextafter(at, 1.0)});
+  }
+  for (double a : special) {
+    for (double b : special) u.push_back(a), v.push_back(b);
+  }
+  for (int i = 0; i < 4000; ++i) u.push_back(unit(random)), v.push_back(unit(random));
+  constexpr size_t kBlock = superellipsoid_internal::kBlock;
+  u.resize(u.size() / kBlock * kBlock), v.resize(u.size());
+  const size_t n = u.size();
+  struct Kernel {
+    math::VectorPath path;
+    size_t (*points)(Shape, const double*, const double*, size_t, double*, double*, double*);
+  };
+  const Kernel kernels[] = {{math::VectorPath::kAvx2, superellipsoid_internal::PointsAvx2},
+                            {math::VectorPath::kAvx512, superellipsoid_internal::PointsAvx512}};
+  for (const Shape shape : {Shape{1.0 / 3, false}, Shape{1.0 / 3, true}, Shape{0.25, false},
+                            Shape{0.5, true}, Shape{1, false}, Shape{3, true}}) {
+    const auto surface = MakeSuperellipsoid(shape.e, shape.reparam);
+    for (const Kernel& kernel : kernels) {
+      if (!math::Runs(kernel.path)) continue;
+      std::vector<double> x(n), y(n), z(n);
+      ASSERT_EQ(kernel.points(shape, u.data(), v.data(), n, x.data(), y.data(), z.data()), n);
+      for (size_t i = 0; i < n; ++i) {
+        const Vec3 p = surface->Point(u[i], v[i]);
+        const double got[3] = {x[i], y[i], z[i]}, want[3] = {p.x, p.y, p.z};
+        ASSERT_EQ(std::memcmp(got, want, sizeof(got)), 0)
+            << math::VectorPathName(kernel.path) << " e = " << shape.e << " reparam "
+            << shape.reparam << " at (" << u[i] << ", " << v[i] << ")";
+      }
+      // A parameter outside [0, 1] in point 200: the kernel stops at its block.
+      std::vector<double> w = v;
+      w[200] = 1.5;
+      EXPECT_EQ(kernel.points(shape, u.data(), w.data(), n, x.data(), y.data(), z.data()),
+                200 / kBlock * kBlock);
+    }
+    // The batch call with parameters outside [0, 1] here and there.
+    std::vector<double> w = u;
+    for (size_t i = 5; i < n; i += 97) w[i] = i % 2 ? -0.25 : 1.75;
+    std::vector<double> x(n), y(n), z(n);
+    surface->Points(w.data(), v.data(), n, x.data(), y.data(), z.data());
+    for (size_t i = 0; i < n; ++i) {
+      const Vec3 p = surface->Point(w[i], v[i]);
+      const double got[3] = {x[i], y[i], z[i]}, want[3] = {p.x, p.y, p.z};
+      ASSERT_EQ(std::memcmp(got, want, sizeof(got)), 0) << "at (" << w[i] << ", " << v[i] << ")";
     }
   }
 }
