@@ -296,6 +296,7 @@ void FaceSurface::JetGrid(const double* us, int nu, const double* vs, int nv, in
     }
     return;
   }
+  if (FactoredGrid(us, nu, vs, nv, order, out)) return;
   // The cosines and sines once a row and once a column, not once a point,
   // all in one batch (ClosedForm::TrigsOf: the same bits as TrigU and
   // TrigV). The tree build asks for 3 x 3 grids: no allocation for those.
@@ -316,6 +317,64 @@ void FaceSurface::JetGrid(const double* us, int nu, const double* vs, int nv, in
       ClosedJet(a[i], a[nu + j], t[i], t[nu + j], order, &out[i * nv + j]);
     }
   }
+}
+
+bool FaceSurface::FactoredGrid(const double* us, int nu, const double* vs, int nv, int order,
+                               SurfaceJet* out) const {
+  const ClosedForm& f = *closed_;
+  const bool plane = f.type == ClosedForm::Type::kPlane;
+  if ((!plane && f.type != ClosedForm::Type::kCylinder) || nu > kFactoredSide ||
+      nv > kFactoredSide) {
+    return false;
+  }
+  const double su = map_.DuDs(), sv = map_.DvDt();
+  // A row's part of the point (a plane's u x, a cylinder's a1 x + a2 y) and
+  // its derivatives, and a column's v y or v z: EvaluateWith's terms, each
+  // computed once, then added in its order. Plain arrays: arrays of Vec3
+  // would be zeroed first (a `rep stos` as costly as the rest).
+  double row[kFactoredSide][3], fu[kFactoredSide][3], fuu[kFactoredSide][3];
+  double native[kFactoredSide] = {};
+  ClosedForm::Trig trig[kFactoredSide];
+  for (int i = 0; i < nu; ++i) native[i] = map_.U(us[i]);
+  if (!plane) ClosedForm::TrigsOf(native, nu, trig);
+  for (int i = 0; i < nu; ++i) {
+    if (plane) {
+      for (int k = 0; k < 3; ++k) {
+        row[i][k] = native[i] * f.x[k];
+        fu[i][k] = f.x[k] * su;
+        fuu[i][k] = 0.0 * (su * su);
+      }
+      continue;
+    }
+    const double a1 = f.radius * trig[i].cos, a2 = f.radius * trig[i].sin;
+    for (int k = 0; k < 3; ++k) {
+      const double som = a1 * f.x[k] + a2 * f.y[k];
+      row[i][k] = som;
+      fu[i][k] = (-a2 * f.x[k] + a1 * f.y[k]) * su;
+      fuu[i][k] = -som * (su * su);
+    }
+  }
+  const double* across = plane ? f.y : f.z;
+  const Vec3 fv{across[0] * sv, across[1] * sv, across[2] * sv};
+  const double uv = 0.0 * (su * sv), vv = 0.0 * (sv * sv);
+  const Vec3 fuv{uv, uv, uv}, fvv{vv, vv, vv};
+  for (int j = 0; j < nv; ++j) {
+    const double v = map_.V(vs[j]);
+    const double col[3] = {v * across[0], v * across[1], v * across[2]};
+    for (int i = 0; i < nu; ++i) {
+      SurfaceJet& jet = out[i * nv + j];
+      jet.p = Vec3{row[i][0] + col[0] + f.o[0], row[i][1] + col[1] + f.o[1],
+                   row[i][2] + col[2] + f.o[2]};
+      jet.fu = Vec3{fu[i][0], fu[i][1], fu[i][2]};
+      jet.fv = fv;
+      if (order >= 2) {
+        jet.fuu = Vec3{fuu[i][0], fuu[i][1], fuu[i][2]}, jet.fuv = fuv, jet.fvv = fvv;
+      } else {
+        jet.fuu = jet.fuv = jet.fvv = Vec3{};
+      }
+    }
+  }
+  return true;
 }
 
 void FaceSurface::Points(const double* u, const double* v, size_t n, double* x, double* y,
@@ -571,9 +630,17 @@ void FaceTrim::BuildFineGrid(int i, int j) const {
   });
 }
 
-bool FaceTrim::Contains(double s, double t) const {
-  if (!trimmed_) return true;
-  std::call_once(grid_once_, [this] { BuildGrid(); });
+inline void FaceTrim::EnsureGrid() const {
+  // The flag first: std::call_once writes thread-locals on every call, a
+  // cost the tree build's half a million Contains calls noticed.
+  if (grid_ready_.load(std::memory_order_acquire)) return;
+  std::call_once(grid_once_, [this] {
+    BuildGrid();
+    grid_ready_.store(true, std::memory_order_release);
+  });
+}
+
+inline CellState FaceTrim::GridState(double s, double t) const {
   // floor(2048 s) / 16 = floor(128 s): both scalings are exact.
   constexpr int kSide = kGridSide * kFineSide;
   const int fi = std::clamp(static_cast<int>(s * kSide), 0, kSide - 1);
@@ -584,11 +651,34 @@ bool FaceTrim::Contains(double s, double t) const {
     state = static_cast<CellState>(
         fine_[fine_at_[cell] + (fi % kFineSide) * kFineSide + fj % kFineSide]);
   }
-  switch (state) {
+  return state;
+}
+
+bool FaceTrim::Contains(double s, double t) const {
+  if (!trimmed_) return true;
+  EnsureGrid();
+  switch (GridState(s, t)) {
     case CellState::kInside: return true;
     case CellState::kOutside: return false;
     case CellState::kStraddles: break;
   }
+  return ContainsNearTrim(s, t);
+}
+
+void FaceTrim::ContainsMany(const double* s, const double* t, size_t n, uint8_t* inside) const {
+  if (!trimmed_) {
+    std::fill(inside, inside + n, uint8_t{1});
+    return;
+  }
+  EnsureGrid();
+  for (size_t i = 0; i < n; ++i) {
+    const CellState state = GridState(s[i], t[i]);
+    inside[i] = state == CellState::kStraddles ? ContainsNearTrim(s[i], t[i])
+                                               : state == CellState::kInside;
+  }
+}
+
+bool FaceTrim::ContainsNearTrim(double s, double t) const {
   if (exact_) {
     const LineCircleTrim::Side side = exact_->Classify(map_.U(s), map_.V(t));
     if (side != LineCircleTrim::Side::kUnsure) return side == LineCircleTrim::Side::kIn;

@@ -17,6 +17,7 @@
 #include <Geom2d_Curve.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <TopoDS_Face.hxx>
+#include <atomic>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -160,6 +161,14 @@ class FaceSurface final : public Surface {
   void ClosedJet(double u, double v, const ClosedForm::Trig& tu, const ClosedForm::Trig& tv,
                  int order, SurfaceJet* jet) const;
 
+  // JetGrid of a closed-form plane or cylinder of at most kFactoredSide rows
+  // and columns: each row's and column's terms of ClosedJet computed once and
+  // added per point in ClosedJet's order (the same bits). False, with
+  // nothing written, for any other face or grid.
+  bool FactoredGrid(const double* us, int nu, const double* vs, int nv, int order,
+                    SurfaceJet* out) const;
+  static constexpr int kFactoredSide = 9;
+
   // The native parameter intervals of the unit-square ones, by map_'s
   // operations on intervals.
   Interval NativeU(double u0, double u1) const;
@@ -201,6 +210,8 @@ class FaceTrim {
 
   bool trimmed() const { return trimmed_; }
   bool Contains(double s, double t) const;
+  // inside[i] = Contains(s[i], t[i]) for i < n, with one grid check for all.
+  void ContainsMany(const double* s, const double* t, size_t n, uint8_t* inside) const;
   CellState Classify(double s0, double s1, double t0, double t1) const;
   // A lower bound on the distance from (s, t) to every trim curve widened by
   // the kernel's ON band: every point closer than it to (s, t), joined to it
@@ -237,6 +248,13 @@ class FaceTrim {
 
  private:
   void BuildGrid() const;
+  // BuildGrid, once, before the grid is read.
+  void EnsureGrid() const;
+  // Contains' answer from the grid (and sub-cells), kStraddles where only the
+  // exact trim or the kernel can tell. REQUIRES: the grid built.
+  CellState GridState(double s, double t) const;
+  // Contains' answer for a point GridState leaves kStraddles.
+  bool ContainsNearTrim(double s, double t) const;
   void BuildFineGrid(int i, int j) const;
   CellState KernelState(double s, double t) const;
   // KernelState, compared with exact_'s answer (BuildGrid only): a
@@ -272,6 +290,7 @@ class FaceTrim {
   mutable std::optional<LineCircleTrim> exact_;
   mutable bool exact_agrees_ = true;  // written by BuildGrid only
   mutable std::once_flag grid_once_;
+  mutable std::atomic<bool> grid_ready_{false};  // set once grid_once_'s BuildGrid is done
   mutable std::vector<CellState> grid_;  // row s, column t; filled by BuildGrid
   // For grid cell k that the boundary may cross, fine_[fine_at_[k] + a *
   // kFineSide + b] is its sub-cell (a, b); fine_at_[k] = -1 otherwise.
