@@ -37,8 +37,9 @@ bool Intersects(const Box2& a, const Box2& b) {
 }
 
 // Gives every unmarked cell of a side x side grid (row-major) the state of
-// its piece, the unmarked cells joined to it by sides, which `classify(k)`
-// answers for the piece's first cell k; marked cells get kStraddles.
+// its piece, the unmarked cells joined to it by sides, which
+// `classify(k, piece)` answers for the piece's first cell k (and its cells,
+// `piece`); marked cells get kStraddles.
 template <typename State, typename Classify>
 void ClassifyPieces(const std::vector<char>& marked, int side, State* out,
                     const Classify& classify) {
@@ -59,7 +60,7 @@ void ClassifyPieces(const std::vector<char>& marked, int side, State* out,
         if (!marked[k] && !seen[k]) seen[k] = 1, piece.push_back(k);
       }
     }
-    const State state = static_cast<State>(classify(start));
+    const State state = static_cast<State>(classify(start, piece));
     for (int k : piece) out[k] = state;
   }
 }
@@ -573,7 +574,7 @@ void FaceTrim::BuildGrid() const {
     MarkBox({node.box.s0 - ms, node.box.s1 + ms, node.box.t0 - mt, node.box.t1 + mt}, 0, 0,
             1.0 / kGridSide, kGridSide, &marked);
   }
-  ClassifyPieces(marked, kGridSide, grid_.data(), [&](int k) {
+  ClassifyPieces(marked, kGridSide, grid_.data(), [&](int k, const std::vector<int>&) {
     return CheckedKernelState((k / kGridSide + 0.5) / kGridSide,
                               (k % kGridSide + 0.5) / kGridSide);
   });
@@ -588,14 +589,43 @@ void FaceTrim::BuildGrid() const {
 
 CellState FaceTrim::CheckedKernelState(double s, double t) const {
   const CellState state = KernelState(s, t);
-  if (exact_) {
-    const LineCircleTrim::Side side = exact_->Classify(map_.U(s), map_.V(t));
-    if (side != LineCircleTrim::Side::kUnsure &&
-        (side == LineCircleTrim::Side::kIn) != (state != CellState::kOutside)) {
-      exact_agrees_ = false;
+  CheckExact(s, t, state);
+  return state;
+}
+
+void FaceTrim::CheckExact(double s, double t, CellState state) const {
+  if (!exact_) return;
+  const LineCircleTrim::Side side = exact_->Classify(map_.U(s), map_.V(t));
+  if (side != LineCircleTrim::Side::kUnsure &&
+      (side == LineCircleTrim::Side::kIn) != (state != CellState::kOutside)) {
+    exact_agrees_ = false;
+  }
+}
+
+CellState FaceTrim::StateAcross(int i, int j, const std::vector<int>& piece) const {
+  CellState found = CellState::kStraddles;
+  for (int k : piece) {
+    const int a = k / kFineSide, c = k % kFineSide;
+    const int across[4][3] = {{a == 0, i - 1, j},
+                              {a == kFineSide - 1, i + 1, j},
+                              {c == 0, i, j - 1},
+                              {c == kFineSide - 1, i, j + 1}};
+    for (const auto& n : across) {
+      if (!n[0] || n[1] < 0 || n[1] >= kGridSide || n[2] < 0 || n[2] >= kGridSide) continue;
+      const int cell = n[1] * kGridSide + n[2];
+      CellState state = grid_[cell];
+      if (state == CellState::kStraddles && fine_at_[cell] >= 0) {
+        // A cell with sub-cells already classified: the sub-cell across.
+        const int sa = n[1] != i ? kFineSide - 1 - a : a, sc = n[2] != j ? kFineSide - 1 - c : c;
+        state = static_cast<CellState>(fine_[fine_at_[cell] + sa * kFineSide + sc]);
+      }
+      if (state == CellState::kStraddles) continue;
+      // Two answers that differ (a kernel wrong somewhere): ask it here.
+      if (found != CellState::kStraddles && state != found) return CellState::kStraddles;
+      found = state;
     }
   }
-  return state;
+  return found;
 }
 
 void FaceTrim::BuildFineGrid(int i, int j) const {
@@ -625,8 +655,18 @@ void FaceTrim::BuildFineGrid(int i, int j) const {
   const int32_t at = static_cast<int32_t>(fine_.size());
   fine_at_[i * kGridSide + j] = at;
   fine_.resize(fine_.size() + kCells, static_cast<uint8_t>(CellState::kStraddles));
-  ClassifyPieces(marked, kFineSide, fine_.data() + at, [&](int k) {
-    return CheckedKernelState(s0 + (k / kFineSide + 0.5) * w, t0 + (k % kFineSide + 0.5) * w);
+  // A piece with a sub-cell on the cell's side takes the state of the grid
+  // cell across that side, if that one is no curve's (the kernel classified
+  // its piece): no curve separates the two, and the kernel, asked here, would
+  // answer the same (the premise of pieces, kFineSide). The exact trim is
+  // checked against it as against a kernel answer. Pieces enclosed in the
+  // cell, or beside cells the trim may cross, ask the kernel.
+  ClassifyPieces(marked, kFineSide, fine_.data() + at, [&](int k, const std::vector<int>& piece) {
+    const double s = s0 + (k / kFineSide + 0.5) * w, t = t0 + (k % kFineSide + 0.5) * w;
+    const CellState across = StateAcross(i, j, piece);
+    if (across == CellState::kStraddles) return CheckedKernelState(s, t);
+    CheckExact(s, t, across);
+    return across;
   });
 }
 

@@ -231,7 +231,10 @@ class FaceTrim {
   // kFineSide x kFineSide sub-cells (cell width 1/2048, the boxes' size):
   // sub-cells no curve box (widened by the kernel's ON band) touches are
   // flood-filled into connected pieces, and one kernel answer classifies each
-  // piece, since no curve separates its points.
+  // piece, since no curve separates its points; a piece on the cell's side
+  // takes, instead, the answer of a classified cell (or sub-cell) across it
+  // (StateAcross), which no curve separates from it either (the box with a
+  // hole: 330 kernel answers a face -> 23).
   //
   // Pieces (of cells and of sub-cells) and Clearance() rely on the kernel
   // answering the truth away from the curves, which holds where its polygon's
@@ -260,6 +263,14 @@ class FaceTrim {
   // KernelState, compared with exact_'s answer (BuildGrid only): a
   // disagreement clears exact_agrees_.
   CellState CheckedKernelState(double s, double t) const;
+  // Clears exact_agrees_ if exact_ is sure of (s, t) and differs from `state`.
+  void CheckExact(double s, double t, CellState state) const;
+  // The state of the grid cells across the sides of grid cell (i, j) that
+  // the sub-cells of `piece` (indices in the cell's kFineSide x kFineSide
+  // sub-grid) lie on, or of the sub-cells across them in a cell whose
+  // sub-cells are classified, where those are classified (not kStraddles)
+  // and agree; kStraddles when there is none, or they differ.
+  CellState StateAcross(int i, int j, const std::vector<int>& piece) const;
   struct Node {
     Box2 box;
     int first_child = -1;  // children at first_child, first_child + 1; -1 for a leaf
@@ -285,8 +296,9 @@ class FaceTrim {
   bool trimmed_ = true;
   mutable LeasePool<BRepTopAdaptor_FClass2d> classifiers_;  // thread-safe
   // Faces of lines and circles: Contains() asks it before the kernel. Checked
-  // against every kernel answer BuildGrid gets (hundreds, many within a few
-  // sub-cells of a curve), and dropped there if one differs.
+  // against every answer BuildGrid gives a piece, the kernel's or one taken
+  // from across a side (hundreds, many within a few sub-cells of a curve),
+  // and dropped there if one differs.
   mutable std::optional<LineCircleTrim> exact_;
   mutable bool exact_agrees_ = true;  // written by BuildGrid only
   mutable std::once_flag grid_once_;
