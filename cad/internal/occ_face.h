@@ -137,6 +137,12 @@ class FaceSurface final : public Surface {
   // True when the face is evaluated from its closed form (ClosedForm), not
   // through the kernel's adaptors.
   bool closed_form() const { return closed_.has_value(); }
+  // A closed-form plane: its jets' fu, fv are x and y of its placement times
+  // the map's constant scales, the same bits everywhere, and its second
+  // derivatives zero.
+  bool IsAffine() const override {
+    return closed_ && closed_->type == ClosedForm::Type::kPlane;
+  }
 
   // Relative widening of a kernel face's bound: the kernel's point is within
   // a few ulp of the exact surface (its de Boor sums and ElSLib's formulas
