@@ -151,7 +151,7 @@ class CurveTree::Builder {
         control_(control),
         curve_(Curve::Get(options.curve)),
         order_(density.NeedsCurvature() ? 2 : 1),
-        exact_models_(surface.IsAffine() && density.IsUniform()) {}
+        affine_(surface.IsAffine()) {}
 
   // One cell's mass estimate and model (file comment of curve_tree.h).
   struct CellEval {
@@ -813,11 +813,13 @@ class CurveTree::Builder {
     bool rough = false;
     CellEval children[9];
     if (examine && depth < curve_.max_depth()) {
-      // An exact model (exact_models_) has no error for its children to
-      // show: they are evaluated only when the flatness test splits the
-      // cell, and its error is 0 (the children's quadrature gives the
-      // model's integrals to rounding, so the test could not fail either).
-      const bool exact = exact_models_ && !eval.piecewise && !eval.warped();
+      // An exact model (affine_, a uniform density on the closed cell) has
+      // no error for its children to show: they are evaluated only when the
+      // flatness test splits the cell, and its error is 0 (the children's
+      // quadrature gives the model's integrals to rounding, so the test
+      // could not fail either).
+      const bool exact = affine_ && !eval.piecewise && !eval.warped() &&
+                         density_.IsUniformOn(x * h, x * h + h, y * h, y * h + h);
       int flat = kNeverFails;
       if (exact) {
         ASSIGN_OR_RETURN(flat, FlatGrade(eval, depth, x, y, h));
@@ -990,9 +992,10 @@ class CurveTree::Builder {
   uint64_t cells_since_check_ = 0;
   const Curve& curve_;
   const int order_;
-  // Every cell's quadratic model is exact (Surface::IsAffine under a uniform
-  // density): the error test's children are evaluated only for a split.
-  const bool exact_models_;
+  // Surface::IsAffine: a cell's quadratic model is exact where the density
+  // is uniform (Density::IsUniformOn), and the error test's children are
+  // evaluated there only for a split.
+  const bool affine_;
   double base_ = 1;
   int grade_ = 0;
   bool stage2_ = false;  // past stage 1: the count shapes the tree

@@ -423,6 +423,43 @@ TEST(CadBoxWithHole, ContainsManyAnswersAsContains) {
   }
 }
 
+// KeepsWhole (a trimmed face's density is uniform on the cell, so the tree
+// skips its error test there on a plane): Contains is true at every point of
+// the closed cell, its sides and corners included, for cells of the tree's
+// sizes at its positions and anywhere; and it holds for most cells away from
+// the hole.
+TEST(CadBoxWithHole, KeepsWholeOnlyWhereEveryPointIsInside) {
+  auto model = LoadOk(Solid::kBoxWithHole, ModelFormat::kStep);
+  ASSERT_NE(model, nullptr);
+  std::mt19937_64 rng(10);
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (const HoledFace& h : HoledFaces(*model)) {
+    const Face& face = *h.face;
+    int whole = 0, cells = 0;
+    for (int depth = 3; depth <= 9; ++depth) {
+      const double side = std::ldexp(1.0, -depth);
+      for (int k = 0; k < 300; ++k, ++cells) {
+        // Half the cells on the tree's grid, half anywhere.
+        const double s0 = k % 2 ? std::floor(unit(rng) / side) * side : unit(rng) * (1 - side);
+        const double t0 = k % 2 ? std::floor(unit(rng) / side) * side : unit(rng) * (1 - side);
+        if (!face.KeepsWhole(s0, s0 + side, t0, t0 + side)) continue;
+        ++whole;
+        for (int i = 0; i <= 16; ++i) {
+          for (int j = 0; j <= 16; ++j) {
+            const double s = i == 16 ? s0 + side : s0 + i * (side / 16);
+            const double t = j == 16 ? t0 + side : t0 + j * (side / 16);
+            ASSERT_TRUE(face.Contains(s, t))
+                << "face " << face.index() << " cell (" << s0 << ", " << t0 << ") side " << side
+                << " at (" << s << ", " << t << ")";
+          }
+        }
+      }
+    }
+    EXPECT_GT(whole, cells / 3) << "face " << face.index();
+    EXPECT_LT(whole, cells) << "face " << face.index();
+  }
+}
+
 // Clearance: every point nearer than it keeps the answer (checked on circles
 // against the exact hole), and it is not uselessly small: at least half the
 // distance to the hole where that is 1e-4 of the square or more.

@@ -705,6 +705,22 @@ bool FaceTrim::Contains(double s, double t) const {
   return ContainsNearTrim(s, t);
 }
 
+bool FaceTrim::KeepsWhole(double s0, double s1, double t0, double t1) const {
+  if (!trimmed_) return true;
+  EnsureGrid();
+  // Contains reads grid cell floor(128 s) (GridState, clamped), so the
+  // closed cell's points read cells floor(128 s0) .. floor(128 s1).
+  auto cell = [](double x) {
+    return std::clamp(static_cast<int>(x * kGridSide), 0, kGridSide - 1);
+  };
+  for (int i = cell(s0); i <= cell(s1); ++i) {
+    for (int j = cell(t0); j <= cell(t1); ++j) {
+      if (grid_[i * kGridSide + j] != CellState::kInside) return false;
+    }
+  }
+  return true;
+}
+
 void FaceTrim::ContainsMany(const double* s, const double* t, size_t n, uint8_t* inside) const {
   if (!trimmed_) {
     std::fill(inside, inside + n, uint8_t{1});

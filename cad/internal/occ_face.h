@@ -216,6 +216,8 @@ class FaceTrim {
 
   bool trimmed() const { return trimmed_; }
   bool Contains(double s, double t) const;
+  // Face::KeepsWhole: the grid cells the closed cell meets are all kInside.
+  bool KeepsWhole(double s0, double s1, double t0, double t1) const;
   // inside[i] = Contains(s[i], t[i]) for i < n, with one grid check for all.
   void ContainsMany(const double* s, const double* t, size_t n, uint8_t* inside) const;
   CellState Classify(double s0, double s1, double t0, double t1) const;
