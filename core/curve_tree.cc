@@ -817,8 +817,9 @@ class CurveTree::Builder {
       // no error for its children to show: they are evaluated only when the
       // flatness test splits the cell, and its error is 0 (the children's
       // quadrature gives the model's integrals to rounding, so the test
-      // could not fail either).
-      const bool exact = affine_ && !eval.piecewise && !eval.warped() &&
+      // could not fail either). Not for a density that bounds itself: a
+      // hidden-mass bound could split the cell too, and the split needs them.
+      const bool exact = affine_ && !eval.piecewise && !eval.warped() && !density_.Bounds() &&
                          density_.IsUniformOn(x * h, x * h + h, y * h, y * h + h);
       int flat = kNeverFails;
       if (exact) {
