@@ -52,6 +52,12 @@ Face::Face(int index, FaceType type, double area, ParameterBox box, bool reverse
       trim_(std::move(trim)) {}
 
 bool Face::Contains(double s, double t) const { return trim_->Contains(s, t); }
+bool Face::KeepsWhole(double s0, double s1, double t0, double t1) const {
+  return trim_->KeepsWhole(s0, s1, t0, t1);
+}
+void Face::ContainsMany(const double* s, const double* t, size_t n, uint8_t* inside) const {
+  trim_->ContainsMany(s, t, n, inside);
+}
 double Face::TrimGridCell() { return 1.0 / FaceTrim::kGridSide; }
 
 double Face::Clearance(double s, double t) const { return trim_->Clearance(s, t); }

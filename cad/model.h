@@ -20,6 +20,8 @@
 #ifndef SFCSAMPLER_CAD_MODEL_H_
 #define SFCSAMPLER_CAD_MODEL_H_
 
+#include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -106,6 +108,13 @@ class Face {
   // only the points within ~1/2048 of the boundary.
   // REQUIRES: (s, t) in [0,1]^2.
   bool Contains(double s, double t) const;
+  // inside[i] = Contains(s[i], t[i]) for i < n (1 or 0), one call for a batch.
+  void ContainsMany(const double* s, const double* t, size_t n, uint8_t* inside) const;
+  // True when Contains answers true at every point of the closed cell
+  // [s0,s1]x[t0,t1] from the grid alone (every grid cell it meets is inside
+  // the trim); false may also mean the grid cannot tell. REQUIRES: 0 <= s0
+  // <= s1 <= 1, same for t.
+  bool KeepsWhole(double s0, double s1, double t0, double t1) const;
   // The side of that grid's cells in the unit square (1/128).
   static double TrimGridCell();
 

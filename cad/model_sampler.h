@@ -109,8 +109,11 @@ class ModelSampleCursor {
       : tree_(std::move(tree)), sequence_(sequence), region_(region), fields_(fields),
         threads_(threads) {}
   absl::Status OpenPiece();
-  // Moves sample i of `b` into the trim of `piece` if it lies outside.
-  void KeepInTrim(const ModelTree::Piece& piece, size_t i, SampleBatch* b);
+  // Moves samples [begin, end) of `b` that lie outside the trim of `piece`
+  // into it (MoveIntoTrim), one trim check for the batch.
+  void KeepInTrim(const ModelTree::Piece& piece, size_t begin, size_t end, SampleBatch* b);
+  // Moves sample i of `b`, outside the trim, to the nearest inside point.
+  void MoveIntoTrim(const ModelTree::Piece& piece, size_t i, SampleBatch* b);
 
   const std::shared_ptr<const ModelTree> tree_;
   const Sequence sequence_;
@@ -126,6 +129,7 @@ class ModelSampleCursor {
   size_t piece_ = 0;                      // the piece being read
   std::unique_ptr<SampleCursor> cursor_;  // its cursor, null until opened
   SampleBatch scratch_;
+  std::vector<uint8_t> inside_;  // KeepInTrim's answers, reused
   uint64_t moved_ = 0;
 };
 

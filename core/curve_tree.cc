@@ -150,7 +150,8 @@ class CurveTree::Builder {
         options_(options),
         control_(control),
         curve_(Curve::Get(options.curve)),
-        order_(density.NeedsCurvature() ? 2 : 1) {}
+        order_(density.NeedsCurvature() ? 2 : 1),
+        affine_(surface.IsAffine()) {}
 
   // One cell's mass estimate and model (file comment of curve_tree.h).
   struct CellEval {
@@ -812,33 +813,33 @@ class CurveTree::Builder {
     bool rough = false;
     CellEval children[9];
     if (examine && depth < curve_.max_depth()) {
-      for (int c = 0; c < curve_.arity(); ++c) {
-        const Curve::Child& ch = curve_.ChildOf(state, c);
-        ASSIGN_OR_RETURN(children[c], Evaluate(depth + 1, x * g + ch.dx, y * g + ch.dy));
-        error += std::fabs(ModelOverChild(eval, ch.dx, ch.dy, h) - children[c].mass);
+      // An exact model (affine_, a uniform density on the closed cell) has
+      // no error for its children to show: they are evaluated only when the
+      // flatness test splits the cell, and its error is 0 (the children's
+      // quadrature gives the model's integrals to rounding, so the test
+      // could not fail either). Not for a density that bounds itself: a
+      // hidden-mass bound could split the cell too, and the split needs them.
+      const bool exact = affine_ && !eval.piecewise && !eval.warped() && !density_.Bounds() &&
+                         density_.IsUniformOn(x * h, x * h + h, y * h, y * h + h);
+      int flat = kNeverFails;
+      if (exact) {
+        ASSIGN_OR_RETURN(flat, FlatGrade(eval, depth, x, y, h));
       }
-      error += EdgeError(eval, x * h, y * h, h);
-      fail = FailGrade(error, eval.mass, base_, options_.rho);
-      rough = IsRough(eval, error) && follow_steps;
-      if (rough) fail = std::min(fail, RoughGrade(eval.mass, base_));
-      // The paper's flatness test, for leaves that carry a whole sample.
-      int flat = SamplesGrade(eval.mass, base_, kFlatnessFloor);
-      // Beside a line where the area element blows up (a warp with power
-      // above 1) the mapped probes spread like h^(1 + p), p < 0, and the test
-      // would split down to the sample floors: many small leaves, each a
-      // separate square the line's thin bands cut across, which loses the
-      // stratification the warped curve gives (docs/ALGORITHM.md, "Singular
-      // parameterisations"). The model error test governs those leaves.
-      if (eval.warp[0].power > 1 || eval.warp[1].power > 1) flat = kNeverFails;
-      if (flat <= grade_) {
-        ASSIGN_OR_RETURN(const double spread, CellSpread(x * h, y * h, h));
-        if (!(spread > options_.tolerance)) {
-          flat = kNeverFails;
-        } else if (depth >= options_.depth_cap) {
-          ++report_.geometry_capped_leaves;
-          RecordHit({DepthCapHit::Test::kGeometry, x * h, y * h, h, spread, options_.tolerance},
-                    &report_.worst);
+      if (!exact || flat <= grade_) {
+        for (int c = 0; c < curve_.arity(); ++c) {
+          const Curve::Child& ch = curve_.ChildOf(state, c);
+          ASSIGN_OR_RETURN(children[c], Evaluate(depth + 1, x * g + ch.dx, y * g + ch.dy));
+          error += std::fabs(ModelOverChild(eval, ch.dx, ch.dy, h) - children[c].mass);
         }
+        error += EdgeError(eval, x * h, y * h, h);
+        fail = FailGrade(error, eval.mass, base_, options_.rho);
+        rough = IsRough(eval, error) && follow_steps;
+        if (rough) fail = std::min(fail, RoughGrade(eval.mass, base_));
+        if (!exact) {
+          ASSIGN_OR_RETURN(flat, FlatGrade(eval, depth, x, y, h));
+        }
+      } else {
+        fail = kNeverFails;
       }
       fail = std::min(fail, flat);
     }
@@ -870,6 +871,31 @@ class CurveTree::Builder {
                                          (rough_parent ? kRoughParentBit : 0)));
     if (hidden > 0) NoteHidden(hidden, depth, x, y, h);
     return absl::OkStatus();
+  }
+
+  // The paper's flatness test, for leaves that carry a whole sample: the
+  // grade at which the examined cell fails it.
+  absl::StatusOr<int> FlatGrade(const CellEval& eval, int depth, uint64_t x, uint64_t y,
+                                double h) {
+    int flat = SamplesGrade(eval.mass, base_, kFlatnessFloor);
+    // Beside a line where the area element blows up (a warp with power
+    // above 1) the mapped probes spread like h^(1 + p), p < 0, and the test
+    // would split down to the sample floors: many small leaves, each a
+    // separate square the line's thin bands cut across, which loses the
+    // stratification the warped curve gives (docs/ALGORITHM.md, "Singular
+    // parameterisations"). The model error test governs those leaves.
+    if (eval.warp[0].power > 1 || eval.warp[1].power > 1) flat = kNeverFails;
+    if (flat <= grade_) {
+      ASSIGN_OR_RETURN(const double spread, CellSpread(x * h, y * h, h));
+      if (!(spread > options_.tolerance)) {
+        flat = kNeverFails;
+      } else if (depth >= options_.depth_cap) {
+        ++report_.geometry_capped_leaves;
+        RecordHit({DepthCapHit::Test::kGeometry, x * h, y * h, h, spread, options_.tolerance},
+                  &report_.worst);
+      }
+    }
+    return flat;
   }
 
   // Adds a leaf's hidden-mass bound to the sum and the places reported.
@@ -967,6 +993,10 @@ class CurveTree::Builder {
   uint64_t cells_since_check_ = 0;
   const Curve& curve_;
   const int order_;
+  // Surface::IsAffine: a cell's quadratic model is exact where the density
+  // is uniform (Density::IsUniformOn), and the error test's children are
+  // evaluated there only for a split.
+  const bool affine_;
   double base_ = 1;
   int grade_ = 0;
   bool stage2_ = false;  // past stage 1: the count shapes the tree

@@ -26,6 +26,10 @@
 //     examined, so leaves grow like N^(1/2) at worst (smooth surfaces: much
 //     slower), and a singular line (where a smooth model's relative error
 //     never shrinks) ends at leaves of a few samples, reported in precision().
+//     On an affine surface, in a cell where the density is uniform
+//     (Surface::IsAffine, Density::IsUniformOn) the model is exact: the
+//     error is 0 and the children are evaluated only when the flatness test
+//     splits the leaf.
 //     Every condition only tightens as N grows, so each leaf stores the
 //     smallest grade at which it must be examined again ("fail grade"), and a
 //     coarser tree refines exactly those leaves.

@@ -40,6 +40,14 @@ class Density {
   // mass is its area: CAD models then share samples among their faces by
   // their exact trimmed areas, with no coarse tree to estimate them.
   virtual bool IsUniform() const { return false; }
+  // True when Value is the uniform density's at every point of the closed
+  // rectangle [u0,u1] x [v0,v1] (a CAD face's density on a cell its trim
+  // keeps whole): the tree treats the cell as under IsUniform
+  // (core/curve_tree.h). IsUniform(), the default.
+  virtual bool IsUniformOn(double u0, double u1, double v0, double v1) const {
+    (void)u0, (void)u1, (void)v0, (void)v1;
+    return IsUniform();
+  }
   // Whether UpperBound can be finite: the tree then checks that no feature
   // narrower than its probes hides mass in a leaf (docs/ALGORITHM.md,
   // "Features narrower than the probes"). False (the default, and every

@@ -70,6 +70,13 @@ class Surface {
   // bound itself, which is the default; callers then test points one by one. REQUIRES: 0 <= u0 <=
   // u1 <= 1 and 0 <= v0 <= v1 <= 1.
   virtual std::optional<Box3> Bound(double u0, double u1, double v0, double v1) const;
+
+  // True when Jet's fu and fv are the same bits at every (u, v) and its second
+  // derivatives are zero (an affine map: a CAD model's plane), so the area
+  // element is one constant: under a uniform density every cell's quadratic
+  // model is exact, and the tree's error test has nothing to find
+  // (core/curve_tree.h). False, the default, for any other surface.
+  virtual bool IsAffine() const { return false; }
 };
 
 // Points for a final surface class S through S::Point, inlined: what S's

@@ -388,6 +388,78 @@ TEST(CadBoxWithHole, ContainsMatchesTheExactHoleNearItsEdge) {
   }
 }
 
+// ContainsMany answers as Contains point by point: near the hole (where the
+// sub-cells, the exact trim and the kernel answer), anywhere in the square,
+// and on untrimmed faces (every point inside).
+TEST(CadBoxWithHole, ContainsManyAnswersAsContains) {
+  auto model = LoadOk(Solid::kBoxWithHole, ModelFormat::kStep);
+  ASSERT_NE(model, nullptr);
+  const auto holed = HoledFaces(*model);
+  ASSERT_EQ(holed.size(), 2u);
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (const Face& face : model->faces()) {
+    std::vector<double> s, t;
+    for (int k = 0; k < 4000; ++k) s.push_back(unit(rng)), t.push_back(unit(rng));
+    for (const HoledFace& h : holed) {
+      if (h.face != &face) continue;
+      for (int k = 0; k < 4000; ++k) {
+        const double off = (k % 2 ? 1 : -1) * std::pow(10.0, -6 + 6.6 * unit(rng));  // mm
+        const auto [a, b] = h.AtOffset(off, 2 * kPi * unit(rng));
+        s.push_back(a), t.push_back(b);
+      }
+    }
+    s.insert(s.end(), {0, 1, 0, 1}), t.insert(t.end(), {0, 0, 1, 1});
+    std::vector<uint8_t> inside(s.size(), 7);
+    face.ContainsMany(s.data(), t.data(), s.size(), inside.data());
+    int out = 0;
+    for (size_t i = 0; i < s.size(); ++i) {
+      ASSERT_EQ(inside[i], face.Contains(s[i], t[i]) ? 1 : 0)
+          << "face " << face.index() << " at (" << s[i] << ", " << t[i] << ")";
+      out += inside[i] == 0;
+    }
+    if (face.trimmed()) EXPECT_GT(out, 100) << "face " << face.index();
+    if (!face.trimmed()) EXPECT_EQ(out, 0) << "face " << face.index();
+  }
+}
+
+// KeepsWhole (a trimmed face's density is uniform on the cell, so the tree
+// skips its error test there on a plane): Contains is true at every point of
+// the closed cell, its sides and corners included, for cells of the tree's
+// sizes at its positions and anywhere; and it holds for most cells away from
+// the hole.
+TEST(CadBoxWithHole, KeepsWholeOnlyWhereEveryPointIsInside) {
+  auto model = LoadOk(Solid::kBoxWithHole, ModelFormat::kStep);
+  ASSERT_NE(model, nullptr);
+  std::mt19937_64 rng(10);
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (const HoledFace& h : HoledFaces(*model)) {
+    const Face& face = *h.face;
+    int whole = 0, cells = 0;
+    for (int depth = 3; depth <= 9; ++depth) {
+      const double side = std::ldexp(1.0, -depth);
+      for (int k = 0; k < 300; ++k, ++cells) {
+        // Half the cells on the tree's grid, half anywhere.
+        const double s0 = k % 2 ? std::floor(unit(rng) / side) * side : unit(rng) * (1 - side);
+        const double t0 = k % 2 ? std::floor(unit(rng) / side) * side : unit(rng) * (1 - side);
+        if (!face.KeepsWhole(s0, s0 + side, t0, t0 + side)) continue;
+        ++whole;
+        for (int i = 0; i <= 16; ++i) {
+          for (int j = 0; j <= 16; ++j) {
+            const double s = i == 16 ? s0 + side : s0 + i * (side / 16);
+            const double t = j == 16 ? t0 + side : t0 + j * (side / 16);
+            ASSERT_TRUE(face.Contains(s, t))
+                << "face " << face.index() << " cell (" << s0 << ", " << t0 << ") side " << side
+                << " at (" << s << ", " << t << ")";
+          }
+        }
+      }
+    }
+    EXPECT_GT(whole, cells / 3) << "face " << face.index();
+    EXPECT_LT(whole, cells) << "face " << face.index();
+  }
+}
+
 // Clearance: every point nearer than it keeps the answer (checked on circles
 // against the exact hole), and it is not uselessly small: at least half the
 // distance to the hole where that is 1e-4 of the square or more.

@@ -139,6 +139,68 @@ TEST(CurveTree, RefiningACachedTreeEqualsBuildingAFreshOne) {
   }
 }
 
+// A tilted plane whose jets have the same fu and fv everywhere; `affine`
+// says so (Surface::IsAffine) or not.
+class TiltedPlane final : public Surface {
+ public:
+  explicit TiltedPlane(bool affine) : affine_(affine) {}
+  Vec3 Point(double u, double v) const override {
+    return Vec3{2.5 * u - 0.7 * v + 0.3, 0.4 * u + 1.9 * v - 1.0, 1.1 * u + 0.2 * v};
+  }
+  SurfaceJet Jet(double u, double v, int) const override {
+    SurfaceJet jet;
+    jet.p = Point(u, v);
+    jet.fu = Vec3{2.5, 0.4, 1.1};
+    jet.fv = Vec3{-0.7, 1.9, 0.2};
+    return jet;
+  }
+  bool IsAffine() const override { return affine_; }
+
+ private:
+  bool affine_;
+};
+
+// An affine surface under a uniform density skips the error test's children
+// (its quadratic models are exact) and keeps every leaf, mass and model of
+// the full test, down to leaves the flatness test splits (a small tolerance)
+// and at high grades; its leaves' errors are 0, and a refined tree still
+// equals a fresh one.
+TEST(CurveTree, AnAffineSurfaceSkipsTheErrorTestAndKeepsItsLeaves) {
+  const TiltedPlane affine(true), general(false);
+  auto uniform = MakeUniformDensity();
+  for (double tolerance : {0.0, 0.004}) {
+    CurveTreeOptions options;
+    options.tolerance = tolerance;
+    for (int grade : {8, 16, 24, 40}) {
+      auto fast = CurveTree::Build(affine, *uniform, options, grade);
+      auto full = CurveTree::Build(general, *uniform, options, grade);
+      ASSERT_TRUE(fast.ok() && full.ok()) << fast.status() << full.status();
+      const CurveTree& a = **fast;
+      const CurveTree& b = **full;
+      ASSERT_EQ(a.leaf_count(), b.leaf_count()) << tolerance << " " << grade;
+      for (size_t l = 0; l < a.leaf_count(); ++l) {
+        ASSERT_EQ(a.leaf_start(l), b.leaf_start(l));
+        ASSERT_EQ(a.mass_end(l), b.mass_end(l));  // bit-identical
+        ASSERT_EQ(a.leaf_rough_parent(l), b.leaf_rough_parent(l));
+        for (int k = 0; k < 9; ++k) ASSERT_EQ(a.leaf_model(l).c[k], b.leaf_model(l).c[k]);
+        ASSERT_EQ(a.leaf_error(l), 0.0);
+      }
+      if (tolerance > 0 && grade >= 16) EXPECT_GT(a.max_depth(), 6) << "no flatness split";
+    }
+    auto coarse = CurveTree::Build(affine, *uniform, options, 8);
+    auto fresh = CurveTree::Build(affine, *uniform, options, 24);
+    ASSERT_TRUE(coarse.ok() && fresh.ok());
+    auto refined = (*coarse)->Refined(affine, *uniform, 24);
+    ASSERT_TRUE(refined.ok()) << refined.status();
+    ASSERT_EQ((*refined)->leaf_count(), (*fresh)->leaf_count());
+    for (size_t l = 0; l < (*fresh)->leaf_count(); ++l) {
+      ASSERT_EQ((*refined)->leaf_start(l), (*fresh)->leaf_start(l));
+      ASSERT_EQ((*refined)->mass_end(l), (*fresh)->mass_end(l));
+      ASSERT_EQ((*refined)->leaf_fail_grade(l), (*fresh)->leaf_fail_grade(l));
+    }
+  }
+}
+
 TEST(CurveTree, LeafBudgetIsResourceExhausted) {
   auto sphere = MakeSphere(1);
   auto uniform = MakeUniformDensity();

@@ -37,8 +37,9 @@ bool Intersects(const Box2& a, const Box2& b) {
 }
 
 // Gives every unmarked cell of a side x side grid (row-major) the state of
-// its piece, the unmarked cells joined to it by sides, which `classify(k)`
-// answers for the piece's first cell k; marked cells get kStraddles.
+// its piece, the unmarked cells joined to it by sides, which
+// `classify(k, piece)` answers for the piece's first cell k (and its cells,
+// `piece`); marked cells get kStraddles.
 template <typename State, typename Classify>
 void ClassifyPieces(const std::vector<char>& marked, int side, State* out,
                     const Classify& classify) {
@@ -59,7 +60,7 @@ void ClassifyPieces(const std::vector<char>& marked, int side, State* out,
         if (!marked[k] && !seen[k]) seen[k] = 1, piece.push_back(k);
       }
     }
-    const State state = static_cast<State>(classify(start));
+    const State state = static_cast<State>(classify(start, piece));
     for (int k : piece) out[k] = state;
   }
 }
@@ -296,6 +297,7 @@ void FaceSurface::JetGrid(const double* us, int nu, const double* vs, int nv, in
     }
     return;
   }
+  if (FactoredGrid(us, nu, vs, nv, order, out)) return;
   // The cosines and sines once a row and once a column, not once a point,
   // all in one batch (ClosedForm::TrigsOf: the same bits as TrigU and
   // TrigV). The tree build asks for 3 x 3 grids: no allocation for those.
@@ -316,6 +318,64 @@ void FaceSurface::JetGrid(const double* us, int nu, const double* vs, int nv, in
       ClosedJet(a[i], a[nu + j], t[i], t[nu + j], order, &out[i * nv + j]);
     }
   }
+}
+
+bool FaceSurface::FactoredGrid(const double* us, int nu, const double* vs, int nv, int order,
+                               SurfaceJet* out) const {
+  const ClosedForm& f = *closed_;
+  const bool plane = f.type == ClosedForm::Type::kPlane;
+  if ((!plane && f.type != ClosedForm::Type::kCylinder) || nu > kFactoredSide ||
+      nv > kFactoredSide) {
+    return false;
+  }
+  const double su = map_.DuDs(), sv = map_.DvDt();
+  // A row's part of the point (a plane's u x, a cylinder's a1 x + a2 y) and
+  // its derivatives, and a column's v y or v z: EvaluateWith's terms, each
+  // computed once, then added in its order. Plain arrays: arrays of Vec3
+  // would be zeroed first (a `rep stos` as costly as the rest).
+  double row[kFactoredSide][3], fu[kFactoredSide][3], fuu[kFactoredSide][3];
+  double native[kFactoredSide] = {};
+  ClosedForm::Trig trig[kFactoredSide];
+  for (int i = 0; i < nu; ++i) native[i] = map_.U(us[i]);
+  if (!plane) ClosedForm::TrigsOf(native, nu, trig);
+  for (int i = 0; i < nu; ++i) {
+    if (plane) {
+      for (int k = 0; k < 3; ++k) {
+        row[i][k] = native[i] * f.x[k];
+        fu[i][k] = f.x[k] * su;
+        fuu[i][k] = 0.0 * (su * su);
+      }
+      continue;
+    }
+    const double a1 = f.radius * trig[i].cos, a2 = f.radius * trig[i].sin;
+    for (int k = 0; k < 3; ++k) {
+      const double som = a1 * f.x[k] + a2 * f.y[k];
+      row[i][k] = som;
+      fu[i][k] = (-a2 * f.x[k] + a1 * f.y[k]) * su;
+      fuu[i][k] = -som * (su * su);
+    }
+  }
+  const double* across = plane ? f.y : f.z;
+  const Vec3 fv{across[0] * sv, across[1] * sv, across[2] * sv};
+  const double uv = 0.0 * (su * sv), vv = 0.0 * (sv * sv);
+  const Vec3 fuv{uv, uv, uv}, fvv{vv, vv, vv};
+  for (int j = 0; j < nv; ++j) {
+    const double v = map_.V(vs[j]);
+    const double col[3] = {v * across[0], v * across[1], v * across[2]};
+    for (int i = 0; i < nu; ++i) {
+      SurfaceJet& jet = out[i * nv + j];
+      jet.p = Vec3{row[i][0] + col[0] + f.o[0], row[i][1] + col[1] + f.o[1],
+                   row[i][2] + col[2] + f.o[2]};
+      jet.fu = Vec3{fu[i][0], fu[i][1], fu[i][2]};
+      jet.fv = fv;
+      if (order >= 2) {
+        jet.fuu = Vec3{fuu[i][0], fuu[i][1], fuu[i][2]}, jet.fuv = fuv, jet.fvv = fvv;
+      } else {
+        jet.fuu = jet.fuv = jet.fvv = Vec3{};
+      }
+    }
+  }
+  return true;
 }
 
 void FaceSurface::Points(const double* u, const double* v, size_t n, double* x, double* y,
@@ -514,7 +574,7 @@ void FaceTrim::BuildGrid() const {
     MarkBox({node.box.s0 - ms, node.box.s1 + ms, node.box.t0 - mt, node.box.t1 + mt}, 0, 0,
             1.0 / kGridSide, kGridSide, &marked);
   }
-  ClassifyPieces(marked, kGridSide, grid_.data(), [&](int k) {
+  ClassifyPieces(marked, kGridSide, grid_.data(), [&](int k, const std::vector<int>&) {
     return CheckedKernelState((k / kGridSide + 0.5) / kGridSide,
                               (k % kGridSide + 0.5) / kGridSide);
   });
@@ -529,14 +589,43 @@ void FaceTrim::BuildGrid() const {
 
 CellState FaceTrim::CheckedKernelState(double s, double t) const {
   const CellState state = KernelState(s, t);
-  if (exact_) {
-    const LineCircleTrim::Side side = exact_->Classify(map_.U(s), map_.V(t));
-    if (side != LineCircleTrim::Side::kUnsure &&
-        (side == LineCircleTrim::Side::kIn) != (state != CellState::kOutside)) {
-      exact_agrees_ = false;
+  CheckExact(s, t, state);
+  return state;
+}
+
+void FaceTrim::CheckExact(double s, double t, CellState state) const {
+  if (!exact_) return;
+  const LineCircleTrim::Side side = exact_->Classify(map_.U(s), map_.V(t));
+  if (side != LineCircleTrim::Side::kUnsure &&
+      (side == LineCircleTrim::Side::kIn) != (state != CellState::kOutside)) {
+    exact_agrees_ = false;
+  }
+}
+
+CellState FaceTrim::StateAcross(int i, int j, const std::vector<int>& piece) const {
+  CellState found = CellState::kStraddles;
+  for (int k : piece) {
+    const int a = k / kFineSide, c = k % kFineSide;
+    const int across[4][3] = {{a == 0, i - 1, j},
+                              {a == kFineSide - 1, i + 1, j},
+                              {c == 0, i, j - 1},
+                              {c == kFineSide - 1, i, j + 1}};
+    for (const auto& n : across) {
+      if (!n[0] || n[1] < 0 || n[1] >= kGridSide || n[2] < 0 || n[2] >= kGridSide) continue;
+      const int cell = n[1] * kGridSide + n[2];
+      CellState state = grid_[cell];
+      if (state == CellState::kStraddles && fine_at_[cell] >= 0) {
+        // A cell with sub-cells already classified: the sub-cell across.
+        const int sa = n[1] != i ? kFineSide - 1 - a : a, sc = n[2] != j ? kFineSide - 1 - c : c;
+        state = static_cast<CellState>(fine_[fine_at_[cell] + sa * kFineSide + sc]);
+      }
+      if (state == CellState::kStraddles) continue;
+      // Two answers that differ (a kernel wrong somewhere): ask it here.
+      if (found != CellState::kStraddles && state != found) return CellState::kStraddles;
+      found = state;
     }
   }
-  return state;
+  return found;
 }
 
 void FaceTrim::BuildFineGrid(int i, int j) const {
@@ -566,14 +655,32 @@ void FaceTrim::BuildFineGrid(int i, int j) const {
   const int32_t at = static_cast<int32_t>(fine_.size());
   fine_at_[i * kGridSide + j] = at;
   fine_.resize(fine_.size() + kCells, static_cast<uint8_t>(CellState::kStraddles));
-  ClassifyPieces(marked, kFineSide, fine_.data() + at, [&](int k) {
-    return CheckedKernelState(s0 + (k / kFineSide + 0.5) * w, t0 + (k % kFineSide + 0.5) * w);
+  // A piece with a sub-cell on the cell's side takes the state of the grid
+  // cell across that side, if that one is no curve's (the kernel classified
+  // its piece): no curve separates the two, and the kernel, asked here, would
+  // answer the same (the premise of pieces, kFineSide). The exact trim is
+  // checked against it as against a kernel answer. Pieces enclosed in the
+  // cell, or beside cells the trim may cross, ask the kernel.
+  ClassifyPieces(marked, kFineSide, fine_.data() + at, [&](int k, const std::vector<int>& piece) {
+    const double s = s0 + (k / kFineSide + 0.5) * w, t = t0 + (k % kFineSide + 0.5) * w;
+    const CellState across = StateAcross(i, j, piece);
+    if (across == CellState::kStraddles) return CheckedKernelState(s, t);
+    CheckExact(s, t, across);
+    return across;
   });
 }
 
-bool FaceTrim::Contains(double s, double t) const {
-  if (!trimmed_) return true;
-  std::call_once(grid_once_, [this] { BuildGrid(); });
+inline void FaceTrim::EnsureGrid() const {
+  // The flag first: std::call_once writes thread-locals on every call, a
+  // cost the tree build's half a million Contains calls noticed.
+  if (grid_ready_.load(std::memory_order_acquire)) return;
+  std::call_once(grid_once_, [this] {
+    BuildGrid();
+    grid_ready_.store(true, std::memory_order_release);
+  });
+}
+
+inline CellState FaceTrim::GridState(double s, double t) const {
   // floor(2048 s) / 16 = floor(128 s): both scalings are exact.
   constexpr int kSide = kGridSide * kFineSide;
   const int fi = std::clamp(static_cast<int>(s * kSide), 0, kSide - 1);
@@ -584,11 +691,50 @@ bool FaceTrim::Contains(double s, double t) const {
     state = static_cast<CellState>(
         fine_[fine_at_[cell] + (fi % kFineSide) * kFineSide + fj % kFineSide]);
   }
-  switch (state) {
+  return state;
+}
+
+bool FaceTrim::Contains(double s, double t) const {
+  if (!trimmed_) return true;
+  EnsureGrid();
+  switch (GridState(s, t)) {
     case CellState::kInside: return true;
     case CellState::kOutside: return false;
     case CellState::kStraddles: break;
   }
+  return ContainsNearTrim(s, t);
+}
+
+bool FaceTrim::KeepsWhole(double s0, double s1, double t0, double t1) const {
+  if (!trimmed_) return true;
+  EnsureGrid();
+  // Contains reads grid cell floor(128 s) (GridState, clamped), so the
+  // closed cell's points read cells floor(128 s0) .. floor(128 s1).
+  auto cell = [](double x) {
+    return std::clamp(static_cast<int>(x * kGridSide), 0, kGridSide - 1);
+  };
+  for (int i = cell(s0); i <= cell(s1); ++i) {
+    for (int j = cell(t0); j <= cell(t1); ++j) {
+      if (grid_[i * kGridSide + j] != CellState::kInside) return false;
+    }
+  }
+  return true;
+}
+
+void FaceTrim::ContainsMany(const double* s, const double* t, size_t n, uint8_t* inside) const {
+  if (!trimmed_) {
+    std::fill(inside, inside + n, uint8_t{1});
+    return;
+  }
+  EnsureGrid();
+  for (size_t i = 0; i < n; ++i) {
+    const CellState state = GridState(s[i], t[i]);
+    inside[i] = state == CellState::kStraddles ? ContainsNearTrim(s[i], t[i])
+                                               : state == CellState::kInside;
+  }
+}
+
+bool FaceTrim::ContainsNearTrim(double s, double t) const {
   if (exact_) {
     const LineCircleTrim::Side side = exact_->Classify(map_.U(s), map_.V(t));
     if (side != LineCircleTrim::Side::kUnsure) return side == LineCircleTrim::Side::kIn;

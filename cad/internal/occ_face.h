@@ -17,6 +17,7 @@
 #include <Geom2d_Curve.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <TopoDS_Face.hxx>
+#include <atomic>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -136,6 +137,12 @@ class FaceSurface final : public Surface {
   // True when the face is evaluated from its closed form (ClosedForm), not
   // through the kernel's adaptors.
   bool closed_form() const { return closed_.has_value(); }
+  // A closed-form plane: its jets' fu, fv are x and y of its placement times
+  // the map's constant scales, the same bits everywhere, and its second
+  // derivatives zero.
+  bool IsAffine() const override {
+    return closed_ && closed_->type == ClosedForm::Type::kPlane;
+  }
 
   // Relative widening of a kernel face's bound: the kernel's point is within
   // a few ulp of the exact surface (its de Boor sums and ElSLib's formulas
@@ -159,6 +166,14 @@ class FaceSurface final : public Surface {
   Vec3 ClosedPoint(double u, double v) const;
   void ClosedJet(double u, double v, const ClosedForm::Trig& tu, const ClosedForm::Trig& tv,
                  int order, SurfaceJet* jet) const;
+
+  // JetGrid of a closed-form plane or cylinder of at most kFactoredSide rows
+  // and columns: each row's and column's terms of ClosedJet computed once and
+  // added per point in ClosedJet's order (the same bits). False, with
+  // nothing written, for any other face or grid.
+  bool FactoredGrid(const double* us, int nu, const double* vs, int nv, int order,
+                    SurfaceJet* out) const;
+  static constexpr int kFactoredSide = 9;
 
   // The native parameter intervals of the unit-square ones, by map_'s
   // operations on intervals.
@@ -201,6 +216,10 @@ class FaceTrim {
 
   bool trimmed() const { return trimmed_; }
   bool Contains(double s, double t) const;
+  // Face::KeepsWhole: the grid cells the closed cell meets are all kInside.
+  bool KeepsWhole(double s0, double s1, double t0, double t1) const;
+  // inside[i] = Contains(s[i], t[i]) for i < n, with one grid check for all.
+  void ContainsMany(const double* s, const double* t, size_t n, uint8_t* inside) const;
   CellState Classify(double s0, double s1, double t0, double t1) const;
   // A lower bound on the distance from (s, t) to every trim curve widened by
   // the kernel's ON band: every point closer than it to (s, t), joined to it
@@ -220,7 +239,10 @@ class FaceTrim {
   // kFineSide x kFineSide sub-cells (cell width 1/2048, the boxes' size):
   // sub-cells no curve box (widened by the kernel's ON band) touches are
   // flood-filled into connected pieces, and one kernel answer classifies each
-  // piece, since no curve separates its points.
+  // piece, since no curve separates its points; a piece on the cell's side
+  // takes, instead, the answer of a classified cell (or sub-cell) across it
+  // (StateAcross), which no curve separates from it either (the box with a
+  // hole: 330 kernel answers a face -> 23).
   //
   // Pieces (of cells and of sub-cells) and Clearance() rely on the kernel
   // answering the truth away from the curves, which holds where its polygon's
@@ -237,11 +259,26 @@ class FaceTrim {
 
  private:
   void BuildGrid() const;
+  // BuildGrid, once, before the grid is read.
+  void EnsureGrid() const;
+  // Contains' answer from the grid (and sub-cells), kStraddles where only the
+  // exact trim or the kernel can tell. REQUIRES: the grid built.
+  CellState GridState(double s, double t) const;
+  // Contains' answer for a point GridState leaves kStraddles.
+  bool ContainsNearTrim(double s, double t) const;
   void BuildFineGrid(int i, int j) const;
   CellState KernelState(double s, double t) const;
   // KernelState, compared with exact_'s answer (BuildGrid only): a
   // disagreement clears exact_agrees_.
   CellState CheckedKernelState(double s, double t) const;
+  // Clears exact_agrees_ if exact_ is sure of (s, t) and differs from `state`.
+  void CheckExact(double s, double t, CellState state) const;
+  // The state of the grid cells across the sides of grid cell (i, j) that
+  // the sub-cells of `piece` (indices in the cell's kFineSide x kFineSide
+  // sub-grid) lie on, or of the sub-cells across them in a cell whose
+  // sub-cells are classified, where those are classified (not kStraddles)
+  // and agree; kStraddles when there is none, or they differ.
+  CellState StateAcross(int i, int j, const std::vector<int>& piece) const;
   struct Node {
     Box2 box;
     int first_child = -1;  // children at first_child, first_child + 1; -1 for a leaf
@@ -267,11 +304,13 @@ class FaceTrim {
   bool trimmed_ = true;
   mutable LeasePool<BRepTopAdaptor_FClass2d> classifiers_;  // thread-safe
   // Faces of lines and circles: Contains() asks it before the kernel. Checked
-  // against every kernel answer BuildGrid gets (hundreds, many within a few
-  // sub-cells of a curve), and dropped there if one differs.
+  // against every answer BuildGrid gives a piece, the kernel's or one taken
+  // from across a side (hundreds, many within a few sub-cells of a curve),
+  // and dropped there if one differs.
   mutable std::optional<LineCircleTrim> exact_;
   mutable bool exact_agrees_ = true;  // written by BuildGrid only
   mutable std::once_flag grid_once_;
+  mutable std::atomic<bool> grid_ready_{false};  // set once grid_once_'s BuildGrid is done
   mutable std::vector<CellState> grid_;  // row s, column t; filled by BuildGrid
   // For grid cell k that the boundary may cross, fine_[fine_at_[k] + a *
   // kFineSide + b] is its sub-cell (a, b); fine_at_[k] = -1 otherwise.
