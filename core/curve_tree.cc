@@ -15,6 +15,10 @@ namespace sfc {
 namespace {
 
 constexpr int kNeverFails = 63;
+// The least rho at which an exact model skips the error test's children
+// (Refine): its rounding noise then fails the test at no grade (the default
+// rho is 1; the test fails the noise near rho 0.2).
+constexpr double kExactLeastRho = 1;
 // Fixed-point scale of the running masses: S_base is 2^56 units.
 constexpr int kMassBits = 56;
 static_assert(CurveTree::kSmallestMass == 0x1p-1022 * static_cast<double>(uint64_t{1} << kMassBits),
@@ -815,11 +819,15 @@ class CurveTree::Builder {
     if (examine && depth < curve_.max_depth()) {
       // An exact model (affine_, a uniform density on the closed cell) has
       // no error for its children to show: they are evaluated only when the
-      // flatness test splits the cell, and its error is 0 (the children's
-      // quadrature gives the model's integrals to rounding, so the test
-      // could not fail either). Not for a density that bounds itself: a
-      // hidden-mass bound could split the cell too, and the split needs them.
-      const bool exact = affine_ && !eval.piecewise && !eval.warped() && !density_.Bounds() &&
+      // flatness test splits the cell, and its error is 0. The full test
+      // would find rounding noise between the model's integrals and the
+      // children's quadrature (up to ~6e-16 of the cell's mass), which its
+      // allowance, scaled by rho, dwarfs at rho >= kExactLeastRho; at a
+      // smaller rho the noise could set a fail grade or a rough cell, so the
+      // full test runs. Not for a density that bounds itself: a hidden-mass
+      // bound could split the cell too, and the split needs the children.
+      const bool exact = affine_ && options_.rho >= kExactLeastRho && !eval.piecewise &&
+                         !eval.warped() && !density_.Bounds() &&
                          density_.IsUniformOn(x * h, x * h + h, y * h, y * h + h);
       int flat = kNeverFails;
       if (exact) {

@@ -27,9 +27,11 @@
 //     slower), and a singular line (where a smooth model's relative error
 //     never shrinks) ends at leaves of a few samples, reported in precision().
 //     On an affine surface, in a cell where the density is uniform
-//     (Surface::IsAffine, Density::IsUniformOn) the model is exact: the
-//     error is 0 and the children are evaluated only when the flatness test
-//     splits the leaf.
+//     (Surface::IsAffine, Density::IsUniformOn) and does not bound itself,
+//     the model is exact: at rho >= 1 the error is taken as 0 (the full
+//     test's rounding noise could fail it only at a much smaller rho) and
+//     the children are evaluated only when the flatness test splits the
+//     leaf; the same tree as the full test's.
 //     Every condition only tightens as N grows, so each leaf stores the
 //     smallest grade at which it must be examined again ("fail grade"), and a
 //     coarser tree refines exactly those leaves.

@@ -172,6 +172,7 @@ TEST(CurveTree, AnAffineSurfaceSkipsTheErrorTestAndKeepsItsLeaves) {
     CurveTreeOptions options;
     options.tolerance = tolerance;
     for (int grade : {8, 16, 24, 40}) {
+      SCOPED_TRACE(::testing::Message() << "tolerance " << tolerance << " grade " << grade);
       auto fast = CurveTree::Build(affine, *uniform, options, grade);
       auto full = CurveTree::Build(general, *uniform, options, grade);
       ASSERT_TRUE(fast.ok() && full.ok()) << fast.status() << full.status();
@@ -183,9 +184,22 @@ TEST(CurveTree, AnAffineSurfaceSkipsTheErrorTestAndKeepsItsLeaves) {
         ASSERT_EQ(a.mass_end(l), b.mass_end(l));  // bit-identical
         ASSERT_EQ(a.leaf_rough_parent(l), b.leaf_rough_parent(l));
         for (int k = 0; k < 9; ++k) ASSERT_EQ(a.leaf_model(l).c[k], b.leaf_model(l).c[k]);
+        ASSERT_EQ(a.leaf_fail_grade(l), b.leaf_fail_grade(l));  // refinement sees the same tree
         ASSERT_EQ(a.leaf_error(l), 0.0);
       }
       if (tolerance > 0 && grade >= 16) EXPECT_GT(a.max_depth(), 6) << "no flatness split";
+    }
+    // A tiny rho turns the full test's rounding noise into splits: the
+    // shortcut then stands aside, and the trees stay alike.
+    CurveTreeOptions fine = options;
+    fine.rho = 1e-12;
+    auto fast_fine = CurveTree::Build(affine, *uniform, fine, 16);
+    auto full_fine = CurveTree::Build(general, *uniform, fine, 16);
+    ASSERT_TRUE(fast_fine.ok() && full_fine.ok()) << fast_fine.status() << full_fine.status();
+    ASSERT_EQ((*fast_fine)->leaf_count(), (*full_fine)->leaf_count());
+    for (size_t l = 0; l < (*fast_fine)->leaf_count(); ++l) {
+      ASSERT_EQ((*fast_fine)->mass_end(l), (*full_fine)->mass_end(l));
+      ASSERT_EQ((*fast_fine)->leaf_fail_grade(l), (*full_fine)->leaf_fail_grade(l));
     }
     auto coarse = CurveTree::Build(affine, *uniform, options, 8);
     auto fresh = CurveTree::Build(affine, *uniform, options, 24);
