@@ -62,23 +62,22 @@ __attribute__((always_inline)) inline Doubles NegateWhere(Ints mask, Doubles x) 
   return (Doubles)((Words)x ^ ((Words)mask & kSignBit));
 }
 
-// Rounded toward zero, and toward -infinity: exact, one instruction (the
-// zero-masked AVX-512F form: GCC's unmasked one warns of its undefined source).
-__attribute__((always_inline)) inline Doubles Trunc(Doubles x) {
+// x rounded by `kMode` (_MM_FROUND_TO_ZERO, _MM_FROUND_TO_NEG_INF): exact, one
+// instruction (the zero-masked AVX-512F form: GCC's unmasked one warns of its
+// undefined source).
+template <int kMode>
+__attribute__((always_inline)) inline Doubles Round(Doubles x) {
 #ifdef __AVX512F__
-  return (Doubles)_mm512_maskz_roundscale_pd(0xff, (__m512d)x,
-                                             _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC);
+  return (Doubles)_mm512_maskz_roundscale_pd(0xff, (__m512d)x, kMode | _MM_FROUND_NO_EXC);
 #else
-  return (Doubles)_mm256_round_pd((__m256d)x, _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC);
+  return (Doubles)_mm256_round_pd((__m256d)x, kMode | _MM_FROUND_NO_EXC);
 #endif
 }
+__attribute__((always_inline)) inline Doubles Trunc(Doubles x) {
+  return Round<_MM_FROUND_TO_ZERO>(x);
+}
 __attribute__((always_inline)) inline Doubles Floor(Doubles x) {
-#ifdef __AVX512F__
-  return (Doubles)_mm512_maskz_roundscale_pd(0xff, (__m512d)x,
-                                             _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
-#else
-  return (Doubles)_mm256_round_pd((__m256d)x, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
-#endif
+  return Round<_MM_FROUND_TO_NEG_INF>(x);
 }
 
 // SLEEF's cinz functions of core/vector_math.h for this build's vectors.
