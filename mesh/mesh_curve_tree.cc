@@ -104,12 +104,13 @@ constexpr size_t kRanksPerBox = 8;
 // Meshes with fewer triangles place their ranks on one thread.
 constexpr size_t kParallelRanks = 16384;
 
-// A density with no mass on the whole mesh: INVALID_ARGUMENT, as a formula
-// surface's (core/curve_tree.cc).
+// A density whose mass over the mesh, as the tree measured it, is zero:
+// INVALID_ARGUMENT, as a formula surface's (core/curve_tree.cc).
 absl::Status ZeroDensity(const MeshDensity& density, const std::string& mesh) {
   return absl::InvalidArgumentError(absl::StrFormat(
-      "the density '%s' is zero on the whole of mesh '%s': there is nothing to sample (check the "
-      "density, or add a floor)",
+      "the density '%s' gave no mass over mesh '%s' where the tree measured it (zero everywhere, "
+      "or positive only in features narrower than the triangles): there is nothing to sample "
+      "(check the density, or add a floor)",
       density.spec(), mesh));
 }
 

@@ -69,7 +69,7 @@ const char* LessWorkingMemory(SequenceKind sequence) {
     return "this sequence sorts its whole set whatever range, shard or region is asked: ask for "
            "a set of fewer samples (count) or fewer columns";
   }
-  return "ask for a smaller index range or fewer columns";
+  return "ask for a smaller index range, a smaller batch_size or fewer columns";
 }
 
 // The bytes the stream header takes in the first message, at most, over what
@@ -123,6 +123,21 @@ grpc::Status SamplerService::Sample(grpc::ServerContext* context, const v1::Samp
   return status;
 }
 
+grpc::Status SamplerService::CheckStream(const SampleCall& call) const {
+  const SampleRequest& request = call.request;
+  const StreamOptions& stream = call.stream;
+  if (stream.batch_size > options_.max_batch_size) {
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                        absl::StrFormat("batch_size %d is above the server's limit of %d "
+                                        "(max_batch_size)",
+                                        stream.batch_size, options_.max_batch_size));
+  }
+  if (absl::Status valid = engine_.CheckRequest(request); !valid.ok()) return ToGrpcStatus(valid);
+  return ToGrpcStatus(stream_memory_.CheckFits(
+      StreamWorkingBytes(request, stream, options_.stream_pipeline_depth), "this stream",
+      LessWorkingMemory(request.sequence)));
+}
+
 grpc::Status SamplerService::PrepareModelOutsideSlot(grpc::ServerContext* context,
                                                      const v1::SampleRequest& wire,
                                                      const absl::StatusOr<SampleCall>& call,
@@ -136,8 +151,9 @@ grpc::Status SamplerService::PrepareModelOutsideSlot(grpc::ServerContext* contex
   const auto deadline =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(
                          std::chrono::duration<double>(options_.request_deadline_seconds));
-  // The request's own checks first: a bad one is refused before a tree is made for it.
-  if (absl::Status valid = engine_.CheckRequest(request); !valid.ok()) return ToGrpcStatus(valid);
+  // The request's and its stream's checks first: a bad one is refused before a
+  // tree is made for it.
+  if (grpc::Status valid = CheckStream(*call); !valid.ok()) return valid;
   auto tree_count = ResolveTreeCount(request);
   if (!tree_count.ok()) return ToGrpcStatus(tree_count.status());
   auto prepared =
@@ -159,17 +175,11 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
                   std::chrono::duration<double>(options_.request_deadline_seconds));
   const SampleRequest& request = call.request;
   const StreamOptions& stream = call.stream;
-  if (stream.batch_size > options_.max_batch_size) {
-    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                        absl::StrFormat("batch_size %d is above the server's limit of %d "
-                                        "(max_batch_size)",
-                                        stream.batch_size, options_.max_batch_size));
-  }
   const BuildControl control = RequestControl(context, deadline, options_.request_deadline_seconds);
   // The request's own checks first, so that a request the engine refuses
   // gets its reason rather than a memory refusal; then the stream's working
   // memory, reserved before its cursor sorts anything.
-  if (absl::Status valid = engine_.CheckRequest(request); !valid.ok()) return ToGrpcStatus(valid);
+  if (grpc::Status valid = CheckStream(call); !valid.ok()) return valid;
   auto memory =
       stream_memory_.Reserve(StreamWorkingBytes(request, stream, options_.stream_pipeline_depth),
                              "this stream", LessWorkingMemory(request.sequence), control.check);

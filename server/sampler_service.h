@@ -72,6 +72,10 @@ class SamplerService final : public ::sfcsampler::v1::Sampler::Service {
  private:
   // UNAVAILABLE while draining; UNAUTHENTICATED without the token.
   grpc::Status Admit(const grpc::ServerContext& context) const;
+  // The checks of a Sample that need no tree: its batch_size, the engine's
+  // (SamplingEngine::CheckRequest) and whether its working memory could fit
+  // the stream memory at all. Made before any tree is built for it.
+  grpc::Status CheckStream(const SampleCall& call) const;
   // A Sample naming a model: its parse and tree, made (or waited for) before
   // the stream takes a slot, so a slow or hostile parse holds none; `call`
   // is `wire` as read (proto/convert.h FromProto), its error returned here

@@ -3,6 +3,7 @@
 #include <utility>
 
 #include "absl/strings/str_format.h"
+#include "base/status_macros.h"
 #include "absl/time/time.h"
 
 namespace sfc {
@@ -23,15 +24,18 @@ StreamMemory::Reservation::~Reservation() {
   if (owner_) owner_->Release(bytes_);
 }
 
+absl::Status StreamMemory::CheckFits(uint64_t bytes, const char* what, const char* advice) const {
+  if (bytes <= budget_) return absl::OkStatus();
+  return absl::ResourceExhaustedError(absl::StrFormat(
+      "%s needs %d bytes of working memory, more than this server's %d for all streams "
+      "(stream_memory_bytes); %s",
+      what, bytes, budget_, advice));
+}
+
 absl::StatusOr<StreamMemory::Reservation> StreamMemory::Reserve(
     uint64_t bytes, const char* what, const char* advice,
     const std::function<absl::Status()>& check) {
-  if (bytes > budget_) {
-    return absl::ResourceExhaustedError(absl::StrFormat(
-        "%s needs %d bytes of working memory, more than this server's %d for all streams "
-        "(stream_memory_bytes); %s",
-        what, bytes, budget_, advice));
-  }
+  RETURN_IF_ERROR(CheckFits(bytes, what, advice));
   absl::MutexLock lock(&mu_);
   bool waited = false;
   while (reserved_ + bytes > budget_) {

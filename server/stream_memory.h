@@ -48,6 +48,10 @@ class StreamMemory {
   // wait with that status. RESOURCE_EXHAUSTED when `bytes` exceeds the
   // budget; `what` names the request's part that needs them and `advice`
   // says what would need less, for the message.
+  // OK, or the RESOURCE_EXHAUSTED Reserve gives at once for `bytes` over the
+  // whole budget: for a caller that refuses such a request before it does
+  // anything costly for it.
+  absl::Status CheckFits(uint64_t bytes, const char* what, const char* advice) const;
   absl::StatusOr<Reservation> Reserve(uint64_t bytes, const char* what, const char* advice,
                                       const std::function<absl::Status()>& check)
       ABSL_LOCKS_EXCLUDED(mu_);

@@ -572,6 +572,34 @@ TEST(ServerModels, TheHeaderReportsAModelsTreeAsTheRequestFoundIt) {
   EXPECT_FALSE(larger.refined);
 }
 
+// A model request the stream could never serve (a batch_size over the
+// server's limit, or a set whose working memory exceeds all the stream
+// memory) is refused before its model's tree is built, as a formula's is.
+TEST(ServerModels, AStreamThatCannotRunIsRefusedBeforeTheModelsTree) {
+  ServerOptions options = LoopbackOptions();
+  options.stream_memory_bytes = 1 << 20;
+  ClientOptions co;
+  co.stream.batch_size = options.max_batch_size + 1;
+  Running r = StartServer(options, co);
+  auto info = r.client->UploadModel("obj", "grid.obj", GridObj(20));
+  ASSERT_TRUE(info.ok()) << info.status();
+  const absl::Status batch = SampleStatus(*r.client, Request(info->spec(), 1000));
+  EXPECT_EQ(batch.code(), absl::StatusCode::kInvalidArgument) << batch;
+  EXPECT_NE(batch.message().find("max_batch_size"), std::string::npos) << batch;
+
+  Running small = StartServer(options);
+  auto held = small.client->UploadModel("obj", "grid.obj", GridObj(20));
+  ASSERT_TRUE(held.ok()) << held.status();
+  SampleRequest blue = Request(held->spec(), 50'000);
+  blue.sequence = SequenceKind::kBlue;
+  blue.begin = 0, blue.end = 10;
+  const absl::Status memory = SampleStatus(*small.client, blue);
+  EXPECT_EQ(memory.code(), absl::StatusCode::kResourceExhausted) << memory;
+  EXPECT_NE(memory.message().find("fewer samples (count)"), std::string::npos) << memory;
+  EXPECT_EQ(r.client->GetCacheStats()->builds(), 0u);
+  EXPECT_EQ(small.client->GetCacheStats()->builds(), 0u);
+}
+
 // The same for a CAD model: its cached tree counts the model it keeps alive.
 TEST(ServerModels, ACachedCadTreeCountsTheModelItKeepsAlive) {
   auto step = cad::fixtures::SolidBytes(cad::fixtures::Solid::kSphere, ModelFormat::kStep);
