@@ -176,9 +176,10 @@ grpc::Status SamplerService::RunSample(grpc::ServerContext* context, const v1::S
   const SampleRequest& request = call.request;
   const StreamOptions& stream = call.stream;
   const BuildControl control = RequestControl(context, deadline, options_.request_deadline_seconds);
-  // The request's own checks first, so that a request the engine refuses
-  // gets its reason rather than a memory refusal; then the stream's working
-  // memory, reserved before its cursor sorts anything.
+  // The request's and its stream's checks first (again, cheaply, for a model
+  // checked before its tree), so that a request the engine refuses gets its
+  // reason rather than a memory refusal; then the stream's working memory,
+  // reserved before its cursor sorts anything.
   if (grpc::Status valid = CheckStream(call); !valid.ok()) return valid;
   auto memory =
       stream_memory_.Reserve(StreamWorkingBytes(request, stream, options_.stream_pipeline_depth),

@@ -3,8 +3,8 @@
 #include <utility>
 
 #include "absl/strings/str_format.h"
-#include "base/status_macros.h"
 #include "absl/time/time.h"
+#include "base/status_macros.h"
 
 namespace sfc {
 
