@@ -16,8 +16,10 @@ namespace {
 
 constexpr int kNeverFails = 63;
 // The least rho at which an exact model skips the error test's children
-// (Refine): its rounding noise then fails the test at no grade (the default
-// rho is 1; the test fails the noise near rho 0.2).
+// (Refine): the default, where the full test's rounding noise fails at no
+// grade. At rho 1e-12 it split cells (a STEP box at 10^5 samples: 77 762
+// leaves with the full test, 37 826 with the shortcut); the rho at which it
+// starts to was not measured.
 constexpr double kExactLeastRho = 1;
 // Fixed-point scale of the running masses: S_base is 2^56 units.
 constexpr int kMassBits = 56;
@@ -821,8 +823,8 @@ class CurveTree::Builder {
       // no error for its children to show: they are evaluated only when the
       // flatness test splits the cell, and its error is 0. The full test
       // would find rounding noise between the model's integrals and the
-      // children's quadrature (up to ~6e-16 of the cell's mass), which its
-      // allowance, scaled by rho, dwarfs at rho >= kExactLeastRho; at a
+      // children's quadrature (of the order of 1e-16 of the cell's mass),
+      // which its allowance, scaled by rho, dwarfs at rho >= kExactLeastRho; at a
       // smaller rho the noise could set a fail grade or a rough cell, so the
       // full test runs. Not for a density that bounds itself: a hidden-mass
       // bound could split the cell too, and the split needs the children.
